@@ -1,0 +1,58 @@
+//! Compiles every GLSL shader in `shaders/` to SPIR-V with glslangValidator and
+//! generates the table `shaders.rs` that embeds them. The target is SPIR-V 1.3
+//! (vulkan1.1 environment): from SPIR-V 1.4 on, entry points list every global
+//! in their interface, which the vendored spirv-reflect cannot parse. A missing compiler stops
+//! the build with the name of the Debian package that provides it.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn main() {
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let dir = Path::new("shaders");
+    println!("cargo:rerun-if-changed=shaders");
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("shaders/ directory is missing")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("vert" | "frag" | "comp")
+            )
+        })
+        .collect();
+    entries.sort();
+    let compiler = std::env::var("GLSLANG_VALIDATOR").unwrap_or_else(|_| "glslangValidator".into());
+    let mut table = String::from("/// (file name, SPIR-V bytes) of every shader in shaders/, built by build.rs.\npub static SHADERS: &[(&str, &[u8])] = &[\n");
+    for src in &entries {
+        println!("cargo:rerun-if-changed={}", src.display());
+        let name = src.file_name().unwrap().to_string_lossy().to_string();
+        let spv = out.join(format!("{name}.spv"));
+        let status = Command::new(&compiler)
+            .args(["-V", "--target-env", "vulkan1.1", "-Ishaders", "-o"])
+            .arg(&spv)
+            .arg(src)
+            .output();
+        match status {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => panic!(
+                "glslangValidator not found: install the Debian package glslang-tools (apt-get install glslang-tools), or set GLSLANG_VALIDATOR"
+            ),
+            Err(e) => panic!("running glslangValidator on {name}: {e}"),
+            Ok(o) if !o.status.success() => panic!(
+                "glslangValidator failed on shaders/{name}:\n{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            ),
+            Ok(_) => {}
+        }
+        writeln!(
+            table,
+            "    ({name:?}, include_bytes!({:?})),",
+            spv.display().to_string()
+        )
+        .unwrap();
+    }
+    table.push_str("];\n");
+    std::fs::write(out.join("shaders.rs"), table).expect("writing shaders.rs");
+}

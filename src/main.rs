@@ -1,0 +1,385 @@
+//! The `dermis` command line. Only argument handling lives here; the work is in
+//! the library (`dermis::run`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use dermis::render::{Method, RenderSettings};
+use dermis::run::{run, slug, write_exr, write_png, RunOptions};
+use dermis::scene::camera::Camera;
+use dermis::scene::gltf_load::TextureOverrides;
+use dermis::scene::{default_scene, load_gltf_scene, Scene};
+use dermis::skin::kernel::{Preset, SeparableKernel};
+use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
+
+#[derive(Parser)]
+#[command(
+    name = "dermis",
+    version,
+    about = "Real-time skin rendering (Vulkan) that measures every pass"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a frame: writes DIR/frame.png and DIR/report.json and prints the per-pass table.
+    Render {
+        #[command(flatten)]
+        common: Common,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Also write every pass output as linear EXR under DIR/passes/.
+        #[arg(long)]
+        dump: bool,
+        #[arg(long, default_value_t = 3)]
+        warmup: usize,
+        #[arg(long, default_value_t = 10)]
+        frames: usize,
+    },
+    /// Measure many frames and the device ceilings; writes the report only.
+    Bench {
+        #[command(flatten)]
+        common: Common,
+        /// Report path (JSON).
+        #[arg(long, default_value = "out/bench.json")]
+        report: PathBuf,
+        #[arg(long, default_value_t = 20)]
+        warmup: usize,
+        #[arg(long, default_value_t = 100)]
+        frames: usize,
+    },
+    /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
+    Kernel {
+        #[arg(long, default_value_t = 17)]
+        samples: usize,
+        #[arg(long, default_value = "table6.1")]
+        preset: String,
+        /// Override the preset's width (mm).
+        #[arg(long)]
+        width_mm: Option<f32>,
+    },
+    /// List the Vulkan devices.
+    Devices {
+        #[arg(long)]
+        validate: bool,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum Shot {
+    /// The head fills the screen height.
+    Close,
+    /// Twice the close-up distance.
+    Mid,
+    /// Five times the close-up distance.
+    Far,
+}
+
+#[derive(Args)]
+struct Common {
+    /// Vulkan device: index or case-insensitive name substring (default: first discrete GPU).
+    #[arg(long)]
+    device: Option<String>,
+    /// Enable the Khronos validation layer with synchronization validation; any message fails the run.
+    #[arg(long)]
+    validate: bool,
+    /// glTF/GLB scene (default: the embedded procedural head).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    #[arg(long)]
+    albedo: Option<PathBuf>,
+    #[arg(long)]
+    normal_map: Option<PathBuf>,
+    #[arg(long)]
+    spec_map: Option<PathBuf>,
+    /// Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head).
+    #[arg(long)]
+    mm_per_unit: Option<f32>,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// SSS method: separable | none.
+    #[arg(long, default_value = "separable")]
+    method: String,
+    /// Kernel samples per SSS pass (odd: 9, 17, 33, ...).
+    #[arg(long, default_value_t = 17)]
+    samples: usize,
+    /// Kernel preset: table6.1 | demo.
+    #[arg(long, default_value = "table6.1")]
+    preset: String,
+    /// Override the kernel half-width in millimetres.
+    #[arg(long)]
+    sss_width_mm: Option<f32>,
+    /// Override the per-channel strength: R,G,B.
+    #[arg(long, value_delimiter = ',', num_args = 3)]
+    strength: Option<Vec<f32>>,
+    /// Override the per-channel falloff: R,G,B.
+    #[arg(long, value_delimiter = ',', num_args = 3)]
+    falloff: Option<Vec<f32>>,
+    #[arg(long)]
+    no_follow_surface: bool,
+    #[arg(long)]
+    no_transmittance: bool,
+    /// Number of heads in a grid (multi-character stress).
+    #[arg(long, default_value_t = 1)]
+    heads: u32,
+    /// Camera shot (ignored when --distance is given).
+    #[arg(long, value_enum, default_value_t = Shot::Mid)]
+    shot: Shot,
+    /// Camera distance from the head centre in head heights.
+    #[arg(long)]
+    distance: Option<f32>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 20.0)]
+    fovy: f32,
+    /// Key light azimuth in degrees (0 = from the camera side).
+    #[arg(long, default_value_t = 60.0)]
+    light_azimuth: f32,
+    #[arg(long, default_value_t = 30.0)]
+    light_elevation: f32,
+    #[arg(long, default_value_t = 2.5)]
+    light_intensity: f32,
+    #[arg(long, default_value_t = 0.08)]
+    ambient: f32,
+    #[arg(long, default_value_t = 2.0)]
+    exposure: f32,
+    #[arg(long, default_value_t = 2048)]
+    shadow_size: u32,
+}
+
+impl Common {
+    fn settings(&self) -> Result<RenderSettings> {
+        let preset: Preset = self.preset.parse()?;
+        let mut params = preset.params();
+        if let Some(w) = self.sss_width_mm {
+            params.width_mm = w;
+        }
+        if let Some(s) = &self.strength {
+            params.strength = [s[0], s[1], s[2]];
+        }
+        if let Some(f) = &self.falloff {
+            params.falloff = [f[0], f[1], f[2]];
+        }
+        let close = Camera::close_up_distance_heads(self.fovy);
+        let distance = self.distance.unwrap_or(match self.shot {
+            Shot::Close => close,
+            Shot::Mid => 2.0 * close,
+            Shot::Far => 5.0 * close,
+        });
+        let mut s = RenderSettings {
+            width: self.width,
+            height: self.height,
+            method: self.method.parse::<Method>()?,
+            samples: self.samples,
+            preset,
+            params,
+            follow_surface: !self.no_follow_surface,
+            transmittance: !self.no_transmittance,
+            heads: self.heads,
+            distance_heads: distance,
+            fovy_deg: self.fovy,
+            ..RenderSettings::default()
+        };
+        s.light.azimuth_deg = self.light_azimuth;
+        s.light.elevation_deg = self.light_elevation;
+        s.light.intensity = self.light_intensity;
+        s.ambient = self.ambient;
+        s.exposure = self.exposure;
+        s.shadow_size = self.shadow_size;
+        // Checked again against the device limits once a device is open.
+        s.validate(u32::MAX)?;
+        Ok(s)
+    }
+
+    fn scene(&self) -> Result<Scene> {
+        match &self.scene {
+            None => {
+                let mut s = default_scene();
+                if let Some(mm) = self.mm_per_unit {
+                    if !mm.is_finite() || mm <= 0.0 {
+                        bail!("mm_per_unit must be a positive number, got {mm}");
+                    }
+                    s.mm_per_unit = mm;
+                }
+                Ok(s)
+            }
+            Some(p) => load_gltf_scene(
+                p,
+                &TextureOverrides {
+                    albedo: self.albedo.clone(),
+                    normal_map: self.normal_map.clone(),
+                    specular_map: self.spec_map.clone(),
+                },
+                self.mm_per_unit,
+            ),
+        }
+    }
+
+    fn context(&self) -> Result<Context> {
+        Context::new(&ContextDesc {
+            device: self
+                .device
+                .as_deref()
+                .map(|d| d.parse::<DeviceChoice>().unwrap_or_default())
+                .unwrap_or_default(),
+            validate: self.validate,
+        })
+    }
+}
+
+fn command_line() -> String {
+    std::env::args().collect::<Vec<_>>().join(" ")
+}
+
+fn print_header(ctx: &Context, r: &dermis::run::Report) {
+    println!(
+        "dermis {} | {} ({}) | {}x{} | method {} | {} samples | scene '{}' ({:.1} mm/unit) | {} head(s) | {} measured frames",
+        r.dermis_version, ctx.facts.name, ctx.facts.driver, r.width, r.height, r.method, r.samples, r.scene, r.mm_per_unit, r.heads, r.measured_frames
+    );
+}
+
+fn main_result() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Render {
+            common,
+            out,
+            dump,
+            warmup,
+            frames,
+        } => {
+            let settings = common.settings()?;
+            let scene = common.scene()?;
+            let ctx = common.context()?;
+            let opts = RunOptions {
+                warmup,
+                measured: frames,
+                capture: true,
+                dump,
+                ceilings: false,
+                command: command_line(),
+                progress: true,
+            };
+            let output = run(&ctx, &scene, &settings, &opts)?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let capture = output.capture.as_ref().context("no frame was captured")?;
+            write_png(&out.join("frame.png"), capture)?;
+            if dump {
+                let dir = out.join("passes");
+                std::fs::create_dir_all(&dir)
+                    .with_context(|| format!("creating {}", dir.display()))?;
+                for (i, d) in capture.dumps.iter().enumerate() {
+                    write_exr(
+                        &dir.join(format!("{:02}_{}_{}.exr", i, slug(&d.pass), slug(&d.image))),
+                        d,
+                    )?;
+                }
+            }
+            let json = serde_json::to_string_pretty(&output.report)?;
+            std::fs::write(out.join("report.json"), json)
+                .with_context(|| format!("writing {}", out.join("report.json").display()))?;
+            print_header(&ctx, &output.report);
+            print!(
+                "{}",
+                dermis::report::table(&output.report.passes, output.report.frame.as_ref())
+            );
+            println!(
+                "wrote {} and {}",
+                out.join("frame.png").display(),
+                out.join("report.json").display()
+            );
+        }
+        Command::Bench {
+            common,
+            report,
+            warmup,
+            frames,
+        } => {
+            let settings = common.settings()?;
+            let scene = common.scene()?;
+            let ctx = common.context()?;
+            let opts = RunOptions {
+                warmup,
+                measured: frames,
+                capture: false,
+                dump: false,
+                ceilings: true,
+                command: command_line(),
+                progress: true,
+            };
+            let output = run(&ctx, &scene, &settings, &opts)?;
+            if let Some(parent) = report.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(parent)
+                    .with_context(|| format!("creating {}", parent.display()))?;
+            }
+            std::fs::write(&report, serde_json::to_string_pretty(&output.report)?)
+                .with_context(|| format!("writing {}", report.display()))?;
+            print_header(&ctx, &output.report);
+            print!(
+                "{}",
+                dermis::report::table(&output.report.passes, output.report.frame.as_ref())
+            );
+            if let Some(c) = &output.report.ceilings {
+                println!(
+                    "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, fill rgba16f {:.2} Gpix/s",
+                    c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.fill_rgba16f_gpix
+                );
+            }
+            println!("wrote {}", report.display());
+        }
+        Command::Kernel {
+            samples,
+            preset,
+            width_mm,
+        } => {
+            let preset: Preset = preset.parse()?;
+            let mut params = preset.params();
+            if let Some(w) = width_mm {
+                params.width_mm = w;
+            }
+            params.validate()?;
+            let k = SeparableKernel::build(params, samples)?;
+            println!(
+                "{}",
+                serde_json::to_string_pretty(
+                    &serde_json::json!({ "preset": preset.name(), "samples": samples, "kernel": k })
+                )?
+            );
+        }
+        Command::Devices { validate } => {
+            let ctx = Context::new(&ContextDesc {
+                device: DeviceChoice::Auto,
+                validate,
+            })?;
+            let devices = unsafe { ctx.instance.enumerate_physical_devices() }?;
+            for (i, d) in devices.iter().enumerate() {
+                let p = unsafe { ctx.instance.get_physical_device_properties(*d) };
+                let name = p
+                    .device_name_as_c_str()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                println!("{i}: {name} ({:?})", p.device_type);
+            }
+        }
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match main_result() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the error and its causes.
+            eprintln!("error: {}", format!("{e:#}").replace('\n', " | "));
+            ExitCode::FAILURE
+        }
+    }
+}

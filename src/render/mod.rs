@@ -1,0 +1,994 @@
+//! The frame: shadow map -> geometry MRTs -> separable SSS (stencil-masked) ->
+//! composite -> Hable tone map, recorded through the pass graph.
+
+pub mod readback;
+pub mod scene_gpu;
+pub mod separable;
+pub mod settings;
+pub mod upload;
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+use glam::Mat4;
+
+use crate::graph::{record_passes, ImageId, Pass, PassContext, Resources};
+use crate::scene::camera::Camera;
+use crate::scene::instancing::{grid_bounds, head_grid};
+use crate::scene::light::{shadow_frame, LightFrame};
+use crate::scene::Scene;
+use crate::skin::beckmann::beckmann_lut;
+use crate::skin::kernel::SeparableKernel;
+use crate::skin::transmittance::shrink_units;
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::memory::{Buffer, Image};
+use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput};
+use crate::vk::profiler::{PassSample, Profiler};
+use readback::{DumpedImage, ReadbackPlan};
+use scene_gpu::GpuObject;
+use separable::{set_viewport, SeparableSss, SssTargets, SssView, STENCIL_SKIN};
+pub use settings::{Method, RenderSettings};
+
+pub const DIFFUSE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const LINEAR_DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+pub const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: [[f32; 4]; 4],
+    pub view: [[f32; 4]; 4],
+    pub light_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub light_dir: [f32; 4],
+    pub light_color: [f32; 4],
+    pub ambient: [f32; 4],
+    pub params: [f32; 4],
+    pub shadow_params: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadowPush {
+    model: [[f32; 4]; 4],
+    light_view_proj: [[f32; 4]; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TonemapPush {
+    exposure: f32,
+    white_point: f32,
+}
+
+/// The first depth/stencil format the device can render and copy.
+pub fn depth_stencil_format(ctx: &Context) -> Result<vk::Format> {
+    for f in [
+        vk::Format::D32_SFLOAT_S8_UINT,
+        vk::Format::D24_UNORM_S8_UINT,
+    ] {
+        if ctx.format_supports(
+            f,
+            vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+                | vk::FormatFeatureFlags::TRANSFER_SRC
+                | vk::FormatFeatureFlags::TRANSFER_DST,
+        ) {
+            return Ok(f);
+        }
+    }
+    bail!(
+        "device '{}' supports no depth/stencil format dermis can use (D32S8 or D24S8)",
+        ctx.facts.name
+    )
+}
+
+/// Every target of the frame, with its id in the graph.
+pub struct Targets {
+    pub shadow: (ImageId, Image),
+    pub diffuse: (ImageId, Image),
+    pub specular: (ImageId, Image),
+    pub linear_depth: (ImageId, Image),
+    pub depth_stencil: (ImageId, Image),
+    pub sss_tmp: (ImageId, Image),
+    pub hdr: (ImageId, Image),
+    pub ldr: (ImageId, Image),
+}
+
+impl Targets {
+    fn new(
+        ctx: &Context,
+        res: &mut Resources,
+        extent: vk::Extent2D,
+        shadow_size: u32,
+    ) -> Result<Self> {
+        let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC
+            | vk::ImageUsageFlags::TRANSFER_DST;
+        if !ctx.format_supports(
+            LINEAR_DEPTH_FORMAT,
+            vk::FormatFeatureFlags::COLOR_ATTACHMENT
+                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR,
+        ) {
+            bail!(
+                "device '{}' cannot render to and linearly filter R32_SFLOAT (linear depth)",
+                ctx.facts.name
+            );
+        }
+        let ds_format = depth_stencil_format(ctx)?;
+        let mut add = |name: &str,
+                       ext: vk::Extent2D,
+                       format: vk::Format,
+                       usage: vk::ImageUsageFlags|
+         -> Result<(ImageId, Image)> {
+            let img = Image::new(ctx, name, ext, format, usage)?;
+            let id = res.add_image(name, img.raw, img.subresource_range());
+            Ok((id, img))
+        };
+        let shadow_ext = vk::Extent2D {
+            width: shadow_size,
+            height: shadow_size,
+        };
+        Ok(Targets {
+            shadow: add(
+                "shadow map",
+                shadow_ext,
+                SHADOW_FORMAT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+            )?,
+            diffuse: add("diffuse", extent, DIFFUSE_FORMAT, color_usage)?,
+            specular: add("specular", extent, DIFFUSE_FORMAT, color_usage)?,
+            linear_depth: add("linear depth", extent, LINEAR_DEPTH_FORMAT, color_usage)?,
+            depth_stencil: add(
+                "depth stencil",
+                extent,
+                ds_format,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
+            )?,
+            sss_tmp: add("sss intermediate", extent, DIFFUSE_FORMAT, color_usage)?,
+            hdr: add("hdr", extent, DIFFUSE_FORMAT, color_usage)?,
+            ldr: add(
+                "ldr",
+                extent,
+                LDR_FORMAT,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            )?,
+        })
+    }
+
+    fn all_mut(&mut self) -> [&mut Image; 8] {
+        [
+            &mut self.shadow.1,
+            &mut self.diffuse.1,
+            &mut self.specular.1,
+            &mut self.linear_depth.1,
+            &mut self.depth_stencil.1,
+            &mut self.sss_tmp.1,
+            &mut self.hdr.1,
+            &mut self.ldr.1,
+        ]
+    }
+
+    /// Image by graph id (for dumps).
+    pub fn by_id(&self, id: ImageId) -> Option<&Image> {
+        [
+            &self.shadow,
+            &self.diffuse,
+            &self.specular,
+            &self.linear_depth,
+            &self.depth_stencil,
+            &self.sss_tmp,
+            &self.hdr,
+            &self.ldr,
+        ]
+        .into_iter()
+        .find(|(i, _)| *i == id)
+        .map(|(_, img)| img)
+    }
+}
+
+/// Everything the frame's passes read; immutable while a frame is recorded.
+pub struct FrameGpu {
+    pub settings: RenderSettings,
+    pub extent: vk::Extent2D,
+    pub mm_per_unit: f32,
+    pub scene_name: String,
+    pub targets: Targets,
+    pub camera: Camera,
+    pub light_frame: LightFrame,
+    samplers: Samplers,
+    pool: DescriptorPool,
+    shadow_pipeline: Pipeline,
+    geometry_pipeline: Pipeline,
+    composite_pipeline: Pipeline,
+    tonemap_pipeline: Pipeline,
+    frame_set: vk::DescriptorSet,
+    composite_set: vk::DescriptorSet,
+    tonemap_set: vk::DescriptorSet,
+    frame_ubo: Buffer,
+    beckmann: Image,
+    objects: Vec<GpuObject>,
+    instances: Vec<Mat4>,
+    pub sss: Option<SeparableSss>,
+}
+
+pub struct Renderer<'c> {
+    pub ctx: &'c Context,
+    pub gpu: FrameGpu,
+    pub resources: Resources,
+    profiler: Profiler,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+/// A finished frame read back to the host.
+pub struct Capture {
+    /// sRGB-encoded RGBA8, row-major, top row first.
+    pub ldr: Vec<u8>,
+    pub width: u32,
+    pub height: u32,
+    /// Every pass output (with `dump`), linear float.
+    pub dumps: Vec<DumpedImage>,
+    pub samples: Vec<PassSample>,
+}
+
+impl<'c> Renderer<'c> {
+    pub fn new(ctx: &'c Context, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
+        settings.validate(ctx.facts.max_image_dimension_2d)?;
+        let extent = vk::Extent2D {
+            width: settings.width,
+            height: settings.height,
+        };
+        let mut resources = Resources::default();
+        let targets = Targets::new(ctx, &mut resources, extent, settings.shadow_size)?;
+        let samplers = Samplers::new(ctx)?;
+        let pool = DescriptorPool::new(ctx, 64)?;
+        let ds_format = targets.depth_stencil.1.format;
+
+        let shadow_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "shadow".into(),
+                vert: "shadow.vert",
+                frag: None,
+                color_formats: vec![],
+                depth_format: Some(SHADOW_FORMAT),
+                stencil_format: None,
+                vertex_input: VertexInput::MeshPositionOnly,
+                // No culling: thin parts (ears) must cast from both faces.
+                cull: vk::CullModeFlags::NONE,
+                depth_test: true,
+                depth_write: true,
+                depth_compare: vk::CompareOp::LESS,
+                stencil: None,
+                depth_bias: Some((0.0, 1.5)),
+                blend: pipeline_blend_none(),
+            },
+        )?;
+        let geometry_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "geometry".into(),
+                vert: "geometry.vert",
+                frag: Some("geometry.frag"),
+                color_formats: vec![DIFFUSE_FORMAT, DIFFUSE_FORMAT, LINEAR_DEPTH_FORMAT],
+                depth_format: Some(ds_format),
+                stencil_format: Some(ds_format),
+                vertex_input: VertexInput::Mesh,
+                cull: vk::CullModeFlags::BACK,
+                depth_test: true,
+                depth_write: true,
+                depth_compare: vk::CompareOp::LESS,
+                // Every drawn pixel gets the object's skin bit (reference per draw).
+                stencil: Some(vk::StencilOpState {
+                    fail_op: vk::StencilOp::KEEP,
+                    pass_op: vk::StencilOp::REPLACE,
+                    depth_fail_op: vk::StencilOp::KEEP,
+                    compare_op: vk::CompareOp::ALWAYS,
+                    compare_mask: 0xff,
+                    write_mask: STENCIL_SKIN,
+                    reference: 0,
+                }),
+                depth_bias: None,
+                blend: pipeline_blend_none(),
+            },
+        )?;
+        let composite_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc::fullscreen("composite", "composite.frag", DIFFUSE_FORMAT),
+        )?;
+        let tonemap_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc::fullscreen("tonemap", "tonemap.frag", LDR_FORMAT),
+        )?;
+
+        // Beckmann texture for the specular lobe (seed 004).
+        const BECKMANN_SIZE: usize = 256;
+        let lut: Vec<u16> = beckmann_lut(BECKMANN_SIZE)
+            .iter()
+            .map(|&v| half::f16::from_f32(v).to_bits())
+            .collect();
+        let beckmann = upload::texture(
+            ctx,
+            "beckmann",
+            vk::Extent2D {
+                width: BECKMANN_SIZE as u32,
+                height: BECKMANN_SIZE as u32,
+            },
+            vk::Format::R16_SFLOAT,
+            bytemuck::cast_slice(&lut),
+        )?;
+
+        // Camera and light from the scene and the settings.
+        let head_height = scene.head_height_units();
+        let center = scene.head_center();
+        let local_bounds = scene.head_bounds;
+        let instances = head_grid(settings.heads, &local_bounds);
+        let gb = grid_bounds(settings.heads, &local_bounds);
+        let aspect = settings.width as f32 / settings.height as f32;
+        // Many heads: pull back so the whole grid stays in view.
+        let grid_h = gb.size().y.max(gb.size().x / aspect);
+        let fit = if settings.heads > 1 {
+            (grid_h / head_height).max(1.0)
+        } else {
+            1.0
+        };
+        let target = if settings.heads > 1 {
+            gb.center()
+        } else {
+            center
+        };
+        let camera = Camera::framing(
+            target,
+            scene.forward,
+            head_height,
+            settings.distance_heads * fit,
+            settings.fovy_deg,
+        );
+        let light_dir = settings.light.direction_to_light(scene.forward);
+        let light_frame = shadow_frame(light_dir, gb.center(), gb.bounding_radius());
+
+        let light = settings.light;
+        let mm = scene.mm_per_unit;
+        // Receiver bias: 0.5 mm along the light, in shadow-map depth units.
+        let bias = 0.5 / mm / light_frame.depth_range_units;
+        let uniforms = FrameUniforms {
+            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
+            view: camera.view().to_cols_array_2d(),
+            light_view_proj: light_frame.view_proj.to_cols_array_2d(),
+            camera_pos: camera.eye.extend(1.0).to_array(),
+            light_dir: light_dir.extend(0.0).to_array(),
+            light_color: [
+                light.color[0] * light.intensity,
+                light.color[1] * light.intensity,
+                light.color[2] * light.intensity,
+                0.0,
+            ],
+            ambient: [settings.ambient; 4],
+            params: [
+                mm,
+                light_frame.depth_range_units,
+                shrink_units(mm),
+                if settings.transmittance { 1.0 } else { 0.0 },
+            ],
+            shadow_params: [1.0 / settings.shadow_size as f32, bias, 0.0, 0.0],
+        };
+        let frame_ubo = Buffer::with_data(
+            ctx,
+            "frame uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let frame_set = pool.write_set(
+            ctx,
+            &geometry_pipeline,
+            0,
+            &[
+                (
+                    "frame",
+                    Bind::Uniform {
+                        buffer: frame_ubo.raw,
+                        size: std::mem::size_of::<FrameUniforms>() as u64,
+                    },
+                ),
+                (
+                    "shadowMap",
+                    Bind::Image {
+                        view: targets.shadow.1.view,
+                        sampler: samplers.shadow_compare,
+                    },
+                ),
+                (
+                    "shadowDepth",
+                    Bind::Image {
+                        view: targets.shadow.1.view,
+                        sampler: samplers.nearest_clamp,
+                    },
+                ),
+                (
+                    "beckmannTex",
+                    Bind::Image {
+                        view: beckmann.view,
+                        sampler: samplers.linear_clamp,
+                    },
+                ),
+            ],
+        )?;
+        let composite_set = pool.write_set(
+            ctx,
+            &composite_pipeline,
+            0,
+            &[
+                (
+                    "diffuseTex",
+                    Bind::Image {
+                        view: targets.diffuse.1.view,
+                        sampler: samplers.nearest_clamp,
+                    },
+                ),
+                (
+                    "specularTex",
+                    Bind::Image {
+                        view: targets.specular.1.view,
+                        sampler: samplers.nearest_clamp,
+                    },
+                ),
+            ],
+        )?;
+        let tonemap_set = pool.write_set(
+            ctx,
+            &tonemap_pipeline,
+            0,
+            &[(
+                "hdrTex",
+                Bind::Image {
+                    view: targets.hdr.1.view,
+                    sampler: samplers.nearest_clamp,
+                },
+            )],
+        )?;
+
+        let mut objects = Vec::new();
+        if let Some(b) = &scene.backdrop {
+            objects.push(GpuObject::new(
+                ctx,
+                "backdrop",
+                b,
+                &pool,
+                &geometry_pipeline,
+                &samplers,
+            )?);
+        }
+        objects.push(GpuObject::new(
+            ctx,
+            "head",
+            &scene.head,
+            &pool,
+            &geometry_pipeline,
+            &samplers,
+        )?);
+
+        let sss = match settings.method {
+            Method::Separable => {
+                let kernel = SeparableKernel::build(settings.params, settings.samples)?;
+                Some(SeparableSss::new(
+                    ctx,
+                    &pool,
+                    &samplers,
+                    kernel,
+                    &targets.diffuse.1,
+                    &targets.sss_tmp.1,
+                    &targets.linear_depth.1,
+                    ds_format,
+                )?)
+            }
+            Method::None => None,
+        };
+
+        let profiler = Profiler::new(ctx, 64)?;
+        let cmd = unsafe {
+            ctx.device.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(ctx.command_pool)
+                    .command_buffer_count(1),
+            )
+        }?[0];
+        ctx.name(cmd, "frame commands");
+        let fence = unsafe {
+            ctx.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }?;
+        ctx.name(fence, "frame fence");
+
+        let gpu = FrameGpu {
+            settings: settings.clone(),
+            extent,
+            mm_per_unit: mm,
+            scene_name: scene.name.clone(),
+            targets,
+            camera,
+            light_frame,
+            samplers,
+            pool,
+            shadow_pipeline,
+            geometry_pipeline,
+            composite_pipeline,
+            tonemap_pipeline,
+            frame_set,
+            composite_set,
+            tonemap_set,
+            frame_ubo,
+            beckmann,
+            objects,
+            instances,
+            sss,
+        };
+        ctx.check_validation("while setting up the renderer")?;
+        Ok(Renderer {
+            ctx,
+            gpu,
+            resources,
+            profiler,
+            cmd,
+            fence,
+        })
+    }
+
+    /// Records, submits and waits for one frame; returns its per-pass samples and
+    /// the dumps/readbacks the plan asked for.
+    fn run_frame(&mut self, plan: Option<&mut ReadbackPlan>) -> Result<Vec<PassSample>> {
+        let ctx = self.ctx;
+        let mut passes = self.gpu.passes();
+        if let Some(plan) = plan {
+            passes = plan.interleave(ctx, &mut self.resources, passes, &self.gpu.targets)?;
+        }
+        let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
+        unsafe {
+            ctx.device
+                .reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
+            ctx.device.begin_command_buffer(
+                self.cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+        }
+        record_passes(
+            ctx,
+            self.cmd,
+            &mut self.resources,
+            &passes,
+            Some(&self.profiler),
+        );
+        drop(passes);
+        unsafe {
+            ctx.device.end_command_buffer(self.cmd)?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(self.cmd)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            ctx.device
+                .queue_submit2(ctx.queue, &submit, self.fence)
+                .context("submitting the frame")?;
+            ctx.device
+                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .context("waiting for the frame (device lost?)")?;
+            ctx.device.reset_fences(&[self.fence])?;
+        }
+        ctx.check_validation("during the frame")?;
+        self.profiler.read(ctx, &names)
+    }
+
+    /// Renders `n` frames and returns each frame's pass samples.
+    pub fn frames(
+        &mut self,
+        n: usize,
+        mut progress: impl FnMut(usize),
+    ) -> Result<Vec<Vec<PassSample>>> {
+        let mut all = Vec::with_capacity(n);
+        for i in 0..n {
+            all.push(self.run_frame(None)?);
+            progress(i + 1);
+        }
+        Ok(all)
+    }
+
+    /// Renders one frame and reads back the tone-mapped image, and with `dump`
+    /// every pass output.
+    pub fn capture(&mut self, dump: bool) -> Result<Capture> {
+        let mut plan = ReadbackPlan::new(dump, self.gpu.targets.ldr.0);
+        let samples = self.run_frame(Some(&mut plan))?;
+        let (ldr, dumps) = plan.finish(self.ctx, &mut self.resources, &self.gpu.targets)?;
+        // Readback passes are bookkeeping, not frame cost.
+        let samples = samples
+            .into_iter()
+            .filter(|s| !ReadbackPlan::is_readback_pass(&s.name))
+            .collect();
+        Ok(Capture {
+            ldr,
+            width: self.gpu.extent.width,
+            height: self.gpu.extent.height,
+            dumps,
+            samples,
+        })
+    }
+
+    /// Uploads synthetic inputs into the SSS targets (tests): diffuse RGBA as f16,
+    /// linear depth, and the stencil skin bit. Leaves them ready for the SSS passes.
+    pub fn upload_sss_inputs(
+        &mut self,
+        diffuse_f16: &[u16],
+        depth: &[f32],
+        skin: &[bool],
+    ) -> Result<()> {
+        let t = &self.gpu.targets;
+        upload::fill_image(
+            self.ctx,
+            &t.diffuse.1,
+            vk::ImageAspectFlags::COLOR,
+            bytemuck::cast_slice(diffuse_f16),
+            AccessKind::FragmentSampledRead,
+        )?;
+        upload::fill_image(
+            self.ctx,
+            &t.linear_depth.1,
+            vk::ImageAspectFlags::COLOR,
+            bytemuck::cast_slice(depth),
+            AccessKind::FragmentSampledRead,
+        )?;
+        let stencil: Vec<u8> = skin
+            .iter()
+            .map(|&s| if s { STENCIL_SKIN as u8 } else { 0 })
+            .collect();
+        upload::fill_image(
+            self.ctx,
+            &t.depth_stencil.1,
+            vk::ImageAspectFlags::STENCIL,
+            &stencil,
+            AccessKind::DepthStencilReadOnly,
+        )?;
+        self.resources.images[t.diffuse.0 .0].last = AccessKind::FragmentSampledRead;
+        self.resources.images[t.linear_depth.0 .0].last = AccessKind::FragmentSampledRead;
+        self.resources.images[t.depth_stencil.0 .0].last = AccessKind::DepthStencilReadOnly;
+        Ok(())
+    }
+
+    /// Runs only the SSS passes on whatever the targets hold (tests) and reads
+    /// back the diffuse target as f32 RGBA with the pass samples.
+    pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
+        let sss = self
+            .gpu
+            .sss
+            .as_ref()
+            .context("the SSS-only run needs --method separable")?;
+        let passes = sss.passes(self.gpu.sss_targets(), self.gpu.sss_view());
+        let mut plan = ReadbackPlan::single(self.gpu.targets.diffuse.0);
+        let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu.targets)?;
+        let ctx = self.ctx;
+        let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
+        let cmd = self.cmd;
+        unsafe {
+            ctx.device
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())?;
+            ctx.device
+                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
+        }
+        record_passes(ctx, cmd, &mut self.resources, &passes, Some(&self.profiler));
+        drop(passes);
+        ctx.submit_and_wait(cmd)?;
+        ctx.check_validation("during the SSS-only run")?;
+        let samples = self.profiler.read(ctx, &names)?;
+        let img = plan.finish_single(ctx, &mut self.resources, &self.gpu.targets)?;
+        Ok((
+            img,
+            samples
+                .into_iter()
+                .filter(|s| !ReadbackPlan::is_readback_pass(&s.name))
+                .collect(),
+        ))
+    }
+}
+
+fn pipeline_blend_none() -> crate::vk::pipeline::Blend {
+    crate::vk::pipeline::Blend::None
+}
+
+impl FrameGpu {
+    pub fn sss_targets(&self) -> SssTargets {
+        let t = &self.targets;
+        SssTargets {
+            diffuse: (t.diffuse.0, t.diffuse.1.raw, t.diffuse.1.view),
+            tmp: (t.sss_tmp.0, t.sss_tmp.1.raw, t.sss_tmp.1.view),
+            linear_depth: t.linear_depth.0,
+            depth_stencil: (t.depth_stencil.0, t.depth_stencil.1.view),
+            extent: self.extent,
+        }
+    }
+
+    pub fn sss_view(&self) -> SssView {
+        SssView {
+            fovy_rad: self.settings.fovy_deg.to_radians(),
+            mm_per_unit: self.mm_per_unit,
+            follow_surface: self.settings.follow_surface,
+        }
+    }
+
+    /// The frame's passes in order.
+    pub fn passes(&self) -> Vec<Pass<'_>> {
+        let mut passes = vec![self.shadow_pass(), self.geometry_pass()];
+        if let Some(sss) = &self.sss {
+            passes.extend(sss.passes(self.sss_targets(), self.sss_view()));
+        }
+        passes.push(self.composite_pass());
+        passes.push(self.tonemap_pass());
+        passes
+    }
+
+    fn shadow_pass(&self) -> Pass<'_> {
+        let (id, img) = &self.targets.shadow;
+        let view = img.view;
+        let extent = img.extent;
+        Pass::new("shadow map")
+            .image(*id, AccessKind::DepthStencilWrite)
+            .record(move |pc: &PassContext| {
+                let ctx = pc.ctx;
+                let cmd = pc.cmd;
+                let depth = vk::RenderingAttachmentInfo::default()
+                    .image_view(view)
+                    .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        depth_stencil: vk::ClearDepthStencilValue {
+                            depth: 1.0,
+                            stencil: 0,
+                        },
+                    });
+                let info = vk::RenderingInfo::default()
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent,
+                    })
+                    .layer_count(1)
+                    .depth_attachment(&depth);
+                unsafe {
+                    ctx.device.cmd_begin_rendering(cmd, &info);
+                    ctx.device.cmd_bind_pipeline(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.shadow_pipeline.raw,
+                    );
+                    set_viewport(ctx, cmd, extent);
+                }
+                // Heads only: the backdrop receives shadows but casts none worth a texel.
+                for obj in self.objects.iter().filter(|o| o.skin) {
+                    for m in &self.instances {
+                        let push = ShadowPush {
+                            model: m.to_cols_array_2d(),
+                            light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
+                        };
+                        self.shadow_pipeline.push(ctx, cmd, &push);
+                        obj.bind_and_draw(ctx, cmd);
+                    }
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            })
+    }
+
+    fn geometry_pass(&self) -> Pass<'_> {
+        let t = &self.targets;
+        let extent = self.extent;
+        let views = [t.diffuse.1.view, t.specular.1.view, t.linear_depth.1.view];
+        let ds_view = t.depth_stencil.1.view;
+        let far = self.camera.far;
+        Pass::new("geometry")
+            .image(t.shadow.0, AccessKind::FragmentSampledRead)
+            .image(t.diffuse.0, AccessKind::ColorAttachmentWrite)
+            .image(t.specular.0, AccessKind::ColorAttachmentWrite)
+            .image(t.linear_depth.0, AccessKind::ColorAttachmentWrite)
+            .image(t.depth_stencil.0, AccessKind::DepthStencilWrite)
+            .record(move |pc: &PassContext| {
+                let ctx = pc.ctx;
+                let cmd = pc.cmd;
+                let clears = [[0.0f32; 4], [0.0; 4], [far, 0.0, 0.0, 0.0]];
+                let colors: Vec<vk::RenderingAttachmentInfo> = views
+                    .iter()
+                    .zip(clears)
+                    .map(|(&v, c)| {
+                        vk::RenderingAttachmentInfo::default()
+                            .image_view(v)
+                            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                            .load_op(vk::AttachmentLoadOp::CLEAR)
+                            .store_op(vk::AttachmentStoreOp::STORE)
+                            .clear_value(vk::ClearValue {
+                                color: vk::ClearColorValue { float32: c },
+                            })
+                    })
+                    .collect();
+                let ds = vk::RenderingAttachmentInfo::default()
+                    .image_view(ds_view)
+                    .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        depth_stencil: vk::ClearDepthStencilValue {
+                            depth: 1.0,
+                            stencil: 0,
+                        },
+                    });
+                let info = vk::RenderingInfo::default()
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent,
+                    })
+                    .layer_count(1)
+                    .color_attachments(&colors)
+                    .depth_attachment(&ds)
+                    .stencil_attachment(&ds);
+                let p = &self.geometry_pipeline;
+                unsafe {
+                    ctx.device.cmd_begin_rendering(cmd, &info);
+                    ctx.device
+                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, p.raw);
+                    set_viewport(ctx, cmd, extent);
+                    ctx.device.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        p.layout,
+                        0,
+                        &[self.frame_set],
+                        &[],
+                    );
+                }
+                for obj in &self.objects {
+                    unsafe {
+                        ctx.device.cmd_bind_descriptor_sets(
+                            cmd,
+                            vk::PipelineBindPoint::GRAPHICS,
+                            p.layout,
+                            1,
+                            &[obj.material_set],
+                            &[],
+                        );
+                        ctx.device.cmd_set_stencil_reference(
+                            cmd,
+                            vk::StencilFaceFlags::FRONT_AND_BACK,
+                            if obj.skin { STENCIL_SKIN } else { 0 },
+                        );
+                    }
+                    let models: &[Mat4] = if obj.skin {
+                        &self.instances
+                    } else {
+                        &[Mat4::IDENTITY]
+                    };
+                    for m in models {
+                        p.push(ctx, cmd, &m.to_cols_array_2d());
+                        obj.bind_and_draw(ctx, cmd);
+                    }
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            })
+    }
+
+    fn fullscreen_pass<'a>(
+        &'a self,
+        name: &str,
+        pipeline: &'a Pipeline,
+        set: vk::DescriptorSet,
+        reads: &[ImageId],
+        target: (ImageId, vk::ImageView),
+        push: Option<TonemapPush>,
+    ) -> Pass<'a> {
+        let extent = self.extent;
+        let mut pass = Pass::new(name);
+        for &r in reads {
+            pass = pass.image(r, AccessKind::FragmentSampledRead);
+        }
+        pass.image(target.0, AccessKind::ColorAttachmentWrite)
+            .record(move |pc: &PassContext| {
+                let ctx = pc.ctx;
+                let cmd = pc.cmd;
+                let att = [vk::RenderingAttachmentInfo::default()
+                    .image_view(target.1)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::DONT_CARE)
+                    .store_op(vk::AttachmentStoreOp::STORE)];
+                let info = vk::RenderingInfo::default()
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent,
+                    })
+                    .layer_count(1)
+                    .color_attachments(&att);
+                unsafe {
+                    ctx.device.cmd_begin_rendering(cmd, &info);
+                    ctx.device.cmd_bind_pipeline(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        pipeline.raw,
+                    );
+                    set_viewport(ctx, cmd, extent);
+                    ctx.device.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        pipeline.layout,
+                        0,
+                        &[set],
+                        &[],
+                    );
+                }
+                if let Some(p) = &push {
+                    pipeline.push(ctx, cmd, p);
+                }
+                unsafe {
+                    ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+                    ctx.device.cmd_end_rendering(cmd);
+                }
+            })
+    }
+
+    fn composite_pass(&self) -> Pass<'_> {
+        let t = &self.targets;
+        self.fullscreen_pass(
+            "composite",
+            &self.composite_pipeline,
+            self.composite_set,
+            &[t.diffuse.0, t.specular.0],
+            (t.hdr.0, t.hdr.1.view),
+            None,
+        )
+    }
+
+    fn tonemap_pass(&self) -> Pass<'_> {
+        let t = &self.targets;
+        self.fullscreen_pass(
+            "tonemap",
+            &self.tonemap_pipeline,
+            self.tonemap_set,
+            &[t.hdr.0],
+            (t.ldr.0, t.ldr.1.view),
+            Some(TonemapPush {
+                exposure: self.settings.exposure,
+                white_point: 11.2,
+            }),
+        )
+    }
+}
+
+impl Drop for Renderer<'_> {
+    fn drop(&mut self) {
+        let ctx = self.ctx;
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            ctx.device.destroy_fence(self.fence, None);
+            ctx.device
+                .free_command_buffers(ctx.command_pool, &[self.cmd]);
+        }
+        self.profiler.destroy(ctx);
+        let g = &mut self.gpu;
+        if let Some(s) = &mut g.sss {
+            s.destroy(ctx);
+        }
+        for o in &mut g.objects {
+            o.destroy(ctx);
+        }
+        g.beckmann.destroy(ctx);
+        g.frame_ubo.destroy(ctx);
+        for p in [
+            &mut g.shadow_pipeline,
+            &mut g.geometry_pipeline,
+            &mut g.composite_pipeline,
+            &mut g.tonemap_pipeline,
+        ] {
+            p.destroy(ctx);
+        }
+        g.pool.destroy(ctx);
+        g.samplers.destroy(ctx);
+        for img in g.targets.all_mut() {
+            img.destroy(ctx);
+        }
+    }
+}

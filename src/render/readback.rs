@@ -1,0 +1,315 @@
+//! Reading targets back to the host: the final image, and with `--dump` every
+//! pass output right after the pass that wrote it (later passes may overwrite
+//! a target, as the vertical SSS pass does with the diffuse one).
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use super::Targets;
+use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::memory::{bytes_per_texel, Buffer};
+
+/// One pass output as linear float RGBA.
+pub struct DumpedImage {
+    pub pass: String,
+    pub image: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<[f32; 4]>,
+}
+
+struct Pending {
+    pass: String,
+    image: ImageId,
+    buffer: Buffer,
+    buffer_id: BufferId,
+}
+
+/// Which images to read back and where they land.
+pub struct ReadbackPlan {
+    dump: bool,
+    final_image: ImageId,
+    pending: Vec<Pending>,
+    /// Buffer count of the graph before this plan added its own, restored at the end.
+    buffers_before: usize,
+}
+
+const PREFIX: &str = "readback";
+
+/// Bytes per texel copied out of `format`, with the aspect to copy, or `None`
+/// when dermis does not read that format back.
+fn copy_format(format: vk::Format) -> Option<(usize, vk::ImageAspectFlags)> {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => {
+            Some((4, vk::ImageAspectFlags::DEPTH))
+        }
+        f if bytes_per_texel(f) > 0 => Some((bytes_per_texel(f), vk::ImageAspectFlags::COLOR)),
+        _ => None,
+    }
+}
+
+pub fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Texels of `format` as linear float RGBA (single channels replicated to RGB).
+pub fn to_rgba_f32(format: vk::Format, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
+    Ok(match format {
+        vk::Format::R16G16B16A16_SFLOAT => bytes
+            .chunks_exact(8)
+            .map(|c| {
+                let h =
+                    |i: usize| half::f16::from_bits(u16::from_le_bytes([c[i], c[i + 1]])).to_f32();
+                [h(0), h(2), h(4), h(6)]
+            })
+            .collect(),
+        vk::Format::R32_SFLOAT | vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => bytes
+            .chunks_exact(4)
+            .map(|c| {
+                let v = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+                [v, v, v, 1.0]
+            })
+            .collect(),
+        vk::Format::R8G8B8A8_SRGB => bytes
+            .chunks_exact(4)
+            .map(|c| {
+                [
+                    srgb_to_linear(c[0]),
+                    srgb_to_linear(c[1]),
+                    srgb_to_linear(c[2]),
+                    c[3] as f32 / 255.0,
+                ]
+            })
+            .collect(),
+        vk::Format::R8G8B8A8_UNORM => bytes
+            .chunks_exact(4)
+            .map(|c| {
+                [
+                    c[0] as f32 / 255.0,
+                    c[1] as f32 / 255.0,
+                    c[2] as f32 / 255.0,
+                    c[3] as f32 / 255.0,
+                ]
+            })
+            .collect(),
+        other => bail!("reading back {other:?} is not supported"),
+    })
+}
+
+impl ReadbackPlan {
+    /// The final image, plus every pass output when `dump` is set.
+    pub fn new(dump: bool, final_image: ImageId) -> Self {
+        ReadbackPlan {
+            dump,
+            final_image,
+            pending: Vec::new(),
+            buffers_before: 0,
+        }
+    }
+
+    /// Just one image, read after all passes.
+    pub fn single(image: ImageId) -> Self {
+        Self::new(false, image)
+    }
+
+    pub fn is_readback_pass(name: &str) -> bool {
+        name.starts_with(PREFIX)
+    }
+
+    fn copy_pass<'a>(
+        &mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        targets: &Targets,
+        pass: &str,
+        id: ImageId,
+    ) -> Result<Option<Pass<'a>>> {
+        let img = targets
+            .by_id(id)
+            .context("readback of an image that is not a frame target")?;
+        let Some((bpt, aspect)) = copy_format(img.format) else {
+            return Ok(None);
+        };
+        let size = img.extent.width as u64 * img.extent.height as u64 * bpt as u64;
+        let name = format!("{PREFIX} {pass} -> {}", img.name);
+        let buffer = Buffer::new(
+            ctx,
+            &name,
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let buffer_id = res.add_buffer(&name, buffer.raw);
+        let (raw_img, raw_buf, extent) = (img.raw, buffer.raw, img.extent);
+        self.pending.push(Pending {
+            pass: pass.to_string(),
+            image: id,
+            buffer,
+            buffer_id,
+        });
+        Ok(Some(
+            Pass::new(name)
+                .image(id, AccessKind::TransferRead)
+                .buffer(buffer_id, AccessKind::TransferWrite)
+                .record(move |pc: &PassContext| {
+                    let region = vk::BufferImageCopy::default()
+                        .image_subresource(
+                            vk::ImageSubresourceLayers::default()
+                                .aspect_mask(aspect)
+                                .layer_count(1),
+                        )
+                        .image_extent(vk::Extent3D {
+                            width: extent.width,
+                            height: extent.height,
+                            depth: 1,
+                        });
+                    unsafe {
+                        pc.ctx.device.cmd_copy_image_to_buffer(
+                            pc.cmd,
+                            raw_img,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            raw_buf,
+                            &[region],
+                        )
+                    };
+                }),
+        ))
+    }
+
+    /// Returns `passes` with the readback copies inserted, and a last pass that
+    /// makes the copies visible to the host.
+    pub fn interleave<'a>(
+        &mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        passes: Vec<Pass<'a>>,
+        targets: &Targets,
+    ) -> Result<Vec<Pass<'a>>> {
+        self.buffers_before = res.buffers.len();
+        let mut out = Vec::with_capacity(passes.len() * 2 + 2);
+        for p in passes {
+            let written: Vec<ImageId> = p
+                .images
+                .iter()
+                .filter(|(_, a)| a.is_write())
+                .map(|(i, _)| *i)
+                .collect();
+            let name = p.name.clone();
+            out.push(p);
+            if self.dump {
+                for id in written {
+                    if let Some(c) = self.copy_pass(ctx, res, targets, &name, id)? {
+                        out.push(c);
+                    }
+                }
+            }
+        }
+        if !self.dump || !self.pending.iter().any(|p| p.image == self.final_image) {
+            let c = self
+                .copy_pass(ctx, res, targets, "final", self.final_image)?
+                .context("the final image's format cannot be read back")?;
+            out.push(c);
+        }
+        let mut host = Pass::new(format!("{PREFIX} to host"));
+        for p in &self.pending {
+            host = host.buffer(p.buffer_id, AccessKind::HostRead);
+        }
+        out.push(host);
+        Ok(out)
+    }
+
+    fn read(&self, p: &Pending, targets: &Targets) -> Result<(u32, u32, vk::Format, Vec<u8>)> {
+        let img = targets.by_id(p.image).context("readback image vanished")?;
+        Ok((
+            img.extent.width,
+            img.extent.height,
+            img.format,
+            p.buffer.read()?.to_vec(),
+        ))
+    }
+
+    /// After the fence: the final image's raw bytes and every dump as float.
+    pub fn finish(
+        mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        targets: &Targets,
+    ) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
+        let mut final_bytes = None;
+        let mut dumps = Vec::new();
+        for p in &self.pending {
+            let (w, h, format, bytes) = self.read(p, targets)?;
+            if p.image == self.final_image {
+                final_bytes = Some(bytes.clone());
+            }
+            if self.dump {
+                let image = targets
+                    .by_id(p.image)
+                    .map(|i| i.name.clone())
+                    .unwrap_or_default();
+                dumps.push(DumpedImage {
+                    pass: p.pass.clone(),
+                    image,
+                    width: w,
+                    height: h,
+                    rgba: to_rgba_f32(format, &bytes)?,
+                });
+            }
+        }
+        self.release(ctx, res);
+        Ok((
+            final_bytes.context("the final image was not read back")?,
+            dumps,
+        ))
+    }
+
+    /// After the fence: the single image as float RGBA.
+    pub fn finish_single(
+        mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        targets: &Targets,
+    ) -> Result<Vec<[f32; 4]>> {
+        let p = self.pending.first().context("nothing was read back")?;
+        let (_, _, format, bytes) = self.read(p, targets)?;
+        let out = to_rgba_f32(format, &bytes);
+        self.release(ctx, res);
+        out
+    }
+
+    fn release(&mut self, ctx: &Context, res: &mut Resources) {
+        for mut p in self.pending.drain(..) {
+            p.buffer.destroy(ctx);
+        }
+        res.buffers.truncate(self.buffers_before);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn converts_formats() {
+        let one = half::f16::from_f32(1.5).to_bits().to_le_bytes();
+        let mut b = Vec::new();
+        for _ in 0..4 {
+            b.extend_from_slice(&one);
+        }
+        assert_eq!(
+            to_rgba_f32(vk::Format::R16G16B16A16_SFLOAT, &b).unwrap(),
+            vec![[1.5; 4]]
+        );
+        let px = to_rgba_f32(vk::Format::R8G8B8A8_SRGB, &[255, 0, 188, 255]).unwrap()[0];
+        assert!((px[0] - 1.0).abs() < 1e-6 && px[1] == 0.0 && (px[2] - 0.5).abs() < 0.01);
+        assert!(to_rgba_f32(vk::Format::BC1_RGB_UNORM_BLOCK, &[0; 8]).is_err());
+    }
+}

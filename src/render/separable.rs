@@ -1,0 +1,305 @@
+//! Separable subsurface scattering on the GPU (thesis ch. 6): a seed copy of the
+//! diffuse target into the intermediate, a horizontal pass diffuse -> tmp and a
+//! vertical pass tmp -> diffuse, both stencil-tested on the skin bit.
+//!
+//! Why the seed copy: the passes only shade skin pixels, but a skin pixel's taps
+//! may land on non-skin texels of the intermediate. Seeding it with the diffuse
+//! image makes those texels hold what the horizontal pass would have read, so
+//! the vertical pass sees the same neighbourhood as a full-screen blur would,
+//! and non-skin pixels of the output are untouched, bit for bit.
+
+use anyhow::Result;
+use ash::vk;
+
+use crate::graph::{ImageId, Pass, PassContext};
+use crate::skin::kernel::SeparableKernel;
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::memory::{Buffer, Image};
+use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
+
+/// Push constants of sss_blur.frag.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SssPush {
+    pub dir: [f32; 2],
+    pub aspect: f32,
+    pub tan_half_fovy: f32,
+    pub mm_per_unit: f32,
+    pub follow_tol_mm: f32,
+    pub n_samples: i32,
+    pub follow_surface: i32,
+}
+
+/// View-dependent inputs of the blur.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SssView {
+    pub fovy_rad: f32,
+    pub mm_per_unit: f32,
+    pub follow_surface: bool,
+}
+
+/// The targets the SSS passes use, as graph ids plus raw handles.
+#[derive(Clone, Copy, Debug)]
+pub struct SssTargets {
+    pub diffuse: (ImageId, vk::Image, vk::ImageView),
+    pub tmp: (ImageId, vk::Image, vk::ImageView),
+    pub linear_depth: ImageId,
+    pub depth_stencil: (ImageId, vk::ImageView),
+    pub extent: vk::Extent2D,
+}
+
+pub struct SeparableSss {
+    pub pipeline: Pipeline,
+    pub kernel: SeparableKernel,
+    kernel_buffer: Buffer,
+    set_h: vk::DescriptorSet,
+    set_v: vk::DescriptorSet,
+}
+
+pub const STENCIL_SKIN: u32 = 1;
+
+/// Stencil state of every SSS pass: shade only where the skin bit is set.
+pub fn skin_stencil_test() -> vk::StencilOpState {
+    vk::StencilOpState {
+        fail_op: vk::StencilOp::KEEP,
+        pass_op: vk::StencilOp::KEEP,
+        depth_fail_op: vk::StencilOp::KEEP,
+        compare_op: vk::CompareOp::EQUAL,
+        compare_mask: STENCIL_SKIN,
+        write_mask: 0,
+        reference: STENCIL_SKIN,
+    }
+}
+
+impl SeparableSss {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &Context,
+        pool: &DescriptorPool,
+        samplers: &Samplers,
+        kernel: SeparableKernel,
+        diffuse: &Image,
+        tmp: &Image,
+        linear_depth: &Image,
+        depth_stencil_format: vk::Format,
+    ) -> Result<Self> {
+        let mut desc = GraphicsDesc::fullscreen("sss blur", "sss_blur.frag", diffuse.format);
+        desc.depth_format = Some(depth_stencil_format);
+        desc.stencil_format = Some(depth_stencil_format);
+        desc.stencil = Some(skin_stencil_test());
+        let pipeline = Pipeline::graphics(ctx, &desc)?;
+        let mut data = kernel.gpu_data();
+        data.resize(SeparableKernel::MAX_SAMPLES, [0.0; 4]);
+        let kernel_buffer = Buffer::with_data(
+            ctx,
+            "sss kernel",
+            bytemuck::cast_slice(&data),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let size = (data.len() * 16) as u64;
+        let set = |color: &Image| {
+            pool.write_set(
+                ctx,
+                &pipeline,
+                0,
+                &[
+                    (
+                        "colorTex",
+                        Bind::Image {
+                            view: color.view,
+                            sampler: samplers.linear_clamp,
+                        },
+                    ),
+                    (
+                        "depthTex",
+                        Bind::Image {
+                            view: linear_depth.view,
+                            sampler: samplers.linear_clamp,
+                        },
+                    ),
+                    (
+                        "kernel",
+                        Bind::Uniform {
+                            buffer: kernel_buffer.raw,
+                            size,
+                        },
+                    ),
+                ],
+            )
+        };
+        let set_h = set(diffuse)?;
+        let set_v = set(tmp)?;
+        Ok(SeparableSss {
+            pipeline,
+            kernel,
+            kernel_buffer,
+            set_h,
+            set_v,
+        })
+    }
+
+    fn push(&self, view: &SssView, extent: vk::Extent2D, dir: [f32; 2]) -> SssPush {
+        let tol = self.kernel.params.width_mm;
+        SssPush {
+            dir,
+            aspect: extent.width as f32 / extent.height as f32,
+            tan_half_fovy: (view.fovy_rad * 0.5).tan(),
+            mm_per_unit: view.mm_per_unit,
+            follow_tol_mm: tol,
+            n_samples: self.kernel.samples.len() as i32,
+            // A zero-width kernel has no extent to compare depth steps against.
+            follow_surface: (view.follow_surface && tol > 0.0) as i32,
+        }
+    }
+
+    /// The three passes, in order: seed copy, horizontal, vertical.
+    pub fn passes<'a>(&'a self, t: SssTargets, view: SssView) -> Vec<Pass<'a>> {
+        let extent = t.extent;
+        let seed = Pass::new("sss seed copy")
+            .image(t.diffuse.0, AccessKind::TransferRead)
+            .image(t.tmp.0, AccessKind::TransferWrite)
+            .record(move |pc: &PassContext| {
+                let layers = vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(1);
+                let region = vk::ImageCopy::default()
+                    .src_subresource(layers)
+                    .dst_subresource(layers)
+                    .extent(vk::Extent3D {
+                        width: extent.width,
+                        height: extent.height,
+                        depth: 1,
+                    });
+                unsafe {
+                    pc.ctx.device.cmd_copy_image(
+                        pc.cmd,
+                        t.diffuse.1,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        t.tmp.1,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &[region],
+                    )
+                };
+            });
+        let blur = |name: &str,
+                    src: ImageId,
+                    dst: (ImageId, vk::Image, vk::ImageView),
+                    set: vk::DescriptorSet,
+                    dir: [f32; 2]| {
+            let push = self.push(&view, extent, dir);
+            Pass::new(name)
+                .image(src, AccessKind::FragmentSampledRead)
+                .image(t.linear_depth, AccessKind::FragmentSampledRead)
+                .image(t.depth_stencil.0, AccessKind::DepthStencilReadOnly)
+                .image(dst.0, AccessKind::ColorAttachmentLoadWrite)
+                .record(move |pc: &PassContext| {
+                    fullscreen_stencil_draw(
+                        pc,
+                        &self.pipeline,
+                        set,
+                        dst.2,
+                        t.depth_stencil.1,
+                        extent,
+                        STENCIL_SKIN,
+                        |c, cmd| self.pipeline.push(c, cmd, &push),
+                    );
+                })
+        };
+        vec![
+            seed,
+            blur("sss horizontal", t.diffuse.0, t.tmp, self.set_h, [1.0, 0.0]),
+            blur("sss vertical", t.tmp.0, t.diffuse, self.set_v, [0.0, 1.0]),
+        ]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+        self.kernel_buffer.destroy(ctx);
+    }
+}
+
+/// Viewport and scissor covering `extent`.
+pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
+    unsafe {
+        ctx.device.cmd_set_viewport(
+            cmd,
+            0,
+            &[vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: extent.width as f32,
+                height: extent.height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            }],
+        );
+        ctx.device.cmd_set_scissor(
+            cmd,
+            0,
+            &[vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            }],
+        );
+    }
+}
+
+/// A full-screen triangle into `color` (loaded, stored), stencil-tested against
+/// a read-only depth/stencil attachment.
+#[allow(clippy::too_many_arguments)]
+pub fn fullscreen_stencil_draw(
+    pc: &PassContext,
+    pipeline: &Pipeline,
+    set: vk::DescriptorSet,
+    color: vk::ImageView,
+    depth_stencil: vk::ImageView,
+    extent: vk::Extent2D,
+    stencil_ref: u32,
+    push: impl Fn(&Context, vk::CommandBuffer),
+) {
+    let ctx = pc.ctx;
+    let cmd = pc.cmd;
+    let color_att = [vk::RenderingAttachmentInfo::default()
+        .image_view(color)
+        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::LOAD)
+        .store_op(vk::AttachmentStoreOp::STORE)];
+    // Read-only depth/stencil: loaded for the test, never stored.
+    let ds_att = vk::RenderingAttachmentInfo::default()
+        .image_view(depth_stencil)
+        .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::LOAD)
+        .store_op(vk::AttachmentStoreOp::NONE);
+    let info = vk::RenderingInfo::default()
+        .render_area(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        })
+        .layer_count(1)
+        .color_attachments(&color_att)
+        .depth_attachment(&ds_att)
+        .stencil_attachment(&ds_att);
+    unsafe {
+        ctx.device.cmd_begin_rendering(cmd, &info);
+        ctx.device
+            .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
+        set_viewport(ctx, cmd, extent);
+        ctx.device.cmd_set_stencil_reference(
+            cmd,
+            vk::StencilFaceFlags::FRONT_AND_BACK,
+            stencil_ref,
+        );
+        ctx.device.cmd_bind_descriptor_sets(
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            pipeline.layout,
+            0,
+            &[set],
+            &[],
+        );
+        push(ctx, cmd);
+        ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+        ctx.device.cmd_end_rendering(cmd);
+    }
+}

@@ -1,0 +1,227 @@
+//! Anatomical measurements of a head mesh: which way the face looks and where the chin and
+//! crown are. The subsurface passes work in millimetres, so the scene's scale comes from
+//! the chin-to-crown height (a human head is ~230 mm); scans often carry a neck and
+//! shoulders, which is why the plain vertical extent is not good enough.
+
+use super::mesh::{Aabb, Mesh};
+use glam::Vec3;
+
+/// Human chin-to-crown height in millimetres, used to derive `mm_per_unit`.
+pub const HEAD_HEIGHT_MM: f32 = 230.0;
+
+/// Unit horizontal vector from the head's centre toward its face. Y is taken as up (glTF's
+/// convention). The nose is the narrowest protrusion of a head: for each horizontal axis
+/// direction, the vertices within 5% of the size of the mesh from its extreme plane are
+/// collected and their sideways spread measured; the face is the direction whose extreme
+/// is narrowest (the back of the skull, the shoulders, and the side of the skull are all
+/// broad). Falls back to +Z, the glTF "front", for empty meshes.
+pub fn face_direction(mesh: &Mesh) -> Vec3 {
+    let bounds = mesh.bounds();
+    let delta = 0.05 * bounds.size().max_element();
+    if mesh.vertices.is_empty() || delta <= 0.0 || !delta.is_finite() {
+        return Vec3::Z;
+    }
+    let candidates = [Vec3::Z, Vec3::NEG_Z, Vec3::X, Vec3::NEG_X];
+    let mut best = (f32::INFINITY, Vec3::Z);
+    for dir in candidates {
+        let side = dir.cross(Vec3::Y);
+        let extreme = mesh
+            .vertices
+            .iter()
+            .map(|v| Vec3::from(v.position).dot(dir))
+            .fold(f32::NEG_INFINITY, f32::max);
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for v in &mesh.vertices {
+            let p = Vec3::from(v.position);
+            if p.dot(dir) >= extreme - delta {
+                let s = p.dot(side);
+                lo = lo.min(s);
+                hi = hi.max(s);
+            }
+        }
+        let spread = hi - lo;
+        if spread < best.0 {
+            best = (spread, dir);
+        }
+    }
+    best.1
+}
+
+/// Chin and crown heights (Y) of a head looking along `forward`.
+///
+/// The front profile F(y) (most forward point of the triangles crossing each horizontal
+/// slice) peaks at the nose
+/// tip. Going down from there, the chin ends where the profile falls below 30% of the way
+/// from the median profile value below the nose (the front of the neck) to the nose: the
+/// underside of the chin is where the profile retreats fastest, and 30% lands at its
+/// bottom (the menton) on the Lee Perry-Smith scan. A mesh whose bottom narrows to a
+/// point (no neck, like the procedural head) has its chin at its lowest point.
+pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
+    let b = mesh.bounds();
+    let (bottom, crown) = (b.min.y, b.max.y);
+    let extent = crown - bottom;
+    if mesh.vertices.is_empty() || extent <= 0.0 || !extent.is_finite() {
+        return (bottom, crown);
+    }
+    // A mesh that narrows to a point at the bottom was not cut through a neck: its
+    // lowest point is the chin. Cut necks and busts end in a broad ring or cap.
+    let band: Vec<Vec3> = mesh
+        .vertices
+        .iter()
+        .map(|v| Vec3::from(v.position))
+        .filter(|p| p.y <= bottom + 0.02 * extent)
+        .collect();
+    if let Some(bb) = Aabb::from_points(band) {
+        let base = bb.size().x.max(bb.size().z);
+        if base < 0.25 * b.size().x.max(b.size().z) {
+            return (bottom, crown);
+        }
+    }
+    const SLICES: usize = 200;
+    // Triangles, not vertices, fill the slices: a slice between two vertex rings must
+    // still see the surface crossing it, or other parts (ears) would speak for it.
+    let mut front = [f32::NEG_INFINITY; SLICES];
+    let slice_of = |y: f32| ((((y - bottom) / extent) * SLICES as f32) as usize).min(SLICES - 1);
+    for tri in mesh.indices.chunks_exact(3) {
+        let Some(p) = tri
+            .iter()
+            .map(|&i| {
+                mesh.vertices
+                    .get(i as usize)
+                    .map(|v| Vec3::from(v.position))
+            })
+            .collect::<Option<Vec<Vec3>>>()
+        else {
+            continue;
+        };
+        let (lo, hi) = (
+            p.iter().map(|p| p.y).fold(f32::INFINITY, f32::min),
+            p.iter().map(|p| p.y).fold(f32::NEG_INFINITY, f32::max),
+        );
+        for (i, f) in front
+            .iter_mut()
+            .enumerate()
+            .take(slice_of(hi) + 1)
+            .skip(slice_of(lo))
+        {
+            let y0 = bottom + i as f32 / SLICES as f32 * extent;
+            let y1 = y0 + extent / SLICES as f32;
+            // The triangle's farthest reach within the slice is at a vertex inside it or
+            // where an edge crosses the slice's top or bottom.
+            for k in 0..3 {
+                let (a, b) = (p[k], p[(k + 1) % 3]);
+                if (y0..=y1).contains(&a.y) {
+                    *f = f.max(a.dot(forward));
+                }
+                for y in [y0, y1] {
+                    if (a.y - y) * (b.y - y) < 0.0 {
+                        let t = (y - a.y) / (b.y - a.y);
+                        *f = f.max(a.lerp(b, t).dot(forward));
+                    }
+                }
+            }
+        }
+    }
+    let slice_y = |i: usize| bottom + (i as f32 + 0.5) / SLICES as f32 * extent;
+    let Some(nose) = (0..SLICES).max_by(|&a, &b| front[a].total_cmp(&front[b])) else {
+        return (bottom, crown);
+    };
+    // The typical profile below the nose: mostly neck and chest on a bust, which a
+    // minimum would not be (the cut edge at the bottom of a bust reaches far back).
+    let mut below: Vec<f32> = front[..=nose]
+        .iter()
+        .copied()
+        .filter(|f| f.is_finite())
+        .collect();
+    below.sort_by(f32::total_cmp);
+    let neck_front = below[below.len() / 2];
+    let threshold = neck_front + 0.3 * (front[nose] - neck_front);
+    let mut chin = nose;
+    for i in (0..nose).rev() {
+        if !front[i].is_finite() {
+            continue; // an empty slice says nothing
+        }
+        if front[i] < threshold {
+            break;
+        }
+        chin = i;
+    }
+    (slice_y(chin) - 0.5 / SLICES as f32 * extent, crown)
+}
+
+/// Bounds of the part of the mesh from the chin up: the head without neck or shoulders,
+/// which is what a camera should frame.
+pub fn head_part_bounds(mesh: &Mesh, forward: Vec3) -> Aabb {
+    let (chin, _) = chin_and_crown(mesh, forward);
+    Aabb::from_points(
+        mesh.vertices
+            .iter()
+            .map(|v| Vec3::from(v.position))
+            .filter(|p| p.y >= chin),
+    )
+    .unwrap_or_else(|| mesh.bounds())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::mesh::Vertex;
+    use super::super::procedural;
+    use super::*;
+    use glam::Mat4;
+
+    #[test]
+    fn procedural_head_faces_plus_z_and_rotations_follow() {
+        let head = procedural::head_mesh();
+        assert_eq!(face_direction(&head), Vec3::Z);
+        for (angle, expect) in [
+            (std::f32::consts::PI, Vec3::NEG_Z),
+            (std::f32::consts::FRAC_PI_2, Vec3::X),
+            (-std::f32::consts::FRAC_PI_2, Vec3::NEG_X),
+        ] {
+            let mut m = head.clone();
+            m.transform(&Mat4::from_rotation_y(angle));
+            let got = face_direction(&m);
+            assert!((got - expect).length() < 1e-4, "{angle}: {got}");
+        }
+    }
+
+    #[test]
+    fn head_without_neck_measures_its_full_height() {
+        let head = procedural::head_mesh();
+        let (chin, crown) = chin_and_crown(&head, Vec3::Z);
+        let b = head.bounds();
+        assert_eq!((chin, crown), (b.min.y, b.max.y));
+    }
+
+    #[test]
+    fn neck_and_shoulders_below_the_chin_are_excluded() {
+        let mut m = procedural::head_mesh();
+        let chin = m.bounds().min.y;
+        // A neck tube and broad shoulders below it, as scans have.
+        let base = m.vertices.len() as u32;
+        const RING: u32 = 16;
+        for k in 0..60 {
+            let y = chin + 1.0 - k as f32 * 0.25;
+            let (r, depth) = if k < 30 { (5.0, 0.6) } else { (18.0, 0.25) };
+            for a in 0..RING {
+                let t = a as f32 / RING as f32 * std::f32::consts::TAU;
+                m.vertices.push(Vertex {
+                    position: [r * t.cos(), y, depth * r * t.sin()],
+                    ..Default::default()
+                });
+            }
+        }
+        for k in 0..59 {
+            for a in 0..RING {
+                let at = |k: u32, a: u32| base + k * RING + a % RING;
+                m.indices.extend([at(k, a), at(k + 1, a), at(k + 1, a + 1)]);
+            }
+        }
+        let (got, crown) = chin_and_crown(&m, Vec3::Z);
+        assert!(
+            (got - chin).abs() < 0.15 * (crown - chin),
+            "chin {got} vs {chin}"
+        );
+        assert!(m.bounds().min.y < chin - 10.0);
+    }
+}

@@ -1,0 +1,427 @@
+//! CPU-side geometry and material data, laid out so the renderer can upload it as-is.
+
+use anyhow::{bail, Result};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+/// One vertex exactly as the vertex buffer holds it (48 bytes, no padding), so a
+/// `&[Vertex]` can be uploaded with `bytemuck::cast_slice` without repacking.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+    /// xyz: tangent along +u; w: handedness (+1 or -1) so the shader can rebuild the
+    /// bitangent as `cross(normal, tangent.xyz) * tangent.w` (mirrored UVs flip it).
+    pub tangent: [f32; 4],
+}
+
+/// An indexed triangle list. Front faces are counter-clockwise seen from outside, which is
+/// what back-face culling and the "inside/outside" tests of the skin passes rely on.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+/// Axis-aligned bounding box in the mesh's own units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    pub fn size(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// Smallest box holding every point; `None` for no points, because a box around
+    /// nothing has no honest value.
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Option<Aabb> {
+        let mut it = points.into_iter();
+        let first = it.next()?;
+        let mut b = Aabb {
+            min: first,
+            max: first,
+        };
+        for p in it {
+            b.min = b.min.min(p);
+            b.max = b.max.max(p);
+        }
+        Some(b)
+    }
+
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// Box around the 8 transformed corners: conservative, which is what culling and
+    /// shadow fitting need.
+    pub fn transformed(&self, m: &Mat4) -> Aabb {
+        let corners = (0..8).map(|i| {
+            let c = Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            );
+            m.transform_point3(c)
+        });
+        Aabb::from_points(corners).unwrap_or(*self)
+    }
+
+    /// Radius of the sphere around `center()` that holds the box.
+    pub fn bounding_radius(&self) -> f32 {
+        self.size().length() * 0.5
+    }
+
+    /// True when the boxes share interior volume (touching faces do not count).
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmplt(other.max).all() && other.min.cmplt(self.max).all()
+    }
+}
+
+/// Raw RGBA8 pixels, row 0 = top of the image as decoded, which is also where glTF puts
+/// v = 0, so UVs sample it without flipping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+/// Shading parameters of one object. `skin` selects the subsurface path; the rest of the
+/// numbers follow d'Eon & Luebke's skin model (Beckmann roughness, Kelemen/Szirmay-Kalos
+/// specular scale).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub skin: bool,
+    /// Linear RGB, multiplied with `base_color` when there is one.
+    pub base_color_factor: [f32; 3],
+    /// sRGB-encoded albedo: upload as an `_SRGB` format so sampling linearises it.
+    pub base_color: Option<Texture>,
+    /// Linear tangent-space normal map (upload as `_UNORM`).
+    pub normal_map: Option<Texture>,
+    /// Linear specular intensity in R (upload as `_UNORM`).
+    pub specular_map: Option<Texture>,
+    /// Beckmann m; skin ~0.3.
+    pub roughness: f32,
+    /// rho_s; skin ~0.18.
+    pub specular_intensity: f32,
+    /// 0..1, written to the alpha of the diffuse target so the blur passes know how much
+    /// of each pixel scatters.
+    pub sss_strength: f32,
+}
+
+impl Material {
+    /// The untextured skin defaults the project uses everywhere.
+    pub fn skin(base_color_factor: [f32; 3]) -> Material {
+        Material {
+            skin: true,
+            base_color_factor,
+            base_color: None,
+            normal_map: None,
+            specular_map: None,
+            roughness: 0.3,
+            specular_intensity: 0.18,
+            sss_strength: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub mesh: Mesh,
+    pub material: Material,
+}
+
+impl Mesh {
+    /// Bounds of the vertex positions; an empty mesh gets a zero box at the origin so
+    /// callers that only frame a camera never have to special-case it (`validate`
+    /// rejects empty meshes where it matters).
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.vertices.iter().map(|v| Vec3::from(v.position))).unwrap_or(Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+        })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Per-vertex tangents from UV derivatives (Lengyel's method): each triangle's
+    /// dP/du and dP/dv are accumulated per vertex (area weighted, because the unnormalised
+    /// derivatives already scale with triangle size), then Gram-Schmidt against the
+    /// normal. The handedness in w says whether dP/dv agrees with cross(n, t). Vertices
+    /// whose UVs are degenerate get an arbitrary vector orthogonal to the normal, which
+    /// is harmless because a normal map cannot vary across a zero-area UV patch.
+    pub fn generate_tangents(&mut self) {
+        let n = self.vertices.len();
+        let mut tan = vec![Vec3::ZERO; n];
+        let mut bit = vec![Vec3::ZERO; n];
+        for tri in self.indices.chunks_exact(3) {
+            let [a, b, c] = [tri[0] as usize, tri[1] as usize, tri[2] as usize];
+            if a >= n || b >= n || c >= n {
+                continue;
+            }
+            let (va, vb, vc) = (self.vertices[a], self.vertices[b], self.vertices[c]);
+            let e1 = Vec3::from(vb.position) - Vec3::from(va.position);
+            let e2 = Vec3::from(vc.position) - Vec3::from(va.position);
+            let d1 = Vec2::from(vb.uv) - Vec2::from(va.uv);
+            let d2 = Vec2::from(vc.uv) - Vec2::from(va.uv);
+            let det = d1.x * d2.y - d2.x * d1.y;
+            if !det.is_finite() || det.abs() < 1e-12 {
+                continue;
+            }
+            // Scaling by |det| rather than dividing keeps tiny UV islands from dominating.
+            let sign = det.signum();
+            let t = (e1 * d2.y - e2 * d1.y) * sign;
+            let bt = (e2 * d1.x - e1 * d2.x) * sign;
+            if !t.is_finite() || !bt.is_finite() {
+                continue;
+            }
+            for i in [a, b, c] {
+                tan[i] += t;
+                bit[i] += bt;
+            }
+        }
+        for (i, v) in self.vertices.iter_mut().enumerate() {
+            let nrm = Vec3::from(v.normal).normalize_or(Vec3::Y);
+            let t = tan[i] - nrm * nrm.dot(tan[i]);
+            let (t, w) = match t.try_normalize() {
+                Some(t) => {
+                    let w = if nrm.cross(t).dot(bit[i]) < 0.0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    (t, w)
+                }
+                None => (nrm.any_orthonormal_vector(), 1.0),
+            };
+            v.tangent = [t.x, t.y, t.z, w];
+        }
+    }
+
+    /// Smooth normals from area-weighted face normals. Vertices at the same position are
+    /// treated as one (UV seams duplicate vertices), so seams do not show as creases.
+    pub fn compute_normals(&mut self) {
+        use std::collections::HashMap;
+        let key = |p: [f32; 3]| [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+        let mut acc: HashMap<[u32; 3], Vec3> = HashMap::new();
+        for tri in self.indices.chunks_exact(3) {
+            let p: Vec<Vec3> = tri
+                .iter()
+                .filter_map(|&i| self.vertices.get(i as usize))
+                .map(|v| Vec3::from(v.position))
+                .collect();
+            if p.len() != 3 {
+                continue;
+            }
+            let fnrm = (p[1] - p[0]).cross(p[2] - p[0]);
+            for &i in tri {
+                *acc.entry(key(self.vertices[i as usize].position))
+                    .or_insert(Vec3::ZERO) += fnrm;
+            }
+        }
+        for v in &mut self.vertices {
+            let n = acc
+                .get(&key(v.position))
+                .and_then(|n| n.try_normalize())
+                .unwrap_or(Vec3::Y);
+            v.normal = n.into();
+        }
+    }
+
+    /// Applies a model transform: positions by `m`, normals by its inverse transpose,
+    /// tangents by its linear part. A mirroring transform (negative determinant) would
+    /// turn outside-CCW into outside-CW, so the winding is flipped back, as glTF requires.
+    pub fn transform(&mut self, m: &Mat4) {
+        let lin = Mat3::from_mat4(*m);
+        let normal_m = lin.inverse().transpose();
+        let mirrored = lin.determinant() < 0.0;
+        for v in &mut self.vertices {
+            v.position = m.transform_point3(Vec3::from(v.position)).into();
+            let n = (normal_m * Vec3::from(v.normal)).normalize_or(Vec3::Y);
+            v.normal = n.into();
+            let t = Vec4::from(v.tangent);
+            let tt = (lin * t.truncate()).normalize_or(n.any_orthonormal_vector());
+            let w = if mirrored { -t.w } else { t.w };
+            v.tangent = [tt.x, tt.y, tt.z, w];
+        }
+        if mirrored {
+            for tri in self.indices.chunks_exact_mut(3) {
+                tri.swap(1, 2);
+            }
+        }
+    }
+
+    /// Appends another mesh, rebasing its indices.
+    pub fn append(&mut self, other: &Mesh) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend_from_slice(&other.vertices);
+        self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+
+    /// Rejects meshes the GPU would choke on or silently misdraw: empty, not a whole number
+    /// of triangles, indices past the end, or non-finite positions/normals.
+    pub fn validate(&self) -> Result<()> {
+        if self.vertices.is_empty() || self.indices.is_empty() {
+            bail!(
+                "mesh is empty ({} vertices, {} indices)",
+                self.vertices.len(),
+                self.indices.len()
+            );
+        }
+        // `% 3` rather than `is_multiple_of`: the crate's rust-version is 1.85.
+        #[allow(clippy::manual_is_multiple_of)]
+        if self.indices.len() % 3 != 0 {
+            bail!(
+                "mesh index count {} is not a multiple of 3 (triangle list)",
+                self.indices.len()
+            );
+        }
+        let n = self.vertices.len();
+        if let Some((pos, &i)) = self
+            .indices
+            .iter()
+            .enumerate()
+            .find(|(_, &i)| i as usize >= n)
+        {
+            bail!("mesh index {i} at position {pos} is out of range ({n} vertices)");
+        }
+        if let Some(i) = self
+            .vertices
+            .iter()
+            .position(|v| !Vec3::from(v.position).is_finite())
+        {
+            bail!("mesh vertex {i} has a non-finite position");
+        }
+        if let Some(i) = self
+            .vertices
+            .iter()
+            .position(|v| !Vec3::from(v.normal).is_finite())
+        {
+            bail!("mesh vertex {i} has a non-finite normal");
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vtx(p: [f32; 3], uv: [f32; 2]) -> Vertex {
+        Vertex {
+            position: p,
+            normal: [0.0, 0.0, 1.0],
+            uv,
+            tangent: [0.0; 4],
+        }
+    }
+
+    fn quad() -> Mesh {
+        Mesh {
+            vertices: vec![
+                vtx([0.0, 0.0, 0.0], [0.0, 1.0]),
+                vtx([1.0, 0.0, 0.0], [1.0, 1.0]),
+                vtx([1.0, 1.0, 0.0], [1.0, 0.0]),
+                vtx([0.0, 1.0, 0.0], [0.0, 0.0]),
+            ],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        }
+    }
+
+    #[test]
+    fn vertex_is_48_bytes() {
+        assert_eq!(std::mem::size_of::<Vertex>(), 48);
+    }
+
+    #[test]
+    fn tangents_follow_u_and_handedness_follows_v() {
+        let mut m = quad();
+        m.generate_tangents();
+        for v in &m.vertices {
+            let t = Vec4::from(v.tangent);
+            assert!((t.truncate() - Vec3::X).length() < 1e-5, "{t:?}");
+            // v grows downward (glTF convention): dP/dv = -Y, cross(n, t) = +Y -> w = -1.
+            assert_eq!(t.w, -1.0);
+        }
+        let mut flipped = quad();
+        for v in &mut flipped.vertices {
+            v.uv[1] = 1.0 - v.uv[1];
+        }
+        flipped.generate_tangents();
+        assert!(flipped.vertices.iter().all(|v| v.tangent[3] == 1.0));
+    }
+
+    #[test]
+    fn degenerate_uvs_still_give_orthogonal_unit_tangents() {
+        let mut m = quad();
+        for v in &mut m.vertices {
+            v.uv = [0.5, 0.5];
+        }
+        m.generate_tangents();
+        for v in &m.vertices {
+            let t = Vec4::from(v.tangent).truncate();
+            assert!((t.length() - 1.0).abs() < 1e-5);
+            assert!(t.dot(Vec3::from(v.normal)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn validate_catches_each_defect() {
+        assert!(quad().validate().is_ok());
+        let mut m = quad();
+        m.indices.push(0);
+        assert!(format!("{:#}", m.validate().unwrap_err()).contains("multiple of 3"));
+        let mut m = quad();
+        m.indices[4] = 9;
+        assert!(format!("{:#}", m.validate().unwrap_err()).contains("out of range"));
+        let mut m = quad();
+        m.vertices[1].position[0] = f32::NAN;
+        assert!(format!("{:#}", m.validate().unwrap_err()).contains("non-finite position"));
+        assert!(format!("{:#}", Mesh::default().validate().unwrap_err()).contains("empty"));
+    }
+
+    #[test]
+    fn mirroring_transform_keeps_ccw_outside() {
+        let mut m = quad();
+        m.generate_tangents();
+        m.transform(&Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
+        let face_n = (p(m.indices[1]) - p(m.indices[0])).cross(p(m.indices[2]) - p(m.indices[0]));
+        assert!(face_n.dot(Vec3::from(m.vertices[0].normal)) > 0.0);
+        assert_eq!(m.vertices[0].tangent[3], 1.0);
+    }
+
+    #[test]
+    fn bounds_and_aabb_helpers() {
+        let b = quad().bounds();
+        assert_eq!(b.min, Vec3::ZERO);
+        assert_eq!(b.max, Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(b.center(), Vec3::new(0.5, 0.5, 0.0));
+        let moved = b.transformed(&Mat4::from_translation(Vec3::X * 2.0));
+        assert!(!b.overlaps(&moved));
+        assert_eq!(Mesh::default().bounds().size(), Vec3::ZERO);
+    }
+
+    #[test]
+    fn compute_normals_points_along_face_normal() {
+        let mut m = quad();
+        for v in &mut m.vertices {
+            v.normal = [1.0, 0.0, 0.0];
+        }
+        m.compute_normals();
+        assert!(m.vertices.iter().all(|v| v.normal == [0.0, 0.0, 1.0]));
+    }
+}

@@ -1,0 +1,196 @@
+//! What gets rendered: the head (procedural or loaded from glTF), the backdrop, the
+//! camera and light placement, and multi-head layouts. Everything here is CPU-side and
+//! independent of Vulkan so it can be tested without a GPU.
+
+pub mod camera;
+pub mod gltf_load;
+pub mod head_measure;
+pub mod instancing;
+pub mod light;
+pub mod mesh;
+pub mod procedural;
+
+use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use std::path::Path;
+
+/// A head and its surroundings, with the scale that ties scene units to millimetres
+/// (subsurface scattering profiles are specified in mm).
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub mm_per_unit: f32,
+    pub head: mesh::Object,
+    pub backdrop: Option<mesh::Object>,
+    /// Bounds of the whole head object, neck and shoulders included when a scan has them
+    /// (what shadows must cover); frame the camera with `head_center`/`head_height_units`.
+    pub head_bounds: mesh::Aabb,
+    /// Unit vector from the head centre toward the face: where the camera goes.
+    pub forward: Vec3,
+}
+
+impl Scene {
+    /// Chin-to-crown extent along +Y in scene units. Measured from the mesh on every
+    /// call (a few hundred microseconds): keep the result if you need it per frame.
+    pub fn head_height_units(&self) -> f32 {
+        let (chin, crown) = head_measure::chin_and_crown(&self.head.mesh, self.forward);
+        crown - chin
+    }
+
+    /// Centre of the head from the chin up (not of a scan's shoulders): the camera target.
+    pub fn head_center(&self) -> Vec3 {
+        head_measure::head_part_bounds(&self.head.mesh, self.forward).center()
+    }
+}
+
+/// The built-in scene: procedural head and backdrop, no files needed.
+pub fn default_scene() -> Scene {
+    let head = procedural::head_mesh();
+    let head_bounds = head.bounds();
+    Scene {
+        name: "procedural head".to_owned(),
+        mm_per_unit: procedural::MM_PER_UNIT,
+        head: mesh::Object {
+            mesh: head,
+            material: mesh::Material::skin([0.62, 0.40, 0.32]),
+        },
+        backdrop: Some(backdrop(procedural::backdrop_mesh())),
+        head_bounds,
+        forward: Vec3::Z,
+    }
+}
+
+/// Matte grey, no subsurface: it only catches shadows and frames the silhouette.
+fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
+    mesh::Object {
+        mesh,
+        material: mesh::Material {
+            skin: false,
+            base_color_factor: [0.35; 3],
+            base_color: None,
+            normal_map: None,
+            specular_map: None,
+            roughness: 0.6,
+            specular_intensity: 0.02,
+            sss_strength: 0.0,
+        },
+    }
+}
+
+/// Loads a head scan. `mm_per_unit` defaults to 230 mm over the measured chin-to-crown
+/// height, since a human head is ~230 mm tall and most scans carry no usable unit.
+pub fn load_gltf_scene(
+    path: &Path,
+    overrides: &gltf_load::TextureOverrides,
+    mm_per_unit: Option<f32>,
+) -> Result<Scene> {
+    if let Some(mm) = mm_per_unit {
+        if !mm.is_finite() || mm <= 0.0 {
+            bail!("mm_per_unit must be a finite number > 0, got {mm}");
+        }
+    }
+    let head = gltf_load::load_head(path, overrides)
+        .with_context(|| format!("loading scene {}", path.display()))?;
+    let forward = gltf_load::face_direction(&head.mesh);
+    let head_part = head_measure::head_part_bounds(&head.mesh, forward);
+    let height = head_part.size().y;
+    let mm_per_unit = match mm_per_unit {
+        Some(mm) => mm,
+        None if height.is_finite() && height > 0.0 => head_measure::HEAD_HEIGHT_MM / height,
+        None => bail!(
+            "cannot derive mm_per_unit: the head in {} has no height",
+            path.display()
+        ),
+    };
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string());
+    Ok(Scene {
+        name,
+        mm_per_unit,
+        head_bounds: head.mesh.bounds(),
+        backdrop: Some(backdrop(procedural::backdrop_behind(
+            head_part.center(),
+            forward,
+            height,
+        ))),
+        head,
+        forward,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::gltf_load::tests::{lps_path, temp_dir, tiny_gltf};
+    use super::*;
+
+    #[test]
+    fn default_scene_is_consistent() {
+        let s = default_scene();
+        s.head.mesh.validate().unwrap();
+        assert!((s.head_height_units() * s.mm_per_unit - 230.0).abs() < 5.0);
+        assert_eq!(s.forward, Vec3::Z);
+        assert_eq!(gltf_load::face_direction(&s.head.mesh), s.forward);
+        let m = &s.head.material;
+        assert!(m.skin && m.roughness == 0.3 && m.specular_intensity == 0.18);
+        let bd = s.backdrop.as_ref().unwrap();
+        assert!(!bd.material.skin);
+        assert!(bd.mesh.bounds().max.z < s.head_bounds.min.z);
+    }
+
+    #[test]
+    fn bad_mm_per_unit_is_rejected() {
+        let dir = temp_dir("mm");
+        let p = tiny_gltf(&dir, true, true, [0.0; 3]);
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let e = load_gltf_scene(&p, &Default::default(), Some(bad)).unwrap_err();
+            assert!(format!("{e:#}").contains("mm_per_unit must be"), "{e:#}");
+        }
+        let s = load_gltf_scene(&p, &Default::default(), Some(2.5)).unwrap();
+        assert_eq!(s.mm_per_unit, 2.5);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn lee_perry_smith_loads() {
+        let Some(path) = lps_path() else {
+            eprintln!("skipping: LeePerrySmith.glb not found");
+            return;
+        };
+        let s = load_gltf_scene(&path, &Default::default(), None).unwrap();
+        let m = &s.head.mesh;
+        assert_eq!(m.triangle_count(), 17_684);
+        assert!(
+            (9_000..=9_600).contains(&m.vertices.len()),
+            "{}",
+            m.vertices.len()
+        );
+        for v in &m.vertices {
+            let t = glam::Vec4::from(v.tangent);
+            assert!(t.is_finite() && (t.truncate().length() - 1.0).abs() < 1e-3);
+            assert!(t.truncate().dot(Vec3::from(v.normal)).abs() < 1e-3);
+        }
+        let mat = &s.head.material;
+        for t in [&mat.base_color, &mat.normal_map, &mat.specular_map] {
+            let t = t.as_ref().expect("texture found beside the .glb");
+            assert_eq!((t.width, t.height), (1024, 1024));
+            assert_eq!(t.rgba8.len(), 1024 * 1024 * 4);
+        }
+        assert_eq!(mat.base_color_factor, [1.0; 3]);
+        // Y up, face toward +Z, ~46 mm per unit (the scan includes neck and shoulders,
+        // so the Y extent of 7.9 units is not the head height).
+        assert_eq!(s.forward, Vec3::Z);
+        let h = s.head_height_units();
+        assert!((4.3..=5.6).contains(&h), "head height {h}");
+        assert!((40.0..=55.0).contains(&s.mm_per_unit), "{}", s.mm_per_unit);
+        let c = s.head_center();
+        assert!(c.y > 1.0 && c.y < 2.2, "{c}");
+        let bd = s.backdrop.unwrap().mesh.bounds();
+        assert!(bd.max.z < s.head_bounds.min.z, "{bd:?}");
+        eprintln!(
+            "LPS: head {h:.3} units, {:.2} mm/unit, centre {c}, bounds {:?}",
+            s.mm_per_unit, s.head_bounds
+        );
+    }
+}

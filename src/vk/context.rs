@@ -1,0 +1,501 @@
+//! Instance, physical-device choice, logical device, queue, allocator and the
+//! validation messenger. Headless: no surface, no swapchain.
+
+use std::ffi::{c_void, CStr, CString};
+use std::sync::{Arc, Mutex};
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use ash::{ext, vk};
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+/// How to choose the physical device.
+#[derive(Clone, Debug, Default)]
+pub enum DeviceChoice {
+    /// First discrete GPU, else the first device.
+    #[default]
+    Auto,
+    /// Index in enumeration order.
+    Index(usize),
+    /// Case-insensitive substring of the device name.
+    Name(String),
+}
+
+impl std::str::FromStr for DeviceChoice {
+    type Err = std::convert::Infallible;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ok(match s.parse::<usize>() {
+            Ok(i) => DeviceChoice::Index(i),
+            Err(_) => DeviceChoice::Name(s.to_string()),
+        })
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct ContextDesc {
+    pub device: DeviceChoice,
+    /// Enables VK_LAYER_KHRONOS_validation with synchronization validation.
+    pub validate: bool,
+}
+
+/// Facts about the chosen device that the renderer and the report need.
+#[derive(Clone, Debug)]
+pub struct DeviceFacts {
+    pub name: String,
+    pub driver: String,
+    pub api_version: String,
+    pub device_type: String,
+    pub timestamp_period_ns: f64,
+    pub timestamp_valid_bits: u32,
+    pub pipeline_statistics: bool,
+    pub occlusion_query_precise: bool,
+    pub max_image_dimension_2d: u32,
+    pub sub_texel_precision_bits: u32,
+}
+
+/// Validation messages collected by the debug messenger. Any message is an error:
+/// callers drain it with [`Context::check_validation`].
+pub type MessageLog = Arc<Mutex<Vec<String>>>;
+
+pub struct Context {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub facts: DeviceFacts,
+    pub debug_utils: ext::debug_utils::Device,
+    debug_instance: Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    messages: MessageLog,
+    // Boxed so the pointer handed to the messenger stays valid.
+    _messages_box: Box<MessageLog>,
+    pub allocator: Option<Mutex<Allocator>>,
+    pub command_pool: vk::CommandPool,
+    pub validation: bool,
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    if data.is_null() || user.is_null() {
+        return vk::FALSE;
+    }
+    let data = &*data;
+    let msg = if data.p_message.is_null() {
+        String::from("(no message)")
+    } else {
+        CStr::from_ptr(data.p_message)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let log = &*(user as *const MessageLog);
+    if let Ok(mut v) = log.lock() {
+        v.push(format!("[{severity:?} {kind:?}] {msg}"));
+    }
+    vk::FALSE
+}
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+impl Context {
+    pub fn new(desc: &ContextDesc) -> Result<Self> {
+        // SAFETY: loading the system Vulkan loader; failure is reported as an error.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| {
+            anyhow!("no Vulkan loader found ({e}); install libvulkan1 and a driver (mesa-vulkan-drivers for lavapipe)")
+        })?;
+
+        let app_name = c"dermis";
+        let app_info = vk::ApplicationInfo::default()
+            .application_name(app_name)
+            .application_version(1)
+            .engine_name(app_name)
+            .api_version(vk::API_VERSION_1_3);
+
+        let mut layers: Vec<*const i8> = Vec::new();
+        let mut extensions: Vec<*const i8> = Vec::new();
+        if desc.validate {
+            let available = unsafe { entry.enumerate_instance_layer_properties() }?;
+            let have = available
+                .iter()
+                .any(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER));
+            if !have {
+                bail!("validation requested but VK_LAYER_KHRONOS_validation is not installed (Debian package vulkan-validationlayers)");
+            }
+            layers.push(VALIDATION_LAYER.as_ptr());
+        }
+        extensions.push(ext::debug_utils::NAME.as_ptr());
+
+        // Synchronization validation is off by default in the layer: turn it on.
+        let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+        if desc.validate {
+            extensions.push(ext::validation_features::NAME.as_ptr());
+        }
+
+        let messages: MessageLog = Arc::new(Mutex::new(Vec::new()));
+        let messages_box = Box::new(messages.clone());
+        let user_ptr = &*messages_box as *const MessageLog as *mut c_void;
+        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(user_ptr);
+
+        let mut create_info = vk::InstanceCreateInfo::default()
+            .application_info(&app_info)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        if desc.validate {
+            create_info = create_info
+                .push_next(&mut validation_features)
+                .push_next(&mut messenger_info);
+        }
+        let instance = unsafe { entry.create_instance(&create_info, None) }
+            .context("creating the Vulkan instance")?;
+
+        let debug_instance = if desc.validate {
+            // A fresh create-info: the one above is chained into the instance's pNext.
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(messenger_info.message_severity)
+                .message_type(messenger_info.message_type)
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(user_ptr);
+            let loader = ext::debug_utils::Instance::new(&entry, &instance);
+            let m = unsafe { loader.create_debug_utils_messenger(&info, None) }?;
+            Some((loader, m))
+        } else {
+            None
+        };
+
+        let result = Self::with_instance(
+            entry,
+            instance,
+            desc,
+            debug_instance,
+            messages,
+            messages_box,
+        );
+        result
+    }
+
+    fn with_instance(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        desc: &ContextDesc,
+        debug_instance: Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+        messages: MessageLog,
+        messages_box: Box<MessageLog>,
+    ) -> Result<Self> {
+        let destroy_instance =
+            |instance: &ash::Instance,
+             dbg: &Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>| unsafe {
+                if let Some((l, m)) = dbg {
+                    l.destroy_debug_utils_messenger(*m, None);
+                }
+                instance.destroy_instance(None);
+            };
+        let physical = match pick_physical(&instance, &desc.device) {
+            Ok(p) => p,
+            Err(e) => {
+                destroy_instance(&instance, &debug_instance);
+                return Err(e);
+            }
+        };
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let name = props
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if props.api_version < vk::API_VERSION_1_3 {
+            destroy_instance(&instance, &debug_instance);
+            bail!(
+                "device '{name}' supports Vulkan {}.{} but dermis needs 1.3 (synchronization2 and dynamic rendering)",
+                vk::api_version_major(props.api_version),
+                vk::api_version_minor(props.api_version)
+            );
+        }
+        let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver_props);
+        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+        let driver = format!(
+            "{} {}",
+            driver_props
+                .driver_name_as_c_str()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            driver_props
+                .driver_info_as_c_str()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        );
+
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let Some((queue_family, family)) = families.iter().enumerate().find(|(_, f)| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        }) else {
+            destroy_instance(&instance, &debug_instance);
+            bail!("device '{name}' has no graphics+compute queue");
+        };
+        let queue_family = queue_family as u32;
+        let features = unsafe { instance.get_physical_device_features(physical) };
+
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+            .synchronization2(true)
+            .dynamic_rendering(true);
+        let base_features = vk::PhysicalDeviceFeatures::default()
+            .pipeline_statistics_query(features.pipeline_statistics_query == vk::TRUE)
+            .occlusion_query_precise(features.occlusion_query_precise == vk::TRUE)
+            .sampler_anisotropy(false);
+        let mut features2 = vk::PhysicalDeviceFeatures2::default().features(base_features);
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .push_next(&mut features2)
+            .push_next(&mut f13);
+        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                destroy_instance(&instance, &debug_instance);
+                bail!("creating the logical device on '{name}': {e}");
+            }
+        };
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let debug_utils = ext::debug_utils::Device::new(&instance, &device);
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .context("creating the GPU memory allocator")?;
+
+        let command_pool = unsafe {
+            device.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(queue_family)
+                    .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                None,
+            )
+        }?;
+
+        let device_type = format!("{:?}", props.device_type);
+        let facts = DeviceFacts {
+            name,
+            driver: driver.trim().to_string(),
+            api_version: format!(
+                "{}.{}.{}",
+                vk::api_version_major(props.api_version),
+                vk::api_version_minor(props.api_version),
+                vk::api_version_patch(props.api_version)
+            ),
+            device_type,
+            timestamp_period_ns: props.limits.timestamp_period as f64,
+            timestamp_valid_bits: family.timestamp_valid_bits,
+            pipeline_statistics: features.pipeline_statistics_query == vk::TRUE,
+            occlusion_query_precise: features.occlusion_query_precise == vk::TRUE,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            sub_texel_precision_bits: props.limits.sub_texel_precision_bits,
+        };
+
+        let ctx = Context {
+            entry,
+            instance,
+            physical,
+            device,
+            queue,
+            queue_family,
+            facts,
+            debug_utils,
+            debug_instance,
+            messages,
+            _messages_box: messages_box,
+            allocator: Some(Mutex::new(allocator)),
+            command_pool,
+            validation: desc.validate,
+        };
+        ctx.name(ctx.queue, "main queue");
+        ctx.name(ctx.command_pool, "main command pool");
+        Ok(ctx)
+    }
+
+    /// Names a Vulkan object for validation messages and captures.
+    pub fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Ok(cname) = CString::new(name) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&cname);
+        // Naming is best effort: a failure only loses a label.
+        let _ = unsafe { self.debug_utils.set_debug_utils_object_name(&info) };
+    }
+
+    pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        self.allocator
+            .as_ref()
+            .expect("allocator used after teardown")
+            .lock()
+            .expect("allocator mutex poisoned")
+    }
+
+    /// Returns every validation message received since the last call as an error.
+    pub fn check_validation(&self, when: &str) -> Result<()> {
+        let mut v = self.messages.lock().expect("validation log poisoned");
+        if v.is_empty() {
+            return Ok(());
+        }
+        let all = std::mem::take(&mut *v);
+        bail!(
+            "{} validation message(s) {when}:\n{}",
+            all.len(),
+            all.join("\n")
+        )
+    }
+
+    /// Image format support for the given usage features.
+    pub fn format_supports(&self, format: vk::Format, features: vk::FormatFeatureFlags) -> bool {
+        let p = unsafe {
+            self.instance
+                .get_physical_device_format_properties(self.physical, format)
+        };
+        p.optimal_tiling_features.contains(features)
+    }
+
+    /// Records and submits one command buffer and waits for it.
+    pub fn one_shot(&self, label: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let cmd = unsafe {
+            self.device.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(self.command_pool)
+                    .command_buffer_count(1),
+            )
+        }?[0];
+        self.name(cmd, label);
+        unsafe {
+            self.device.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+        }
+        record(cmd);
+        let result = self.submit_and_wait(cmd);
+        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+        result.with_context(|| format!("submitting '{label}'"))
+    }
+
+    /// Ends, submits and waits for a recorded command buffer.
+    pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
+        unsafe {
+            self.device.end_command_buffer(cmd)?;
+            let fence = self
+                .device
+                .create_fence(&vk::FenceCreateInfo::default(), None)?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            let r = self
+                .device
+                .queue_submit2(self.queue, &submit, fence)
+                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX));
+            self.device.destroy_fence(fence, None);
+            r.context("queue submit / wait (device lost?)")?;
+        }
+        Ok(())
+    }
+
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        let Ok(cname) = CString::new(name) else {
+            return;
+        };
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&cname);
+        unsafe { self.debug_utils.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        unsafe { self.debug_utils.cmd_end_debug_utils_label(cmd) };
+    }
+}
+
+fn pick_physical(instance: &ash::Instance, choice: &DeviceChoice) -> Result<vk::PhysicalDevice> {
+    let devices =
+        unsafe { instance.enumerate_physical_devices() }.context("enumerating Vulkan devices")?;
+    if devices.is_empty() {
+        bail!("no Vulkan device found; install a driver (mesa-vulkan-drivers gives lavapipe)");
+    }
+    let names: Vec<(vk::PhysicalDevice, String, vk::PhysicalDeviceType)> = devices
+        .iter()
+        .map(|&d| {
+            let p = unsafe { instance.get_physical_device_properties(d) };
+            let n = p
+                .device_name_as_c_str()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (d, n, p.device_type)
+        })
+        .collect();
+    let list = || {
+        names
+            .iter()
+            .enumerate()
+            .map(|(i, (_, n, _))| format!("{i}: {n}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match choice {
+        DeviceChoice::Auto => Ok(names
+            .iter()
+            .find(|(_, _, t)| *t == vk::PhysicalDeviceType::DISCRETE_GPU)
+            .unwrap_or(&names[0])
+            .0),
+        DeviceChoice::Index(i) => names
+            .get(*i)
+            .map(|d| d.0)
+            .ok_or_else(|| anyhow!("no Vulkan device with index {i} (devices: {})", list())),
+        DeviceChoice::Name(s) => {
+            let s = s.to_lowercase();
+            names
+                .iter()
+                .find(|(_, n, _)| n.to_lowercase().contains(&s))
+                .map(|d| d.0)
+                .ok_or_else(|| {
+                    anyhow!(
+                        "no Vulkan device whose name contains '{s}' (devices: {})",
+                        list()
+                    )
+                })
+        }
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            // The allocator must go before the device.
+            self.allocator.take();
+            self.device.destroy_device(None);
+            if let Some((l, m)) = self.debug_instance.take() {
+                l.destroy_debug_utils_messenger(m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}

@@ -1,0 +1,256 @@
+//! Images and buffers, all memory through gpu-allocator. Objects are freed
+//! explicitly with `destroy` once the GPU is done with them (after a fence or
+//! wait-idle): a Drop impl could not know that.
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::context::Context;
+
+pub struct Image {
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub aspect: vk::ImageAspectFlags,
+    /// A depth-only view of a depth/stencil image, for sampling.
+    pub depth_view: Option<vk::ImageView>,
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+pub fn is_depth_format(f: vk::Format) -> bool {
+    matches!(
+        f,
+        vk::Format::D32_SFLOAT
+            | vk::Format::D16_UNORM
+            | vk::Format::D24_UNORM_S8_UINT
+            | vk::Format::D32_SFLOAT_S8_UINT
+            | vk::Format::D16_UNORM_S8_UINT
+    )
+}
+
+pub fn has_stencil(f: vk::Format) -> bool {
+    matches!(
+        f,
+        vk::Format::D24_UNORM_S8_UINT
+            | vk::Format::D32_SFLOAT_S8_UINT
+            | vk::Format::D16_UNORM_S8_UINT
+    )
+}
+
+/// Bytes per texel of the colour formats dermis reads back or uploads.
+pub fn bytes_per_texel(f: vk::Format) -> usize {
+    match f {
+        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT => 4,
+        vk::Format::R16_SFLOAT => 2,
+        vk::Format::R16G16B16A16_SFLOAT => 8,
+        vk::Format::R32G32B32A32_SFLOAT => 16,
+        vk::Format::D32_SFLOAT => 4,
+        _ => 0,
+    }
+}
+
+impl Image {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self> {
+        let aspect = if is_depth_format(format) {
+            if has_stencil(format) {
+                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+            } else {
+                vk::ImageAspectFlags::DEPTH
+            }
+        } else {
+            vk::ImageAspectFlags::COLOR
+        };
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(usage)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let raw = unsafe { ctx.device.create_image(&info, None) }.with_context(|| {
+            format!(
+                "creating image '{name}' {}x{} {format:?}",
+                extent.width, extent.height
+            )
+        })?;
+        let req = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        let allocation = ctx
+            .allocator()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements: req,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::DedicatedImage(raw),
+            })
+            .with_context(|| format!("allocating memory for image '{name}'"))?;
+        unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }?;
+        let make_view = |aspect: vk::ImageAspectFlags| unsafe {
+            ctx.device.create_image_view(
+                &vk::ImageViewCreateInfo::default()
+                    .image(raw)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(format)
+                    .subresource_range(
+                        vk::ImageSubresourceRange::default()
+                            .aspect_mask(aspect)
+                            .level_count(1)
+                            .layer_count(1),
+                    ),
+                None,
+            )
+        };
+        let view = make_view(aspect)?;
+        let depth_view = if has_stencil(format) && usage.contains(vk::ImageUsageFlags::SAMPLED) {
+            Some(make_view(vk::ImageAspectFlags::DEPTH)?)
+        } else {
+            None
+        };
+        ctx.name(raw, name);
+        ctx.name(view, &format!("{name} view"));
+        Ok(Image {
+            raw,
+            view,
+            format,
+            extent,
+            aspect,
+            depth_view,
+            name: name.to_string(),
+            allocation: Some(allocation),
+        })
+    }
+
+    /// The view to sample: the depth aspect for depth/stencil images.
+    pub fn sampled_view(&self) -> vk::ImageView {
+        self.depth_view.unwrap_or(self.view)
+    }
+
+    pub fn subresource_range(&self) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange::default()
+            .aspect_mask(self.aspect)
+            .level_count(1)
+            .layer_count(1)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            if let Some(v) = self.depth_view.take() {
+                ctx.device.destroy_image_view(v, None);
+            }
+            ctx.device.destroy_image_view(self.view, None);
+            ctx.device.destroy_image(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            let _ = ctx.allocator().free(a);
+        }
+    }
+}
+
+pub struct Buffer {
+    pub raw: vk::Buffer,
+    pub size: u64,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self> {
+        let raw = unsafe {
+            ctx.device.create_buffer(
+                &vk::BufferCreateInfo::default()
+                    .size(size.max(4))
+                    .usage(usage)
+                    .sharing_mode(vk::SharingMode::EXCLUSIVE),
+                None,
+            )
+        }
+        .with_context(|| format!("creating buffer '{name}' ({size} bytes)"))?;
+        let req = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx
+            .allocator()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements: req,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .with_context(|| format!("allocating memory for buffer '{name}'"))?;
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }?;
+        ctx.name(raw, name);
+        Ok(Buffer {
+            raw,
+            size,
+            allocation: Some(allocation),
+        })
+    }
+
+    /// A host-visible buffer filled with `data`.
+    pub fn with_data(
+        ctx: &Context,
+        name: &str,
+        data: &[u8],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self> {
+        let mut b = Buffer::new(
+            ctx,
+            name,
+            data.len() as u64,
+            usage,
+            MemoryLocation::CpuToGpu,
+        )?;
+        b.write(data)?;
+        Ok(b)
+    }
+
+    pub fn write(&mut self, data: &[u8]) -> Result<()> {
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .context("buffer is not host visible")?;
+        slice[..data.len()].copy_from_slice(data);
+        Ok(())
+    }
+
+    pub fn read(&self) -> Result<&[u8]> {
+        let a = self.allocation.as_ref().context("buffer freed")?;
+        let s = a.mapped_slice().context("buffer is not host visible")?;
+        Ok(&s[..self.size as usize])
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe { ctx.device.destroy_buffer(self.raw, None) };
+        if let Some(a) = self.allocation.take() {
+            let _ = ctx.allocator().free(a);
+        }
+    }
+}

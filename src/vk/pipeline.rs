@@ -1,0 +1,489 @@
+//! Pipelines described by plain values, with layouts from reflection, and
+//! descriptor sets written by binding *name*.
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use ash::vk;
+
+use super::context::Context;
+use super::shader::{create_module, reflect, Reflection};
+
+/// Vertex layout of `scene::mesh::Vertex` (position, normal, uv, tangent; 48 bytes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum VertexInput {
+    None,
+    Mesh,
+    /// Position only (shadow pass), from the same vertex buffer.
+    MeshPositionOnly,
+}
+
+/// Blend of colour attachment 0..n (the same for all attachments).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Blend {
+    None,
+}
+
+#[derive(Clone, Debug)]
+pub struct GraphicsDesc {
+    pub name: String,
+    pub vert: &'static str,
+    pub frag: Option<&'static str>,
+    pub color_formats: Vec<vk::Format>,
+    pub depth_format: Option<vk::Format>,
+    pub stencil_format: Option<vk::Format>,
+    pub vertex_input: VertexInput,
+    pub cull: vk::CullModeFlags,
+    pub depth_test: bool,
+    pub depth_write: bool,
+    pub depth_compare: vk::CompareOp,
+    /// Stencil op state for both faces; the reference is dynamic.
+    pub stencil: Option<vk::StencilOpState>,
+    pub depth_bias: Option<(f32, f32)>,
+    pub blend: Blend,
+}
+
+impl GraphicsDesc {
+    pub fn fullscreen(name: &str, frag: &'static str, color: vk::Format) -> Self {
+        GraphicsDesc {
+            name: name.into(),
+            vert: "fullscreen.vert",
+            frag: Some(frag),
+            color_formats: vec![color],
+            depth_format: None,
+            stencil_format: None,
+            vertex_input: VertexInput::None,
+            cull: vk::CullModeFlags::NONE,
+            depth_test: false,
+            depth_write: false,
+            depth_compare: vk::CompareOp::ALWAYS,
+            stencil: None,
+            depth_bias: None,
+            blend: Blend::None,
+        }
+    }
+}
+
+pub struct Pipeline {
+    pub raw: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+    pub set_layouts: Vec<vk::DescriptorSetLayout>,
+    pub reflection: Reflection,
+    pub bind_point: vk::PipelineBindPoint,
+    pub name: String,
+}
+
+fn make_layout(
+    ctx: &Context,
+    name: &str,
+    r: &Reflection,
+) -> Result<(vk::PipelineLayout, Vec<vk::DescriptorSetLayout>)> {
+    let set_layouts = r.create_set_layouts(ctx, name)?;
+    let ranges: Vec<vk::PushConstantRange> = r
+        .push_constants
+        .iter()
+        .map(|&(offset, size, stages)| vk::PushConstantRange {
+            stage_flags: stages,
+            offset,
+            size,
+        })
+        .collect();
+    let layout = unsafe {
+        ctx.device.create_pipeline_layout(
+            &vk::PipelineLayoutCreateInfo::default()
+                .set_layouts(&set_layouts)
+                .push_constant_ranges(&ranges),
+            None,
+        )
+    }?;
+    ctx.name(layout, &format!("{name} layout"));
+    Ok((layout, set_layouts))
+}
+
+impl Pipeline {
+    pub fn graphics(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
+        let mut stages_names = vec![d.vert];
+        if let Some(f) = d.frag {
+            stages_names.push(f);
+        }
+        let reflection =
+            reflect(&stages_names).with_context(|| format!("pipeline '{}'", d.name))?;
+        let (layout, set_layouts) = make_layout(ctx, &d.name, &reflection)?;
+        let vs = create_module(ctx, d.vert)?;
+        let fs = d.frag.map(|f| create_module(ctx, f)).transpose()?;
+        let entry = c"main";
+        let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(vs)
+            .name(entry)];
+        if let Some(fs) = fs {
+            stages.push(
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(vk::ShaderStageFlags::FRAGMENT)
+                    .module(fs)
+                    .name(entry),
+            );
+        }
+        let stride = 48u32;
+        let vb = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let attrs_full = [
+            (0, vk::Format::R32G32B32_SFLOAT, 0),
+            (1, vk::Format::R32G32B32_SFLOAT, 12),
+            (2, vk::Format::R32G32_SFLOAT, 24),
+            (3, vk::Format::R32G32B32A32_SFLOAT, 32),
+        ]
+        .map(
+            |(location, format, offset)| vk::VertexInputAttributeDescription {
+                location,
+                binding: 0,
+                format,
+                offset,
+            },
+        );
+        let vi = match d.vertex_input {
+            VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
+            VertexInput::Mesh => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vb)
+                .vertex_attribute_descriptions(&attrs_full),
+            VertexInput::MeshPositionOnly => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vb)
+                .vertex_attribute_descriptions(&attrs_full[..1]),
+        };
+        let ia = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let vp = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let mut rs = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(d.cull)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        if let Some((constant, slope)) = d.depth_bias {
+            rs = rs
+                .depth_bias_enable(true)
+                .depth_bias_constant_factor(constant)
+                .depth_bias_slope_factor(slope);
+        }
+        let ms = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let mut ds = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(d.depth_test)
+            .depth_write_enable(d.depth_write)
+            .depth_compare_op(d.depth_compare);
+        if let Some(s) = d.stencil {
+            ds = ds.stencil_test_enable(true).front(s).back(s);
+        }
+        let attachments: Vec<vk::PipelineColorBlendAttachmentState> = d
+            .color_formats
+            .iter()
+            .map(|_| match d.blend {
+                Blend::None => vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA),
+            })
+            .collect();
+        let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+        let mut dynamic = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        if d.stencil.is_some() {
+            dynamic.push(vk::DynamicState::STENCIL_REFERENCE);
+        }
+        let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(&d.color_formats)
+            .depth_attachment_format(d.depth_format.unwrap_or(vk::Format::UNDEFINED))
+            .stencil_attachment_format(d.stencil_format.unwrap_or(vk::Format::UNDEFINED));
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vi)
+            .input_assembly_state(&ia)
+            .viewport_state(&vp)
+            .rasterization_state(&rs)
+            .multisample_state(&ms)
+            .depth_stencil_state(&ds)
+            .color_blend_state(&cb)
+            .dynamic_state(&dyn_state)
+            .layout(layout)
+            .push_next(&mut rendering);
+        let result = unsafe {
+            ctx.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        unsafe {
+            ctx.device.destroy_shader_module(vs, None);
+            if let Some(fs) = fs {
+                ctx.device.destroy_shader_module(fs, None);
+            }
+        }
+        let raw = result.map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))?[0];
+        ctx.name(raw, &d.name);
+        Ok(Pipeline {
+            raw,
+            layout,
+            set_layouts,
+            reflection,
+            bind_point: vk::PipelineBindPoint::GRAPHICS,
+            name: d.name.clone(),
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.raw, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            for l in self.set_layouts.drain(..) {
+                ctx.device.destroy_descriptor_set_layout(l, None);
+            }
+        }
+    }
+
+    /// Pushes constants to every stage of the reflected range.
+    pub fn push<T: bytemuck::Pod>(&self, ctx: &Context, cmd: vk::CommandBuffer, value: &T) {
+        let (offset, size, stages) = self
+            .reflection
+            .push_constants
+            .unwrap_or_else(|| panic!("pipeline '{}' declares no push constants", self.name));
+        let bytes = bytemuck::bytes_of(value);
+        // Reflection reports the block's size rounded up to 16 bytes; only that
+        // tail padding may be missing from the Rust struct.
+        assert!(
+            bytes.len() as u32 + 15 >= size,
+            "pipeline '{}': push constant struct is {} bytes, shaders use {size}",
+            self.name,
+            bytes.len()
+        );
+        let len = (bytes.len() as u32).min(size);
+        unsafe {
+            ctx.device.cmd_push_constants(
+                cmd,
+                self.layout,
+                stages,
+                offset,
+                &bytes[offset as usize..len as usize],
+            )
+        };
+    }
+}
+
+/// A resource to bind, by the shader's variable name.
+pub enum Bind {
+    Image {
+        view: vk::ImageView,
+        sampler: vk::Sampler,
+    },
+    Uniform {
+        buffer: vk::Buffer,
+        size: u64,
+    },
+}
+
+/// A descriptor pool sized for the whole renderer (everything is allocated once).
+pub struct DescriptorPool {
+    pub raw: vk::DescriptorPool,
+}
+
+impl DescriptorPool {
+    pub fn new(ctx: &Context, max_sets: u32) -> Result<Self> {
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                descriptor_count: max_sets * 8,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: max_sets * 2,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: max_sets * 2,
+            },
+        ];
+        let raw = unsafe {
+            ctx.device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(max_sets)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }?;
+        ctx.name(raw, "descriptor pool");
+        Ok(DescriptorPool { raw })
+    }
+
+    /// Allocates set `set` of `pipeline` and writes every binding from `binds`.
+    /// Each binding the shader declares must be given, and each name given must exist.
+    pub fn write_set(
+        &self,
+        ctx: &Context,
+        pipeline: &Pipeline,
+        set: u32,
+        binds: &[(&str, Bind)],
+    ) -> Result<vk::DescriptorSet> {
+        let layout = *pipeline
+            .set_layouts
+            .get(set as usize)
+            .ok_or_else(|| anyhow!("pipeline '{}' has no descriptor set {set}", pipeline.name))?;
+        let ds = unsafe {
+            ctx.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(self.raw)
+                    .set_layouts(&[layout]),
+            )
+        }
+        .with_context(|| format!("allocating set {set} of '{}'", pipeline.name))?[0];
+        ctx.name(ds, &format!("{} set {set}", pipeline.name));
+        let declared: Vec<_> = pipeline
+            .reflection
+            .bindings
+            .iter()
+            .filter(|b| b.set == set)
+            .collect();
+        for b in &declared {
+            if !binds.iter().any(|(n, _)| *n == b.name) {
+                bail!(
+                    "pipeline '{}': binding '{}' (set {set}) was not given a resource",
+                    pipeline.name,
+                    b.name
+                );
+            }
+        }
+        let mut image_infos = Vec::new();
+        let mut buffer_infos = Vec::new();
+        let mut targets = Vec::new();
+        for (name, bind) in binds {
+            let info = pipeline.reflection.find(set, name).ok_or_else(|| {
+                anyhow!(
+                    "pipeline '{}' has no binding named '{name}' in set {set}",
+                    pipeline.name
+                )
+            })?;
+            match bind {
+                Bind::Image { view, sampler } => {
+                    image_infos.push((
+                        info.binding,
+                        info.descriptor_type,
+                        vk::DescriptorImageInfo {
+                            sampler: *sampler,
+                            image_view: *view,
+                            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                        },
+                    ));
+                }
+                Bind::Uniform { buffer, size } => {
+                    buffer_infos.push((
+                        info.binding,
+                        info.descriptor_type,
+                        vk::DescriptorBufferInfo {
+                            buffer: *buffer,
+                            offset: 0,
+                            range: *size,
+                        },
+                    ));
+                }
+            }
+            targets.push(info.binding);
+        }
+        let mut writes = Vec::new();
+        for (binding, ty, info) in &image_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(ds)
+                    .dst_binding(*binding)
+                    .descriptor_type(*ty)
+                    .image_info(std::slice::from_ref(info)),
+            );
+        }
+        for (binding, ty, info) in &buffer_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(ds)
+                    .dst_binding(*binding)
+                    .descriptor_type(*ty)
+                    .buffer_info(std::slice::from_ref(info)),
+            );
+        }
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(ds)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe { ctx.device.destroy_descriptor_pool(self.raw, None) };
+    }
+}
+
+/// Samplers used across the renderer.
+pub struct Samplers {
+    pub linear_clamp: vk::Sampler,
+    pub nearest_clamp: vk::Sampler,
+    pub linear_repeat: vk::Sampler,
+    /// Depth comparison (LESS_OR_EQUAL) with linear filtering: 2x2 PCF in hardware.
+    pub shadow_compare: vk::Sampler,
+}
+
+impl Samplers {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let make = |name: &str,
+                    filter: vk::Filter,
+                    mode: vk::SamplerAddressMode,
+                    compare: bool|
+         -> Result<vk::Sampler> {
+            let mut info = vk::SamplerCreateInfo::default()
+                .mag_filter(filter)
+                .min_filter(filter)
+                .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+                .address_mode_u(mode)
+                .address_mode_v(mode)
+                .address_mode_w(mode)
+                .max_lod(0.0)
+                .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE);
+            if compare {
+                info = info
+                    .compare_enable(true)
+                    .compare_op(vk::CompareOp::LESS_OR_EQUAL);
+            }
+            let s = unsafe { ctx.device.create_sampler(&info, None) }?;
+            ctx.name(s, name);
+            Ok(s)
+        };
+        Ok(Samplers {
+            linear_clamp: make(
+                "linear clamp",
+                vk::Filter::LINEAR,
+                vk::SamplerAddressMode::CLAMP_TO_EDGE,
+                false,
+            )?,
+            nearest_clamp: make(
+                "nearest clamp",
+                vk::Filter::NEAREST,
+                vk::SamplerAddressMode::CLAMP_TO_EDGE,
+                false,
+            )?,
+            linear_repeat: make(
+                "linear repeat",
+                vk::Filter::LINEAR,
+                vk::SamplerAddressMode::REPEAT,
+                false,
+            )?,
+            shadow_compare: make(
+                "shadow compare",
+                vk::Filter::LINEAR,
+                vk::SamplerAddressMode::CLAMP_TO_BORDER,
+                true,
+            )?,
+        })
+    }
+
+    pub fn destroy(&self, ctx: &Context) {
+        unsafe {
+            for s in [
+                self.linear_clamp,
+                self.nearest_clamp,
+                self.linear_repeat,
+                self.shadow_compare,
+            ] {
+                ctx.device.destroy_sampler(s, None);
+            }
+        }
+    }
+}

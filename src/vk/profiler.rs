@@ -1,0 +1,206 @@
+//! GPU timing and counting: one timestamp pool and one pipeline-statistics pool,
+//! reset at the start of every frame's command buffer and read after its fence.
+//!
+//! Each pass gets three timestamps: before its barriers, after its barriers
+//! (the pass starts), and after its commands. Barrier time is reported on its own
+//! and never charged to the pass.
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+
+use super::context::Context;
+
+pub struct Profiler {
+    pub timestamps: vk::QueryPool,
+    pub stats: Option<vk::QueryPool>,
+    /// Samples that passed the depth and stencil tests (precise occlusion
+    /// queries): exact on every driver, unlike invocation counters, which some
+    /// drivers (llvmpipe) take before the early tests.
+    pub occlusion: vk::QueryPool,
+    precise: bool,
+    pub max_passes: u32,
+    period_ns: f64,
+    valid_mask: u64,
+}
+
+/// What the GPU measured for one pass in one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassSample {
+    pub name: String,
+    pub barrier_ms: f64,
+    pub gpu_ms: f64,
+    pub fragment_invocations: Option<u64>,
+    pub samples_passed: u64,
+}
+
+impl Profiler {
+    pub fn new(ctx: &Context, max_passes: u32) -> Result<Self> {
+        if ctx.facts.timestamp_valid_bits == 0 {
+            anyhow::bail!(
+                "device '{}' has no timestamps on its graphics queue",
+                ctx.facts.name
+            );
+        }
+        let timestamps = unsafe {
+            ctx.device.create_query_pool(
+                &vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::TIMESTAMP)
+                    .query_count(max_passes * 3),
+                None,
+            )
+        }?;
+        ctx.name(timestamps, "pass timestamps");
+        let stats = if ctx.facts.pipeline_statistics {
+            let p = unsafe {
+                ctx.device.create_query_pool(
+                    &vk::QueryPoolCreateInfo::default()
+                        .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                        .pipeline_statistics(
+                            vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                        )
+                        .query_count(max_passes),
+                    None,
+                )
+            }?;
+            ctx.name(p, "pass fragment invocations");
+            Some(p)
+        } else {
+            None
+        };
+        let occlusion = unsafe {
+            ctx.device.create_query_pool(
+                &vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::OCCLUSION)
+                    .query_count(max_passes),
+                None,
+            )
+        }?;
+        ctx.name(occlusion, "pass samples passed");
+        let bits = ctx.facts.timestamp_valid_bits;
+        Ok(Profiler {
+            timestamps,
+            stats,
+            occlusion,
+            precise: ctx.facts.occlusion_query_precise,
+            max_passes,
+            period_ns: ctx.facts.timestamp_period_ns,
+            valid_mask: if bits >= 64 {
+                u64::MAX
+            } else {
+                (1u64 << bits) - 1
+            },
+        })
+    }
+
+    pub fn reset(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe {
+            ctx.device
+                .cmd_reset_query_pool(cmd, self.timestamps, 0, self.max_passes * 3);
+            if let Some(s) = self.stats {
+                ctx.device.cmd_reset_query_pool(cmd, s, 0, self.max_passes);
+            }
+            ctx.device
+                .cmd_reset_query_pool(cmd, self.occlusion, 0, self.max_passes);
+        }
+    }
+
+    /// Timestamp `slot` (0 = before barriers, 1 = pass start, 2 = pass end) of pass `i`.
+    pub fn stamp(&self, ctx: &Context, cmd: vk::CommandBuffer, i: u32, slot: u32) {
+        // ALL_COMMANDS here is a timestamp stage, not a barrier: the value is written
+        // once every earlier command has finished, which is what a pass boundary means.
+        unsafe {
+            ctx.device.cmd_write_timestamp2(
+                cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.timestamps,
+                i * 3 + slot,
+            )
+        };
+    }
+
+    pub fn begin_stats(&self, ctx: &Context, cmd: vk::CommandBuffer, i: u32) {
+        unsafe {
+            if let Some(s) = self.stats {
+                ctx.device
+                    .cmd_begin_query(cmd, s, i, vk::QueryControlFlags::empty());
+            }
+            let flags = if self.precise {
+                vk::QueryControlFlags::PRECISE
+            } else {
+                vk::QueryControlFlags::empty()
+            };
+            ctx.device.cmd_begin_query(cmd, self.occlusion, i, flags);
+        }
+    }
+
+    pub fn end_stats(&self, ctx: &Context, cmd: vk::CommandBuffer, i: u32) {
+        unsafe {
+            ctx.device.cmd_end_query(cmd, self.occlusion, i);
+            if let Some(s) = self.stats {
+                ctx.device.cmd_end_query(cmd, s, i);
+            }
+        }
+    }
+
+    /// Reads the results of `names.len()` passes after the frame's fence.
+    pub fn read(&self, ctx: &Context, names: &[String]) -> Result<Vec<PassSample>> {
+        let n = names.len() as u32;
+        let mut ts = vec![0u64; (n * 3) as usize];
+        unsafe {
+            ctx.device.get_query_pool_results(
+                self.timestamps,
+                0,
+                &mut ts,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .context("reading timestamps")?;
+        let mut inv = vec![0u64; n as usize];
+        if let Some(s) = self.stats {
+            unsafe {
+                ctx.device.get_query_pool_results(
+                    s,
+                    0,
+                    &mut inv,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+            }
+            .context("reading pipeline statistics")?;
+        }
+        let mut occ = vec![0u64; n as usize];
+        unsafe {
+            ctx.device.get_query_pool_results(
+                self.occlusion,
+                0,
+                &mut occ,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .context("reading occlusion queries")?;
+        let ms = |a: u64, b: u64| {
+            let d = (b & self.valid_mask).wrapping_sub(a & self.valid_mask) & self.valid_mask;
+            d as f64 * self.period_ns * 1e-6
+        };
+        Ok(names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| PassSample {
+                name: name.clone(),
+                barrier_ms: ms(ts[i * 3], ts[i * 3 + 1]),
+                gpu_ms: ms(ts[i * 3 + 1], ts[i * 3 + 2]),
+                fragment_invocations: self.stats.map(|_| inv[i]),
+                samples_passed: occ[i],
+            })
+            .collect())
+    }
+
+    pub fn destroy(&self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_query_pool(self.timestamps, None);
+            if let Some(s) = self.stats {
+                ctx.device.destroy_query_pool(s, None);
+            }
+            ctx.device.destroy_query_pool(self.occlusion, None);
+        }
+    }
+}
