@@ -4,12 +4,15 @@
 // Kelemen/Szirmay-Kalos specular into a second target, linear view depth into a third.
 #extension GL_GOOGLE_include_directive : require
 #include "frame_uniforms.glsl"
-layout(set = 0, binding = 1) uniform sampler2DShadow shadowMap;
-layout(set = 0, binding = 2) uniform sampler2D shadowDepth;
-layout(set = 0, binding = 3) uniform sampler2D beckmannTex;
-layout(set = 1, binding = 0) uniform sampler2D albedoTex;
-layout(set = 1, binding = 1) uniform sampler2D normalTex;
-layout(set = 1, binding = 2) uniform sampler2D specTex;
+layout(set = 0, binding = 1) uniform texture2D shadowMap;
+layout(set = 0, binding = 2) uniform samplerShadow shadowCompare;  // LESS_OR_EQUAL, bilinear: 2x2 PCF
+layout(set = 0, binding = 3) uniform sampler nearestClamp;
+layout(set = 0, binding = 4) uniform texture2D beckmannTex;
+layout(set = 0, binding = 5) uniform sampler linearClamp;
+layout(set = 1, binding = 0) uniform texture2D albedoTex;
+layout(set = 1, binding = 1) uniform texture2D normalTex;
+layout(set = 1, binding = 2) uniform texture2D specTex;
+layout(set = 1, binding = 4) uniform sampler materialSampler;
 layout(set = 1, binding = 3) uniform MaterialUniforms {
     vec4 baseColor;   // rgb linear factor
     vec4 params;      // x: Beckmann roughness m, y: rho_s, z: SSS strength, w: 1 if skin
@@ -51,7 +54,7 @@ float shadowPcf(vec3 worldPos, vec3 n) {
     float sum = 0.0;
     for (int y = -1; y <= 1; y++)
         for (int x = -1; x <= 1; x++)
-            sum += texture(shadowMap, vec3(c.xy + vec2(x, y) * texel, ref));
+            sum += texture(sampler2DShadow(shadowMap, shadowCompare), vec3(c.xy + vec2(x, y) * texel, ref));
     return sum / 9.0;
 }
 
@@ -68,7 +71,7 @@ float kelemenSzirmayKalos(vec3 N, vec3 L, vec3 V, float m, float rhoS) {
     vec3 h = L + V;
     vec3 H = normalize(h);
     float nDotH = dot(N, H);
-    float PH = pow(2.0 * texture(beckmannTex, vec2(nDotH, m)).r, 10.0);
+    float PH = pow(2.0 * texture(sampler2D(beckmannTex, linearClamp), vec2(nDotH, m)).r, 10.0);
     float F = fresnelSchlick(dot(H, V), 0.028);
     float frSpec = max(PH * F / dot(h, h), 0.0);
     return nDotL * rhoS * frSpec;
@@ -79,11 +82,11 @@ void main() {
     vec3 T = vTangent.xyz - Nv * dot(Nv, vTangent.xyz);
     T = dot(T, T) > 1e-12 ? normalize(T) : vec3(0.0);
     vec3 B = cross(Nv, T) * vTangent.w;
-    vec3 tn = texture(normalTex, vUv).xyz * 2.0 - 1.0;
+    vec3 tn = texture(sampler2D(normalTex, materialSampler), vUv).xyz * 2.0 - 1.0;
     vec3 N = normalize(mat3(T, B, Nv) * tn);
     if (dot(T, T) == 0.0) N = Nv;
 
-    vec3 albedo = texture(albedoTex, vUv).rgb * material.baseColor.rgb;
+    vec3 albedo = texture(sampler2D(albedoTex, materialSampler), vUv).rgb * material.baseColor.rgb;
     vec3 L = normalize(frame.lightDir.xyz);
     vec3 V = normalize(frame.cameraPos.xyz - vWorldPos);
     float shadow = shadowPcf(vWorldPos, Nv);
@@ -96,13 +99,13 @@ void main() {
         // Listing 5.1: shrink along the vertex normal, read the light-side depth,
         // distance in millimetres, back irradiance from the reversed vertex normal.
         vec3 c = shadowCoord(vWorldPos - frame.params.z * Nv);
-        float d1 = texture(shadowDepth, c.xy).r;
+        float d1 = texture(sampler2D(shadowMap, nearestClamp), c.xy).r;
         float sMm = abs(c.z - d1) * frame.params.y * frame.params.x;
         float E = max(0.3 + dot(-Nv, L), 0.0);
         diffuse += transmittanceProfile(sMm) * light * albedo * E;
     }
 
-    float specMask = texture(specTex, vUv).r;
+    float specMask = texture(sampler2D(specTex, materialSampler), vUv).r;
     float spec = kelemenSzirmayKalos(N, L, V, material.params.x, material.params.y) * specMask;
 
     outDiffuse = vec4(diffuse, skin ? material.params.z : 0.0);

@@ -1,11 +1,13 @@
 #version 450
+#extension GL_EXT_samplerless_texture_functions : require
 // Separable SSS, one direction per pass (thesis ch. 6 and its HLSL listing).
 // Stencil-tested on the skin bit: early tests are forced so masked pixels never
 // run this shader.
 layout(early_fragment_tests) in;
 
-layout(set = 0, binding = 0) uniform sampler2D colorTex;   // RGBA16F, alpha = SSS strength
-layout(set = 0, binding = 1) uniform sampler2D depthTex;   // linear view depth, scene units
+layout(set = 0, binding = 0) uniform texture2D colorTex;   // RGBA16F, alpha = SSS strength
+layout(set = 0, binding = 1) uniform texture2D depthTex;   // linear view depth, scene units
+layout(set = 0, binding = 3) uniform sampler linearClamp;
 layout(set = 0, binding = 2) uniform KernelUniforms {
     vec4 samples[63];   // rgb weight, w: offset in millimetres; [0] is the centre
 } kernel;
@@ -26,7 +28,7 @@ void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec4 colorM = texelFetch(colorTex, p, 0);
     float depthM = texelFetch(depthTex, p, 0).r;
-    vec2 uv = (vec2(p) + 0.5) / vec2(textureSize(colorTex, 0));
+    vec2 uv = (vec2(p) + 0.5) / vec2(textureSize(sampler2D(colorTex, linearClamp), 0));
 
     // Screen height in scene units at this depth; one millimetre in uv, the same
     // on-screen length in both directions.
@@ -39,11 +41,11 @@ void main() {
     for (int i = 1; i < pc.nSamples; i++) {
         vec4 k = kernel.samples[i];
         vec2 o = uv + k.w * stepUv;
-        vec3 c = texture(colorTex, o).rgb;
+        vec3 c = texture(sampler2D(colorTex, linearClamp), o).rgb;
         if (pc.followSurface != 0) {
             // Follow the surface: a sample across a depth step larger than the
             // kernel is replaced by the centre colour.
-            float d = texture(depthTex, o).r;
+            float d = texture(sampler2D(depthTex, linearClamp), o).r;
             float s = clamp(abs(depthM - d) * pc.mmPerUnit / pc.followTolMm, 0.0, 1.0);
             c = c + (colorM.rgb - c) * s;
         }

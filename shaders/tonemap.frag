@@ -1,6 +1,7 @@
 #version 450
+#extension GL_EXT_samplerless_texture_functions : require
 // Hable's filmic curve; the sRGB attachment does the encode.
-layout(set = 0, binding = 0) uniform sampler2D hdrTex;
+layout(set = 0, binding = 0) uniform texture2D hdrTex;
 layout(push_constant) uniform Push { float exposure; float whitePoint; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;

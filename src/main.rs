@@ -99,6 +99,10 @@ struct Common {
     normal_map: Option<PathBuf>,
     #[arg(long)]
     spec_map: Option<PathBuf>,
+    /// Texture files beside the scene (or given above) are top-down; by default they
+    /// are taken as bottom-up (OpenGL convention), as the Lee Perry-Smith head's are.
+    #[arg(long)]
+    sidecar_top_down: bool,
     /// Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head).
     #[arg(long)]
     mm_per_unit: Option<f32>,
@@ -119,10 +123,10 @@ struct Common {
     #[arg(long)]
     sss_width_mm: Option<f32>,
     /// Override the per-channel strength: R,G,B.
-    #[arg(long, value_delimiter = ',', num_args = 3)]
+    #[arg(long, value_delimiter = ',')]
     strength: Option<Vec<f32>>,
     /// Override the per-channel falloff: R,G,B.
-    #[arg(long, value_delimiter = ',', num_args = 3)]
+    #[arg(long, value_delimiter = ',')]
     falloff: Option<Vec<f32>>,
     #[arg(long)]
     no_follow_surface: bool,
@@ -140,10 +144,11 @@ struct Common {
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 20.0)]
     fovy: f32,
-    /// Key light azimuth in degrees (0 = from the camera side).
-    #[arg(long, default_value_t = 60.0)]
+    /// Key light azimuth in degrees (0 = from the camera side, positive toward the viewer's right).
+    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     light_azimuth: f32,
-    #[arg(long, default_value_t = 30.0)]
+    /// Key light elevation in degrees above the horizon.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     light_elevation: f32,
     #[arg(long, default_value_t = 2.5)]
     light_intensity: f32,
@@ -162,11 +167,17 @@ impl Common {
         if let Some(w) = self.sss_width_mm {
             params.width_mm = w;
         }
+        let rgb = |what: &str, v: &[f32]| -> Result<[f32; 3]> {
+            match v {
+                [r, g, b] => Ok([*r, *g, *b]),
+                _ => bail!("--{what} takes three comma-separated values R,G,B, got {}", v.len()),
+            }
+        };
         if let Some(s) = &self.strength {
-            params.strength = [s[0], s[1], s[2]];
+            params.strength = rgb("strength", s)?;
         }
         if let Some(f) = &self.falloff {
-            params.falloff = [f[0], f[1], f[2]];
+            params.falloff = rgb("falloff", f)?;
         }
         let close = Camera::close_up_distance_heads(self.fovy);
         let distance = self.distance.unwrap_or(match self.shot {
@@ -217,6 +228,7 @@ impl Common {
                     albedo: self.albedo.clone(),
                     normal_map: self.normal_map.clone(),
                     specular_map: self.spec_map.clone(),
+                    sidecar_top_down: self.sidecar_top_down,
                 },
                 self.mm_per_unit,
             ),

@@ -107,13 +107,7 @@ pub fn measure(
                 ctx,
                 &fetch,
                 0,
-                &[(
-                    "srcTex",
-                    Bind::Image {
-                        view: img.view,
-                        sampler,
-                    },
-                )],
+                &[("srcTex", Bind::Texture(img.view)), ("srcSampler", Bind::Sampler(sampler))],
             )
         };
         let probes: Vec<(&str, Option<(vk::DescriptorSet, ImageId)>)> = vec![

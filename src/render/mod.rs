@@ -397,27 +397,9 @@ impl<'c> Renderer<'c> {
                         size: std::mem::size_of::<FrameUniforms>() as u64,
                     },
                 ),
-                (
-                    "shadowMap",
-                    Bind::Image {
-                        view: targets.shadow.1.view,
-                        sampler: samplers.shadow_compare,
-                    },
-                ),
-                (
-                    "shadowDepth",
-                    Bind::Image {
-                        view: targets.shadow.1.view,
-                        sampler: samplers.nearest_clamp,
-                    },
-                ),
-                (
-                    "beckmannTex",
-                    Bind::Image {
-                        view: beckmann.view,
-                        sampler: samplers.linear_clamp,
-                    },
-                ),
+                ("shadowMap", Bind::Texture(targets.shadow.1.view)), ("shadowCompare", Bind::Sampler(samplers.shadow_compare)),
+                ("nearestClamp", Bind::Sampler(samplers.nearest_clamp)),
+                ("beckmannTex", Bind::Texture(beckmann.view)), ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
             ],
         )?;
         let composite_set = pool.write_set(
@@ -425,33 +407,15 @@ impl<'c> Renderer<'c> {
             &composite_pipeline,
             0,
             &[
-                (
-                    "diffuseTex",
-                    Bind::Image {
-                        view: targets.diffuse.1.view,
-                        sampler: samplers.nearest_clamp,
-                    },
-                ),
-                (
-                    "specularTex",
-                    Bind::Image {
-                        view: targets.specular.1.view,
-                        sampler: samplers.nearest_clamp,
-                    },
-                ),
+                ("diffuseTex", Bind::Texture(targets.diffuse.1.view)),
+                ("specularTex", Bind::Texture(targets.specular.1.view)),
             ],
         )?;
         let tonemap_set = pool.write_set(
             ctx,
             &tonemap_pipeline,
             0,
-            &[(
-                "hdrTex",
-                Bind::Image {
-                    view: targets.hdr.1.view,
-                    sampler: samplers.nearest_clamp,
-                },
-            )],
+            &[("hdrTex", Bind::Texture(targets.hdr.1.view))],
         )?;
 
         let mut objects = Vec::new();

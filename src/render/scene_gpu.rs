@@ -129,27 +129,9 @@ impl GpuObject {
             geometry,
             1,
             &[
-                (
-                    "albedoTex",
-                    Bind::Image {
-                        view: albedo.view,
-                        sampler: samplers.linear_repeat,
-                    },
-                ),
-                (
-                    "normalTex",
-                    Bind::Image {
-                        view: normal.view,
-                        sampler: samplers.linear_repeat,
-                    },
-                ),
-                (
-                    "specTex",
-                    Bind::Image {
-                        view: spec.view,
-                        sampler: samplers.linear_repeat,
-                    },
-                ),
+                ("albedoTex", Bind::Texture(albedo.view)),
+                ("normalTex", Bind::Texture(normal.view)),
+                ("specTex", Bind::Texture(spec.view)), ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
                 (
                     "material",
                     Bind::Uniform {

@@ -104,20 +104,8 @@ impl SeparableSss {
                 &pipeline,
                 0,
                 &[
-                    (
-                        "colorTex",
-                        Bind::Image {
-                            view: color.view,
-                            sampler: samplers.linear_clamp,
-                        },
-                    ),
-                    (
-                        "depthTex",
-                        Bind::Image {
-                            view: linear_depth.view,
-                            sampler: samplers.linear_clamp,
-                        },
-                    ),
+                    ("colorTex", Bind::Texture(color.view)),
+                    ("depthTex", Bind::Texture(linear_depth.view)), ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
                     (
                         "kernel",
                         Bind::Uniform {

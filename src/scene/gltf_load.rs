@@ -18,6 +18,24 @@ pub struct TextureOverrides {
     pub albedo: Option<PathBuf>,
     pub normal_map: Option<PathBuf>,
     pub specular_map: Option<PathBuf>,
+    /// Textures found beside the file or given as overrides were not authored
+    /// against the glTF's texture-coordinate convention (v = 0 at the top row).
+    /// By default they are taken as bottom-up (OpenGL convention: the three.js
+    /// example that distributes the Lee Perry-Smith head loads them with
+    /// flipY = true); set this when such files are top-down.
+    pub sidecar_top_down: bool,
+}
+
+/// Loads a texture that came from beside the scene file or the command line,
+/// flipped into the glTF convention unless it is already top-down.
+fn sidecar_texture(path: &Path, what: &str, overrides: &TextureOverrides) -> Result<Texture> {
+    let mut t = load_texture(path, what)?;
+    if !overrides.sidecar_top_down {
+        let row = t.width as usize * 4;
+        let rows: Vec<&[u8]> = t.rgba8.chunks_exact(row).rev().collect();
+        t.rgba8 = rows.concat();
+    }
+    Ok(t)
 }
 
 /// The parsed file: document, its buffers, the raw JSON (for extensions the `gltf` crate
@@ -339,29 +357,29 @@ pub fn load_head(path: &Path, overrides: &TextureOverrides) -> Result<Object> {
     let beside = detect_beside(&src.dir);
     if base_color.is_none() {
         if let Some(p) = &beside[Slot::Albedo as usize] {
-            base_color = Some(load_texture(p, "albedo")?);
+            base_color = Some(sidecar_texture(p, "albedo", overrides)?);
             factor = [1.0; 4];
         }
     }
     if normal_map.is_none() {
         if let Some(p) = &beside[Slot::Normal as usize] {
-            normal_map = Some(load_texture(p, "normal map")?);
+            normal_map = Some(sidecar_texture(p, "normal map", overrides)?);
         }
     }
     if specular_map.is_none() {
         if let Some(p) = &beside[Slot::Specular as usize] {
-            specular_map = Some(load_texture(p, "specular")?);
+            specular_map = Some(sidecar_texture(p, "specular", overrides)?);
         }
     }
     if let Some(p) = &overrides.albedo {
-        base_color = Some(load_texture(p, "albedo")?);
+        base_color = Some(sidecar_texture(p, "albedo", overrides)?);
         factor = [1.0; 4];
     }
     if let Some(p) = &overrides.normal_map {
-        normal_map = Some(load_texture(p, "normal map")?);
+        normal_map = Some(sidecar_texture(p, "normal map", overrides)?);
     }
     if let Some(p) = &overrides.specular_map {
-        specular_map = Some(load_texture(p, "specular")?);
+        specular_map = Some(sidecar_texture(p, "specular", overrides)?);
     }
     Ok(Object {
         mesh,

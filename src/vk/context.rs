@@ -160,8 +160,13 @@ impl Context {
                 .push_next(&mut validation_features)
                 .push_next(&mut messenger_info);
         }
-        let instance = unsafe { entry.create_instance(&create_info, None) }
-            .context("creating the Vulkan instance")?;
+        let instance = match unsafe { entry.create_instance(&create_info, None) } {
+            Ok(i) => i,
+            Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => bail!(
+                "no Vulkan device found: the Vulkan loader found no driver (install mesa-vulkan-drivers for lavapipe, or a GPU driver)"
+            ),
+            Err(e) => bail!("creating the Vulkan instance: {e}"),
+        };
 
         let debug_instance = if desc.validate {
             // A fresh create-info: the one above is chained into the instance's pNext.

@@ -266,12 +266,12 @@ impl Pipeline {
     }
 }
 
-/// A resource to bind, by the shader's variable name.
+/// A resource to bind, by the shader's variable name. Textures and samplers are
+/// separate objects (`texture2D` + `sampler` in GLSL): naga's SPIR-V reader, which
+/// validates every module, does not take combined image samplers.
 pub enum Bind {
-    Image {
-        view: vk::ImageView,
-        sampler: vk::Sampler,
-    },
+    Texture(vk::ImageView),
+    Sampler(vk::Sampler),
     Uniform {
         buffer: vk::Buffer,
         size: u64,
@@ -287,8 +287,12 @@ impl DescriptorPool {
     pub fn new(ctx: &Context, max_sets: u32) -> Result<Self> {
         let sizes = [
             vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                ty: vk::DescriptorType::SAMPLED_IMAGE,
                 descriptor_count: max_sets * 8,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::SAMPLER,
+                descriptor_count: max_sets * 4,
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::UNIFORM_BUFFER,
@@ -359,14 +363,25 @@ impl DescriptorPool {
                 )
             })?;
             match bind {
-                Bind::Image { view, sampler } => {
+                Bind::Texture(view) => {
+                    image_infos.push((
+                        info.binding,
+                        info.descriptor_type,
+                        vk::DescriptorImageInfo {
+                            sampler: vk::Sampler::null(),
+                            image_view: *view,
+                            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                        },
+                    ));
+                }
+                Bind::Sampler(sampler) => {
                     image_infos.push((
                         info.binding,
                         info.descriptor_type,
                         vk::DescriptorImageInfo {
                             sampler: *sampler,
-                            image_view: *view,
-                            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                            image_view: vk::ImageView::null(),
+                            image_layout: vk::ImageLayout::UNDEFINED,
                         },
                     ));
                 }

@@ -67,8 +67,7 @@ fn stage_flags(s: ReflectShaderStageFlags) -> vk::ShaderStageFlags {
 fn descriptor_type(t: ReflectDescriptorType) -> Result<vk::DescriptorType> {
     Ok(match t {
         ReflectDescriptorType::Sampler => vk::DescriptorType::SAMPLER,
-        ReflectDescriptorType::CombinedImageSampler => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-        ReflectDescriptorType::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+                ReflectDescriptorType::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
         ReflectDescriptorType::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         ReflectDescriptorType::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
         ReflectDescriptorType::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
@@ -217,10 +216,9 @@ mod tests {
     fn reflection_finds_sss_interface() {
         let r = reflect(&["fullscreen.vert", "sss_blur.frag"]).unwrap();
         let color = r.find(0, "colorTex").expect("colorTex binding");
-        assert_eq!(
-            color.descriptor_type,
-            vk::DescriptorType::COMBINED_IMAGE_SAMPLER
-        );
+        assert_eq!(color.descriptor_type, vk::DescriptorType::SAMPLED_IMAGE);
+        let sampler = r.find(0, "linearClamp").expect("linearClamp binding");
+        assert_eq!(sampler.descriptor_type, vk::DescriptorType::SAMPLER);
         assert_eq!(color.stages, vk::ShaderStageFlags::FRAGMENT);
         assert!(r.find(0, "depthTex").is_some());
         assert!(r

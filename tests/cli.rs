@@ -1,0 +1,190 @@
+//! The command line: bad input gives one clear error line and a non-zero exit,
+//! never a panic or a validation error; good input writes what it promises.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn dermis() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_dermis"));
+    c.env("RUST_BACKTRACE", "0");
+    c
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("dermis-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `dermis render` on lavapipe with validation and the given extra
+/// arguments; asserts failure with one error line containing `phrase`.
+fn fails_with(args: &[&str], phrase: &str) {
+    fails_with_env(args, phrase, &[]);
+}
+
+fn fails_with_env(args: &[&str], phrase: &str, env: &[(&str, &str)]) {
+    let out_dir = tmp("bad");
+    let mut c = dermis();
+    c.args(["render", "--validate", "--frames", "1", "--warmup", "0", "--out"]).arg(&out_dir);
+    // Small lavapipe defaults, unless the case sets the flag itself.
+    for (flag, value) in [("--device", "llvmpipe"), ("--width", "64"), ("--height", "48")] {
+        if !args.contains(&flag) {
+            c.args([flag, value]);
+        }
+    }
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let o = c.output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{args:?} succeeded");
+    assert_ne!(o.status.code(), Some(101), "{args:?} panicked: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{args:?}: expected one error line, got: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{args:?}: {stderr}");
+    assert!(lines[0].contains(phrase), "{args:?}: '{phrase}' not in: {stderr}");
+    assert!(!stderr.contains("Validation"), "{args:?} raised a validation message: {stderr}");
+}
+
+/// A minimal glTF (one triangle) with some attributes left out.
+fn tiny_gltf(dir: &PathBuf, name: &str, normals: bool, uvs: bool) -> PathBuf {
+    let mut bin: Vec<u8> = Vec::new();
+    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in v {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let pos_len = bin.len();
+    for _ in 0..3 {
+        for c in [0.0f32, 0.0, 1.0] {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for _ in 0..3 {
+        for c in [0.5f32, 0.5] {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let b64 = {
+        const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut s = String::new();
+        for ch in bin.chunks(3) {
+            let n = (ch[0] as u32) << 16 | (*ch.get(1).unwrap_or(&0) as u32) << 8 | *ch.get(2).unwrap_or(&0) as u32;
+            for i in 0..4 {
+                if i <= ch.len() {
+                    s.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
+                } else {
+                    s.push('=');
+                }
+            }
+        }
+        s
+    };
+    let mut attrs = vec![r#""POSITION": 0"#.to_string()];
+    if normals {
+        attrs.push(r#""NORMAL": 1"#.into());
+    }
+    if uvs {
+        attrs.push(r#""TEXCOORD_0": 2"#.into());
+    }
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"name":"tri","primitives":[{{"attributes":{{{}}}}}]}}],
+"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{}}},{{"buffer":0,"byteOffset":{},"byteLength":36}},{{"buffer":0,"byteOffset":{},"byteLength":24}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}},{{"bufferView":2,"componentType":5126,"count":3,"type":"VEC2"}}]}}"#,
+        attrs.join(","),
+        bin.len(),
+        b64,
+        pos_len,
+        pos_len,
+        pos_len + 36
+    );
+    let p = dir.join(name);
+    std::fs::write(&p, json).unwrap();
+    p
+}
+
+#[test]
+fn missing_and_corrupt_scene_files() {
+    let d = tmp("files");
+    fails_with(&["--scene", "/nonexistent/head.glb"], "scene file not found");
+    let corrupt = d.join("corrupt.glb");
+    std::fs::write(&corrupt, b"this is not a glTF file at all").unwrap();
+    fails_with(&["--scene", corrupt.to_str().unwrap()], "not a valid glTF");
+    let no_normals = tiny_gltf(&d, "nonormals.gltf", false, true);
+    fails_with(&["--scene", no_normals.to_str().unwrap()], "has no normals");
+    let no_uvs = tiny_gltf(&d, "nouvs.gltf", true, false);
+    fails_with(&["--scene", no_uvs.to_str().unwrap()], "no texture coordinates");
+}
+
+#[test]
+fn missing_and_corrupt_textures() {
+    let d = tmp("tex");
+    let ok = tiny_gltf(&d, "ok.gltf", true, true);
+    fails_with(&["--scene", ok.to_str().unwrap(), "--albedo", "/nonexistent/albedo.png"], "albedo texture not found");
+    let broken = d.join("broken.jpg");
+    std::fs::write(&broken, b"\xff\xd8\xff garbage").unwrap();
+    fails_with(&["--scene", ok.to_str().unwrap(), "--normal-map", broken.to_str().unwrap()], "cannot decode normal map");
+}
+
+#[test]
+fn bad_sizes_and_parameters() {
+    fails_with(&["--width", "0"], "width must be at least 1");
+    fails_with(&["--height", "100000"], "exceeds the device limit");
+    fails_with(&["--sss-width-mm", "NaN"], "width");
+    fails_with(&["--sss-width-mm=-2"], "width");
+    fails_with(&["--strength", "1.5,0.5,0.5"], "strength");
+    fails_with(&["--samples", "16"], "odd");
+    fails_with(&["--distance=-1"], "distance");
+    fails_with(&["--light-intensity", "NaN"], "intensity");
+    fails_with(&["--mm-per-unit", "0"], "mm_per_unit");
+    fails_with(&["--method", "blur"], "unknown method");
+    fails_with(&["--preset", "nope"], "preset");
+}
+
+#[test]
+fn missing_devices() {
+    fails_with(&["--device", "no-such-gpu"], "no Vulkan device whose name contains");
+    fails_with(&["--device", "99"], "no Vulkan device with index 99");
+    // No driver at all: point the loader at an empty driver list.
+    let d = tmp("noicd");
+    let fake = d.join("none.json");
+    fails_with_env(&[], "no Vulkan device", &[("VK_DRIVER_FILES", fake.to_str().unwrap()), ("VK_ICD_FILENAMES", fake.to_str().unwrap())]);
+}
+
+#[test]
+fn render_writes_png_report_and_dumps() {
+    let d = tmp("good");
+    let o = dermis()
+        .args(["render", "--validate", "--device", "llvmpipe", "--width", "96", "--height", "64", "--frames", "2", "--warmup", "1", "--dump", "--out"])
+        .arg(&d)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}{}", stdout, String::from_utf8_lossy(&o.stderr));
+    for pass in ["shadow map", "geometry", "sss horizontal", "sss vertical", "composite", "tonemap"] {
+        assert!(stdout.contains(pass), "table lacks {pass}: {stdout}");
+    }
+    let png = image::open(d.join("frame.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (96, 64));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["method"], "separable");
+    assert_eq!(report["passes"].as_array().unwrap().len(), 7);
+    let dumps: Vec<_> = std::fs::read_dir(d.join("passes")).unwrap().collect();
+    assert!(dumps.len() >= 8, "{} dumps", dumps.len());
+}
+
+#[test]
+fn kernel_prints_json() {
+    let o = dermis().args(["kernel", "--samples", "9", "--preset", "demo"]).output().unwrap();
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let samples = v["kernel"]["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 9);
+    assert_eq!(samples[0]["offset_mm"], 0.0);
+    let o = dermis().args(["kernel", "--samples", "8"]).output().unwrap();
+    assert!(!o.status.success());
+}
