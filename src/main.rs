@@ -170,7 +170,10 @@ impl Common {
         let rgb = |what: &str, v: &[f32]| -> Result<[f32; 3]> {
             match v {
                 [r, g, b] => Ok([*r, *g, *b]),
-                _ => bail!("--{what} takes three comma-separated values R,G,B, got {}", v.len()),
+                _ => bail!(
+                    "--{what} takes three comma-separated values R,G,B, got {}",
+                    v.len()
+                ),
             }
         };
         if let Some(s) = &self.strength {

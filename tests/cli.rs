@@ -25,9 +25,22 @@ fn fails_with(args: &[&str], phrase: &str) {
 fn fails_with_env(args: &[&str], phrase: &str, env: &[(&str, &str)]) {
     let out_dir = tmp("bad");
     let mut c = dermis();
-    c.args(["render", "--validate", "--frames", "1", "--warmup", "0", "--out"]).arg(&out_dir);
+    c.args([
+        "render",
+        "--validate",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--out",
+    ])
+    .arg(&out_dir);
     // Small lavapipe defaults, unless the case sets the flag itself.
-    for (flag, value) in [("--device", "llvmpipe"), ("--width", "64"), ("--height", "48")] {
+    for (flag, value) in [
+        ("--device", "llvmpipe"),
+        ("--width", "64"),
+        ("--height", "48"),
+    ] {
         if !args.contains(&flag) {
             c.args([flag, value]);
         }
@@ -42,10 +55,20 @@ fn fails_with_env(args: &[&str], phrase: &str, env: &[(&str, &str)]) {
     assert_ne!(o.status.code(), Some(101), "{args:?} panicked: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
     let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{args:?}: expected one error line, got: {stderr}");
+    assert_eq!(
+        lines.len(),
+        1,
+        "{args:?}: expected one error line, got: {stderr}"
+    );
     assert!(lines[0].starts_with("error: "), "{args:?}: {stderr}");
-    assert!(lines[0].contains(phrase), "{args:?}: '{phrase}' not in: {stderr}");
-    assert!(!stderr.contains("Validation"), "{args:?} raised a validation message: {stderr}");
+    assert!(
+        lines[0].contains(phrase),
+        "{args:?}: '{phrase}' not in: {stderr}"
+    );
+    assert!(
+        !stderr.contains("Validation"),
+        "{args:?} raised a validation message: {stderr}"
+    );
 }
 
 /// A minimal glTF (one triangle) with some attributes left out.
@@ -71,7 +94,9 @@ fn tiny_gltf(dir: &PathBuf, name: &str, normals: bool, uvs: bool) -> PathBuf {
         const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
         let mut s = String::new();
         for ch in bin.chunks(3) {
-            let n = (ch[0] as u32) << 16 | (*ch.get(1).unwrap_or(&0) as u32) << 8 | *ch.get(2).unwrap_or(&0) as u32;
+            let n = (ch[0] as u32) << 16
+                | (*ch.get(1).unwrap_or(&0) as u32) << 8
+                | *ch.get(2).unwrap_or(&0) as u32;
             for i in 0..4 {
                 if i <= ch.len() {
                     s.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
@@ -110,24 +135,46 @@ fn tiny_gltf(dir: &PathBuf, name: &str, normals: bool, uvs: bool) -> PathBuf {
 #[test]
 fn missing_and_corrupt_scene_files() {
     let d = tmp("files");
-    fails_with(&["--scene", "/nonexistent/head.glb"], "scene file not found");
+    fails_with(
+        &["--scene", "/nonexistent/head.glb"],
+        "scene file not found",
+    );
     let corrupt = d.join("corrupt.glb");
     std::fs::write(&corrupt, b"this is not a glTF file at all").unwrap();
     fails_with(&["--scene", corrupt.to_str().unwrap()], "not a valid glTF");
     let no_normals = tiny_gltf(&d, "nonormals.gltf", false, true);
     fails_with(&["--scene", no_normals.to_str().unwrap()], "has no normals");
     let no_uvs = tiny_gltf(&d, "nouvs.gltf", true, false);
-    fails_with(&["--scene", no_uvs.to_str().unwrap()], "no texture coordinates");
+    fails_with(
+        &["--scene", no_uvs.to_str().unwrap()],
+        "no texture coordinates",
+    );
 }
 
 #[test]
 fn missing_and_corrupt_textures() {
     let d = tmp("tex");
     let ok = tiny_gltf(&d, "ok.gltf", true, true);
-    fails_with(&["--scene", ok.to_str().unwrap(), "--albedo", "/nonexistent/albedo.png"], "albedo texture not found");
+    fails_with(
+        &[
+            "--scene",
+            ok.to_str().unwrap(),
+            "--albedo",
+            "/nonexistent/albedo.png",
+        ],
+        "albedo texture not found",
+    );
     let broken = d.join("broken.jpg");
     std::fs::write(&broken, b"\xff\xd8\xff garbage").unwrap();
-    fails_with(&["--scene", ok.to_str().unwrap(), "--normal-map", broken.to_str().unwrap()], "cannot decode normal map");
+    fails_with(
+        &[
+            "--scene",
+            ok.to_str().unwrap(),
+            "--normal-map",
+            broken.to_str().unwrap(),
+        ],
+        "cannot decode normal map",
+    );
 }
 
 #[test]
@@ -147,30 +194,68 @@ fn bad_sizes_and_parameters() {
 
 #[test]
 fn missing_devices() {
-    fails_with(&["--device", "no-such-gpu"], "no Vulkan device whose name contains");
+    fails_with(
+        &["--device", "no-such-gpu"],
+        "no Vulkan device whose name contains",
+    );
     fails_with(&["--device", "99"], "no Vulkan device with index 99");
     // No driver at all: point the loader at an empty driver list.
     let d = tmp("noicd");
     let fake = d.join("none.json");
-    fails_with_env(&[], "no Vulkan device", &[("VK_DRIVER_FILES", fake.to_str().unwrap()), ("VK_ICD_FILENAMES", fake.to_str().unwrap())]);
+    fails_with_env(
+        &[],
+        "no Vulkan device",
+        &[
+            ("VK_DRIVER_FILES", fake.to_str().unwrap()),
+            ("VK_ICD_FILENAMES", fake.to_str().unwrap()),
+        ],
+    );
 }
 
 #[test]
 fn render_writes_png_report_and_dumps() {
     let d = tmp("good");
     let o = dermis()
-        .args(["render", "--validate", "--device", "llvmpipe", "--width", "96", "--height", "64", "--frames", "2", "--warmup", "1", "--dump", "--out"])
+        .args([
+            "render",
+            "--validate",
+            "--device",
+            "llvmpipe",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+            "--dump",
+            "--out",
+        ])
         .arg(&d)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}{}", stdout, String::from_utf8_lossy(&o.stderr));
-    for pass in ["shadow map", "geometry", "sss horizontal", "sss vertical", "composite", "tonemap"] {
+    assert!(
+        o.status.success(),
+        "{}{}",
+        stdout,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for pass in [
+        "shadow map",
+        "geometry",
+        "sss horizontal",
+        "sss vertical",
+        "composite",
+        "tonemap",
+    ] {
         assert!(stdout.contains(pass), "table lacks {pass}: {stdout}");
     }
     let png = image::open(d.join("frame.png")).unwrap();
     assert_eq!((png.width(), png.height()), (96, 64));
-    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["method"], "separable");
     assert_eq!(report["passes"].as_array().unwrap().len(), 7);
     let dumps: Vec<_> = std::fs::read_dir(d.join("passes")).unwrap().collect();
@@ -179,12 +264,18 @@ fn render_writes_png_report_and_dumps() {
 
 #[test]
 fn kernel_prints_json() {
-    let o = dermis().args(["kernel", "--samples", "9", "--preset", "demo"]).output().unwrap();
+    let o = dermis()
+        .args(["kernel", "--samples", "9", "--preset", "demo"])
+        .output()
+        .unwrap();
     assert!(o.status.success());
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let samples = v["kernel"]["samples"].as_array().unwrap();
     assert_eq!(samples.len(), 9);
     assert_eq!(samples[0]["offset_mm"], 0.0);
-    let o = dermis().args(["kernel", "--samples", "8"]).output().unwrap();
+    let o = dermis()
+        .args(["kernel", "--samples", "8"])
+        .output()
+        .unwrap();
     assert!(!o.status.success());
 }

@@ -24,7 +24,13 @@ fn synthetic() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
             let g = 0.40 + 0.20 * (fx / 11.0 + fy / 7.0).cos();
             let b = 0.30 + 0.15 * (fy / 5.0).sin();
             // Strength varies across the image (alpha of the diffuse target).
-            let strength = if x < W / 3 { 1.0 } else if x < 2 * W / 3 { 0.6 } else { 0.85 };
+            let strength = if x < W / 3 {
+                1.0
+            } else if x < 2 * W / 3 {
+                0.6
+            } else {
+                0.85
+            };
             let is_skin = {
                 let (dx, dy) = (fx - 48.0, fy - 32.0);
                 let inside = dx * dx / (44.0 * 44.0) + dy * dy / (30.0 * 30.0) < 1.0;
@@ -41,7 +47,12 @@ fn synthetic() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
 }
 
 fn renderer_settings() -> RenderSettings {
-    RenderSettings { width: W as u32, height: H as u32, shadow_size: 64, ..RenderSettings::default() }
+    RenderSettings {
+        width: W as u32,
+        height: H as u32,
+        shadow_size: 64,
+        ..RenderSettings::default()
+    }
 }
 
 #[test]
@@ -51,9 +62,16 @@ fn gpu_matches_cpu_reference() {
     let settings = renderer_settings();
     let (diffuse, depth, skin) = synthetic();
     for follow in [true, false] {
-        let s = RenderSettings { follow_surface: follow, ..settings.clone() };
+        let s = RenderSettings {
+            follow_surface: follow,
+            ..settings.clone()
+        };
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let f16: Vec<u16> = diffuse.iter().flatten().map(|&v| half::f16::from_f32(v).to_bits()).collect();
+        let f16: Vec<u16> = diffuse
+            .iter()
+            .flatten()
+            .map(|&v| half::f16::from_f32(v).to_bits())
+            .collect();
         r.upload_sss_inputs(&f16, &depth, &skin).unwrap();
         let (gpu, samples) = r.run_sss_only().unwrap();
 
@@ -64,7 +82,17 @@ fn gpu_matches_cpu_reference() {
             follow_surface: follow,
             follow_tolerance_mm: kernel.params.width_mm,
         };
-        let cpu = separable_sss(&SssInput { width: W, height: H, diffuse: &diffuse, linear_depth: &depth, skin: &skin }, &kernel, &view);
+        let cpu = separable_sss(
+            &SssInput {
+                width: W,
+                height: H,
+                diffuse: &diffuse,
+                linear_depth: &depth,
+                skin: &skin,
+            },
+            &kernel,
+            &view,
+        );
 
         // Bound. Storage: the intermediate and the output are RGBA16F; where the GPU's
         // unrounded value and the CPU's straddle a rounding boundary, each store can
@@ -106,7 +134,10 @@ fn gpu_matches_cpu_reference() {
         }
         println!("follow_surface={follow}: worst relative error {worst:.3e} at {worst_at:?}, {changed} skin pixels changed");
         // The stated aim: 2e-3 relative (two half-float ulps at worst).
-        assert!(worst <= 2e-3 + filter_term / 0.15, "worst relative error {worst:.3e}");
+        assert!(
+            worst <= 2e-3 + filter_term / 0.15,
+            "worst relative error {worst:.3e}"
+        );
         // The blur really did something (a test of an identity pass would pass too).
         assert!(changed > skin.iter().filter(|&&s| s).count() / 2);
 
@@ -115,7 +146,13 @@ fn gpu_matches_cpu_reference() {
         for name in ["sss horizontal", "sss vertical"] {
             let p = samples.iter().find(|p| p.name == name).unwrap();
             assert_eq!(p.samples_passed, skin_count, "{name}: samples passed");
-            check_invocations(&ctx, p.fragment_invocations, skin_count, (W * H) as u64, name);
+            check_invocations(
+                &ctx,
+                p.fragment_invocations,
+                skin_count,
+                (W * H) as u64,
+                name,
+            );
         }
     }
 }
@@ -125,7 +162,13 @@ fn gpu_matches_cpu_reference() {
 /// early depth/stencil test (measured: the full screen, rounded up to its
 /// blocks), so there the occlusion count above is the proof, and the invocation
 /// count must at least cover the screen.
-fn check_invocations(ctx: &dermis::vk::context::Context, inv: Option<u64>, expected: u64, screen: u64, name: &str) {
+fn check_invocations(
+    ctx: &dermis::vk::context::Context,
+    inv: Option<u64>,
+    expected: u64,
+    screen: u64,
+    name: &str,
+) {
     let Some(inv) = inv else { return };
     if ctx.facts.name.contains("llvmpipe") {
         assert!(inv >= screen, "{name}: llvmpipe counted {inv} < {screen}");
@@ -142,7 +185,11 @@ fn no_skin_means_no_sss_work() {
     let (diffuse, depth, _) = synthetic();
     let skin = vec![false; W * H];
     let diffuse: Vec<[f32; 4]> = diffuse.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
-    let f16: Vec<u16> = diffuse.iter().flatten().map(|&v| half::f16::from_f32(v).to_bits()).collect();
+    let f16: Vec<u16> = diffuse
+        .iter()
+        .flatten()
+        .map(|&v| half::f16::from_f32(v).to_bits())
+        .collect();
     r.upload_sss_inputs(&f16, &depth, &skin).unwrap();
     let (gpu, samples) = r.run_sss_only().unwrap();
     for name in ["sss horizontal", "sss vertical"] {

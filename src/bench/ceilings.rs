@@ -107,7 +107,10 @@ pub fn measure(
                 ctx,
                 &fetch,
                 0,
-                &[("srcTex", Bind::Texture(img.view)), ("srcSampler", Bind::Sampler(sampler))],
+                &[
+                    ("srcTex", Bind::Texture(img.view)),
+                    ("srcSampler", Bind::Sampler(sampler)),
+                ],
             )
         };
         let probes: Vec<(&str, Option<(vk::DescriptorSet, ImageId)>)> = vec![

@@ -397,9 +397,11 @@ impl<'c> Renderer<'c> {
                         size: std::mem::size_of::<FrameUniforms>() as u64,
                     },
                 ),
-                ("shadowMap", Bind::Texture(targets.shadow.1.view)), ("shadowCompare", Bind::Sampler(samplers.shadow_compare)),
+                ("shadowMap", Bind::Texture(targets.shadow.1.view)),
+                ("shadowCompare", Bind::Sampler(samplers.shadow_compare)),
                 ("nearestClamp", Bind::Sampler(samplers.nearest_clamp)),
-                ("beckmannTex", Bind::Texture(beckmann.view)), ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
+                ("beckmannTex", Bind::Texture(beckmann.view)),
+                ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
             ],
         )?;
         let composite_set = pool.write_set(

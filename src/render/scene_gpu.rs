@@ -131,7 +131,8 @@ impl GpuObject {
             &[
                 ("albedoTex", Bind::Texture(albedo.view)),
                 ("normalTex", Bind::Texture(normal.view)),
-                ("specTex", Bind::Texture(spec.view)), ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
+                ("specTex", Bind::Texture(spec.view)),
+                ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
                 (
                     "material",
                     Bind::Uniform {

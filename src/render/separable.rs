@@ -105,7 +105,8 @@ impl SeparableSss {
                 0,
                 &[
                     ("colorTex", Bind::Texture(color.view)),
-                    ("depthTex", Bind::Texture(linear_depth.view)), ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
+                    ("depthTex", Bind::Texture(linear_depth.view)),
+                    ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
                     (
                         "kernel",
                         Bind::Uniform {

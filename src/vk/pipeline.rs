@@ -272,10 +272,7 @@ impl Pipeline {
 pub enum Bind {
     Texture(vk::ImageView),
     Sampler(vk::Sampler),
-    Uniform {
-        buffer: vk::Buffer,
-        size: u64,
-    },
+    Uniform { buffer: vk::Buffer, size: u64 },
 }
 
 /// A descriptor pool sized for the whole renderer (everything is allocated once).

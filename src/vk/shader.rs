@@ -67,7 +67,7 @@ fn stage_flags(s: ReflectShaderStageFlags) -> vk::ShaderStageFlags {
 fn descriptor_type(t: ReflectDescriptorType) -> Result<vk::DescriptorType> {
     Ok(match t {
         ReflectDescriptorType::Sampler => vk::DescriptorType::SAMPLER,
-                ReflectDescriptorType::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+        ReflectDescriptorType::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
         ReflectDescriptorType::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         ReflectDescriptorType::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
         ReflectDescriptorType::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,

@@ -18,10 +18,17 @@ pub fn ctx() -> Context {
 pub fn lps_path() -> Option<PathBuf> {
     let candidates = [
         std::env::var("DERMIS_ASSETS").ok().map(PathBuf::from),
-        Some(PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets/lee-perry-smith/LeePerrySmith.glb"))),
+        Some(PathBuf::from(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../shared/assets/lee-perry-smith/LeePerrySmith.glb"
+        ))),
     ];
     for c in candidates.into_iter().flatten() {
-        let p = if c.is_dir() { c.join("LeePerrySmith.glb") } else { c };
+        let p = if c.is_dir() {
+            c.join("LeePerrySmith.glb")
+        } else {
+            c
+        };
         if p.exists() {
             return Some(p);
         }
