@@ -110,7 +110,7 @@ struct Common {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// SSS method: separable | none.
+    /// SSS method: separable | ssg | ss-jittered | none.
     #[arg(long, default_value = "separable")]
     method: String,
     /// Kernel samples per SSS pass (odd: 9, 17, 33, ...).
@@ -130,6 +130,15 @@ struct Common {
     falloff: Option<Vec<f32>>,
     #[arg(long)]
     no_follow_surface: bool,
+    /// ssg: Gaussian fit of thesis Table 4.2: 6 or 4.
+    #[arg(long, default_value = "6")]
+    fit: String,
+    /// ssg: draw every Gaussian everywhere (no depth-based level of detail).
+    #[arg(long)]
+    no_lod: bool,
+    /// ssg: keep non-skin pixels out with the stencil test or a shader branch: stencil | branch.
+    #[arg(long, default_value = "stencil")]
+    mask: String,
     #[arg(long)]
     no_transmittance: bool,
     /// Number of heads in a grid (multi-character stress).
@@ -197,6 +206,9 @@ impl Common {
             params,
             follow_surface: !self.no_follow_surface,
             transmittance: !self.no_transmittance,
+            fit: self.fit.parse()?,
+            lod: !self.no_lod,
+            mask: self.mask.parse()?,
             heads: self.heads,
             distance_heads: distance,
             fovy_deg: self.fovy,

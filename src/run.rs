@@ -42,6 +42,10 @@ pub struct Report {
     pub sss_params: SssParams,
     pub follow_surface: bool,
     pub transmittance: bool,
+    /// ssg settings (reported for every method; only ssg reads them).
+    pub fit: crate::skin::ssg::GaussianFit,
+    pub lod: bool,
+    pub mask: crate::render::screen::MaskMode,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,
@@ -80,8 +84,9 @@ pub struct RunOptions {
     pub progress: bool,
 }
 
+/// The passes of every SSS method (their names start with the method's prefix).
 fn is_sss_pass(name: &str) -> bool {
-    name.starts_with("sss ")
+    ["sss ", "ssg ", "ss-jittered", "poisson"].iter().any(|p| name.starts_with(p))
 }
 
 /// The cost model of a pass by name, where one exists.
@@ -181,6 +186,9 @@ pub fn run(
         sss_params: settings.params,
         follow_surface: settings.follow_surface,
         transmittance: settings.transmittance,
+        fit: settings.fit,
+        lod: settings.lod,
+        mask: settings.mask,
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -3,6 +3,7 @@
 
 pub mod readback;
 pub mod scene_gpu;
+pub mod screen;
 pub mod separable;
 pub mod settings;
 pub mod upload;
@@ -17,7 +18,9 @@ use crate::scene::instancing::{grid_bounds, head_grid};
 use crate::scene::light::{shadow_frame, LightFrame};
 use crate::scene::Scene;
 use crate::skin::beckmann::beckmann_lut;
+use crate::skin::jittered::hable_kernel;
 use crate::skin::kernel::SeparableKernel;
+use crate::skin::ssg::{ssg_gaussians, Stretch};
 use crate::skin::transmittance::shrink_units;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
@@ -26,6 +29,7 @@ use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers
 use crate::vk::profiler::{PassSample, Profiler};
 use readback::{DumpedImage, ReadbackPlan};
 use scene_gpu::GpuObject;
+use screen::{JitteredSss, ScreenTargets, SsgInit, SsgSss};
 use separable::{set_viewport, SeparableSss, SssTargets, SssView, STENCIL_SKIN};
 pub use settings::{Method, RenderSettings};
 
@@ -92,6 +96,7 @@ pub struct Targets {
     pub linear_depth: (ImageId, Image),
     pub depth_stencil: (ImageId, Image),
     pub sss_tmp: (ImageId, Image),
+    pub sss_tmp2: (ImageId, Image),
     pub hdr: (ImageId, Image),
     pub ldr: (ImageId, Image),
 }
@@ -152,6 +157,7 @@ impl Targets {
                     | vk::ImageUsageFlags::TRANSFER_DST,
             )?,
             sss_tmp: add("sss intermediate", extent, DIFFUSE_FORMAT, color_usage)?,
+            sss_tmp2: add("sss intermediate 2", extent, DIFFUSE_FORMAT, color_usage)?,
             hdr: add("hdr", extent, DIFFUSE_FORMAT, color_usage)?,
             ldr: add(
                 "ldr",
@@ -162,8 +168,9 @@ impl Targets {
         })
     }
 
-    fn all_mut(&mut self) -> [&mut Image; 8] {
+    fn all_mut(&mut self) -> [&mut Image; 9] {
         [
+            &mut self.sss_tmp2.1,
             &mut self.shadow.1,
             &mut self.diffuse.1,
             &mut self.specular.1,
@@ -184,6 +191,7 @@ impl Targets {
             &self.linear_depth,
             &self.depth_stencil,
             &self.sss_tmp,
+            &self.sss_tmp2,
             &self.hdr,
             &self.ldr,
         ]
@@ -215,7 +223,24 @@ pub struct FrameGpu {
     beckmann: Image,
     objects: Vec<GpuObject>,
     instances: Vec<Mat4>,
-    pub sss: Option<SeparableSss>,
+    pub sss: Option<SssMethod>,
+}
+
+/// The SSS step of the frame, one variant per method.
+pub enum SssMethod {
+    Separable(SeparableSss),
+    Ssg(SsgSss),
+    Jittered(JitteredSss),
+}
+
+impl SssMethod {
+    fn destroy(&mut self, ctx: &Context) {
+        match self {
+            SssMethod::Separable(s) => s.destroy(ctx),
+            SssMethod::Ssg(s) => s.destroy(ctx),
+            SssMethod::Jittered(s) => s.destroy(ctx),
+        }
+    }
 }
 
 pub struct Renderer<'c> {
@@ -440,10 +465,17 @@ impl<'c> Renderer<'c> {
             &samplers,
         )?);
 
+        let stretch = Stretch::for_view(settings.height, settings.fovy_deg.to_radians(), mm);
+        let proj = camera.proj(aspect);
+        // The depth-buffer value of a surface at linear view depth d.
+        let to_ndc = move |d: f32| {
+            let c = proj * glam::Vec4::new(0.0, 0.0, -d, 1.0);
+            c.z / c.w
+        };
         let sss = match settings.method {
             Method::Separable => {
                 let kernel = SeparableKernel::build(settings.params, settings.samples)?;
-                Some(SeparableSss::new(
+                Some(SssMethod::Separable(SeparableSss::new(
                     ctx,
                     &pool,
                     &samplers,
@@ -452,8 +484,34 @@ impl<'c> Renderer<'c> {
                     &targets.sss_tmp.1,
                     &targets.linear_depth.1,
                     ds_format,
-                )?)
+                )?))
             }
+            Method::Ssg => Some(SssMethod::Ssg(SsgSss::new(
+                ctx,
+                &pool,
+                &samplers,
+                SsgInit {
+                    gaussians: ssg_gaussians(settings.fit),
+                    stretch,
+                    lod: settings.lod,
+                    mask: settings.mask,
+                    to_ndc: &to_ndc,
+                },
+                &targets.sss_tmp.1,
+                &targets.sss_tmp2.1,
+                &targets.linear_depth.1,
+                ds_format,
+            )?)),
+            Method::SsJittered => Some(SssMethod::Jittered(JitteredSss::new(
+                ctx,
+                &pool,
+                &samplers,
+                hable_kernel(),
+                stretch,
+                &targets.sss_tmp.1,
+                &targets.linear_depth.1,
+                ds_format,
+            )?)),
             Method::None => None,
         };
 
@@ -582,40 +640,23 @@ impl<'c> Renderer<'c> {
         })
     }
 
+    /// The depth-buffer value of a surface at linear view depth `d` (this camera).
+    pub fn ndc_depth(&self, d: f32) -> f32 {
+        let aspect = self.gpu.extent.width as f32 / self.gpu.extent.height as f32;
+        let c = self.gpu.camera.proj(aspect) * glam::Vec4::new(0.0, 0.0, -d, 1.0);
+        c.z / c.w
+    }
+
     /// Uploads synthetic inputs into the SSS targets (tests): diffuse RGBA as f16,
-    /// linear depth, and the stencil skin bit. Leaves them ready for the SSS passes.
-    pub fn upload_sss_inputs(
-        &mut self,
-        diffuse_f16: &[u16],
-        depth: &[f32],
-        skin: &[bool],
-    ) -> Result<()> {
+    /// linear depth (the depth buffer gets the matching projected depth), and the
+    /// stencil skin bit. Leaves them ready for the SSS passes.
+    pub fn upload_sss_inputs(&mut self, diffuse_f16: &[u16], depth: &[f32], skin: &[bool]) -> Result<()> {
+        let ndc: Vec<f32> = depth.iter().map(|&d| self.ndc_depth(d).clamp(0.0, 1.0)).collect();
         let t = &self.gpu.targets;
-        upload::fill_image(
-            self.ctx,
-            &t.diffuse.1,
-            vk::ImageAspectFlags::COLOR,
-            bytemuck::cast_slice(diffuse_f16),
-            AccessKind::FragmentSampledRead,
-        )?;
-        upload::fill_image(
-            self.ctx,
-            &t.linear_depth.1,
-            vk::ImageAspectFlags::COLOR,
-            bytemuck::cast_slice(depth),
-            AccessKind::FragmentSampledRead,
-        )?;
-        let stencil: Vec<u8> = skin
-            .iter()
-            .map(|&s| if s { STENCIL_SKIN as u8 } else { 0 })
-            .collect();
-        upload::fill_image(
-            self.ctx,
-            &t.depth_stencil.1,
-            vk::ImageAspectFlags::STENCIL,
-            &stencil,
-            AccessKind::DepthStencilReadOnly,
-        )?;
+        upload::fill_image(self.ctx, &t.diffuse.1, vk::ImageAspectFlags::COLOR, bytemuck::cast_slice(diffuse_f16), AccessKind::FragmentSampledRead)?;
+        upload::fill_image(self.ctx, &t.linear_depth.1, vk::ImageAspectFlags::COLOR, bytemuck::cast_slice(depth), AccessKind::FragmentSampledRead)?;
+        let stencil: Vec<u8> = skin.iter().map(|&s| if s { STENCIL_SKIN as u8 } else { 0 }).collect();
+        upload::fill_depth_stencil(self.ctx, &t.depth_stencil.1, &ndc, &stencil, AccessKind::DepthStencilReadOnly)?;
         self.resources.images[t.diffuse.0 .0].last = AccessKind::FragmentSampledRead;
         self.resources.images[t.linear_depth.0 .0].last = AccessKind::FragmentSampledRead;
         self.resources.images[t.depth_stencil.0 .0].last = AccessKind::DepthStencilReadOnly;
@@ -625,12 +666,10 @@ impl<'c> Renderer<'c> {
     /// Runs only the SSS passes on whatever the targets hold (tests) and reads
     /// back the diffuse target as f32 RGBA with the pass samples.
     pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
-        let sss = self
-            .gpu
-            .sss
-            .as_ref()
-            .context("the SSS-only run needs --method separable")?;
-        let passes = sss.passes(self.gpu.sss_targets(), self.gpu.sss_view());
+        if self.gpu.sss.is_none() {
+            bail!("the SSS-only run needs an SSS method");
+        }
+        let passes = self.gpu.sss_passes();
         let mut plan = ReadbackPlan::single(self.gpu.targets.diffuse.0);
         let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu.targets)?;
         let ctx = self.ctx;
@@ -674,6 +713,28 @@ impl FrameGpu {
         }
     }
 
+    pub fn screen_targets(&self) -> ScreenTargets {
+        let t = &self.targets;
+        ScreenTargets {
+            diffuse: (t.diffuse.0, t.diffuse.1.raw, t.diffuse.1.view),
+            rt1: (t.sss_tmp.0, t.sss_tmp.1.raw, t.sss_tmp.1.view),
+            rt2: (t.sss_tmp2.0, t.sss_tmp2.1.raw, t.sss_tmp2.1.view),
+            linear_depth: t.linear_depth.0,
+            depth_stencil: (t.depth_stencil.0, t.depth_stencil.1.view),
+            extent: self.extent,
+        }
+    }
+
+    /// The SSS method's passes (none without a method).
+    pub fn sss_passes(&self) -> Vec<Pass<'_>> {
+        match &self.sss {
+            Some(SssMethod::Separable(s)) => s.passes(self.sss_targets(), self.sss_view()),
+            Some(SssMethod::Ssg(s)) => s.passes(self.screen_targets()),
+            Some(SssMethod::Jittered(s)) => s.passes(self.screen_targets()),
+            None => Vec::new(),
+        }
+    }
+
     pub fn sss_view(&self) -> SssView {
         SssView {
             fovy_rad: self.settings.fovy_deg.to_radians(),
@@ -685,9 +746,7 @@ impl FrameGpu {
     /// The frame's passes in order.
     pub fn passes(&self) -> Vec<Pass<'_>> {
         let mut passes = vec![self.shadow_pass(), self.geometry_pass()];
-        if let Some(sss) = &self.sss {
-            passes.extend(sss.passes(self.sss_targets(), self.sss_view()));
-        }
+        passes.extend(self.sss_passes());
         passes.push(self.composite_pass());
         passes.push(self.tonemap_pass());
         passes

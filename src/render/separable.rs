@@ -187,7 +187,7 @@ impl SeparableSss {
                         pc,
                         &self.pipeline,
                         set,
-                        dst.2,
+                        &[dst.2],
                         t.depth_stencil.1,
                         extent,
                         STENCIL_SKIN,
@@ -234,27 +234,33 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
     }
 }
 
-/// A full-screen triangle into `color` (loaded, stored), stencil-tested against
-/// a read-only depth/stencil attachment.
+/// A full-screen triangle into `colors` (loaded, stored), tested against a
+/// read-only depth/stencil attachment (stencil reference `stencil_ref`, used when
+/// the pipeline tests stencil). `state` sets push constants and other dynamic state.
 #[allow(clippy::too_many_arguments)]
 pub fn fullscreen_stencil_draw(
     pc: &PassContext,
     pipeline: &Pipeline,
     set: vk::DescriptorSet,
-    color: vk::ImageView,
+    colors: &[vk::ImageView],
     depth_stencil: vk::ImageView,
     extent: vk::Extent2D,
     stencil_ref: u32,
-    push: impl Fn(&Context, vk::CommandBuffer),
+    state: impl Fn(&Context, vk::CommandBuffer),
 ) {
     let ctx = pc.ctx;
     let cmd = pc.cmd;
-    let color_att = [vk::RenderingAttachmentInfo::default()
-        .image_view(color)
-        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-        .load_op(vk::AttachmentLoadOp::LOAD)
-        .store_op(vk::AttachmentStoreOp::STORE)];
-    // Read-only depth/stencil: loaded for the test, never stored.
+    let color_att: Vec<vk::RenderingAttachmentInfo> = colors
+        .iter()
+        .map(|&v| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(v)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::LOAD)
+                .store_op(vk::AttachmentStoreOp::STORE)
+        })
+        .collect();
+    // Read-only depth/stencil: loaded for the tests, never stored.
     let ds_att = vk::RenderingAttachmentInfo::default()
         .image_view(depth_stencil)
         .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)
@@ -274,11 +280,10 @@ pub fn fullscreen_stencil_draw(
         ctx.device
             .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
         set_viewport(ctx, cmd, extent);
-        ctx.device.cmd_set_stencil_reference(
-            cmd,
-            vk::StencilFaceFlags::FRONT_AND_BACK,
-            stencil_ref,
-        );
+        if pipeline.has_stencil {
+            ctx.device
+                .cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, stencil_ref);
+        }
         ctx.device.cmd_bind_descriptor_sets(
             cmd,
             vk::PipelineBindPoint::GRAPHICS,
@@ -287,7 +292,7 @@ pub fn fullscreen_stencil_draw(
             &[set],
             &[],
         );
-        push(ctx, cmd);
+        state(ctx, cmd);
         ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
         ctx.device.cmd_end_rendering(cmd);
     }

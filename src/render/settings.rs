@@ -3,8 +3,10 @@
 use anyhow::{bail, Result};
 use serde::Serialize;
 
+use super::screen::MaskMode;
 use crate::scene::light::KeyLight;
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
+use crate::skin::ssg::GaussianFit;
 
 /// The SSS method of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -12,6 +14,10 @@ use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
 pub enum Method {
     /// Separable SSS (thesis ch. 6).
     Separable,
+    /// Screen-space sum of Gaussians (thesis ch. 4, "SS Full").
+    Ssg,
+    /// Hable et al.'s 13-tap jittered kernel in screen space ("SS Jittered").
+    SsJittered,
     /// No subsurface scattering: the baseline every method is compared to.
     None,
 }
@@ -21,8 +27,10 @@ impl std::str::FromStr for Method {
     fn from_str(s: &str) -> Result<Self> {
         match s.trim().to_ascii_lowercase().as_str() {
             "separable" | "ssss" => Ok(Method::Separable),
+            "ssg" => Ok(Method::Ssg),
+            "ss-jittered" | "jittered" => Ok(Method::SsJittered),
             "none" | "off" => Ok(Method::None),
-            other => bail!("unknown method '{other}' (valid: separable, none)"),
+            other => bail!("unknown method '{other}' (valid: separable, ssg, ss-jittered, none)"),
         }
     }
 }
@@ -31,6 +39,8 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Separable => "separable",
+            Method::Ssg => "ssg",
+            Method::SsJittered => "ss-jittered",
             Method::None => "none",
         }
     }
@@ -46,6 +56,12 @@ pub struct RenderSettings {
     pub params: SssParams,
     pub follow_surface: bool,
     pub transmittance: bool,
+    /// ssg: the Gaussian fit of Table 4.2.
+    pub fit: GaussianFit,
+    /// ssg: depth-based Gaussian level of detail (section 4.2.1).
+    pub lod: bool,
+    /// ssg: stencil test or dynamic branch.
+    pub mask: MaskMode,
     pub heads: u32,
     /// Camera distance from the head centre, in head heights.
     pub distance_heads: f32,
@@ -68,6 +84,9 @@ impl Default for RenderSettings {
             params: Preset::Table61.params(),
             follow_surface: true,
             transmittance: true,
+            fit: GaussianFit::Six,
+            lod: true,
+            mask: MaskMode::Stencil,
             heads: 1,
             distance_heads: 4.0,
             fovy_deg: 20.0,
@@ -177,7 +196,7 @@ mod tests {
 
     #[test]
     fn method_names_round_trip() {
-        for m in [Method::Separable, Method::None] {
+        for m in [Method::Separable, Method::Ssg, Method::SsJittered, Method::None] {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
         }
         assert!("ssg-typo".parse::<Method>().is_err());

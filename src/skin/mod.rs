@@ -12,3 +12,8 @@ pub mod kernel;
 pub mod profile;
 pub mod separable_ref;
 pub mod transmittance;
+pub mod jittered;
+pub mod poisson;
+pub mod screen_ref;
+pub mod ssg;
+pub mod ssg_ref;

@@ -48,6 +48,7 @@ pub struct DeviceFacts {
     pub timestamp_valid_bits: u32,
     pub pipeline_statistics: bool,
     pub occlusion_query_precise: bool,
+    pub independent_blend: bool,
     pub max_image_dimension_2d: u32,
     pub sub_texel_precision_bits: u32,
 }
@@ -265,6 +266,8 @@ impl Context {
         let base_features = vk::PhysicalDeviceFeatures::default()
             .pipeline_statistics_query(features.pipeline_statistics_query == vk::TRUE)
             .occlusion_query_precise(features.occlusion_query_precise == vk::TRUE)
+            // Sum-of-Gaussians SSS writes RT1 unblended and blends RTF in one MRT pass.
+            .independent_blend(features.independent_blend == vk::TRUE)
             .sampler_anisotropy(false);
         let mut features2 = vk::PhysicalDeviceFeatures2::default().features(base_features);
         let device_info = vk::DeviceCreateInfo::default()
@@ -315,6 +318,7 @@ impl Context {
             timestamp_valid_bits: family.timestamp_valid_bits,
             pipeline_statistics: features.pipeline_statistics_query == vk::TRUE,
             occlusion_query_precise: features.occlusion_query_precise == vk::TRUE,
+            independent_blend: features.independent_blend == vk::TRUE,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
             sub_texel_precision_bits: props.limits.sub_texel_precision_bits,
         };

@@ -16,10 +16,14 @@ pub enum VertexInput {
     MeshPositionOnly,
 }
 
-/// Blend of colour attachment 0..n (the same for all attachments).
+/// Blending of the colour attachments.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Blend {
     None,
+    /// Attachment `n` mixes `src * c + dst * (1 - c)` per channel with the dynamic
+    /// blend constant `c` (thesis eq. 4.9; alpha takes the source: constant alpha 1);
+    /// the other attachments are written unblended.
+    ConstantMix(usize),
 }
 
 #[derive(Clone, Debug)]
@@ -69,6 +73,8 @@ pub struct Pipeline {
     pub reflection: Reflection,
     pub bind_point: vk::PipelineBindPoint,
     pub name: String,
+    /// Whether the pipeline tests stencil (its reference is dynamic state).
+    pub has_stencil: bool,
 }
 
 fn make_layout(
@@ -179,8 +185,18 @@ impl Pipeline {
         let attachments: Vec<vk::PipelineColorBlendAttachmentState> = d
             .color_formats
             .iter()
-            .map(|_| match d.blend {
-                Blend::None => vk::PipelineColorBlendAttachmentState::default()
+            .enumerate()
+            .map(|(i, _)| match d.blend {
+                Blend::ConstantMix(n) if n == i => vk::PipelineColorBlendAttachmentState::default()
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::CONSTANT_COLOR)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_CONSTANT_COLOR)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::CONSTANT_ALPHA)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_CONSTANT_ALPHA)
+                    .alpha_blend_op(vk::BlendOp::ADD)
+                    .color_write_mask(vk::ColorComponentFlags::RGBA),
+                _ => vk::PipelineColorBlendAttachmentState::default()
                     .color_write_mask(vk::ColorComponentFlags::RGBA),
             })
             .collect();
@@ -188,6 +204,9 @@ impl Pipeline {
         let mut dynamic = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         if d.stencil.is_some() {
             dynamic.push(vk::DynamicState::STENCIL_REFERENCE);
+        }
+        if matches!(d.blend, Blend::ConstantMix(_)) {
+            dynamic.push(vk::DynamicState::BLEND_CONSTANTS);
         }
         let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
@@ -225,6 +244,7 @@ impl Pipeline {
             reflection,
             bind_point: vk::PipelineBindPoint::GRAPHICS,
             name: d.name.clone(),
+            has_stencil: d.stencil.is_some(),
         })
     }
 

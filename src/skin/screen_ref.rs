@@ -1,0 +1,635 @@
+//! CPU references of the single-pass screen-space SSS variants: the
+//! jittered 13-tap kernel (Hable et al., thesis' "SS Jittered") and the
+//! Poisson-disk kernel with depth/normal-aware weights (seed 003), plus the
+//! texture-sampling rules they share with [`super::ssg_ref`].
+//!
+//! As in [`super::separable_ref`], every operation mirrors the shader: f32
+//! arithmetic in the stated order, Vulkan bilinear filtering with
+//! CLAMP_TO_EDGE, and rounding through f16 after every write to an RGBA16F
+//! target, so GPU and CPU images can be compared per pixel.
+//!
+//! Conventions: images are row-major `width x height`; the uv of pixel
+//! `(x, y)` is `((x + 0.5)/width, (y + 0.5)/height)`; non-skin pixels are
+//! never written.
+
+use std::f32::consts::PI;
+
+use super::jittered::{jitter_angle, JitteredKernel};
+use super::poisson::{mip_level, poisson_disk_32, sample_count, PoissonParams};
+use super::separable_ref::round_f16;
+use super::ssg::Stretch;
+
+/// Inputs of a single-pass screen-space SSS effect (slices `width*height`).
+#[derive(Clone, Copy, Debug)]
+pub struct ScreenInput<'a> {
+    pub width: usize,
+    pub height: usize,
+    /// Diffuse light RGBA (RGBA16F-exact); alpha is the per-pixel SSS
+    /// strength (0 on non-skin).
+    pub diffuse: &'a [[f32; 4]],
+    /// View depth in scene units, > 0 on skin.
+    pub linear_depth: &'a [f32],
+    /// Stencil skin bit per pixel.
+    pub skin: &'a [bool],
+}
+
+impl ScreenInput<'_> {
+    /// Panics on a size mismatch: a caller bug, not user input.
+    fn check(&self) {
+        let n = self.width * self.height;
+        assert!(self.width > 0 && self.height > 0, "empty image");
+        assert_eq!(self.diffuse.len(), n, "diffuse size");
+        assert_eq!(self.linear_depth.len(), n, "linear_depth size");
+        assert_eq!(self.skin.len(), n, "skin mask size");
+    }
+}
+
+/// Bilinear taps along one axis, Vulkan's rule with CLAMP_TO_EDGE (the same
+/// rule as `separable_ref`): `t = coord * size - 0.5`, `i0 = floor(t)`,
+/// `frac = t - i0`, indices `i0`, `i0 + 1` clamped into `[0, size - 1]`.
+fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
+    let t = coord * size as f32 - 0.5;
+    let t0 = t.floor();
+    let frac = t - t0;
+    let max = size as i64 - 1;
+    // `as i64` saturates (NaN -> 0), so out-of-range coords stay in bounds.
+    let i0 = t0 as i64;
+    (
+        i0.clamp(0, max) as usize,
+        (i0 + 1).clamp(0, max) as usize,
+        frac,
+    )
+}
+
+/// `a + (b - a) * s`, the lerp form used by every reference here.
+fn lerp(a: f32, b: f32, s: f32) -> f32 {
+    a + (b - a) * s
+}
+
+fn bilinear<const C: usize>(tex: &[[f32; C]], w: usize, h: usize, u: f32, v: f32) -> [f32; C] {
+    let (x0, x1, fx) = axis_taps(u, w);
+    let (y0, y1, fy) = axis_taps(v, h);
+    let (t00, t10) = (tex[y0 * w + x0], tex[y0 * w + x1]);
+    let (t01, t11) = (tex[y1 * w + x0], tex[y1 * w + x1]);
+    let mut out = [0.0; C];
+    for c in 0..C {
+        out[c] = lerp(lerp(t00[c], t10[c], fx), lerp(t01[c], t11[c], fx), fy);
+    }
+    out
+}
+
+/// Bilinear RGBA fetch at `(u, v)` (Vulkan rule, CLAMP_TO_EDGE).
+pub fn bilinear4(img: &[[f32; 4]], w: usize, h: usize, u: f32, v: f32) -> [f32; 4] {
+    bilinear(img, w, h, u, v)
+}
+
+/// Bilinear single-channel fetch at `(u, v)` (Vulkan rule, CLAMP_TO_EDGE).
+pub fn bilinear1(img: &[f32], w: usize, h: usize, u: f32, v: f32) -> f32 {
+    // Same rule as bilinear4; a `[f32; 1]` view avoids a copy.
+    let (x0, x1, fx) = axis_taps(u, w);
+    let (y0, y1, fy) = axis_taps(v, h);
+    lerp(
+        lerp(img[y0 * w + x0], img[y0 * w + x1], fx),
+        lerp(img[y1 * w + x0], img[y1 * w + x1], fx),
+        fy,
+    )
+}
+
+/// uv of the centre of pixel `(x, y)`.
+pub fn pixel_uv(x: usize, y: usize, w: usize, h: usize) -> [f32; 2] {
+    [(x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32]
+}
+
+/// One mip level: `(width, height, texels)`.
+pub type MipLevel<T> = (usize, usize, Vec<T>);
+
+/// Size of the level below a `w x h` level: halved with integer division,
+/// at least 1 (Vulkan's rule).
+fn next_size(w: usize, h: usize) -> (usize, usize) {
+    ((w / 2).max(1), (h / 2).max(1))
+}
+
+/// Generic 2x2 box-filter mip chain; `avg(a, b, c, d)` must compute
+/// `((a + b) + (c + d)) * 0.25` (the order the GPU shader uses).
+fn mip_chain<T: Copy>(
+    level0: &[T],
+    w: usize,
+    h: usize,
+    levels: u32,
+    first: impl Fn(T) -> T,
+    avg: impl Fn(T, T, T, T) -> T,
+) -> Vec<MipLevel<T>> {
+    assert_eq!(level0.len(), w * h, "level0 size");
+    assert!(levels >= 1, "a mip chain has at least level 0");
+    let mut chain: Vec<MipLevel<T>> = vec![(w, h, level0.iter().map(|&t| first(t)).collect())];
+    for _ in 1..levels {
+        let (pw, ph, prev) = chain.last().expect("level 0 exists");
+        let (pw, ph) = (*pw, *ph);
+        let (nw, nh) = next_size(pw, ph);
+        let mut next = Vec::with_capacity(nw * nh);
+        for y in 0..nh {
+            for x in 0..nw {
+                let (x0, x1) = ((2 * x).min(pw - 1), (2 * x + 1).min(pw - 1));
+                let (y0, y1) = ((2 * y).min(ph - 1), (2 * y + 1).min(ph - 1));
+                next.push(avg(
+                    prev[y0 * pw + x0],
+                    prev[y0 * pw + x1],
+                    prev[y1 * pw + x0],
+                    prev[y1 * pw + x1],
+                ));
+            }
+        }
+        chain.push((nw, nh, next));
+    }
+    chain
+}
+
+/// RGBA mip chain of `levels` levels (level 0 included).
+///
+/// Level `l` is `max(1, w_{l-1}/2) x max(1, h_{l-1}/2)`; texel `(x, y)` is
+/// `((a + b) + (c + d)) * 0.25` of the source texels `a = (2x, 2y)`,
+/// `b = (2x+1, 2y)`, `c = (2x, 2y+1)`, `d = (2x+1, 2y+1)`, each index clamped
+/// to the source size (odd sizes drop the last row/column, as a compute
+/// downsample with clamped fetches does). With `round_f16` every level
+/// (level 0 too, a no-op for f16-exact input) is rounded as RGBA16F storage.
+pub fn mip_chain4(
+    level0: &[[f32; 4]],
+    w: usize,
+    h: usize,
+    levels: u32,
+    round_f16: bool,
+) -> Vec<MipLevel<[f32; 4]>> {
+    let store = |t: [f32; 4]| if round_f16 { self::round4(t) } else { t };
+    mip_chain(level0, w, h, levels, store, |a, b, c, d| {
+        let mut o = [0.0f32; 4];
+        for i in 0..4 {
+            o[i] = ((a[i] + b[i]) + (c[i] + d[i])) * 0.25;
+        }
+        store(o)
+    })
+}
+
+/// Single-channel f32 mip chain (same rule as [`mip_chain4`], no rounding:
+/// the depth pyramid is R32F).
+pub fn mip_chain1(level0: &[f32], w: usize, h: usize, levels: u32) -> Vec<MipLevel<f32>> {
+    mip_chain(
+        level0,
+        w,
+        h,
+        levels,
+        |t| t,
+        |a, b, c, d| ((a + b) + (c + d)) * 0.25,
+    )
+}
+
+fn round4(t: [f32; 4]) -> [f32; 4] {
+    round_f16(t)
+}
+
+/// Bilinear RGBA fetch on level `lod` of a chain (the level's own size
+/// defines the texel grid; uv is shared by all levels).
+pub fn bilinear_lod4(chain: &[MipLevel<[f32; 4]>], lod: u32, u: f32, v: f32) -> [f32; 4] {
+    let (w, h, img) = &chain[lod as usize];
+    bilinear4(img, *w, *h, u, v)
+}
+
+/// Bilinear single-channel fetch on level `lod` of a chain.
+pub fn bilinear_lod1(chain: &[MipLevel<f32>], lod: u32, u: f32, v: f32) -> f32 {
+    let (w, h, img) = &chain[lod as usize];
+    bilinear1(img, *w, *h, u, v)
+}
+
+/// Screen-space adaptation of Hable et al.'s jittered 13-tap kernel.
+///
+/// Per skin pixel `p = (x, y)`:
+/// * `colorM = src[p]` where `src` is a copy of the diffuse image (the GPU
+///   seeds an intermediate target with a copy and samples that);
+/// * `[s_x, s_y] = stretch.factors(..) * colorM.a` (eq. 4.1-4.4);
+/// * `theta = jitter_angle(x, y)`; mid ring `k = 0..6`: angle
+///   `a = theta + k * PI/3`, radius `mid_radius_mm`; wide ring: angle
+///   `theta + PI/6 + k * PI/3`, radius `wide_radius_mm`;
+/// * mm offset `(cos a * r, sin a * r)`; pixel offset
+///   `(ox * s_x / 3, oy * s_y / 3)` (Listing 4.1: one mm of sigma spans
+///   `s/3` pixels); uv offset `px / (width, height)`; `c = bilinear4(src,
+///   uv + off)`;
+/// * `out.rgb = center * colorM.rgb + sum_mid (mid/6) c + sum_wide (wide/6) c`,
+///   accumulated in that order (centre, then the six mid taps, then the six
+///   wide taps); `out.a = colorM.a`; stored as f16.
+pub fn jittered(input: &ScreenInput, kernel: &JitteredKernel, stretch: Stretch) -> Vec<[f32; 4]> {
+    input.check();
+    let (w, h) = (input.width, input.height);
+    let src = input.diffuse;
+    let mut out = input.diffuse.to_vec();
+    let mid_w = kernel.mid.map(|m| m / 6.0);
+    let wide_w = kernel.wide.map(|m| m / 6.0);
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
+            if !input.skin[p] {
+                continue;
+            }
+            let color_m = src[p];
+            let [sx, sy] = stretch.factors(input.linear_depth, w, h, x, y);
+            let (sx, sy) = (sx * color_m[3], sy * color_m[3]);
+            let [u, v] = pixel_uv(x, y, w, h);
+            let theta = jitter_angle(x as u32, y as u32);
+            let mut acc = [0.0f32; 3];
+            for c in 0..3 {
+                acc[c] = kernel.center[c] * color_m[c];
+            }
+            let mut ring = |phase: f32, radius: f32, weight: [f32; 3]| {
+                for k in 0..6 {
+                    let a = theta + phase + k as f32 * (PI / 3.0);
+                    let (ox, oy) = (a.cos() * radius, a.sin() * radius);
+                    let (px, py) = (ox * sx / 3.0, oy * sy / 3.0);
+                    let s = bilinear4(src, w, h, u + px / w as f32, v + py / h as f32);
+                    for c in 0..3 {
+                        acc[c] += weight[c] * s[c];
+                    }
+                }
+            };
+            ring(0.0, kernel.mid_radius_mm, mid_w);
+            ring(PI / 6.0, kernel.wide_radius_mm, wide_w);
+            out[p] = round_f16([acc[0], acc[1], acc[2], color_m[3]]);
+        }
+    }
+    out
+}
+
+/// Poisson-disk SSS (seed 003's pseudo code) with mip-mapped fetches.
+///
+/// Chains of `levels` levels are built from the diffuse (RGBA16F), depth
+/// (R32F) and normal (RGBA16F) images with [`mip_chain4`]/[`mip_chain1`].
+/// Per skin pixel:
+/// * `colorM = diffuse[p]`, `d = depth[p]`, `n = normals level 0 [p].xyz`
+///   (the f16-rounded normal, as the GPU reads it from its RGBA16F target);
+/// * `R_px = radius_mm / (mm_per_unit * 2 * d * tan(fovy/2)) * height * colorM.a`
+///   evaluated left to right as written (the kernel radius in pixels: one
+///   pixel covers `mm_per_unit * 2 d tan(fovy/2) / height` mm);
+/// * `N = sample_count(R_px)`, `lod = mip_level(R_px, levels - 1)`;
+/// * `acc = colorM.rgb`, `total = 1`; for each of the first `N` disk points
+///   `q_i`: `uv_s = uv + (q_i.x R_px / width, q_i.y R_px / height)`;
+///   `c`, `ds`, `ns` bilinear on level `lod`; `dD = (ds - d) * mm_per_unit`;
+///   `wc = c.a * exp(-depth_sensitivity dD^2) *
+///   exp(-normal_sensitivity (1 - clamp(dot(ns, n), 0, 1)))`; per channel
+///   `w = wc * exp(-falloff_c * (q.x^2 + q.y^2))`, `acc += c * w`,
+///   `total += w`;
+/// * `out.rgb = acc / total`, `out.a = colorM.a`, stored as f16.
+pub fn poisson(
+    input: &ScreenInput,
+    normals: &[[f32; 4]],
+    params: &PoissonParams,
+    fovy_rad: f32,
+    mm_per_unit: f32,
+    levels: u32,
+) -> Vec<[f32; 4]> {
+    input.check();
+    let (w, h) = (input.width, input.height);
+    assert_eq!(normals.len(), w * h, "normals size");
+    let color_chain = mip_chain4(input.diffuse, w, h, levels, true);
+    let depth_chain = mip_chain1(input.linear_depth, w, h, levels);
+    let normal_chain = mip_chain4(normals, w, h, levels, true);
+    let disk = poisson_disk_32();
+    let tan_half = (0.5 * fovy_rad).tan();
+    let mut out = input.diffuse.to_vec();
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
+            if !input.skin[p] {
+                continue;
+            }
+            let color_m = input.diffuse[p];
+            let d = input.linear_depth[p];
+            let n = normal_chain[0].2[p];
+            let r_px =
+                params.radius_mm / (mm_per_unit * 2.0 * d * tan_half) * h as f32 * color_m[3];
+            let count = sample_count(r_px) as usize;
+            let lod = mip_level(r_px, levels - 1);
+            let [u, v] = pixel_uv(x, y, w, h);
+            let mut acc = [color_m[0], color_m[1], color_m[2]];
+            let mut total = [1.0f32; 3];
+            for q in &disk[..count] {
+                let (us, vs) = (u + q[0] * r_px / w as f32, v + q[1] * r_px / h as f32);
+                let c = bilinear_lod4(&color_chain, lod, us, vs);
+                let ds = bilinear_lod1(&depth_chain, lod, us, vs);
+                let ns = bilinear_lod4(&normal_chain, lod, us, vs);
+                let dd = (ds - d) * mm_per_unit;
+                let dot = ns[0] * n[0] + ns[1] * n[1] + ns[2] * n[2];
+                let wc = c[3]
+                    * (-params.depth_sensitivity * dd * dd).exp()
+                    * (-params.normal_sensitivity * (1.0 - dot.clamp(0.0, 1.0))).exp();
+                let r2 = q[0] * q[0] + q[1] * q[1];
+                for ch in 0..3 {
+                    let wch = wc * (-params.falloff[ch] * r2).exp();
+                    acc[ch] += c[ch] * wch;
+                    total[ch] += wch;
+                }
+            }
+            out[p] = round_f16([
+                acc[0] / total[0],
+                acc[1] / total[1],
+                acc[2] / total[2],
+                color_m[3],
+            ]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::jittered::hable_kernel;
+    use super::*;
+
+    /// Deterministic pseudo-random f16-representable colours in [0, 1).
+    fn noise_image(n: usize, alpha: f32) -> Vec<[f32; 4]> {
+        let mut state = 0x2545_f491_u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        (0..n)
+            .map(|_| round_f16([next(), next(), next(), alpha]))
+            .collect()
+    }
+
+    fn assert_close(a: &[[f32; 4]], b: &[[f32; 4]], rel: f32) {
+        for (i, (x, y)) in a.iter().zip(b).enumerate() {
+            for c in 0..4 {
+                assert!(
+                    (x[c] - y[c]).abs() <= rel * y[c].abs().max(1e-3),
+                    "pixel {i} channel {c}: {x:?} vs {y:?}"
+                );
+            }
+        }
+    }
+
+    /// A head-sized view: 1 unit = 230 mm at depth 1 with the thesis' fov.
+    fn stretch() -> Stretch {
+        Stretch::THESIS
+    }
+
+    #[test]
+    fn bilinear_matches_the_vulkan_rule() {
+        let (w, h) = (3, 2);
+        let img: Vec<f32> = (0..6).map(|i| i as f32).collect();
+        // Texel centres return the texel.
+        for y in 0..h {
+            for x in 0..w {
+                let [u, v] = pixel_uv(x, y, w, h);
+                assert_eq!(bilinear1(&img, w, h, u, v), img[y * w + x]);
+            }
+        }
+        // Halfway between texels 0 and 1, and clamped beyond the edges.
+        assert_eq!(bilinear1(&img, w, h, 1.0 / 3.0, 0.25), 0.5);
+        assert_eq!(bilinear1(&img, w, h, -5.0, 0.25), 0.0);
+        assert_eq!(bilinear1(&img, w, h, 9.0, 9.0), 5.0);
+        let img4: Vec<[f32; 4]> = img.iter().map(|&t| [t, 2.0 * t, -t, 1.0]).collect();
+        assert_eq!(
+            bilinear4(&img4, w, h, 0.5, 0.5),
+            // u = 0.5 is column 1's centre; v = 0.5 is halfway between rows.
+            [2.5, 5.0, -2.5, 1.0]
+        );
+    }
+
+    #[test]
+    fn mip_chain_sizes_and_values() {
+        let (w, h) = (7, 5);
+        let img: Vec<f32> = (0..w * h).map(|i| i as f32).collect();
+        let chain = mip_chain1(&img, w, h, 4);
+        let sizes: Vec<(usize, usize)> = chain.iter().map(|l| (l.0, l.1)).collect();
+        assert_eq!(sizes, [(7, 5), (3, 2), (1, 1), (1, 1)]);
+        // Level 1 texel (2, 1): source texels (4,2), (5,2), (4,3), (5,3).
+        let want = ((img[2 * 7 + 4] + img[2 * 7 + 5]) + (img[3 * 7 + 4] + img[3 * 7 + 5])) * 0.25;
+        assert_eq!(chain[1].2[5], want);
+        // Level 2 from the 3x2 level: (0,0), (1,0), (0,1), (1,1).
+        let l1 = &chain[1].2;
+        assert_eq!(chain[2].2[0], ((l1[0] + l1[1]) + (l1[3] + l1[4])) * 0.25);
+        // A 1-wide source clamps the odd index.
+        let col = mip_chain1(&[1.0, 3.0, 5.0, 7.0], 1, 4, 2);
+        assert_eq!((col[1].0, col[1].1), (1, 2));
+        assert_eq!(col[1].2, [2.0, 6.0]);
+        // RGBA16F chains are rounded.
+        let rgba: Vec<[f32; 4]> = (0..4).map(|i| [0.1 * i as f32 + 0.01; 4]).collect();
+        let c4 = mip_chain4(&rgba, 2, 2, 2, true);
+        assert_eq!(c4[1].2[0], round_f16(c4[1].2[0]));
+        assert_eq!(c4[0].2[1], round_f16(rgba[1]));
+        let raw = mip_chain4(&rgba, 2, 2, 2, false);
+        assert_eq!(raw[0].2, rgba);
+        assert_eq!(bilinear_lod1(&chain, 2, 0.3, 0.9), chain[2].2[0]);
+        assert_eq!(bilinear_lod4(&c4, 1, 0.1, 0.1), c4[1].2[0]);
+    }
+
+    fn scene(w: usize, h: usize, alpha: f32) -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
+        let diffuse = noise_image(w * h, alpha);
+        let depth: Vec<f32> = (0..w * h).map(|i| 1.0 + (i % 5) as f32 * 0.0003).collect();
+        let skin: Vec<bool> = (0..w * h).map(|i| (i / 4) % 3 != 0).collect();
+        (diffuse, depth, skin)
+    }
+
+    #[test]
+    fn jittered_leaves_non_skin_untouched_and_blurs_skin() {
+        let (w, h) = (24, 20);
+        let (diffuse, depth, skin) = scene(w, h, 1.0);
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        };
+        let out = jittered(&input, &hable_kernel(), stretch());
+        let mut changed = 0;
+        for i in 0..w * h {
+            if skin[i] {
+                changed += usize::from(out[i] != diffuse[i]);
+                assert_eq!(out[i][3], diffuse[i][3]);
+                assert_eq!(out[i], round_f16(out[i]));
+            } else {
+                assert_eq!(
+                    out[i].map(f32::to_bits),
+                    diffuse[i].map(f32::to_bits),
+                    "pixel {i}"
+                );
+            }
+        }
+        assert!(changed > w * h / 2, "only {changed} skin pixels changed");
+    }
+
+    #[test]
+    fn jittered_constant_and_zero_strength() {
+        let (w, h) = (16, 12);
+        let colour = round_f16([0.8, 0.45, 0.3, 1.0]);
+        let diffuse = vec![colour; w * h];
+        let depth = vec![1.0; w * h];
+        let skin = vec![true; w * h];
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        };
+        assert_close(
+            &jittered(&input, &hable_kernel(), stretch()),
+            &diffuse,
+            1e-3,
+        );
+        // Strength 0: every tap lands on the centre texel.
+        let flat = noise_image(w * h, 0.0);
+        let input = ScreenInput {
+            diffuse: &flat,
+            ..input
+        };
+        assert_close(&jittered(&input, &hable_kernel(), stretch()), &flat, 1e-3);
+    }
+
+    #[test]
+    fn jittered_spreads_a_point_further_in_red() {
+        let (w, h) = (41, 41);
+        let mut diffuse = vec![[0.0, 0.0, 0.0, 1.0]; w * h];
+        let centre = (h / 2) * w + w / 2;
+        diffuse[centre] = [1.0, 1.0, 1.0, 1.0];
+        // Depth 1 with alpha 31.5: one mm of sigma spans 10.5 pixels.
+        let depth = vec![1.0; w * h];
+        let skin = vec![true; w * h];
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        };
+        let out = jittered(&input, &hable_kernel(), stretch());
+        // Red reaches ~2 mm * 10.5 px = ~21 px away; green/blue stay within
+        // the mid ring (~0.74 mm = ~8 px).
+        let far = |c: usize| {
+            (0..w * h)
+                .filter(|&i| {
+                    let (x, y) = ((i % w) as f32 - 20.0, (i / w) as f32 - 20.0);
+                    out[i][c] > 0.0 && (x * x + y * y).sqrt() > 12.0
+                })
+                .count()
+        };
+        assert!(far(0) > 0);
+        assert_eq!(far(1), 0);
+        assert_eq!(far(2), 0);
+    }
+
+    fn flat_normals(n: usize) -> Vec<[f32; 4]> {
+        vec![[0.0, 0.0, 1.0, 0.0]; n]
+    }
+
+    #[test]
+    fn poisson_leaves_non_skin_untouched_and_blurs_skin() {
+        let (w, h) = (32, 24);
+        let (diffuse, depth, skin) = scene(w, h, 1.0);
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        };
+        let params = PoissonParams::from_profile();
+        let out = poisson(
+            &input,
+            &flat_normals(w * h),
+            &params,
+            20f32.to_radians(),
+            10.0,
+            4,
+        );
+        let mut changed = 0;
+        for i in 0..w * h {
+            if skin[i] {
+                changed += usize::from(out[i] != diffuse[i]);
+                assert_eq!(out[i][3], diffuse[i][3]);
+            } else {
+                assert_eq!(out[i].map(f32::to_bits), diffuse[i].map(f32::to_bits));
+            }
+        }
+        assert!(changed > w * h / 2, "only {changed} skin pixels changed");
+    }
+
+    #[test]
+    fn poisson_keeps_a_constant_image_constant() {
+        let (w, h) = (40, 30);
+        let colour = round_f16([0.8, 0.45, 0.3, 1.0]);
+        let diffuse = vec![colour; w * h];
+        let skin = vec![true; w * h];
+        // Varying depth and normals only change weights, not the average.
+        let depth: Vec<f32> = (0..w * h).map(|i| 0.5 + (i % 7) as f32 * 0.01).collect();
+        let normals: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| {
+                let a = (i % 11) as f32 * 0.1;
+                round_f16([a.sin(), 0.0, a.cos(), 0.0])
+            })
+            .collect();
+        let input = ScreenInput {
+            width: w,
+            height: h,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        };
+        let params = PoissonParams::from_profile();
+        for levels in [1, 3] {
+            let out = poisson(&input, &normals, &params, 20f32.to_radians(), 10.0, levels);
+            assert_close(&out, &diffuse, 1e-3);
+        }
+    }
+
+    #[test]
+    fn poisson_ignores_samples_across_depth_steps() {
+        // Left half red at depth 1, right half blue 20 mm behind (1 unit =
+        // 10 mm, so the 3.5 mm disk spans ~16 px): the depth weight
+        // (sensitivity ~0.04/mm^2) kills the cross-edge samples.
+        let (w, h) = (32, 16);
+        let mm_per_unit = 10.0;
+        let mut diffuse = Vec::new();
+        let mut depth = Vec::new();
+        for _ in 0..h {
+            for x in 0..w {
+                let left = x < w / 2;
+                diffuse.push(if left {
+                    [1.0, 0.0, 0.0, 1.0]
+                } else {
+                    [0.0, 0.0, 1.0, 1.0]
+                });
+                depth.push(if left { 1.0 } else { 3.0 });
+            }
+        }
+        let skin = vec![true; w * h];
+        let run = |depth: &[f32]| {
+            let input = ScreenInput {
+                width: w,
+                height: h,
+                diffuse: &diffuse,
+                linear_depth: depth,
+                skin: &skin,
+            };
+            poisson(
+                &input,
+                &flat_normals(w * h),
+                &PoissonParams::from_profile(),
+                20f32.to_radians(),
+                mm_per_unit,
+                1,
+            )
+        };
+        // First blue pixel of a middle row.
+        let p = (h / 2) * w + w / 2;
+        let step = run(&depth);
+        assert!(step[p][0] < 1e-3, "red bled across the step: {:?}", step[p]);
+        // Control: at equal depth red does bleed in.
+        let flat = run(&vec![3.0; w * h]);
+        assert!(
+            flat[p][0] > 0.05,
+            "no bleeding at equal depth: {:?}",
+            flat[p]
+        );
+    }
+}
