@@ -9,9 +9,9 @@ use dermis::render::{Method, RenderSettings, Renderer, SssMethod};
 use dermis::scene::default_scene;
 use dermis::skin::jittered::hable_kernel;
 use dermis::skin::screen_ref::{jittered, ScreenInput};
-use dermis::skin::separable_ref::round_f16;
+use dermis::skin::separable_ref::{round_f16, F16Rounding};
 use dermis::skin::ssg::{GaussianFit, Stretch};
-use dermis::skin::ssg_ref::{ssg, SsgInput};
+use dermis::skin::ssg_ref::{ssg_with_rounding, SsgInput};
 use dermis::vk::profiler::PassSample;
 
 const W: usize = 96;
@@ -41,12 +41,30 @@ fn synthetic() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
     (diffuse, depth, skin)
 }
 
+/// One head height away: the near plane (0.01 of the distance) is in front of the
+/// whole synthetic depth ramp, so every depth maps into the depth buffer's range.
 fn settings(method: Method) -> RenderSettings {
-    RenderSettings { width: W as u32, height: H as u32, shadow_size: 64, method, ..RenderSettings::default() }
+    RenderSettings {
+        width: W as u32,
+        height: H as u32,
+        shadow_size: 64,
+        method,
+        distance_heads: 1.0,
+        ..RenderSettings::default()
+    }
 }
 
-fn run(r: &mut Renderer, diffuse: &[[f32; 4]], depth: &[f32], skin: &[bool]) -> (Vec<[f32; 4]>, Vec<PassSample>) {
-    let f16: Vec<u16> = diffuse.iter().flatten().map(|&v| half::f16::from_f32(v).to_bits()).collect();
+fn run(
+    r: &mut Renderer,
+    diffuse: &[[f32; 4]],
+    depth: &[f32],
+    skin: &[bool],
+) -> (Vec<[f32; 4]>, Vec<PassSample>) {
+    let f16: Vec<u16> = diffuse
+        .iter()
+        .flatten()
+        .map(|&v| half::f16::from_f32(v).to_bits())
+        .collect();
     r.upload_sss_inputs(&f16, depth, skin).unwrap();
     r.run_sss_only().unwrap()
 }
@@ -67,7 +85,10 @@ fn worst_ulps(gpu: &[[f32; 4]], cpu: &[[f32; 4]]) -> (f32, f32) {
 }
 
 fn samples(s: &[PassSample], name: &str) -> u64 {
-    s.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no pass {name}")).samples_passed
+    s.iter()
+        .find(|p| p.name == name)
+        .unwrap_or_else(|| panic!("no pass {name}"))
+        .samples_passed
 }
 
 #[test]
@@ -75,37 +96,64 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
     let ctx = common::ctx();
     let scene = default_scene();
     let (diffuse, depth, skin) = synthetic();
-    for (fit, lod) in [(GaussianFit::Six, true), (GaussianFit::Six, false), (GaussianFit::Four, true)] {
-        let s = RenderSettings { fit, lod, ..settings(Method::Ssg) };
+    for (fit, lod) in [
+        (GaussianFit::Six, true),
+        (GaussianFit::Six, false),
+        (GaussianFit::Four, true),
+    ] {
+        let s = RenderSettings {
+            fit,
+            lod,
+            ..settings(Method::Ssg)
+        };
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         let (quad_depths, lod_distances) = match &r.gpu.sss {
             Some(SssMethod::Ssg(g)) => (g.quad_depths.clone(), g.lod_distances.clone()),
             _ => unreachable!(),
         };
         let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
-        let ndc: Vec<f32> = depth.iter().map(|&d| r.ndc_depth(d).clamp(0.0, 1.0)).collect();
+        let ndc: Vec<f32> = depth
+            .iter()
+            .map(|&d| r.ndc_depth(d).clamp(0.0, 1.0))
+            .collect();
         let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
-        let cpu = ssg(&SsgInput { width: W, height: H, diffuse: &diffuse, linear_depth: &depth, skin: &skin, ndc_depth: &ndc }, fit, stretch, &quad_depths);
-        let (ulps, rel) = worst_ulps(&gpu, &cpu);
-        println!("ssg fit={fit:?} lod={lod}: worst {ulps:.2} half ulps ({rel:.2e} relative); LOD distances {lod_distances:?}");
-        // Bound: every stored value (RT2, RT1, RTF per Gaussian) may round one ulp
-        // the other way than the CPU's, and a flipped input moves a normalised
-        // kernel's output by at most that ulp, so errors add along the chain: at most
-        // 3 ulps per blurred Gaussian. Vulkan lets a device round f32 -> f16 stores
-        // to nearest or toward zero; lavapipe truncates (measured: its values are
-        // never above the CPU's round-to-nearest ones), so differences are
-        // systematic but at most one ulp per store on average: the mean must stay
-        // below one ulp.
-        let gaussians = fit.variances().len() - 1;
-        let bound = 3.0 * gaussians as f32;
-        assert!(ulps <= bound, "ssg differs from the CPU reference by {ulps} ulps (bound {bound})");
+        let input = SsgInput {
+            width: W,
+            height: H,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+            ndc_depth: &ndc,
+        };
+        // Vulkan lets a device round f32 -> f16 stores to nearest-even or toward
+        // zero; the reference models both and the GPU must match one of them.
+        // Bound, for the matching mode: each stored value (RT2, RT1, RTF per
+        // Gaussian) may still flip one ulp where the GPU's unrounded value differs
+        // from the CPU's by a hair, and a normalised kernel passes a flipped input
+        // on by at most that ulp: 2 ulps covers the measured flips (a wrong kernel
+        // or blend weight shows up as hundreds of ulps); the mean stays under 0.1.
         let ulp16 = |v: f32| 2f32.powi(v.abs().max(6.1e-5).log2().floor() as i32 - 10);
-        let mean: f32 = gpu.iter().zip(&cpu).flat_map(|(g, c)| (0..3).map(move |i| (g[i] - c[i]).abs() / ulp16(c[i]))).sum::<f32>() / (W * H * 3) as f32;
-        println!("  mean {mean:.3} ulps");
-        let below = gpu.iter().zip(&cpu).flat_map(|(g, c)| (0..3).map(move |i| (g[i] < c[i]) as usize)).sum::<usize>();
-        let above = gpu.iter().zip(&cpu).flat_map(|(g, c)| (0..3).map(move |i| (g[i] > c[i]) as usize)).sum::<usize>();
-        println!("  channels below the reference {below}, above {above}");
-        assert!(mean < 1.0, "mean error {mean} ulps");
+        let mut best = None;
+        for mode in [F16Rounding::NearestEven, F16Rounding::TowardZero] {
+            let cpu = ssg_with_rounding(&input, fit, stretch, &quad_depths, mode);
+            let (ulps, rel) = worst_ulps(&gpu, &cpu);
+            let mean: f32 = gpu
+                .iter()
+                .zip(&cpu)
+                .flat_map(|(g, c)| (0..3).map(move |i| (g[i] - c[i]).abs() / ulp16(c[i])))
+                .sum::<f32>()
+                / (W * H * 3) as f32;
+            println!("ssg fit={fit:?} lod={lod} rounding={mode:?}: worst {ulps:.2} half ulps ({rel:.2e} relative), mean {mean:.3}");
+            if best.map_or(true, |(_, m, _)| mean < m) {
+                best = Some((ulps, mean, mode));
+            }
+        }
+        let (ulps, mean, mode) = best.unwrap();
+        println!("  matched {mode:?}; LOD distances {lod_distances:?}");
+        assert!(
+            ulps <= 2.0 && mean < 0.1,
+            "ssg differs from the CPU reference ({mode:?}): worst {ulps} ulps, mean {mean}"
+        );
         for i in 0..W * H {
             if !skin[i] {
                 assert_eq!(gpu[i], diffuse[i], "non-skin pixel {i} changed");
@@ -124,10 +172,13 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         if lod {
             // The ramp puts some LOD cuts inside the image: at least one Gaussian is partial.
             let skin_n = skin.iter().filter(|&&b| b).count() as u64;
-            assert!(quad_depths.iter().enumerate().any(|(k, _)| {
-                let n = samples(&passes, &format!("ssg g{} horizontal", k + 2));
-                n > 0 && n < skin_n
-            }));
+            let counts: Vec<u64> = (0..quad_depths.len())
+                .map(|k| samples(&passes, &format!("ssg g{} horizontal", k + 2)))
+                .collect();
+            assert!(
+                counts.iter().any(|&n| n > 0 && n < skin_n),
+                "no partial Gaussian: {counts:?} of {skin_n}, quads {quad_depths:?}"
+            );
         }
     }
 }
@@ -139,7 +190,11 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
     let (diffuse, depth, skin) = synthetic();
     let mut images = Vec::new();
     for mask in [MaskMode::Stencil, MaskMode::Branch] {
-        let s = RenderSettings { lod: false, mask, ..settings(Method::Ssg) };
+        let s = RenderSettings {
+            lod: false,
+            mask,
+            ..settings(Method::Ssg)
+        };
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         let (img, passes) = run(&mut r, &diffuse, &depth, &skin);
         let skin_n = skin.iter().filter(|&&b| b).count() as u64;
@@ -162,7 +217,11 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
                     if let Some(inv) = inv {
                         assert!(inv >= screen, "{}: {inv} invocations < {screen}", p.name);
                     }
-                    assert!(p.samples_passed >= skin_n && p.samples_passed <= screen, "{}", p.name);
+                    assert!(
+                        p.samples_passed >= skin_n && p.samples_passed <= screen,
+                        "{}",
+                        p.name
+                    );
                 }
             }
         }
@@ -184,15 +243,33 @@ fn jittered_matches_cpu_reference() {
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
     let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
-    let cpu = jittered(&ScreenInput { width: W, height: H, diffuse: &diffuse, linear_depth: &depth, skin: &skin }, &hable_kernel(), stretch);
+    let cpu = jittered(
+        &ScreenInput {
+            width: W,
+            height: H,
+            diffuse: &diffuse,
+            linear_depth: &depth,
+            skin: &skin,
+        },
+        &hable_kernel(),
+        stretch,
+    );
     let (ulps, rel) = worst_ulps(&gpu, &cpu);
     println!("ss-jittered: worst {ulps:.2} half ulps ({rel:.2e} relative)");
     // One pass, one rounding: two ulps cover a flip plus the GPU's sin/cos and
     // sub-texel weight quantisation on smooth input.
     assert!(ulps <= 2.0, "ss-jittered differs by {ulps} ulps");
-    assert_eq!(samples(&passes, "ss-jittered"), skin.iter().filter(|&&b| b).count() as u64);
-    let changed = (0..W * H).filter(|&i| skin[i] && gpu[i] != diffuse[i]).count();
-    assert!(changed > W * H / 2, "the kernel did something ({changed} pixels changed)");
+    assert_eq!(
+        samples(&passes, "ss-jittered"),
+        skin.iter().filter(|&&b| b).count() as u64
+    );
+    let changed = (0..W * H)
+        .filter(|&i| skin[i] && gpu[i] != diffuse[i])
+        .count();
+    assert!(
+        changed > W * H / 2,
+        "the kernel did something ({changed} pixels changed)"
+    );
 }
 
 /// A camera dolly on the default scene: each Gaussian's passes shade exactly the
@@ -207,17 +284,36 @@ fn gaussian_lod_by_counts_on_a_dolly() {
     let mut zero_at: Vec<Option<f32>> = vec![None; 5];
     for distance in [2.0f32, 3.0, 4.5, 7.0, 11.0, 17.0, 26.0] {
         for lod in [true, false] {
-            let s = RenderSettings { width: 128, height: 80, shadow_size: 128, method: Method::Ssg, lod, distance_heads: distance, ..RenderSettings::default() };
+            let s = RenderSettings {
+                width: 128,
+                height: 80,
+                shadow_size: 128,
+                method: Method::Ssg,
+                lod,
+                distance_heads: distance,
+                ..RenderSettings::default()
+            };
             let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
             let lod_distances = match &r.gpu.sss {
                 Some(SssMethod::Ssg(g)) => g.lod_distances.clone(),
                 _ => unreachable!(),
             };
             let cap = r.capture(true).unwrap();
-            let find = |pass: &str, image: &str| cap.dumps.iter().find(|d| d.pass == pass && d.image == image).unwrap();
+            let find = |pass: &str, image: &str| {
+                cap.dumps
+                    .iter()
+                    .find(|d| d.pass == pass && d.image == image)
+                    .unwrap()
+            };
             let depth = find("geometry", "linear depth");
             let diffuse = find("geometry", "diffuse");
-            let skin: Vec<f32> = diffuse.rgba.iter().zip(&depth.rgba).filter(|(c, _)| c[3] > 0.0).map(|(_, d)| d[0]).collect();
+            let skin: Vec<f32> = diffuse
+                .rgba
+                .iter()
+                .zip(&depth.rgba)
+                .filter(|(c, _)| c[3] > 0.0)
+                .map(|(_, d)| d[0])
+                .collect();
             for (k, &d_lod) in lod_distances.iter().enumerate() {
                 let n = samples(&cap.samples, &format!("ssg g{} horizontal", k + 2));
                 if !lod {
@@ -227,8 +323,15 @@ fn gaussian_lod_by_counts_on_a_dolly() {
                 let expected = skin.iter().filter(|&&d| d < d_lod).count() as i64;
                 // Pixels within 1e-4 of the cut may round either way between the linear
                 // and the projected depth.
-                let slack = skin.iter().filter(|&&d| (d - d_lod).abs() <= 1e-4 * d_lod).count() as i64;
-                assert!((n as i64 - expected).abs() <= slack, "g{} at {distance} heads: {n} shaded, {expected} expected", k + 2);
+                let slack = skin
+                    .iter()
+                    .filter(|&&d| (d - d_lod).abs() <= 1e-4 * d_lod)
+                    .count() as i64;
+                assert!(
+                    (n as i64 - expected).abs() <= slack,
+                    "g{} at {distance} heads: {n} shaded, {expected} expected",
+                    k + 2
+                );
                 let nearest = skin.iter().cloned().fold(f32::INFINITY, f32::min);
                 if nearest > d_lod * (1.0 + 1e-4) {
                     assert_eq!(n, 0, "g{} must be skipped beyond {d_lod}", k + 2);
@@ -241,5 +344,8 @@ fn gaussian_lod_by_counts_on_a_dolly() {
     // Narrowest first: a wider Gaussian never switches off before a narrower one.
     let firsts: Vec<f32> = zero_at.iter().map(|z| z.unwrap_or(f32::INFINITY)).collect();
     assert!(firsts.windows(2).all(|w| w[0] <= w[1]), "{firsts:?}");
-    assert!(zero_at[0].is_some() && zero_at[1].is_some(), "the dolly reaches the narrow Gaussians' cut-offs");
+    assert!(
+        zero_at[0].is_some() && zero_at[1].is_some(),
+        "the dolly reaches the narrow Gaussians' cut-offs"
+    );
 }

@@ -650,13 +650,42 @@ impl<'c> Renderer<'c> {
     /// Uploads synthetic inputs into the SSS targets (tests): diffuse RGBA as f16,
     /// linear depth (the depth buffer gets the matching projected depth), and the
     /// stencil skin bit. Leaves them ready for the SSS passes.
-    pub fn upload_sss_inputs(&mut self, diffuse_f16: &[u16], depth: &[f32], skin: &[bool]) -> Result<()> {
-        let ndc: Vec<f32> = depth.iter().map(|&d| self.ndc_depth(d).clamp(0.0, 1.0)).collect();
+    pub fn upload_sss_inputs(
+        &mut self,
+        diffuse_f16: &[u16],
+        depth: &[f32],
+        skin: &[bool],
+    ) -> Result<()> {
+        let ndc: Vec<f32> = depth
+            .iter()
+            .map(|&d| self.ndc_depth(d).clamp(0.0, 1.0))
+            .collect();
         let t = &self.gpu.targets;
-        upload::fill_image(self.ctx, &t.diffuse.1, vk::ImageAspectFlags::COLOR, bytemuck::cast_slice(diffuse_f16), AccessKind::FragmentSampledRead)?;
-        upload::fill_image(self.ctx, &t.linear_depth.1, vk::ImageAspectFlags::COLOR, bytemuck::cast_slice(depth), AccessKind::FragmentSampledRead)?;
-        let stencil: Vec<u8> = skin.iter().map(|&s| if s { STENCIL_SKIN as u8 } else { 0 }).collect();
-        upload::fill_depth_stencil(self.ctx, &t.depth_stencil.1, &ndc, &stencil, AccessKind::DepthStencilReadOnly)?;
+        upload::fill_image(
+            self.ctx,
+            &t.diffuse.1,
+            vk::ImageAspectFlags::COLOR,
+            bytemuck::cast_slice(diffuse_f16),
+            AccessKind::FragmentSampledRead,
+        )?;
+        upload::fill_image(
+            self.ctx,
+            &t.linear_depth.1,
+            vk::ImageAspectFlags::COLOR,
+            bytemuck::cast_slice(depth),
+            AccessKind::FragmentSampledRead,
+        )?;
+        let stencil: Vec<u8> = skin
+            .iter()
+            .map(|&s| if s { STENCIL_SKIN as u8 } else { 0 })
+            .collect();
+        upload::fill_depth_stencil(
+            self.ctx,
+            &t.depth_stencil.1,
+            &ndc,
+            &stencil,
+            AccessKind::DepthStencilReadOnly,
+        )?;
         self.resources.images[t.diffuse.0 .0].last = AccessKind::FragmentSampledRead;
         self.resources.images[t.linear_depth.0 .0].last = AccessKind::FragmentSampledRead;
         self.resources.images[t.depth_stencil.0 .0].last = AccessKind::DepthStencilReadOnly;

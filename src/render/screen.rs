@@ -162,7 +162,10 @@ impl SsgSss {
         ds_format: vk::Format,
     ) -> Result<Self> {
         if !ctx.facts.independent_blend {
-            bail!("device '{}' lacks independentBlend, which ssg's MRT pass needs", ctx.facts.name);
+            bail!(
+                "device '{}' lacks independentBlend, which ssg's MRT pass needs",
+                ctx.facts.name
+            );
         }
         let desc = |name: &str, frag: &'static str, colors: usize| {
             let mut d = GraphicsDesc::fullscreen(name, frag, rt1.format);
@@ -180,7 +183,8 @@ impl SsgSss {
             }
             d
         };
-        let horizontal = Pipeline::graphics(ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?;
+        let horizontal =
+            Pipeline::graphics(ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?;
         let vertical = Pipeline::graphics(ctx, &desc("ssg vertical", "ssg_vertical.frag", 2))?;
         let set_rt1 = source_set(ctx, pool, &horizontal, samplers, rt1, linear_depth)?;
         let set_rt2 = source_set(ctx, pool, &vertical, samplers, rt2, linear_depth)?;
@@ -191,7 +195,13 @@ impl SsgSss {
             .collect();
         let quad_depths = lod_distances
             .iter()
-            .map(|&d| if init.lod { (init.to_ndc)(d).clamp(0.0, 1.0) } else { 1.0 })
+            .map(|&d| {
+                if init.lod {
+                    (init.to_ndc)(d).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                }
+            })
             .collect();
         Ok(SsgSss {
             horizontal,
@@ -207,7 +217,11 @@ impl SsgSss {
     }
 
     pub fn passes<'a>(&'a self, t: ScreenTargets) -> Vec<Pass<'a>> {
-        let mut passes = vec![seed_copy("ssg seed copy", &t, &[(t.rt1.0, t.rt1.1), (t.rt2.0, t.rt2.1)])];
+        let mut passes = vec![seed_copy(
+            "ssg seed copy",
+            &t,
+            &[(t.rt1.0, t.rt1.1), (t.rt2.0, t.rt2.1)],
+        )];
         let extent = t.extent;
         for (g, &quad_depth) in self.gaussians.iter().zip(&self.quad_depths) {
             let base = ScreenPush {
@@ -220,8 +234,14 @@ impl SsgSss {
                 mask_branch: (self.mask == MaskMode::Branch) as i32,
                 ..Default::default()
             };
-            let h = ScreenPush { dir: [1.0, 0.0], ..base };
-            let v = ScreenPush { dir: [0.0, 1.0], ..base };
+            let h = ScreenPush {
+                dir: [1.0, 0.0],
+                ..base
+            };
+            let v = ScreenPush {
+                dir: [0.0, 1.0],
+                ..base
+            };
             let blend = [g.blend[0], g.blend[1], g.blend[2], 1.0];
             let ds = t.depth_stencil;
             passes.push(
@@ -231,9 +251,16 @@ impl SsgSss {
                     .image(ds.0, AccessKind::DepthStencilReadOnly)
                     .image(t.rt2.0, AccessKind::ColorAttachmentLoadWrite)
                     .record(move |pc: &PassContext| {
-                        fullscreen_stencil_draw(pc, &self.horizontal, self.set_rt1, &[t.rt2.2], ds.1, extent, STENCIL_SKIN, |c, cmd| {
-                            self.horizontal.push(c, cmd, &h)
-                        })
+                        fullscreen_stencil_draw(
+                            pc,
+                            &self.horizontal,
+                            self.set_rt1,
+                            &[t.rt2.2],
+                            ds.1,
+                            extent,
+                            STENCIL_SKIN,
+                            |c, cmd| self.horizontal.push(c, cmd, &h),
+                        )
                     }),
             );
             passes.push(
@@ -295,7 +322,12 @@ impl JitteredSss {
         d.stencil = Some(skin_stencil_test());
         let pipeline = Pipeline::graphics(ctx, &d)?;
         let set = source_set(ctx, pool, &pipeline, samplers, rt1, linear_depth)?;
-        Ok(JitteredSss { pipeline, set, kernel, stretch })
+        Ok(JitteredSss {
+            pipeline,
+            set,
+            kernel,
+            stretch,
+        })
     }
 
     pub fn passes<'a>(&'a self, t: ScreenTargets) -> Vec<Pass<'a>> {
@@ -320,9 +352,16 @@ impl JitteredSss {
                 .image(ds.0, AccessKind::DepthStencilReadOnly)
                 .image(t.diffuse.0, AccessKind::ColorAttachmentLoadWrite)
                 .record(move |pc: &PassContext| {
-                    fullscreen_stencil_draw(pc, &self.pipeline, self.set, &[t.diffuse.2], ds.1, extent, STENCIL_SKIN, |c, cmd| {
-                        self.pipeline.push(c, cmd, &push)
-                    })
+                    fullscreen_stencil_draw(
+                        pc,
+                        &self.pipeline,
+                        self.set,
+                        &[t.diffuse.2],
+                        ds.1,
+                        extent,
+                        STENCIL_SKIN,
+                        |c, cmd| self.pipeline.push(c, cmd, &push),
+                    )
                 }),
         ]
     }

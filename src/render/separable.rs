@@ -281,8 +281,11 @@ pub fn fullscreen_stencil_draw(
             .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
         set_viewport(ctx, cmd, extent);
         if pipeline.has_stencil {
-            ctx.device
-                .cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, stencil_ref);
+            ctx.device.cmd_set_stencil_reference(
+                cmd,
+                vk::StencilFaceFlags::FRONT_AND_BACK,
+                stencil_ref,
+            );
         }
         ctx.device.cmd_bind_descriptor_sets(
             cmd,

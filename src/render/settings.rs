@@ -196,7 +196,12 @@ mod tests {
 
     #[test]
     fn method_names_round_trip() {
-        for m in [Method::Separable, Method::Ssg, Method::SsJittered, Method::None] {
+        for m in [
+            Method::Separable,
+            Method::Ssg,
+            Method::SsJittered,
+            Method::None,
+        ] {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
         }
         assert!("ssg-typo".parse::<Method>().is_err());

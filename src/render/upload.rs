@@ -82,23 +82,45 @@ pub fn fill_image(
 
 /// Fills both aspects of a D32S8 depth/stencil image in one submission (two
 /// separate uploads would each discard the other's contents).
-pub fn fill_depth_stencil(ctx: &Context, image: &Image, depth: &[f32], stencil: &[u8], final_access: AccessKind) -> Result<()> {
+pub fn fill_depth_stencil(
+    ctx: &Context,
+    image: &Image,
+    depth: &[f32],
+    stencil: &[u8],
+    final_access: AccessKind,
+) -> Result<()> {
     if image.format != vk::Format::D32_SFLOAT_S8_UINT {
-        anyhow::bail!("depth/stencil uploads need D32_SFLOAT_S8_UINT, the image is {:?}", image.format);
+        anyhow::bail!(
+            "depth/stencil uploads need D32_SFLOAT_S8_UINT, the image is {:?}",
+            image.format
+        );
     }
     let mut bytes: Vec<u8> = bytemuck::cast_slice(depth).to_vec();
     let stencil_offset = bytes.len() as u64;
     bytes.extend_from_slice(stencil);
-    let mut staging = Buffer::with_data(ctx, &format!("{} staging", image.name), &bytes, vk::BufferUsageFlags::TRANSFER_SRC)?;
+    let mut staging = Buffer::with_data(
+        ctx,
+        &format!("{} staging", image.name),
+        &bytes,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+    )?;
     let mut res = Resources::default();
     let id = res.add_image(&image.name, image.raw, image.subresource_range());
-    let extent = vk::Extent3D { width: image.extent.width, height: image.extent.height, depth: 1 };
+    let extent = vk::Extent3D {
+        width: image.extent.width,
+        height: image.extent.height,
+        depth: 1,
+    };
     let result = ctx.one_shot(&format!("upload {}", image.name), |cmd| {
         res.transition(ctx, cmd, &[(id, AccessKind::TransferWrite)], &[]);
         let region = |aspect, offset| {
             vk::BufferImageCopy::default()
                 .buffer_offset(offset)
-                .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(aspect).layer_count(1))
+                .image_subresource(
+                    vk::ImageSubresourceLayers::default()
+                        .aspect_mask(aspect)
+                        .layer_count(1),
+                )
                 .image_extent(extent)
         };
         unsafe {
@@ -107,7 +129,10 @@ pub fn fill_depth_stencil(ctx: &Context, image: &Image, depth: &[f32], stencil: 
                 staging.raw,
                 image.raw,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region(vk::ImageAspectFlags::DEPTH, 0), region(vk::ImageAspectFlags::STENCIL, stencil_offset)],
+                &[
+                    region(vk::ImageAspectFlags::DEPTH, 0),
+                    region(vk::ImageAspectFlags::STENCIL, stencil_offset),
+                ],
             )
         };
         res.transition(ctx, cmd, &[(id, final_access)], &[]);

@@ -8,12 +8,12 @@
 //! screen-space SSS passes.
 
 pub mod beckmann;
-pub mod kernel;
-pub mod profile;
-pub mod separable_ref;
-pub mod transmittance;
 pub mod jittered;
+pub mod kernel;
 pub mod poisson;
+pub mod profile;
 pub mod screen_ref;
+pub mod separable_ref;
 pub mod ssg;
 pub mod ssg_ref;
+pub mod transmittance;

@@ -24,7 +24,7 @@
 //! the next pass may sample: that is the GPU's behaviour too.
 
 use super::screen_ref::{bilinear4, pixel_uv};
-use super::separable_ref::round_f16;
+use super::separable_ref::{round_f16, round_f16_with, F16Rounding};
 use super::ssg::{ssg_gaussians, GaussianFit, Stretch, LISTING_4_1_WEIGHTS};
 
 /// Inputs of the chain (all slices row-major, `width * height`).
@@ -104,6 +104,17 @@ pub fn ssg(
     stretch: Stretch,
     quad_depths: &[f32],
 ) -> Vec<[f32; 4]> {
+    ssg_with_rounding(input, fit, stretch, quad_depths, F16Rounding::NearestEven)
+}
+
+/// `ssg` with the device's f16 store rounding (see [`F16Rounding`]).
+pub fn ssg_with_rounding(
+    input: &SsgInput,
+    fit: GaussianFit,
+    stretch: Stretch,
+    quad_depths: &[f32],
+    rounding: F16Rounding,
+) -> Vec<[f32; 4]> {
     let n = input.width * input.height;
     assert!(input.width > 0 && input.height > 0, "empty image");
     assert_eq!(input.diffuse.len(), n, "diffuse size");
@@ -129,7 +140,7 @@ pub fn ssg(
             true,
             &rt1,
             |p, o| {
-                rt2[p] = round_f16(o);
+                rt2[p] = round_f16_with(o, rounding);
             },
         );
         let wp = g.blend;
@@ -141,14 +152,14 @@ pub fn ssg(
             false,
             &rt2,
             |p, r| {
-                rt1[p] = round_f16(r);
+                rt1[p] = round_f16_with(r, rounding);
                 let d = rtf[p];
                 let mut b = [0.0f32; 4];
                 for c in 0..3 {
                     b[c] = r[c] * wp[c] + d[c] * (1.0 - wp[c]);
                 }
                 b[3] = r[3];
-                rtf[p] = round_f16(b);
+                rtf[p] = round_f16_with(b, rounding);
             },
         );
     }
