@@ -110,7 +110,7 @@ struct Common {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// SSS method: separable | ssg | ss-jittered | none.
+    /// SSS method: separable | ssg | ss-jittered | poisson | none.
     #[arg(long, default_value = "separable")]
     method: String,
     /// Kernel samples per SSS pass (odd: 9, 17, 33, ...).

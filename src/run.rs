@@ -8,7 +8,8 @@ use serde::Serialize;
 
 use crate::bench::ceilings::{self, ProbeResult};
 use crate::bench::floor::{
-    composite_cost, floor_ms, separable_pass_cost, tonemap_cost, Ceilings, PassCost,
+    composite_cost, floor_ms, jittered_cost, separable_pass_cost, ssg_pass_cost, tonemap_cost,
+    Ceilings, PassCost,
 };
 use crate::render::readback::DumpedImage;
 use crate::render::{Capture, RenderSettings, Renderer};
@@ -95,6 +96,9 @@ fn is_sss_pass(name: &str) -> bool {
 fn pass_cost(name: &str, s: &RenderSettings) -> Option<PassCost> {
     match name {
         "sss horizontal" | "sss vertical" => Some(separable_pass_cost(s.samples, s.follow_surface)),
+        "ss-jittered" => Some(jittered_cost()),
+        n if n.starts_with("ssg g") => Some(ssg_pass_cost(n.ends_with("vertical"))),
+        // poisson's sample count varies per pixel (8/16/32 by radius): no single floor.
         "composite" => Some(composite_cost()),
         "tonemap" => Some(tonemap_cost()),
         _ => None,

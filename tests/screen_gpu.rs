@@ -349,3 +349,83 @@ fn gaussian_lod_by_counts_on_a_dolly() {
         "the dolly reaches the narrow Gaussians' cut-offs"
     );
 }
+
+#[test]
+fn poisson_matches_cpu_reference() {
+    use dermis::skin::poisson::PoissonParams;
+    use dermis::skin::screen_ref::poisson_with_rounding;
+    let ctx = common::ctx();
+    let scene = default_scene();
+    let (diffuse, depth, skin) = synthetic();
+    // A smooth view-space normal field with a crease (normal weights matter there).
+    let normals: Vec<[f32; 4]> = (0..W * H)
+        .map(|i| {
+            let (x, y) = ((i % W) as f32, (i / W) as f32);
+            let nx = if x < 48.0 { -0.3 } else { 0.5 } + 0.1 * (y / 9.0).sin();
+            let n = [nx, 0.2 * (x / 13.0).cos(), 1.0];
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            round_f16([n[0] / l, n[1] / l, n[2] / l, 0.0])
+        })
+        .collect();
+    let s = settings(Method::Poisson);
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    let levels = match &r.gpu.sss {
+        Some(SssMethod::Poisson(p)) => p.levels,
+        _ => unreachable!(),
+    };
+    let n16: Vec<u16> = normals
+        .iter()
+        .flatten()
+        .map(|&v| half::f16::from_f32(v).to_bits())
+        .collect();
+    r.upload_normals(&n16).unwrap();
+    let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
+    let input = ScreenInput {
+        width: W,
+        height: H,
+        diffuse: &diffuse,
+        linear_depth: &depth,
+        skin: &skin,
+    };
+    let mut best: Option<(f32, f32, F16Rounding)> = None;
+    for mode in [F16Rounding::NearestEven, F16Rounding::TowardZero] {
+        let cpu = poisson_with_rounding(
+            &input,
+            &normals,
+            &PoissonParams::from_profile(),
+            s.fovy_deg.to_radians(),
+            scene.mm_per_unit,
+            levels,
+            mode,
+        );
+        let (ulps, rel) = worst_ulps(&gpu, &cpu);
+        println!("poisson rounding={mode:?}: worst {ulps:.2} half ulps ({rel:.2e} relative)");
+        if best.is_none_or(|b| ulps < b.0) {
+            best = Some((ulps, rel, mode));
+        }
+    }
+    let (ulps, _, mode) = best.unwrap();
+    // One output rounding plus mip levels rounded once each on the path; exp() on
+    // the GPU is not correctly rounded (a few f32 ulps), which moves weights by
+    // ~1e-6 relative: 2 half ulps bound it.
+    assert!(
+        ulps <= 2.0,
+        "poisson differs from the CPU reference ({mode:?}) by {ulps} ulps"
+    );
+    assert_eq!(
+        samples(&passes, "poisson"),
+        skin.iter().filter(|&&b| b).count() as u64
+    );
+    for i in 0..W * H {
+        if !skin[i] {
+            assert_eq!(gpu[i], diffuse[i], "non-skin pixel {i} changed");
+        }
+    }
+    let changed = (0..W * H)
+        .filter(|&i| skin[i] && gpu[i] != diffuse[i])
+        .count();
+    assert!(
+        changed > W * H / 2,
+        "the kernel did something ({changed} pixels changed)"
+    );
+}

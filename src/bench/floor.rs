@@ -73,6 +73,33 @@ pub fn separable_pass_cost(n_samples: usize, follow_surface: bool) -> PassCost {
     }
 }
 
+/// One pass of an ssg Gaussian (Listing 4.1): centre colour and depth plus two
+/// depth texels for the gradient by texelFetch, 7 bilinear colour taps; the
+/// vertical pass writes two targets (RT1 and the blended RTF).
+pub fn ssg_pass_cost(vertical: bool) -> PassCost {
+    PassCost {
+        fetches: vec![
+            (Fetch::PointRgba16f, 1.0),
+            (Fetch::PointR32f, 3.0),
+            (Fetch::BilinearRgba16f, 7.0),
+        ],
+        writes: if vertical { 2.0 } else { 1.0 },
+    }
+}
+
+/// ss-jittered: centre colour, centre depth and four gradient texels by
+/// texelFetch, 12 bilinear ring taps, one write.
+pub fn jittered_cost() -> PassCost {
+    PassCost {
+        fetches: vec![
+            (Fetch::PointRgba16f, 1.0),
+            (Fetch::PointR32f, 5.0),
+            (Fetch::BilinearRgba16f, 12.0),
+        ],
+        writes: 1.0,
+    }
+}
+
 /// Composite: two point fetches, one write. Tone map: one fetch, one write.
 pub fn composite_cost() -> PassCost {
     PassCost {

@@ -1,6 +1,7 @@
 //! The frame: shadow map -> geometry MRTs -> separable SSS (stencil-masked) ->
 //! composite -> Hable tone map, recorded through the pass graph.
 
+pub mod poisson;
 pub mod readback;
 pub mod scene_gpu;
 pub mod screen;
@@ -27,6 +28,7 @@ use crate::vk::context::Context;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput};
 use crate::vk::profiler::{PassSample, Profiler};
+use poisson::{levels_for, Chains, PoissonSss};
 use readback::{DumpedImage, ReadbackPlan};
 use scene_gpu::GpuObject;
 use screen::{JitteredSss, ScreenTargets, SsgInit, SsgSss};
@@ -99,6 +101,11 @@ pub struct Targets {
     pub sss_tmp2: (ImageId, Image),
     pub hdr: (ImageId, Image),
     pub ldr: (ImageId, Image),
+    /// View-space normals (only for methods that need them: poisson).
+    pub normals: Option<(ImageId, Image)>,
+    /// Graph ids of mip levels 1.. of the diffuse, linear-depth and normal targets
+    /// (each level is tracked apart: the mip passes read one level and write the next).
+    pub extra_levels: Vec<(ImageId, String)>,
 }
 
 impl Targets {
@@ -107,6 +114,7 @@ impl Targets {
         res: &mut Resources,
         extent: vk::Extent2D,
         shadow_size: u32,
+        chain_levels: u32,
     ) -> Result<Self> {
         let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::SAMPLED
@@ -123,15 +131,47 @@ impl Targets {
             );
         }
         let ds_format = depth_stencil_format(ctx)?;
-        let mut add = |name: &str,
-                       ext: vk::Extent2D,
-                       format: vk::Format,
-                       usage: vk::ImageUsageFlags|
+        let mut extra_levels = Vec::new();
+        let mut add_levels = |name: &str,
+                              ext: vk::Extent2D,
+                              format: vk::Format,
+                              usage: vk::ImageUsageFlags,
+                              levels: u32|
          -> Result<(ImageId, Image)> {
-            let img = Image::new(ctx, name, ext, format, usage)?;
+            let img = Image::with_levels(ctx, name, ext, format, usage, levels)?;
             let id = res.add_image(name, img.raw, img.subresource_range());
+            for l in 1..img.levels {
+                let level_name = format!("{name} mip {l}");
+                extra_levels.push((
+                    res.add_image(&level_name, img.raw, img.level_range(l)),
+                    level_name,
+                ));
+            }
             Ok((id, img))
         };
+        let normals = if chain_levels > 1 {
+            Some(add_levels(
+                "normals",
+                extent,
+                DIFFUSE_FORMAT,
+                color_usage,
+                chain_levels,
+            )?)
+        } else {
+            None
+        };
+        let diffuse = add_levels("diffuse", extent, DIFFUSE_FORMAT, color_usage, chain_levels)?;
+        let linear_depth = add_levels(
+            "linear depth",
+            extent,
+            LINEAR_DEPTH_FORMAT,
+            color_usage,
+            chain_levels,
+        )?;
+        let mut add =
+            |name: &str, ext: vk::Extent2D, format: vk::Format, usage: vk::ImageUsageFlags| {
+                add_levels(name, ext, format, usage, 1)
+            };
         let shadow_ext = vk::Extent2D {
             width: shadow_size,
             height: shadow_size,
@@ -145,9 +185,9 @@ impl Targets {
                     | vk::ImageUsageFlags::SAMPLED
                     | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
-            diffuse: add("diffuse", extent, DIFFUSE_FORMAT, color_usage)?,
+            diffuse,
             specular: add("specular", extent, DIFFUSE_FORMAT, color_usage)?,
-            linear_depth: add("linear depth", extent, LINEAR_DEPTH_FORMAT, color_usage)?,
+            linear_depth,
             depth_stencil: add(
                 "depth stencil",
                 extent,
@@ -165,11 +205,19 @@ impl Targets {
                 LDR_FORMAT,
                 vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
+            normals,
+            extra_levels,
         })
     }
 
-    fn all_mut(&mut self) -> [&mut Image; 9] {
-        [
+    fn all_mut(&mut self) -> Vec<&mut Image> {
+        let mut v: Vec<&mut Image> = self
+            .normals
+            .as_mut()
+            .map(|n| &mut n.1)
+            .into_iter()
+            .collect();
+        v.extend([
             &mut self.sss_tmp2.1,
             &mut self.shadow.1,
             &mut self.diffuse.1,
@@ -179,12 +227,13 @@ impl Targets {
             &mut self.sss_tmp.1,
             &mut self.hdr.1,
             &mut self.ldr.1,
-        ]
+        ]);
+        v
     }
 
     /// Image by graph id (for dumps).
     pub fn by_id(&self, id: ImageId) -> Option<&Image> {
-        [
+        let fixed = [
             &self.shadow,
             &self.diffuse,
             &self.specular,
@@ -194,10 +243,12 @@ impl Targets {
             &self.sss_tmp2,
             &self.hdr,
             &self.ldr,
-        ]
-        .into_iter()
-        .find(|(i, _)| *i == id)
-        .map(|(_, img)| img)
+        ];
+        fixed
+            .into_iter()
+            .chain(self.normals.as_ref())
+            .find(|(i, _)| *i == id)
+            .map(|(_, img)| img)
     }
 }
 
@@ -231,6 +282,7 @@ pub enum SssMethod {
     Separable(SeparableSss),
     Ssg(SsgSss),
     Jittered(JitteredSss),
+    Poisson(PoissonSss),
 }
 
 impl SssMethod {
@@ -239,6 +291,7 @@ impl SssMethod {
             SssMethod::Separable(s) => s.destroy(ctx),
             SssMethod::Ssg(s) => s.destroy(ctx),
             SssMethod::Jittered(s) => s.destroy(ctx),
+            SssMethod::Poisson(s) => s.destroy(ctx),
         }
     }
 }
@@ -271,7 +324,18 @@ impl<'c> Renderer<'c> {
             height: settings.height,
         };
         let mut resources = Resources::default();
-        let targets = Targets::new(ctx, &mut resources, extent, settings.shadow_size)?;
+        let chain_levels = if settings.method == Method::Poisson {
+            levels_for(extent)
+        } else {
+            1
+        };
+        let targets = Targets::new(
+            ctx,
+            &mut resources,
+            extent,
+            settings.shadow_size,
+            chain_levels,
+        )?;
         let samplers = Samplers::new(ctx)?;
         let pool = DescriptorPool::new(ctx, 64)?;
         let ds_format = targets.depth_stencil.1.format;
@@ -301,8 +365,21 @@ impl<'c> Renderer<'c> {
             &GraphicsDesc {
                 name: "geometry".into(),
                 vert: "geometry.vert",
-                frag: Some("geometry.frag"),
-                color_formats: vec![DIFFUSE_FORMAT, DIFFUSE_FORMAT, LINEAR_DEPTH_FORMAT],
+                frag: Some(if targets.normals.is_some() {
+                    "geometry_normals.frag"
+                } else {
+                    "geometry.frag"
+                }),
+                color_formats: if targets.normals.is_some() {
+                    vec![
+                        DIFFUSE_FORMAT,
+                        DIFFUSE_FORMAT,
+                        LINEAR_DEPTH_FORMAT,
+                        DIFFUSE_FORMAT,
+                    ]
+                } else {
+                    vec![DIFFUSE_FORMAT, DIFFUSE_FORMAT, LINEAR_DEPTH_FORMAT]
+                },
                 depth_format: Some(ds_format),
                 stencil_format: Some(ds_format),
                 vertex_input: VertexInput::Mesh,
@@ -434,7 +511,15 @@ impl<'c> Renderer<'c> {
             &composite_pipeline,
             0,
             &[
-                ("diffuseTex", Bind::Texture(targets.diffuse.1.view)),
+                // Methods that read the diffuse mip chain leave their result in the intermediate.
+                (
+                    "diffuseTex",
+                    Bind::Texture(if settings.method == Method::Poisson {
+                        targets.sss_tmp.1.view
+                    } else {
+                        targets.diffuse.1.view
+                    }),
+                ),
                 ("specularTex", Bind::Texture(targets.specular.1.view)),
             ],
         )?;
@@ -510,6 +595,19 @@ impl<'c> Renderer<'c> {
                 stretch,
                 &targets.sss_tmp.1,
                 &targets.linear_depth.1,
+                ds_format,
+            )?)),
+            Method::Poisson => Some(SssMethod::Poisson(PoissonSss::new(
+                ctx,
+                &pool,
+                &samplers,
+                &targets.diffuse.1,
+                &targets.linear_depth.1,
+                &targets
+                    .normals
+                    .as_ref()
+                    .context("poisson needs the normal target")?
+                    .1,
                 ds_format,
             )?)),
             Method::None => None,
@@ -692,6 +790,26 @@ impl<'c> Renderer<'c> {
         Ok(())
     }
 
+    /// Uploads synthetic view-space normals (RGBA f16) into level 0 of the normal
+    /// target (tests of methods that read normals).
+    pub fn upload_normals(&mut self, normals_f16: &[u16]) -> Result<()> {
+        let (id, img) = self
+            .gpu
+            .targets
+            .normals
+            .as_ref()
+            .context("this method has no normal target")?;
+        upload::fill_image(
+            self.ctx,
+            img,
+            vk::ImageAspectFlags::COLOR,
+            bytemuck::cast_slice(normals_f16),
+            AccessKind::FragmentSampledRead,
+        )?;
+        self.resources.images[id.0].last = AccessKind::FragmentSampledRead;
+        Ok(())
+    }
+
     /// Runs only the SSS passes on whatever the targets hold (tests) and reads
     /// back the diffuse target as f32 RGBA with the pass samples.
     pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
@@ -699,7 +817,7 @@ impl<'c> Renderer<'c> {
             bail!("the SSS-only run needs an SSS method");
         }
         let passes = self.gpu.sss_passes();
-        let mut plan = ReadbackPlan::single(self.gpu.targets.diffuse.0);
+        let mut plan = ReadbackPlan::single(self.gpu.final_diffuse().0);
         let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu.targets)?;
         let ctx = self.ctx;
         let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
@@ -742,6 +860,46 @@ impl FrameGpu {
         }
     }
 
+    /// The per-level ids of the diffuse, depth and normal mip chains (poisson).
+    pub fn chains(&self) -> Chains {
+        let t = &self.targets;
+        let chain = |main: &(ImageId, Image), name: &str| -> Vec<(ImageId, vk::ImageView)> {
+            let mut v = vec![(main.0, main.1.level_views[0])];
+            for l in 1..main.1.levels {
+                let level_name = format!("{name} mip {l}");
+                let id = t
+                    .extra_levels
+                    .iter()
+                    .find(|(_, n)| *n == level_name)
+                    .map(|(i, _)| *i)
+                    .expect("mip level registered");
+                v.push((id, main.1.level_views[l as usize]));
+            }
+            v
+        };
+        let normals = t
+            .normals
+            .as_ref()
+            .expect("poisson allocates the normal target");
+        Chains {
+            color: chain(&t.diffuse, "diffuse"),
+            depth: chain(&t.linear_depth, "linear depth"),
+            normal: chain(normals, "normals"),
+            extents: (0..t.diffuse.1.levels)
+                .map(|l| t.diffuse.1.level_extent(l))
+                .collect(),
+        }
+    }
+
+    /// The target holding the diffuse light after SSS: the diffuse target itself,
+    /// or the intermediate for methods that read the diffuse mip chain.
+    pub fn final_diffuse(&self) -> &(ImageId, Image) {
+        match self.sss {
+            Some(SssMethod::Poisson(_)) => &self.targets.sss_tmp,
+            _ => &self.targets.diffuse,
+        }
+    }
+
     pub fn screen_targets(&self) -> ScreenTargets {
         let t = &self.targets;
         ScreenTargets {
@@ -760,6 +918,12 @@ impl FrameGpu {
             Some(SssMethod::Separable(s)) => s.passes(self.sss_targets(), self.sss_view()),
             Some(SssMethod::Ssg(s)) => s.passes(self.screen_targets()),
             Some(SssMethod::Jittered(s)) => s.passes(self.screen_targets()),
+            Some(SssMethod::Poisson(s)) => s.passes(
+                self.screen_targets(),
+                &self.chains(),
+                self.settings.fovy_deg.to_radians(),
+                self.mm_per_unit,
+            ),
             None => Vec::new(),
         }
     }
@@ -835,96 +999,100 @@ impl FrameGpu {
     fn geometry_pass(&self) -> Pass<'_> {
         let t = &self.targets;
         let extent = self.extent;
-        let views = [t.diffuse.1.view, t.specular.1.view, t.linear_depth.1.view];
+        let mut views = vec![t.diffuse.1.view, t.specular.1.view, t.linear_depth.1.view];
         let ds_view = t.depth_stencil.1.view;
         let far = self.camera.far;
-        Pass::new("geometry")
+        let mut pass = Pass::new("geometry")
             .image(t.shadow.0, AccessKind::FragmentSampledRead)
             .image(t.diffuse.0, AccessKind::ColorAttachmentWrite)
             .image(t.specular.0, AccessKind::ColorAttachmentWrite)
             .image(t.linear_depth.0, AccessKind::ColorAttachmentWrite)
-            .image(t.depth_stencil.0, AccessKind::DepthStencilWrite)
-            .record(move |pc: &PassContext| {
-                let ctx = pc.ctx;
-                let cmd = pc.cmd;
-                let clears = [[0.0f32; 4], [0.0; 4], [far, 0.0, 0.0, 0.0]];
-                let colors: Vec<vk::RenderingAttachmentInfo> = views
-                    .iter()
-                    .zip(clears)
-                    .map(|(&v, c)| {
-                        vk::RenderingAttachmentInfo::default()
-                            .image_view(v)
-                            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                            .load_op(vk::AttachmentLoadOp::CLEAR)
-                            .store_op(vk::AttachmentStoreOp::STORE)
-                            .clear_value(vk::ClearValue {
-                                color: vk::ClearColorValue { float32: c },
-                            })
-                    })
-                    .collect();
-                let ds = vk::RenderingAttachmentInfo::default()
-                    .image_view(ds_view)
-                    .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue {
-                        depth_stencil: vk::ClearDepthStencilValue {
-                            depth: 1.0,
-                            stencil: 0,
-                        },
-                    });
-                let info = vk::RenderingInfo::default()
-                    .render_area(vk::Rect2D {
-                        offset: vk::Offset2D::default(),
-                        extent,
-                    })
-                    .layer_count(1)
-                    .color_attachments(&colors)
-                    .depth_attachment(&ds)
-                    .stencil_attachment(&ds);
-                let p = &self.geometry_pipeline;
+            .image(t.depth_stencil.0, AccessKind::DepthStencilWrite);
+        if let Some(n) = &t.normals {
+            views.push(n.1.view);
+            pass = pass.image(n.0, AccessKind::ColorAttachmentWrite);
+        }
+        pass.record(move |pc: &PassContext| {
+            let ctx = pc.ctx;
+            let cmd = pc.cmd;
+            let clears = [[0.0f32; 4], [0.0; 4], [far, 0.0, 0.0, 0.0], [0.0; 4]];
+            let colors: Vec<vk::RenderingAttachmentInfo> = views
+                .iter()
+                .zip(clears)
+                .map(|(&v, c)| {
+                    vk::RenderingAttachmentInfo::default()
+                        .image_view(v)
+                        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                        .load_op(vk::AttachmentLoadOp::CLEAR)
+                        .store_op(vk::AttachmentStoreOp::STORE)
+                        .clear_value(vk::ClearValue {
+                            color: vk::ClearColorValue { float32: c },
+                        })
+                })
+                .collect();
+            let ds = vk::RenderingAttachmentInfo::default()
+                .image_view(ds_view)
+                .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: 1.0,
+                        stencil: 0,
+                    },
+                });
+            let info = vk::RenderingInfo::default()
+                .render_area(vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                })
+                .layer_count(1)
+                .color_attachments(&colors)
+                .depth_attachment(&ds)
+                .stencil_attachment(&ds);
+            let p = &self.geometry_pipeline;
+            unsafe {
+                ctx.device.cmd_begin_rendering(cmd, &info);
+                ctx.device
+                    .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, p.raw);
+                set_viewport(ctx, cmd, extent);
+                ctx.device.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    p.layout,
+                    0,
+                    &[self.frame_set],
+                    &[],
+                );
+            }
+            for obj in &self.objects {
                 unsafe {
-                    ctx.device.cmd_begin_rendering(cmd, &info);
-                    ctx.device
-                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, p.raw);
-                    set_viewport(ctx, cmd, extent);
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,
                         p.layout,
-                        0,
-                        &[self.frame_set],
+                        1,
+                        &[obj.material_set],
                         &[],
                     );
+                    ctx.device.cmd_set_stencil_reference(
+                        cmd,
+                        vk::StencilFaceFlags::FRONT_AND_BACK,
+                        if obj.skin { STENCIL_SKIN } else { 0 },
+                    );
                 }
-                for obj in &self.objects {
-                    unsafe {
-                        ctx.device.cmd_bind_descriptor_sets(
-                            cmd,
-                            vk::PipelineBindPoint::GRAPHICS,
-                            p.layout,
-                            1,
-                            &[obj.material_set],
-                            &[],
-                        );
-                        ctx.device.cmd_set_stencil_reference(
-                            cmd,
-                            vk::StencilFaceFlags::FRONT_AND_BACK,
-                            if obj.skin { STENCIL_SKIN } else { 0 },
-                        );
-                    }
-                    let models: &[Mat4] = if obj.skin {
-                        &self.instances
-                    } else {
-                        &[Mat4::IDENTITY]
-                    };
-                    for m in models {
-                        p.push(ctx, cmd, &m.to_cols_array_2d());
-                        obj.bind_and_draw(ctx, cmd);
-                    }
+                let models: &[Mat4] = if obj.skin {
+                    &self.instances
+                } else {
+                    &[Mat4::IDENTITY]
+                };
+                for m in models {
+                    p.push(ctx, cmd, &m.to_cols_array_2d());
+                    obj.bind_and_draw(ctx, cmd);
                 }
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
-            })
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        })
     }
 
     fn fullscreen_pass<'a>(
@@ -990,7 +1158,7 @@ impl FrameGpu {
             "composite",
             &self.composite_pipeline,
             self.composite_set,
-            &[t.diffuse.0, t.specular.0],
+            &[self.final_diffuse().0, t.specular.0],
             (t.hdr.0, t.hdr.1.view),
             None,
         )

@@ -18,6 +18,8 @@ pub enum Method {
     Ssg,
     /// Hable et al.'s 13-tap jittered kernel in screen space ("SS Jittered").
     SsJittered,
+    /// Poisson-disk screen-space SSS weighted by depth and normal (seed 003).
+    Poisson,
     /// No subsurface scattering: the baseline every method is compared to.
     None,
 }
@@ -29,8 +31,11 @@ impl std::str::FromStr for Method {
             "separable" | "ssss" => Ok(Method::Separable),
             "ssg" => Ok(Method::Ssg),
             "ss-jittered" | "jittered" => Ok(Method::SsJittered),
+            "poisson" => Ok(Method::Poisson),
             "none" | "off" => Ok(Method::None),
-            other => bail!("unknown method '{other}' (valid: separable, ssg, ss-jittered, none)"),
+            other => bail!(
+                "unknown method '{other}' (valid: separable, ssg, ss-jittered, poisson, none)"
+            ),
         }
     }
 }
@@ -41,6 +46,7 @@ impl Method {
             Method::Separable => "separable",
             Method::Ssg => "ssg",
             Method::SsJittered => "ss-jittered",
+            Method::Poisson => "poisson",
             Method::None => "none",
         }
     }
@@ -200,6 +206,7 @@ mod tests {
             Method::Separable,
             Method::Ssg,
             Method::SsJittered,
+            Method::Poisson,
             Method::None,
         ] {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);

@@ -16,7 +16,7 @@ use std::f32::consts::PI;
 
 use super::jittered::{jitter_angle, JitteredKernel};
 use super::poisson::{mip_level, poisson_disk_32, sample_count, PoissonParams};
-use super::separable_ref::round_f16;
+use super::separable_ref::{round_f16, round_f16_with, F16Rounding};
 use super::ssg::Stretch;
 
 /// Inputs of a single-pass screen-space SSS effect (slices `width*height`).
@@ -159,7 +159,27 @@ pub fn mip_chain4(
     levels: u32,
     round_f16: bool,
 ) -> Vec<MipLevel<[f32; 4]>> {
-    let store = |t: [f32; 4]| if round_f16 { self::round4(t) } else { t };
+    mip_chain4_with(
+        level0,
+        w,
+        h,
+        levels,
+        round_f16.then_some(F16Rounding::NearestEven),
+    )
+}
+
+/// [`mip_chain4`] with the device's f16 store rounding (`None`: no rounding).
+pub fn mip_chain4_with(
+    level0: &[[f32; 4]],
+    w: usize,
+    h: usize,
+    levels: u32,
+    rounding: Option<F16Rounding>,
+) -> Vec<MipLevel<[f32; 4]>> {
+    let store = move |t: [f32; 4]| match rounding {
+        Some(mode) => round_f16_with(t, mode),
+        None => t,
+    };
     mip_chain(level0, w, h, levels, store, |a, b, c, d| {
         let mut o = [0.0f32; 4];
         for i in 0..4 {
@@ -180,10 +200,6 @@ pub fn mip_chain1(level0: &[f32], w: usize, h: usize, levels: u32) -> Vec<MipLev
         |t| t,
         |a, b, c, d| ((a + b) + (c + d)) * 0.25,
     )
-}
-
-fn round4(t: [f32; 4]) -> [f32; 4] {
-    round_f16(t)
 }
 
 /// Bilinear RGBA fetch on level `lod` of a chain (the level's own size
@@ -283,12 +299,34 @@ pub fn poisson(
     mm_per_unit: f32,
     levels: u32,
 ) -> Vec<[f32; 4]> {
+    poisson_with_rounding(
+        input,
+        normals,
+        params,
+        fovy_rad,
+        mm_per_unit,
+        levels,
+        F16Rounding::NearestEven,
+    )
+}
+
+/// [`poisson`] with the device's f16 store rounding (mip levels and output).
+#[allow(clippy::too_many_arguments)]
+pub fn poisson_with_rounding(
+    input: &ScreenInput,
+    normals: &[[f32; 4]],
+    params: &PoissonParams,
+    fovy_rad: f32,
+    mm_per_unit: f32,
+    levels: u32,
+    rounding: F16Rounding,
+) -> Vec<[f32; 4]> {
     input.check();
     let (w, h) = (input.width, input.height);
     assert_eq!(normals.len(), w * h, "normals size");
-    let color_chain = mip_chain4(input.diffuse, w, h, levels, true);
+    let color_chain = mip_chain4_with(input.diffuse, w, h, levels, Some(rounding));
     let depth_chain = mip_chain1(input.linear_depth, w, h, levels);
-    let normal_chain = mip_chain4(normals, w, h, levels, true);
+    let normal_chain = mip_chain4_with(normals, w, h, levels, Some(rounding));
     let disk = poisson_disk_32();
     let tan_half = (0.5 * fovy_rad).tan();
     let mut out = input.diffuse.to_vec();
@@ -325,12 +363,15 @@ pub fn poisson(
                     total[ch] += wch;
                 }
             }
-            out[p] = round_f16([
-                acc[0] / total[0],
-                acc[1] / total[1],
-                acc[2] / total[2],
-                color_m[3],
-            ]);
+            out[p] = round_f16_with(
+                [
+                    acc[0] / total[0],
+                    acc[1] / total[1],
+                    acc[2] / total[2],
+                    color_m[3],
+                ],
+                rounding,
+            );
         }
     }
     out

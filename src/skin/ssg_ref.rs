@@ -24,7 +24,7 @@
 //! the next pass may sample: that is the GPU's behaviour too.
 
 use super::screen_ref::{bilinear4, pixel_uv};
-use super::separable_ref::{round_f16, round_f16_with, F16Rounding};
+use super::separable_ref::{round_f16_with, F16Rounding};
 use super::ssg::{ssg_gaussians, GaussianFit, Stretch, LISTING_4_1_WEIGHTS};
 
 /// Inputs of the chain (all slices row-major, `width * height`).
@@ -169,6 +169,7 @@ pub fn ssg_with_rounding(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skin::separable_ref::round_f16;
 
     fn noise_image(n: usize, alpha: f32) -> Vec<[f32; 4]> {
         let mut state = 0x1234_5678_u32;

@@ -11,7 +11,14 @@ use super::context::Context;
 
 pub struct Image {
     pub raw: vk::Image,
+    /// View of mip level 0 (attachments, texel fetches).
     pub view: vk::ImageView,
+    /// Mip levels (1 for most targets).
+    pub levels: u32,
+    /// One view per mip level (`level_views[0] == view`).
+    pub level_views: Vec<vk::ImageView>,
+    /// View of the whole mip chain (for `textureLod`); `view` when there is one level.
+    pub chain_view: vk::ImageView,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     pub aspect: vk::ImageAspectFlags,
@@ -61,6 +68,19 @@ impl Image {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self> {
+        Self::with_levels(ctx, name, extent, format, usage, 1)
+    }
+
+    /// An image with `levels` mip levels (each half the size of the previous).
+    pub fn with_levels(
+        ctx: &Context,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        levels: u32,
+    ) -> Result<Self> {
+        let levels = levels.max(1);
         let aspect = if is_depth_format(format) {
             if has_stencil(format) {
                 vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
@@ -78,7 +98,7 @@ impl Image {
                 height: extent.height,
                 depth: 1,
             })
-            .mip_levels(1)
+            .mip_levels(levels)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -105,7 +125,7 @@ impl Image {
             ctx.device
                 .bind_image_memory(raw, allocation.memory(), allocation.offset())
         }?;
-        let make_view = |aspect: vk::ImageAspectFlags| unsafe {
+        let make_view = |aspect: vk::ImageAspectFlags, base: u32, count: u32| unsafe {
             ctx.device.create_image_view(
                 &vk::ImageViewCreateInfo::default()
                     .image(raw)
@@ -114,15 +134,25 @@ impl Image {
                     .subresource_range(
                         vk::ImageSubresourceRange::default()
                             .aspect_mask(aspect)
-                            .level_count(1)
+                            .base_mip_level(base)
+                            .level_count(count)
                             .layer_count(1),
                     ),
                 None,
             )
         };
-        let view = make_view(aspect)?;
+        let mut level_views = Vec::new();
+        for l in 0..levels {
+            level_views.push(make_view(aspect, l, 1)?);
+        }
+        let view = level_views[0];
+        let chain_view = if levels > 1 {
+            make_view(aspect, 0, levels)?
+        } else {
+            view
+        };
         let depth_view = if has_stencil(format) && usage.contains(vk::ImageUsageFlags::SAMPLED) {
-            Some(make_view(vk::ImageAspectFlags::DEPTH)?)
+            Some(make_view(vk::ImageAspectFlags::DEPTH, 0, 1)?)
         } else {
             None
         };
@@ -131,6 +161,9 @@ impl Image {
         Ok(Image {
             raw,
             view,
+            levels,
+            level_views,
+            chain_view,
             format,
             extent,
             aspect,
@@ -145,11 +178,26 @@ impl Image {
         self.depth_view.unwrap_or(self.view)
     }
 
+    /// Mip level 0 (the whole image when it has one level).
     pub fn subresource_range(&self) -> vk::ImageSubresourceRange {
+        self.level_range(0)
+    }
+
+    /// One mip level, for barriers that track levels separately.
+    pub fn level_range(&self, level: u32) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange::default()
             .aspect_mask(self.aspect)
+            .base_mip_level(level)
             .level_count(1)
             .layer_count(1)
+    }
+
+    /// Size of mip level `level`.
+    pub fn level_extent(&self, level: u32) -> vk::Extent2D {
+        vk::Extent2D {
+            width: (self.extent.width >> level).max(1),
+            height: (self.extent.height >> level).max(1),
+        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -157,7 +205,12 @@ impl Image {
             if let Some(v) = self.depth_view.take() {
                 ctx.device.destroy_image_view(v, None);
             }
-            ctx.device.destroy_image_view(self.view, None);
+            if self.levels > 1 {
+                ctx.device.destroy_image_view(self.chain_view, None);
+            }
+            for v in self.level_views.drain(..) {
+                ctx.device.destroy_image_view(v, None);
+            }
             ctx.device.destroy_image(self.raw, None);
         }
         if let Some(a) = self.allocation.take() {

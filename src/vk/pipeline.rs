@@ -451,6 +451,8 @@ pub struct Samplers {
     pub linear_repeat: vk::Sampler,
     /// Depth comparison (LESS_OR_EQUAL) with linear filtering: 2x2 PCF in hardware.
     pub shadow_compare: vk::Sampler,
+    /// Bilinear within the mip level `textureLod` names (nearest between levels).
+    pub mip_clamp: vk::Sampler,
 }
 
 impl Samplers {
@@ -458,7 +460,8 @@ impl Samplers {
         let make = |name: &str,
                     filter: vk::Filter,
                     mode: vk::SamplerAddressMode,
-                    compare: bool|
+                    compare: bool,
+                    max_lod: f32|
          -> Result<vk::Sampler> {
             let mut info = vk::SamplerCreateInfo::default()
                 .mag_filter(filter)
@@ -467,7 +470,7 @@ impl Samplers {
                 .address_mode_u(mode)
                 .address_mode_v(mode)
                 .address_mode_w(mode)
-                .max_lod(0.0)
+                .max_lod(max_lod)
                 .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE);
             if compare {
                 info = info
@@ -478,37 +481,21 @@ impl Samplers {
             ctx.name(s, name);
             Ok(s)
         };
+        use vk::Filter as F;
+        use vk::SamplerAddressMode as M;
         Ok(Samplers {
-            linear_clamp: make(
-                "linear clamp",
-                vk::Filter::LINEAR,
-                vk::SamplerAddressMode::CLAMP_TO_EDGE,
-                false,
-            )?,
-            nearest_clamp: make(
-                "nearest clamp",
-                vk::Filter::NEAREST,
-                vk::SamplerAddressMode::CLAMP_TO_EDGE,
-                false,
-            )?,
-            linear_repeat: make(
-                "linear repeat",
-                vk::Filter::LINEAR,
-                vk::SamplerAddressMode::REPEAT,
-                false,
-            )?,
-            shadow_compare: make(
-                "shadow compare",
-                vk::Filter::LINEAR,
-                vk::SamplerAddressMode::CLAMP_TO_BORDER,
-                true,
-            )?,
+            linear_clamp: make("linear clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 0.0)?,
+            nearest_clamp: make("nearest clamp", F::NEAREST, M::CLAMP_TO_EDGE, false, 0.0)?,
+            linear_repeat: make("linear repeat", F::LINEAR, M::REPEAT, false, 0.0)?,
+            shadow_compare: make("shadow compare", F::LINEAR, M::CLAMP_TO_BORDER, true, 0.0)?,
+            mip_clamp: make("mip clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 16.0)?,
         })
     }
 
     pub fn destroy(&self, ctx: &Context) {
         unsafe {
             for s in [
+                self.mip_clamp,
                 self.linear_clamp,
                 self.nearest_clamp,
                 self.linear_repeat,
