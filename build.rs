@@ -1,7 +1,8 @@
 //! Compiles every GLSL shader in `shaders/` to SPIR-V with glslangValidator and
-//! generates the table `shaders.rs` that embeds them. The target is SPIR-V 1.3
-//! (vulkan1.1 environment): from SPIR-V 1.4 on, entry points list every global
-//! in their interface, which the vendored spirv-reflect cannot parse. A missing compiler stops
+//! generates the table `shaders.rs` that embeds them. The target is SPIR-V 1.0
+//! (vulkan1.0 environment): the vendored spirv-reflect misses storage buffers in
+//! the StorageBuffer storage class (SPIR-V 1.3+) and cannot parse the SPIR-V 1.4+
+//! entry-point interfaces; SPIR-V 1.0 spells SSBOs as Uniform + BufferBlock. A missing compiler stops
 //! the build with the name of the Debian package that provides it.
 
 use std::fmt::Write as _;
@@ -30,7 +31,7 @@ fn main() {
         let name = src.file_name().unwrap().to_string_lossy().to_string();
         let spv = out.join(format!("{name}.spv"));
         let status = Command::new(&compiler)
-            .args(["-V", "--target-env", "vulkan1.1", "-Ishaders", "-o"])
+            .args(["-V", "--target-env", "vulkan1.0", "-Ishaders", "-o"])
             .arg(&spv)
             .arg(src)
             .output();

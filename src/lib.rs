@@ -7,7 +7,9 @@
 //! math: profiles, kernels, CPU references), `render` (the frame), `bench`
 //! (ceilings and floors), `report` (statistics, tables, JSON).
 pub mod bench;
+pub mod eval;
 pub mod graph;
+pub mod reference;
 pub mod render;
 pub mod report;
 pub mod run;

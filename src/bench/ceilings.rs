@@ -11,7 +11,7 @@ use crate::graph::{record_passes, ImageId, Pass, PassContext, Resources};
 use crate::render::separable::set_viewport;
 use crate::render::upload;
 use crate::report::Stats;
-use crate::vk::barrier::AccessKind;
+use crate::vk::barrier::{AccessKind, ResourceState};
 use crate::vk::context::Context;
 use crate::vk::memory::Image;
 use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
@@ -100,8 +100,8 @@ pub fn measure(
         let id_rgba = res.add_image("probe rgba16f", src_rgba.raw, src_rgba.subresource_range());
         let id_r32 = res.add_image("probe r32f", src_r32.raw, src_r32.subresource_range());
         let id_target = res.add_image("probe target", target.raw, target.subresource_range());
-        res.images[id_rgba.0].last = AccessKind::FragmentSampledRead;
-        res.images[id_r32.0].last = AccessKind::FragmentSampledRead;
+        res.images[id_rgba.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
+        res.images[id_r32.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
         let set = |img: &Image, sampler| {
             pool.write_set(
                 ctx,

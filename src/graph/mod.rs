@@ -6,7 +6,7 @@
 
 use ash::vk;
 
-use crate::vk::barrier::{plan_buffer, plan_image, AccessKind};
+use crate::vk::barrier::{AccessKind, ResourceState};
 use crate::vk::context::Context;
 use crate::vk::profiler::Profiler;
 
@@ -23,14 +23,14 @@ pub struct ImageEntry {
     pub name: String,
     pub raw: vk::Image,
     pub range: vk::ImageSubresourceRange,
-    pub last: AccessKind,
+    pub state: ResourceState,
 }
 
 #[derive(Clone, Debug)]
 pub struct BufferEntry {
     pub name: String,
     pub raw: vk::Buffer,
-    pub last: AccessKind,
+    pub state: ResourceState,
 }
 
 /// Tracked resources and their last access. Lives as long as the renderer, so
@@ -52,7 +52,7 @@ impl Resources {
             name: name.into(),
             raw,
             range,
-            last: AccessKind::Nothing,
+            state: ResourceState::default(),
         });
         ImageId(self.images.len() - 1)
     }
@@ -61,7 +61,7 @@ impl Resources {
         self.buffers.push(BufferEntry {
             name: name.into(),
             raw,
-            last: AccessKind::Nothing,
+            state: ResourceState::default(),
         });
         BufferId(self.buffers.len() - 1)
     }
@@ -79,7 +79,7 @@ impl Resources {
         let mut ib = Vec::new();
         for &(id, next) in images {
             let e = &mut self.images[id.0];
-            if let Some(p) = plan_image(e.last, next) {
+            if let Some(p) = e.state.plan(next, true) {
                 ib.push(
                     vk::ImageMemoryBarrier2::default()
                         .src_stage_mask(p.src_stage)
@@ -92,12 +92,11 @@ impl Resources {
                         .subresource_range(e.range),
                 );
             }
-            e.last = next;
         }
         let mut bb = Vec::new();
         for &(id, next) in buffers {
             let e = &mut self.buffers[id.0];
-            if let Some(p) = plan_buffer(e.last, next) {
+            if let Some(p) = e.state.plan(next, false) {
                 bb.push(
                     vk::BufferMemoryBarrier2::default()
                         .src_stage_mask(p.src_stage)
@@ -109,7 +108,6 @@ impl Resources {
                         .size(vk::WHOLE_SIZE),
                 );
             }
-            e.last = next;
         }
         (ib, bb)
     }

@@ -3,6 +3,7 @@
 
 pub mod poisson;
 pub mod readback;
+pub mod reference;
 pub mod scene_gpu;
 pub mod screen;
 pub mod separable;
@@ -23,13 +24,14 @@ use crate::skin::jittered::hable_kernel;
 use crate::skin::kernel::SeparableKernel;
 use crate::skin::ssg::{ssg_gaussians, Stretch};
 use crate::skin::transmittance::shrink_units;
-use crate::vk::barrier::AccessKind;
+use crate::vk::barrier::{AccessKind, ResourceState};
 use crate::vk::context::Context;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput};
 use crate::vk::profiler::{PassSample, Profiler};
 use poisson::{levels_for, Chains, PoissonSss};
 use readback::{DumpedImage, ReadbackPlan};
+use reference::{ReferenceInit, ReferenceSss};
 use scene_gpu::GpuObject;
 use screen::{JitteredSss, ScreenTargets, SsgInit, SsgSss};
 use separable::{set_viewport, SeparableSss, SssTargets, SssView, STENCIL_SKIN};
@@ -103,6 +105,8 @@ pub struct Targets {
     pub ldr: (ImageId, Image),
     /// View-space normals (only for methods that need them: poisson).
     pub normals: Option<(ImageId, Image)>,
+    /// The ground truth's output (RGBA32F storage image; reference only).
+    pub reference_out: Option<(ImageId, Image)>,
     /// Graph ids of mip levels 1.. of the diffuse, linear-depth and normal targets
     /// (each level is tracked apart: the mip passes read one level and write the next).
     pub extra_levels: Vec<(ImageId, String)>,
@@ -115,6 +119,7 @@ impl Targets {
         extent: vk::Extent2D,
         shadow_size: u32,
         chain_levels: u32,
+        reference: bool,
     ) -> Result<Self> {
         let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::SAMPLED
@@ -168,6 +173,19 @@ impl Targets {
             color_usage,
             chain_levels,
         )?;
+        let reference_out = if reference {
+            Some(add_levels(
+                "reference",
+                extent,
+                vk::Format::R32G32B32A32_SFLOAT,
+                vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+                1,
+            )?)
+        } else {
+            None
+        };
         let mut add =
             |name: &str, ext: vk::Extent2D, format: vk::Format, usage: vk::ImageUsageFlags| {
                 add_levels(name, ext, format, usage, 1)
@@ -206,6 +224,7 @@ impl Targets {
                 vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
             normals,
+            reference_out,
             extra_levels,
         })
     }
@@ -247,6 +266,7 @@ impl Targets {
         fixed
             .into_iter()
             .chain(self.normals.as_ref())
+            .chain(self.reference_out.as_ref())
             .find(|(i, _)| *i == id)
             .map(|(_, img)| img)
     }
@@ -283,6 +303,7 @@ pub enum SssMethod {
     Ssg(SsgSss),
     Jittered(JitteredSss),
     Poisson(PoissonSss),
+    Reference(ReferenceSss),
 }
 
 impl SssMethod {
@@ -292,6 +313,7 @@ impl SssMethod {
             SssMethod::Ssg(s) => s.destroy(ctx),
             SssMethod::Jittered(s) => s.destroy(ctx),
             SssMethod::Poisson(s) => s.destroy(ctx),
+            SssMethod::Reference(s) => s.destroy(ctx),
         }
     }
 }
@@ -335,6 +357,7 @@ impl<'c> Renderer<'c> {
             extent,
             settings.shadow_size,
             chain_levels,
+            settings.method == Method::Reference,
         )?;
         let samplers = Samplers::new(ctx)?;
         let pool = DescriptorPool::new(ctx, 64)?;
@@ -477,7 +500,12 @@ impl<'c> Renderer<'c> {
                 mm,
                 light_frame.depth_range_units,
                 shrink_units(mm),
-                if settings.transmittance { 1.0 } else { 0.0 },
+                // The reference gets light through thin parts from the integral itself.
+                if settings.transmittance && settings.method != Method::Reference {
+                    1.0
+                } else {
+                    0.0
+                },
             ],
             shadow_params: [1.0 / settings.shadow_size as f32, bias, 0.0, 0.0],
         };
@@ -487,11 +515,8 @@ impl<'c> Renderer<'c> {
             bytemuck::bytes_of(&uniforms),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
-        let frame_set = pool.write_set(
-            ctx,
-            &geometry_pipeline,
-            0,
-            &[
+        let frame_binds = |binds_beckmann: vk::ImageView| -> Vec<(&'static str, Bind)> {
+            vec![
                 (
                     "frame",
                     Bind::Uniform {
@@ -502,10 +527,11 @@ impl<'c> Renderer<'c> {
                 ("shadowMap", Bind::Texture(targets.shadow.1.view)),
                 ("shadowCompare", Bind::Sampler(samplers.shadow_compare)),
                 ("nearestClamp", Bind::Sampler(samplers.nearest_clamp)),
-                ("beckmannTex", Bind::Texture(beckmann.view)),
+                ("beckmannTex", Bind::Texture(binds_beckmann)),
                 ("linearClamp", Bind::Sampler(samplers.linear_clamp)),
-            ],
-        )?;
+            ]
+        };
+        let frame_set = pool.write_set(ctx, &geometry_pipeline, 0, &frame_binds(beckmann.view))?;
         let composite_set = pool.write_set(
             ctx,
             &composite_pipeline,
@@ -516,6 +542,8 @@ impl<'c> Renderer<'c> {
                     "diffuseTex",
                     Bind::Texture(if settings.method == Method::Poisson {
                         targets.sss_tmp.1.view
+                    } else if let Some(r) = &targets.reference_out {
+                        r.1.view
                     } else {
                         targets.diffuse.1.view
                     }),
@@ -610,6 +638,35 @@ impl<'c> Renderer<'c> {
                     .1,
                 ds_format,
             )?)),
+            Method::Reference => {
+                let head = objects
+                    .iter()
+                    .find(|o| o.skin)
+                    .context("the reference needs a skin object")?;
+                Some(SssMethod::Reference(ReferenceSss::new(
+                    ctx,
+                    &pool,
+                    &mut resources,
+                    ReferenceInit {
+                        head: &scene.head.mesh,
+                        instances: &instances,
+                        mm_per_unit: mm,
+                        density: settings.reference_density,
+                        inv_view: camera.view().inverse(),
+                        tan_half_fovy: (0.5 * settings.fovy_deg.to_radians()).tan(),
+                        aspect,
+                        frame_binds: frame_binds(beckmann.view),
+                        material_binds: head.material_binds(&samplers),
+                    },
+                    &targets.diffuse.1,
+                    &targets.linear_depth.1,
+                    &targets
+                        .reference_out
+                        .as_ref()
+                        .context("the reference output target")?
+                        .1,
+                )?))
+            }
             Method::None => None,
         };
 
@@ -784,9 +841,12 @@ impl<'c> Renderer<'c> {
             &stencil,
             AccessKind::DepthStencilReadOnly,
         )?;
-        self.resources.images[t.diffuse.0 .0].last = AccessKind::FragmentSampledRead;
-        self.resources.images[t.linear_depth.0 .0].last = AccessKind::FragmentSampledRead;
-        self.resources.images[t.depth_stencil.0 .0].last = AccessKind::DepthStencilReadOnly;
+        self.resources.images[t.diffuse.0 .0].state =
+            ResourceState::uploaded(AccessKind::FragmentSampledRead);
+        self.resources.images[t.linear_depth.0 .0].state =
+            ResourceState::uploaded(AccessKind::FragmentSampledRead);
+        self.resources.images[t.depth_stencil.0 .0].state =
+            ResourceState::uploaded(AccessKind::DepthStencilReadOnly);
         Ok(())
     }
 
@@ -806,7 +866,8 @@ impl<'c> Renderer<'c> {
             bytemuck::cast_slice(normals_f16),
             AccessKind::FragmentSampledRead,
         )?;
-        self.resources.images[id.0].last = AccessKind::FragmentSampledRead;
+        self.resources.images[id.0].state =
+            ResourceState::uploaded(AccessKind::FragmentSampledRead);
         Ok(())
     }
 
@@ -894,8 +955,9 @@ impl FrameGpu {
     /// The target holding the diffuse light after SSS: the diffuse target itself,
     /// or the intermediate for methods that read the diffuse mip chain.
     pub fn final_diffuse(&self) -> &(ImageId, Image) {
-        match self.sss {
-            Some(SssMethod::Poisson(_)) => &self.targets.sss_tmp,
+        match (&self.sss, &self.targets.reference_out) {
+            (Some(SssMethod::Poisson(_)), _) => &self.targets.sss_tmp,
+            (Some(SssMethod::Reference(_)), Some(r)) => r,
             _ => &self.targets.diffuse,
         }
     }
@@ -924,6 +986,17 @@ impl FrameGpu {
                 self.settings.fovy_deg.to_radians(),
                 self.mm_per_unit,
             ),
+            Some(SssMethod::Reference(s)) => {
+                let t = &self.targets;
+                let out = t.reference_out.as_ref().expect("reference output target");
+                s.passes(
+                    t.shadow.0,
+                    t.diffuse.0,
+                    t.linear_depth.0,
+                    out.0,
+                    self.extent,
+                )
+            }
             None => Vec::new(),
         }
     }

@@ -78,6 +78,13 @@ pub fn to_rgba_f32(format: vk::Format, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
                 [v, v, v, 1.0]
             })
             .collect(),
+        vk::Format::R32G32B32A32_SFLOAT => bytes
+            .chunks_exact(16)
+            .map(|c| {
+                let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
+                [f(0), f(4), f(8), f(12)]
+            })
+            .collect(),
         vk::Format::R8G8B8A8_SRGB => bytes
             .chunks_exact(4)
             .map(|c| {

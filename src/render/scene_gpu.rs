@@ -5,6 +5,7 @@ use ash::vk;
 
 use super::upload::{device_buffer, texture};
 use crate::scene::mesh::{Material, Object, Texture};
+use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
@@ -74,12 +75,14 @@ impl GpuObject {
             &format!("{name} vertices"),
             bytemuck::cast_slice(&mesh.vertices),
             vk::BufferUsageFlags::VERTEX_BUFFER,
+            AccessKind::VertexInputRead,
         )?;
         let indices = device_buffer(
             ctx,
             &format!("{name} indices"),
             bytemuck::cast_slice(&mesh.indices),
             vk::BufferUsageFlags::INDEX_BUFFER,
+            AccessKind::VertexInputRead,
         )?;
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
@@ -152,6 +155,23 @@ impl GpuObject {
             uniforms,
             material_set,
         })
+    }
+
+    /// The material's bindings (set 1 of the shaders that include lighting.glsl).
+    pub fn material_binds(&self, samplers: &Samplers) -> Vec<(&'static str, Bind)> {
+        vec![
+            ("albedoTex", Bind::Texture(self.textures[0].view)),
+            ("normalTex", Bind::Texture(self.textures[1].view)),
+            ("specTex", Bind::Texture(self.textures[2].view)),
+            ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
+            (
+                "material",
+                Bind::Uniform {
+                    buffer: self.uniforms.raw,
+                    size: std::mem::size_of::<MaterialUniforms>() as u64,
+                },
+            ),
+        ]
     }
 
     pub fn bind_and_draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {

@@ -20,6 +20,8 @@ pub enum Method {
     SsJittered,
     /// Poisson-disk screen-space SSS weighted by depth and normal (seed 003).
     Poisson,
+    /// The ground truth: brute-force integral over the skin surface (compute).
+    Reference,
     /// No subsurface scattering: the baseline every method is compared to.
     None,
 }
@@ -32,9 +34,10 @@ impl std::str::FromStr for Method {
             "ssg" => Ok(Method::Ssg),
             "ss-jittered" | "jittered" => Ok(Method::SsJittered),
             "poisson" => Ok(Method::Poisson),
+            "reference" | "ground-truth" => Ok(Method::Reference),
             "none" | "off" => Ok(Method::None),
             other => bail!(
-                "unknown method '{other}' (valid: separable, ssg, ss-jittered, poisson, none)"
+                "unknown method '{other}' (valid: separable, ssg, ss-jittered, poisson, reference, none)"
             ),
         }
     }
@@ -47,6 +50,7 @@ impl Method {
             Method::Ssg => "ssg",
             Method::SsJittered => "ss-jittered",
             Method::Poisson => "poisson",
+            Method::Reference => "reference",
             Method::None => "none",
         }
     }
@@ -68,6 +72,8 @@ pub struct RenderSettings {
     pub lod: bool,
     /// ssg: stencil test or dynamic branch.
     pub mask: MaskMode,
+    /// reference: surface samples per mm^2.
+    pub reference_density: f32,
     pub heads: u32,
     /// Camera distance from the head centre, in head heights.
     pub distance_heads: f32,
@@ -93,6 +99,7 @@ impl Default for RenderSettings {
             fit: GaussianFit::Six,
             lod: true,
             mask: MaskMode::Stencil,
+            reference_density: 16.0,
             heads: 1,
             distance_heads: 4.0,
             fovy_deg: 20.0,
@@ -207,6 +214,7 @@ mod tests {
             Method::Ssg,
             Method::SsJittered,
             Method::Poisson,
+            Method::Reference,
             Method::None,
         ] {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);

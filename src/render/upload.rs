@@ -30,7 +30,7 @@ pub fn texture(
         &image,
         vk::ImageAspectFlags::COLOR,
         bytes,
-        AccessKind::FragmentSampledRead,
+        AccessKind::AnyShaderSampledRead,
     )
     .with_context(|| format!("uploading texture '{name}'"))?;
     Ok(image)
@@ -148,6 +148,7 @@ pub fn device_buffer(
     name: &str,
     bytes: &[u8],
     usage: vk::BufferUsageFlags,
+    first_use: AccessKind,
 ) -> Result<Buffer> {
     let mut staging = Buffer::with_data(
         ctx,
@@ -178,7 +179,7 @@ pub fn device_buffer(
                 }],
             )
         };
-        res.transition(ctx, cmd, &[], &[(id, AccessKind::VertexInputRead)]);
+        res.transition(ctx, cmd, &[], &[(id, first_use)]);
     });
     staging.destroy(ctx);
     result?;

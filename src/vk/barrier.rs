@@ -34,8 +34,15 @@ pub enum AccessKind {
     FragmentSampledRead,
     /// Sampled in a compute shader.
     ComputeSampledRead,
+    /// Sampled by fragment and compute shaders alike: static textures uploaded
+    /// once and read by both the raster passes and the ground-truth compute passes.
+    AnyShaderSampledRead,
     /// Written as a storage image/buffer by a compute shader (whole contents produced).
     ComputeStorageWrite,
+    /// Read as a storage image/buffer by a compute shader.
+    ComputeStorageRead,
+    /// Read as a storage buffer by a fragment shader.
+    FragmentStorageRead,
     /// Source of a copy.
     TransferRead,
     /// Destination of a copy or clear (whole contents produced).
@@ -99,8 +106,19 @@ impl AccessKind {
                 A::SHADER_SAMPLED_READ,
                 L::SHADER_READ_ONLY_OPTIMAL,
             ),
+            AccessKind::AnyShaderSampledRead => (
+                S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::SHADER_SAMPLED_READ,
+                L::SHADER_READ_ONLY_OPTIMAL,
+            ),
             AccessKind::ComputeStorageWrite => {
                 (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE, L::GENERAL)
+            }
+            AccessKind::ComputeStorageRead => {
+                (S::COMPUTE_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
+            }
+            AccessKind::FragmentStorageRead => {
+                (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
             }
             AccessKind::TransferRead => (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
             AccessKind::TransferWrite => (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
@@ -211,11 +229,125 @@ pub fn plan_buffer(prev: AccessKind, next: AccessKind) -> Option<BarrierPlan> {
     })
 }
 
+/// What the graph remembers of one resource between passes: its layout, the
+/// last write, the stages that read it since, and the stages that write has been
+/// made visible to. One "last access" is not enough: after a write, reads in two
+/// different stages each need the write made visible to them, and the next write
+/// must wait for every one of those reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ResourceState {
+    pub layout: vk::ImageLayout,
+    pub last_write: Option<AccessKind>,
+    pub read_stages: vk::PipelineStageFlags2,
+    pub visible_stages: vk::PipelineStageFlags2,
+    fresh: bool,
+}
+
+impl Default for ResourceState {
+    fn default() -> Self {
+        ResourceState {
+            layout: L::UNDEFINED,
+            last_write: None,
+            read_stages: S::NONE,
+            visible_stages: S::NONE,
+            fresh: true,
+        }
+    }
+}
+
+impl ResourceState {
+    /// A resource filled by a finished upload whose last barrier made a transfer
+    /// write visible to `access` (and left it in `access`'s layout).
+    pub fn uploaded(access: AccessKind) -> Self {
+        let i = access.info();
+        ResourceState {
+            layout: i.layout,
+            last_write: Some(AccessKind::TransferWrite),
+            read_stages: i.stage,
+            visible_stages: i.stage,
+            fresh: false,
+        }
+    }
+
+    /// The barrier `next` needs (if any), and the state after it.
+    pub fn plan(&mut self, next: AccessKind, is_image: bool) -> Option<BarrierPlan> {
+        let n = next.info();
+        let (w_stage, w_access) = match self.last_write {
+            Some(w) => (w.info().stage, w.write_access()),
+            None => (S::NONE, A::NONE),
+        };
+        let new_layout = if is_image { n.layout } else { L::UNDEFINED };
+        let discard = next.discards_contents() || self.fresh;
+        let old_layout = if !is_image || discard {
+            L::UNDEFINED
+        } else {
+            self.layout
+        };
+        let layout_change = is_image && old_layout != new_layout;
+        let plan = if next.is_write() {
+            // Wait for every read since the last write (WAR). When those reads were
+            // themselves ordered after the write by a barrier, that chain also orders
+            // this write after it; otherwise wait for the last write (WAW) directly.
+            let (src_stage, src_access) =
+                if !self.read_stages.is_empty() && !self.visible_stages.is_empty() {
+                    (self.read_stages, A::NONE)
+                } else {
+                    (w_stage | self.read_stages, w_access)
+                };
+            (layout_change || !src_stage.is_empty()).then_some(BarrierPlan {
+                src_stage,
+                src_access,
+                dst_stage: n.stage,
+                dst_access: n.access,
+                old_layout,
+                new_layout,
+            })
+        } else if layout_change
+            || (self.last_write.is_some() && !self.visible_stages.contains(n.stage))
+        {
+            // Make the write visible to this stage; a transition also waits for
+            // the reads in the old layout.
+            Some(BarrierPlan {
+                src_stage: w_stage | self.read_stages,
+                src_access: w_access,
+                dst_stage: n.stage,
+                dst_access: n.access,
+                old_layout,
+                new_layout,
+            })
+        } else {
+            None
+        };
+        if next.is_write() {
+            *self = ResourceState {
+                layout: new_layout,
+                last_write: Some(next),
+                read_stages: S::NONE,
+                visible_stages: S::NONE,
+                fresh: false,
+            };
+        } else {
+            if layout_change {
+                self.visible_stages = n.stage;
+            } else if plan.is_some() {
+                self.visible_stages |= n.stage;
+            }
+            self.layout = new_layout;
+            self.read_stages |= n.stage;
+            self.fresh = false;
+        }
+        plan
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 14] = [
+    const ALL: [AccessKind; 17] = [
+        AccessKind::FragmentStorageRead,
+        AccessKind::AnyShaderSampledRead,
+        AccessKind::ComputeStorageRead,
         AccessKind::Nothing,
         AccessKind::ColorAttachmentWrite,
         AccessKind::ColorAttachmentLoadWrite,
@@ -347,6 +479,60 @@ mod tests {
         );
     }
 
+    // A shadow map written once, read by a fragment shader and then by a compute
+    // shader: each reader stage needs its own visibility barrier from the write,
+    // and the next frame's write waits for both readers.
+    #[test]
+    fn state_makes_a_write_visible_to_every_reader_stage() {
+        let mut st = ResourceState::default();
+        let b = st.plan(AccessKind::DepthStencilWrite, true).unwrap();
+        assert_eq!(b.old_layout, L::UNDEFINED);
+        let b = st.plan(AccessKind::FragmentSampledRead, true).unwrap();
+        assert_eq!(b.src_access, A::DEPTH_STENCIL_ATTACHMENT_WRITE);
+        let b = st
+            .plan(AccessKind::ComputeSampledRead, true)
+            .expect("compute needs the write made visible too");
+        assert_eq!(b.dst_stage, S::COMPUTE_SHADER);
+        assert_eq!(b.src_access, A::DEPTH_STENCIL_ATTACHMENT_WRITE);
+        assert_eq!(b.old_layout, b.new_layout);
+        assert_eq!(st.plan(AccessKind::FragmentSampledRead, true), None);
+        assert_eq!(st.plan(AccessKind::ComputeSampledRead, true), None);
+        let b = st.plan(AccessKind::DepthStencilWrite, true).unwrap();
+        assert!(b.src_stage.contains(S::FRAGMENT_SHADER | S::COMPUTE_SHADER));
+        assert_eq!(b.src_access, A::NONE);
+    }
+
+    #[test]
+    fn state_agrees_with_the_pair_rules_on_simple_chains() {
+        let chain = [
+            AccessKind::ColorAttachmentWrite,
+            AccessKind::FragmentSampledRead,
+            AccessKind::ColorAttachmentLoadWrite,
+            AccessKind::TransferRead,
+            AccessKind::FragmentSampledRead,
+        ];
+        let mut st = ResourceState::default();
+        let mut prev = AccessKind::Nothing;
+        for next in chain {
+            let a = st.plan(next, true);
+            let b = plan_image(prev, next);
+            assert_eq!(
+                a.map(|p| (p.old_layout, p.new_layout, p.dst_stage)),
+                b.map(|p| (p.old_layout, p.new_layout, p.dst_stage)),
+                "{prev:?} -> {next:?}"
+            );
+            prev = next;
+        }
+    }
+
+    #[test]
+    fn uploaded_resources_need_visibility_for_new_stages_only() {
+        let mut st = ResourceState::uploaded(AccessKind::FragmentSampledRead);
+        assert_eq!(st.plan(AccessKind::FragmentSampledRead, true), None);
+        let b = st.plan(AccessKind::ComputeSampledRead, true).unwrap();
+        assert_eq!(b.src_access, A::TRANSFER_WRITE);
+    }
+
     #[test]
     fn table_is_consistent() {
         for k in ALL {
@@ -358,7 +544,13 @@ mod tests {
             // No blanket stages or layouts in the table.
             assert!(!i.stage.contains(S::ALL_COMMANDS), "{k:?}");
             assert!(!i.stage.contains(S::ALL_GRAPHICS), "{k:?}");
-            if k != AccessKind::ComputeStorageWrite {
+            // Storage images live in GENERAL; nothing else does.
+            if !matches!(
+                k,
+                AccessKind::ComputeStorageWrite
+                    | AccessKind::ComputeStorageRead
+                    | AccessKind::FragmentStorageRead
+            ) {
                 assert_ne!(i.layout, L::GENERAL, "{k:?}");
             }
             if k != AccessKind::Nothing {

@@ -248,6 +248,36 @@ impl Pipeline {
         })
     }
 
+    /// A compute pipeline from one shader, its layout reflected.
+    pub fn compute(ctx: &Context, name: &str, shader: &'static str) -> Result<Self> {
+        let reflection = reflect(&[shader]).with_context(|| format!("pipeline '{name}'"))?;
+        let (layout, set_layouts) = make_layout(ctx, name, &reflection)?;
+        let module = create_module(ctx, shader)?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        let result = unsafe {
+            ctx.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        unsafe { ctx.device.destroy_shader_module(module, None) };
+        let raw = result.map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))?[0];
+        ctx.name(raw, name);
+        Ok(Pipeline {
+            raw,
+            layout,
+            set_layouts,
+            reflection,
+            bind_point: vk::PipelineBindPoint::COMPUTE,
+            name: name.to_string(),
+            has_stencil: false,
+        })
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_pipeline(self.raw, None);
@@ -319,6 +349,10 @@ impl DescriptorPool {
                 ty: vk::DescriptorType::STORAGE_IMAGE,
                 descriptor_count: max_sets * 2,
             },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: max_sets * 4,
+            },
         ];
         let raw = unsafe {
             ctx.device.create_descriptor_pool(
@@ -387,7 +421,14 @@ impl DescriptorPool {
                         vk::DescriptorImageInfo {
                             sampler: vk::Sampler::null(),
                             image_view: *view,
-                            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                            // Storage images are accessed in GENERAL (see vk::barrier).
+                            image_layout: if info.descriptor_type
+                                == vk::DescriptorType::STORAGE_IMAGE
+                            {
+                                vk::ImageLayout::GENERAL
+                            } else {
+                                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL
+                            },
                         },
                     ));
                 }

@@ -230,6 +230,33 @@ mod tests {
         assert!(stages.contains(vk::ShaderStageFlags::FRAGMENT));
     }
 
+    /// Every resource binding naga finds in a module is in the reflected
+    /// interface: a binding the layout lacks is undefined behaviour (lavapipe
+    /// crashes in pipeline creation), and the validation layer may not get the
+    /// chance to say so.
+    #[test]
+    fn reflection_sees_every_binding_naga_sees() {
+        for (name, bytes) in SHADERS {
+            let module =
+                naga::front::spv::parse_u8_slice(bytes, &naga::front::spv::Options::default())
+                    .unwrap();
+            let r = reflect(&[name]).unwrap();
+            for (_, var) in module.global_variables.iter() {
+                if let Some(b) = &var.binding {
+                    assert!(
+                        r.bindings
+                            .iter()
+                            .any(|x| x.set == b.group && x.binding == b.binding),
+                        "{name}: set {} binding {} ({:?}) is missing from the reflected layout",
+                        b.group,
+                        b.binding,
+                        var.name
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn unknown_shader_is_an_error() {
         assert!(spirv("nope.frag").is_err());

@@ -1,0 +1,408 @@
+//! The cost-versus-error chart: every measured (method, setting) as a marker,
+//! with the Pareto front drawn through the settings worth using.
+//!
+//! Written as PNG (for a quick look and for reports that embed bitmaps) and SVG
+//! (sharp at any size, for papers). Text needs a font: plotters' `ab_glyph`
+//! backend is used because it is pure Rust (no fontconfig or freetype to link),
+//! with a TrueType font read from the system at run time (`DERMIS_FONT`, or
+//! DejaVu Sans / Liberation Sans from their usual places) rather than shipped
+//! in the repository.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use anyhow::{anyhow, bail, ensure, Context, Result};
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::pareto::{pareto_front, EvalPoint};
+
+/// Pixel size of both outputs.
+const SIZE: (u32, u32) = (1200, 800);
+
+/// Marker colours, one per method in order of first appearance (Okabe-Ito:
+/// distinguishable with the common colour-vision deficiencies).
+const COLOURS: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(120, 120, 120),
+];
+
+/// Marker shapes, cycled with the colours so methods differ also in grey print.
+#[derive(Clone, Copy)]
+enum Shape {
+    Circle,
+    Triangle,
+    Square,
+    Diamond,
+}
+const SHAPES: [Shape; 4] = [
+    Shape::Circle,
+    Shape::Triangle,
+    Shape::Square,
+    Shape::Diamond,
+];
+
+/// Draws `points` as GPU ms (x, linear from 0) against error (y; logarithmic
+/// when the positive errors span more than a decade, so both a coarse and a
+/// near-exact method stay readable, else linear from 0), one marker per method
+/// with a legend, and the Pareto front as a line in cost order. Writes
+/// `png_path` (1200x800) and `svg_path`, creating their folders.
+///
+/// Errors on an empty point set, a negative or non-finite cost or error, a
+/// missing font, or a path that cannot be written.
+pub fn cost_error_chart(
+    points: &[EvalPoint],
+    title: &str,
+    x_label: &str,
+    png_path: &Path,
+    svg_path: &Path,
+) -> Result<()> {
+    let layout = Layout::new(points)?;
+    ensure_font()?;
+
+    let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw(&root, points, &layout, title, x_label).context("drawing the PNG chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the PNG chart")?;
+    }
+    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb)
+        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", SIZE.0, SIZE.1))?;
+    create_parent(png_path)?;
+    image
+        .save_with_format(png_path, image::ImageFormat::Png)
+        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw(&root, points, &layout, title, x_label).context("drawing the SVG chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the SVG chart")?;
+    }
+    create_parent(svg_path)?;
+    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
+}
+
+/// Axis ranges and scale, decided once so PNG and SVG show the same chart.
+struct Layout {
+    x_max: f64,
+    y: (f64, f64),
+    log_y: bool,
+}
+
+impl Layout {
+    fn new(points: &[EvalPoint]) -> Result<Self> {
+        ensure!(!points.is_empty(), "cost/error chart: no points to draw");
+        for p in points {
+            ensure!(
+                p.gpu_ms.is_finite() && p.gpu_ms >= 0.0 && p.error.is_finite() && p.error >= 0.0,
+                "cost/error chart: point {}/{}/{} has gpu_ms {} and error {}; both must be finite and >= 0",
+                p.method,
+                p.setting,
+                p.scene,
+                p.gpu_ms,
+                p.error
+            );
+        }
+        let max_of = |f: fn(&EvalPoint) -> f64| points.iter().map(f).fold(0.0f64, f64::max);
+        let x_max = max_of(|p| p.gpu_ms);
+        let x_max = if x_max > 0.0 { x_max * 1.1 } else { 1.0 };
+        let e_max = max_of(|p| p.error);
+        let e_min = points.iter().map(|p| p.error).fold(f64::INFINITY, f64::min);
+        // A log axis cannot show 0, so an exact point keeps the axis linear.
+        let log_y = e_min > 0.0 && e_max / e_min > 10.0;
+        let y = if log_y {
+            (e_min / 1.5, e_max * 1.5)
+        } else if e_max > 0.0 {
+            (0.0, e_max * 1.1)
+        } else {
+            (0.0, 1.0)
+        };
+        Ok(Self { x_max, y, log_y })
+    }
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    points: &[EvalPoint],
+    layout: &Layout,
+    title: &str,
+    x_label: &str,
+) -> Result<()> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(title, ("sans-serif", 30))
+        .margin(24)
+        .x_label_area_size(60)
+        .y_label_area_size(100);
+    let x = 0.0..layout.x_max;
+    let (lo, hi) = layout.y;
+    if layout.log_y {
+        let chart = builder
+            .build_cartesian_2d(x, (lo..hi).log_scale())
+            .map_err(plot_err)?;
+        draw_in(chart, points, x_label)
+    } else {
+        let chart = builder.build_cartesian_2d(x, lo..hi).map_err(plot_err)?;
+        draw_in(chart, points, x_label)
+    }
+}
+
+/// Everything inside the axes; generic over the y coordinate so the linear and
+/// logarithmic charts share one drawing path.
+fn draw_in<'a, DB, Y>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
+    points: &[EvalPoint],
+    x_label: &str,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc("error")
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(plot_err)?;
+
+    let front: Vec<(f64, f64)> = pareto_front(points)
+        .into_iter()
+        .map(|i| (points[i].gpu_ms, points[i].error))
+        .collect();
+    let front_style = ShapeStyle::from(&RGBColor(40, 40, 40)).stroke_width(2);
+    chart
+        .draw_series(LineSeries::new(front, front_style))
+        .map_err(plot_err)?
+        .label("Pareto front")
+        .legend(move |(x, y)| PathElement::new([(x - 12, y), (x + 12, y)], front_style));
+
+    let mut methods: Vec<&str> = Vec::new();
+    for p in points {
+        if !methods.contains(&p.method.as_str()) {
+            methods.push(&p.method);
+        }
+    }
+    for (m, method) in methods.iter().enumerate() {
+        let fill = COLOURS[m % COLOURS.len()].filled();
+        let shape = outline(SHAPES[m % SHAPES.len()]);
+        let legend_shape = shape.clone();
+        let mine = points.iter().filter(|p| p.method == *method);
+        chart
+            .draw_series(
+                mine.map(|p| {
+                    EmptyElement::at((p.gpu_ms, p.error)) + Polygon::new(shape.clone(), fill)
+                }),
+            )
+            .map_err(plot_err)?
+            .label(*method)
+            .legend(move |c| EmptyElement::at(c) + Polygon::new(legend_shape.clone(), fill));
+    }
+
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 18))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
+}
+
+/// The outline of a marker in pixels around its point. Every shape is a polygon
+/// so that all markers share one element type and one drawing path, in the plot
+/// and in the legend alike.
+fn outline(shape: Shape) -> Vec<(i32, i32)> {
+    match shape {
+        Shape::Circle => (0..16)
+            .map(|k| {
+                let a = f64::from(k) * std::f64::consts::TAU / 16.0;
+                (
+                    (7.0 * a.cos()).round() as i32,
+                    (7.0 * a.sin()).round() as i32,
+                )
+            })
+            .collect(),
+        Shape::Triangle => vec![(0, -8), (8, 6), (-8, 6)],
+        Shape::Square => vec![(-6, -6), (6, -6), (6, 6), (-6, 6)],
+        Shape::Diamond => vec![(0, -8), (8, 0), (0, 8), (-8, 0)],
+    }
+}
+
+/// plotters' errors borrow nothing but are not always `Send + Sync`: keep the text.
+fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("plotting: {e}")
+}
+
+fn create_parent(path: &Path) -> Result<()> {
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(parent) => fs::create_dir_all(parent)
+            .with_context(|| format!("creating folder {}", parent.display())),
+        None => Ok(()),
+    }
+}
+
+/// Where to look for a sans-serif TrueType font, in order, after `DERMIS_FONT`.
+const FONT_PATHS: [&str; 6] = [
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/liberation-sans/LiberationSans-Regular.ttf",
+];
+
+/// Registers a font with plotters once per process. The bytes are leaked on
+/// purpose: plotters keeps a `'static` reference, and it is one font file.
+fn ensure_font() -> Result<()> {
+    static FONT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
+    FONT.get_or_init(|| register_system_font().map_err(|e| format!("{e:#}")))
+        .clone()
+        .map_err(|e| anyhow!(e))
+}
+
+fn register_system_font() -> Result<()> {
+    let mut candidates: Vec<PathBuf> = Vec::new();
+    if let Some(p) = std::env::var_os("DERMIS_FONT") {
+        candidates.push(p.into());
+    }
+    candidates.extend(FONT_PATHS.iter().map(PathBuf::from));
+    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+        bail!(
+            "no font for chart text: set DERMIS_FONT to a .ttf file or install \
+             fonts-dejavu-core (looked in {})",
+            FONT_PATHS.join(", ")
+        );
+    };
+    let bytes = fs::read(path).with_context(|| format!("reading font {}", path.display()))?;
+    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+    for family in ["sans-serif", "serif", "monospace"] {
+        plotters::style::register_font(family, FontStyle::Normal, bytes)
+            .map_err(|_| anyhow!("{} is not a usable TrueType font", path.display()))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(method: &str, gpu_ms: f64, error: f64) -> EvalPoint {
+        EvalPoint {
+            method: method.into(),
+            setting: format!("{gpu_ms}"),
+            scene: "head".into(),
+            gpu_ms,
+            error,
+        }
+    }
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("dermis-chart-{tag}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        dir
+    }
+
+    /// Checks the PNG decodes at full size and is not blank: its luminance
+    /// varies, and the caption band holds dark (text) pixels.
+    fn assert_png_has_content(path: &Path) {
+        let img = image::open(path).unwrap().into_rgb8();
+        assert_eq!(img.dimensions(), SIZE);
+        let luma: Vec<f64> = img
+            .pixels()
+            .map(|p| (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0)
+            .collect();
+        let mean = luma.iter().sum::<f64>() / luma.len() as f64;
+        let var = luma.iter().map(|l| (l - mean) * (l - mean)).sum::<f64>() / luma.len() as f64;
+        assert!(var > 50.0, "PNG looks blank: luminance variance {var}");
+        let caption_dark = (0..SIZE.0)
+            .flat_map(|x| (0..60).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y)[0] < 100)
+            .count();
+        assert!(
+            caption_dark > 100,
+            "no caption text drawn ({caption_dark} dark pixels)"
+        );
+    }
+
+    #[test]
+    fn writes_png_and_svg_log_scale() {
+        let dir = temp_dir("log");
+        let points = vec![
+            pt("separable", 0.4, 0.08),
+            pt("separable", 0.7, 0.03),
+            pt("ssg", 0.9, 0.02),
+            pt("ss-jittered", 0.5, 0.2),
+            pt("poisson", 2.0, 0.001),
+            pt("poisson", 1.2, 0.004),
+        ];
+        let (png, svg) = (dir.join("c.png"), dir.join("sub/c.svg"));
+        cost_error_chart(&points, "Skin SSS: cost vs error", "GPU ms", &png, &svg).unwrap();
+        assert_png_has_content(&png);
+        let text = fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("<svg"));
+        assert!(text.contains("ss-jittered") && text.contains("Pareto front"));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn single_point_and_linear_scale() {
+        let dir = temp_dir("one");
+        let (png, svg) = (dir.join("c.png"), dir.join("c.svg"));
+        cost_error_chart(&[pt("separable", 0.5, 0.05)], "one", "GPU ms", &png, &svg).unwrap();
+        assert_png_has_content(&png);
+        assert!(fs::read_to_string(&svg).unwrap().contains("<svg"));
+        // Zero cost and zero error still give a drawable (linear) chart.
+        cost_error_chart(&[pt("gt", 0.0, 0.0)], "zero", "GPU ms", &png, &svg).unwrap();
+        assert!(
+            !Layout::new(&[pt("a", 1.0, 0.05), pt("b", 2.0, 0.1)])
+                .unwrap()
+                .log_y
+        );
+        assert!(
+            Layout::new(&[pt("a", 1.0, 0.005), pt("b", 2.0, 0.1)])
+                .unwrap()
+                .log_y
+        );
+        assert!(
+            !Layout::new(&[pt("a", 1.0, 0.0), pt("b", 2.0, 0.1)])
+                .unwrap()
+                .log_y
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn errors_cleanly() {
+        let dir = temp_dir("err");
+        let (png, svg) = (dir.join("c.png"), dir.join("c.svg"));
+        assert!(cost_error_chart(&[], "t", "x", &png, &svg).is_err());
+        assert!(cost_error_chart(&[pt("a", f64::NAN, 0.1)], "t", "x", &png, &svg).is_err());
+        assert!(cost_error_chart(&[pt("a", 1.0, -0.1)], "t", "x", &png, &svg).is_err());
+        // Under a regular file nothing can be created.
+        fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("file");
+        fs::write(&file, "x").unwrap();
+        let points = [pt("a", 1.0, 0.1)];
+        assert!(cost_error_chart(&points, "t", "x", &file.join("c.png"), &svg).is_err());
+        assert!(cost_error_chart(&points, "t", "x", &png, &file.join("c.svg")).is_err());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}

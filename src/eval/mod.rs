@@ -1,0 +1,13 @@
+//! Evaluation building blocks: how far a real-time SSS method's frame is from the
+//! brute-force ground truth, and what that accuracy costs.
+//!
+//! Kept apart from the renderer so that the numbers a comparison reports come from
+//! plain, unit-tested CPU code that never touches Vulkan:
+//! - `metrics`: image error measures (energy-normalised relative RMSE on linear
+//!   radiance, NVIDIA FLIP on the tone-mapped sRGB frame, per-pixel error maps and
+//!   their false-colour visualisation, masked energy for halo/leak checks);
+//! - `pareto`: cost/error points, their Pareto front and CSV export;
+//! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows.
+pub mod chart;
+pub mod metrics;
+pub mod pareto;

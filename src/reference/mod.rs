@@ -1,0 +1,5 @@
+//! The ground truth's pure parts: surface sampling, the grid, the profile split,
+//! and an f64 CPU gather that checks the GPU one. The GPU passes are in
+//! `render::reference`.
+pub mod cpu;
+pub mod sampling;
