@@ -13,11 +13,13 @@ struct Sample {
     vec4 uv;        // xy
 };
 layout(std430, set = 0, binding = 6) readonly buffer Samples { Sample samples[]; };
-layout(push_constant) uniform Push { uint count; uint width; } pc;
+// One chunk of the samples per draw (storage-buffer ranges are limited): this
+// draw covers rows firstRow.. of the target and samples first.. of the buffer range.
+layout(push_constant) uniform Push { uint count; uint width; uint firstRow; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outRadiance;
 void main() {
-    uint i = uint(gl_FragCoord.y) * pc.width + uint(gl_FragCoord.x);
+    uint i = (uint(gl_FragCoord.y) - pc.firstRow) * pc.width + uint(gl_FragCoord.x);
     if (i >= pc.count) {
         outRadiance = vec4(0.0);
         return;

@@ -3,7 +3,7 @@
 # compiler, the Vulkan loader, lavapipe (the CPU Vulkan driver the tests run
 # on) and the Khronos validation layer. Idempotent: installed packages are skipped.
 set -euo pipefail
-packages=(glslang-tools mesa-vulkan-drivers libvulkan1 vulkan-validationlayers)
+packages=(glslang-tools mesa-vulkan-drivers libvulkan1 vulkan-validationlayers fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -725,7 +725,7 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         let mut passes = self.gpu.passes();
         if let Some(plan) = plan {
-            passes = plan.interleave(ctx, &mut self.resources, passes, &self.gpu.targets)?;
+            passes = plan.interleave(ctx, &mut self.resources, passes, &self.gpu)?;
         }
         let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
         unsafe {
@@ -780,7 +780,7 @@ impl<'c> Renderer<'c> {
     pub fn capture(&mut self, dump: bool) -> Result<Capture> {
         let mut plan = ReadbackPlan::new(dump, self.gpu.targets.ldr.0);
         let samples = self.run_frame(Some(&mut plan))?;
-        let (ldr, dumps) = plan.finish(self.ctx, &mut self.resources, &self.gpu.targets)?;
+        let (ldr, dumps) = plan.finish(self.ctx, &mut self.resources, &self.gpu)?;
         // Readback passes are bookkeeping, not frame cost.
         let samples = samples
             .into_iter()
@@ -879,7 +879,7 @@ impl<'c> Renderer<'c> {
         }
         let passes = self.gpu.sss_passes();
         let mut plan = ReadbackPlan::single(self.gpu.final_diffuse().0);
-        let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu.targets)?;
+        let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu)?;
         let ctx = self.ctx;
         let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
         let cmd = self.cmd;
@@ -894,7 +894,7 @@ impl<'c> Renderer<'c> {
         ctx.submit_and_wait(cmd)?;
         ctx.check_validation("during the SSS-only run")?;
         let samples = self.profiler.read(ctx, &names)?;
-        let img = plan.finish_single(ctx, &mut self.resources, &self.gpu.targets)?;
+        let img = plan.finish_single(ctx, &mut self.resources, &self.gpu)?;
         Ok((
             img,
             samples
@@ -919,6 +919,14 @@ impl FrameGpu {
             depth_stencil: (t.depth_stencil.0, t.depth_stencil.1.view),
             extent: self.extent,
         }
+    }
+
+    /// Any image of the frame by graph id: the targets, and images a method owns.
+    pub fn image_by_id(&self, id: ImageId) -> Option<&Image> {
+        self.targets.by_id(id).or(match &self.sss {
+            Some(SssMethod::Reference(r)) if r.radiance_id == id => Some(&r.radiance),
+            _ => None,
+        })
     }
 
     /// The per-level ids of the diffuse, depth and normal mip chains (poisson).

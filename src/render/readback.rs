@@ -6,7 +6,7 @@ use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::Targets;
+use super::FrameGpu;
 use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
@@ -135,12 +135,12 @@ impl ReadbackPlan {
         &mut self,
         ctx: &Context,
         res: &mut Resources,
-        targets: &Targets,
+        targets: &FrameGpu,
         pass: &str,
         id: ImageId,
     ) -> Result<Option<Pass<'a>>> {
         // Mip levels above 0 are tracked as their own resources but not dumped.
-        let Some(img) = targets.by_id(id) else {
+        let Some(img) = targets.image_by_id(id) else {
             return Ok(None);
         };
         let Some((bpt, aspect)) = copy_format(img.format) else {
@@ -199,7 +199,7 @@ impl ReadbackPlan {
         ctx: &Context,
         res: &mut Resources,
         passes: Vec<Pass<'a>>,
-        targets: &Targets,
+        targets: &FrameGpu,
     ) -> Result<Vec<Pass<'a>>> {
         self.buffers_before = res.buffers.len();
         let mut out = Vec::with_capacity(passes.len() * 2 + 2);
@@ -234,8 +234,10 @@ impl ReadbackPlan {
         Ok(out)
     }
 
-    fn read(&self, p: &Pending, targets: &Targets) -> Result<(u32, u32, vk::Format, Vec<u8>)> {
-        let img = targets.by_id(p.image).context("readback image vanished")?;
+    fn read(&self, p: &Pending, targets: &FrameGpu) -> Result<(u32, u32, vk::Format, Vec<u8>)> {
+        let img = targets
+            .image_by_id(p.image)
+            .context("readback image vanished")?;
         Ok((
             img.extent.width,
             img.extent.height,
@@ -249,7 +251,7 @@ impl ReadbackPlan {
         mut self,
         ctx: &Context,
         res: &mut Resources,
-        targets: &Targets,
+        targets: &FrameGpu,
     ) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
         let mut final_bytes = None;
         let mut dumps = Vec::new();
@@ -260,7 +262,7 @@ impl ReadbackPlan {
             }
             if self.dump {
                 let image = targets
-                    .by_id(p.image)
+                    .image_by_id(p.image)
                     .map(|i| i.name.clone())
                     .unwrap_or_default();
                 dumps.push(DumpedImage {
@@ -284,7 +286,7 @@ impl ReadbackPlan {
         mut self,
         ctx: &Context,
         res: &mut Resources,
-        targets: &Targets,
+        targets: &FrameGpu,
     ) -> Result<Vec<[f32; 4]>> {
         let p = self.pending.first().context("nothing was read back")?;
         let (_, _, format, bytes) = self.read(p, targets)?;

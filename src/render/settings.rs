@@ -99,7 +99,7 @@ impl Default for RenderSettings {
             fit: GaussianFit::Six,
             lod: true,
             mask: MaskMode::Stencil,
-            reference_density: 16.0,
+            reference_density: 32.0,
             heads: 1,
             distance_heads: 4.0,
             fovy_deg: 20.0,

@@ -41,6 +41,8 @@ pub enum AccessKind {
     ComputeStorageWrite,
     /// Read as a storage image/buffer by a compute shader.
     ComputeStorageRead,
+    /// Read and written (accumulated into) as a storage image by a compute shader.
+    ComputeStorageReadWrite,
     /// Read as a storage buffer by a fragment shader.
     FragmentStorageRead,
     /// Source of a copy.
@@ -117,6 +119,11 @@ impl AccessKind {
             AccessKind::ComputeStorageRead => {
                 (S::COMPUTE_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
             }
+            AccessKind::ComputeStorageReadWrite => (
+                S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+            ),
             AccessKind::FragmentStorageRead => {
                 (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
             }
@@ -150,6 +157,7 @@ impl AccessKind {
                 | AccessKind::ColorAttachmentLoadWrite
                 | AccessKind::DepthStencilWrite
                 | AccessKind::ComputeStorageWrite
+                | AccessKind::ComputeStorageReadWrite
                 | AccessKind::TransferWrite
                 | AccessKind::HostWrite
         )
@@ -344,7 +352,8 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 17] = [
+    const ALL: [AccessKind; 18] = [
+        AccessKind::ComputeStorageReadWrite,
         AccessKind::FragmentStorageRead,
         AccessKind::AnyShaderSampledRead,
         AccessKind::ComputeStorageRead,
@@ -549,6 +558,7 @@ mod tests {
                 k,
                 AccessKind::ComputeStorageWrite
                     | AccessKind::ComputeStorageRead
+                    | AccessKind::ComputeStorageReadWrite
                     | AccessKind::FragmentStorageRead
             ) {
                 assert_ne!(i.layout, L::GENERAL, "{k:?}");

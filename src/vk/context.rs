@@ -50,6 +50,8 @@ pub struct DeviceFacts {
     pub occlusion_query_precise: bool,
     pub independent_blend: bool,
     pub max_image_dimension_2d: u32,
+    pub max_storage_buffer_range: u32,
+    pub min_storage_buffer_offset_alignment: u64,
     pub sub_texel_precision_bits: u32,
 }
 
@@ -320,6 +322,8 @@ impl Context {
             occlusion_query_precise: features.occlusion_query_precise == vk::TRUE,
             independent_blend: features.independent_blend == vk::TRUE,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            min_storage_buffer_offset_alignment: props.limits.min_storage_buffer_offset_alignment,
             sub_texel_precision_bits: props.limits.sub_texel_precision_bits,
         };
 

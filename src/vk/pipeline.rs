@@ -319,10 +319,21 @@ impl Pipeline {
 /// A resource to bind, by the shader's variable name. Textures and samplers are
 /// separate objects (`texture2D` + `sampler` in GLSL): naga's SPIR-V reader, which
 /// validates every module, does not take combined image samplers.
+#[derive(Clone, Copy, Debug)]
 pub enum Bind {
     Texture(vk::ImageView),
     Sampler(vk::Sampler),
-    Uniform { buffer: vk::Buffer, size: u64 },
+    /// A whole buffer (uniform or storage, as the shader declares it).
+    Uniform {
+        buffer: vk::Buffer,
+        size: u64,
+    },
+    /// A range of a buffer (uniform or storage).
+    Range {
+        buffer: vk::Buffer,
+        offset: u64,
+        size: u64,
+    },
 }
 
 /// A descriptor pool sized for the whole renderer (everything is allocated once).
@@ -450,6 +461,21 @@ impl DescriptorPool {
                         vk::DescriptorBufferInfo {
                             buffer: *buffer,
                             offset: 0,
+                            range: *size,
+                        },
+                    ));
+                }
+                Bind::Range {
+                    buffer,
+                    offset,
+                    size,
+                } => {
+                    buffer_infos.push((
+                        info.binding,
+                        info.descriptor_type,
+                        vk::DescriptorBufferInfo {
+                            buffer: *buffer,
+                            offset: *offset,
                             range: *size,
                         },
                     ));

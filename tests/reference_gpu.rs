@@ -1,0 +1,132 @@
+//! The ground truth on lavapipe: the GPU gather (f32, grid, cut-off) against an
+//! independent CPU gather in f64 (brute force over every sample) on a tiny
+//! scene, and convergence of the surface sampling.
+
+mod common;
+
+use dermis::eval::metrics::relative_rmse;
+use dermis::reference::cpu::{gather_f64, GatherView};
+use dermis::render::{Method, RenderSettings, Renderer, SssMethod};
+use dermis::scene::default_scene;
+
+fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
+    RenderSettings {
+        width,
+        height,
+        shadow_size: 256,
+        method: Method::Reference,
+        reference_density: density,
+        distance_heads: 3.0,
+        ..RenderSettings::default()
+    }
+}
+
+struct Run {
+    output: Vec<[f32; 4]>,
+    diffuse: Vec<[f32; 4]>,
+    depth: Vec<f32>,
+    radiance: Vec<[f32; 4]>,
+    samples: Vec<dermis::reference::sampling::SurfaceSample>,
+    view: GatherView,
+}
+
+fn render(s: &RenderSettings) -> Run {
+    let ctx = common::ctx();
+    let scene = default_scene();
+    let mut r = Renderer::new(&ctx, &scene, s).unwrap();
+    let cap = r.capture(true).unwrap();
+    let find = |pass: &str, image: &str| {
+        cap.dumps
+            .iter()
+            .find(|d| d.pass == pass && d.image == image)
+            .unwrap_or_else(|| panic!("no dump {pass} -> {image}"))
+            .rgba
+            .clone()
+    };
+    let (samples, _) = match &r.gpu.sss {
+        Some(SssMethod::Reference(m)) => (m.surface.clone(), m.sample_count),
+        _ => unreachable!(),
+    };
+    let aspect = s.width as f32 / s.height as f32;
+    Run {
+        output: find("reference gather 9/9", "reference"),
+        diffuse: find("geometry", "diffuse"),
+        depth: find("geometry", "linear depth")
+            .iter()
+            .map(|p| p[0])
+            .collect(),
+        radiance: find("reference irradiance", "reference radiance"),
+        samples,
+        view: GatherView {
+            width: s.width as usize,
+            height: s.height as usize,
+            inv_view: r.gpu.camera.view().inverse(),
+            tan_half_fovy: (0.5 * s.fovy_deg.to_radians()).tan(),
+            aspect,
+            mm_per_unit: scene.mm_per_unit,
+        },
+    }
+}
+
+#[test]
+fn gpu_gather_matches_f64_cpu_gather() {
+    // Tiny: 48x32 pixels, 0.5 samples per mm^2 (~60k samples).
+    let run = render(&settings(
+        48,
+        32,
+        std::env::var("GDENSITY")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0.5),
+    ));
+    let cpu = gather_f64(
+        &run.view,
+        &run.diffuse,
+        &run.depth,
+        &run.samples,
+        &run.radiance,
+    );
+    let mut worst = 0.0f64;
+    let mut skin = 0;
+    for (g, c) in run.output.iter().zip(&cpu) {
+        for i in 0..3 {
+            let rel = (g[i] as f64 - c[i]).abs() / c[i].abs().max(1e-3);
+            worst = worst.max(rel);
+        }
+        skin += (c[3] > 0.0) as usize;
+    }
+    println!(
+        "{skin} skin pixels, {} samples: worst relative difference {worst:.2e}",
+        run.samples.len()
+    );
+    assert!(skin > 100, "the tiny view holds skin");
+    // f32 accumulation of a few hundred positive terms: ~1e-6; the bound is 1e-4.
+    assert!(
+        worst <= 1e-4,
+        "GPU reference differs from the f64 CPU one by {worst:.2e}"
+    );
+}
+
+#[test]
+fn surface_sampling_has_converged_at_the_default_density() {
+    let d = std::env::var("DENSITY")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(RenderSettings::default().reference_density);
+    let a = render(&settings(64, 40, d));
+    let b = render(&settings(64, 40, 2.0 * d));
+    let mask: Vec<bool> = a.diffuse.iter().map(|p| p[3] > 0.0).collect();
+    let e = relative_rmse(&a.output, &b.output, &mask).unwrap();
+    println!(
+        "density {d} vs {}: relative RMSE {e:.2e} over {} skin pixels",
+        2.0 * d,
+        mask.iter().filter(|&&m| m).count()
+    );
+    assert!(
+        e < 1e-3,
+        "doubling the density changed the reference by {e:.2e}"
+    );
+    // And the reference is not the unscattered image: scattering did something.
+    let e0 = relative_rmse(&a.diffuse, &a.output, &mask).unwrap();
+    assert!(e0 > 1e-2, "the reference equals its input ({e0:.2e})");
+}
