@@ -8,7 +8,7 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use dermis::render::{Method, RenderSettings};
-use dermis::run::{run, slug, write_exr, write_png, RunOptions};
+use dermis::run::{read_exr, run, slug, write_diffuse_exr, write_exr, write_png, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
@@ -53,6 +53,42 @@ enum Command {
         #[arg(long, default_value_t = 20)]
         warmup: usize,
         #[arg(long, default_value_t = 100)]
+        frames: usize,
+    },
+    /// Render the ground truth (brute-force integral over the skin surface): like
+    /// `render --method reference`, writes frame.png, diffuse.exr and report.json.
+    Reference {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, default_value = "out/reference")]
+        out: PathBuf,
+    },
+    /// Compare two render outputs (DIR with diffuse.exr and frame.png): relative
+    /// RMSE of the linear diffuse over skin pixels (skin from B) and FLIP of the
+    /// tone-mapped frames; writes error images and compare.json into --out.
+    Compare {
+        /// The image under test.
+        a: PathBuf,
+        /// The reference.
+        b: PathBuf,
+        /// Where to write the error images (default: A).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Sweep every registered method and setting over a scene set against the
+    /// ground truth: writes eval.csv, eval.json and the cost/error chart (PNG, SVG).
+    Eval {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, default_value = "out/eval")]
+        out: PathBuf,
+        /// Scene set: thesis (the Lee Perry-Smith head at the perceptual study's 3
+        /// distances x 4 lights, plus the procedural scene) or quick (procedural only).
+        #[arg(long, default_value = "thesis")]
+        scenes: String,
+        #[arg(long, default_value_t = 2)]
+        warmup: usize,
+        #[arg(long, default_value_t = 10)]
         frames: usize,
     },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
@@ -110,7 +146,7 @@ struct Common {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// SSS method: separable | ssg | ss-jittered | poisson | none.
+    /// SSS method: separable | ssg | ss-jittered | poisson | reference | none.
     #[arg(long, default_value = "separable")]
     method: String,
     /// Kernel samples per SSS pass (odd: 9, 17, 33, ...).
@@ -130,6 +166,10 @@ struct Common {
     falloff: Option<Vec<f32>>,
     #[arg(long)]
     no_follow_surface: bool,
+    /// reference: surface samples per mm^2 (32 is converged: doubling it changes
+    /// the image by 5e-4 relative RMSE).
+    #[arg(long, default_value_t = 32.0)]
+    density: f32,
     /// ssg: Gaussian fit of thesis Table 4.2: 6 or 4.
     #[arg(long, default_value = "6")]
     fit: String,
@@ -209,6 +249,7 @@ impl Common {
             fit: self.fit.parse()?,
             lod: !self.no_lod,
             mask: self.mask.parse()?,
+            reference_density: self.density,
             heads: self.heads,
             distance_heads: distance,
             fovy_deg: self.fovy,
@@ -284,46 +325,23 @@ fn main_result() -> Result<()> {
             frames,
         } => {
             let settings = common.settings()?;
-            let scene = common.scene()?;
-            let ctx = common.context()?;
-            let opts = RunOptions {
-                warmup,
-                measured: frames,
-                capture: true,
-                dump,
-                ceilings: false,
-                command: command_line(),
-                progress: true,
-            };
-            let output = run(&ctx, &scene, &settings, &opts)?;
-            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-            let capture = output.capture.as_ref().context("no frame was captured")?;
-            write_png(&out.join("frame.png"), capture)?;
-            if dump {
-                let dir = out.join("passes");
-                std::fs::create_dir_all(&dir)
-                    .with_context(|| format!("creating {}", dir.display()))?;
-                for (i, d) in capture.dumps.iter().enumerate() {
-                    write_exr(
-                        &dir.join(format!("{:02}_{}_{}.exr", i, slug(&d.pass), slug(&d.image))),
-                        d,
-                    )?;
-                }
-            }
-            let json = serde_json::to_string_pretty(&output.report)?;
-            std::fs::write(out.join("report.json"), json)
-                .with_context(|| format!("writing {}", out.join("report.json").display()))?;
-            print_header(&ctx, &output.report);
-            print!(
-                "{}",
-                dermis::report::table(&output.report.passes, output.report.frame.as_ref())
-            );
-            println!(
-                "wrote {} and {}",
-                out.join("frame.png").display(),
-                out.join("report.json").display()
-            );
+            render_to(&common, settings, &out, dump, warmup, frames)?;
         }
+        Command::Reference { common, out } => {
+            let settings = RenderSettings {
+                method: Method::Reference,
+                ..common.settings()?
+            };
+            render_to(&common, settings, &out, false, 0, 1)?;
+        }
+        Command::Compare { a, b, out } => compare(&a, &b, out.as_deref().unwrap_or(&a))?,
+        Command::Eval {
+            common,
+            out,
+            scenes,
+            warmup,
+            frames,
+        } => eval(&common, &out, &scenes, warmup, frames)?,
         Command::Bench {
             common,
             report,
@@ -397,6 +415,193 @@ fn main_result() -> Result<()> {
             }
         }
     }
+    Ok(())
+}
+
+/// Renders `settings` and writes frame.png, diffuse.exr, report.json (and with
+/// `dump`, every pass output) into `out`, printing the per-pass table.
+fn render_to(
+    common: &Common,
+    settings: RenderSettings,
+    out: &std::path::Path,
+    dump: bool,
+    warmup: usize,
+    frames: usize,
+) -> Result<()> {
+    let scene = common.scene()?;
+    let ctx = common.context()?;
+    let opts = RunOptions {
+        warmup,
+        measured: frames,
+        capture: true,
+        dump,
+        ceilings: false,
+        command: command_line(),
+        progress: true,
+    };
+    let output = run(&ctx, &scene, &settings, &opts)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let capture = output.capture.as_ref().context("no frame was captured")?;
+    write_png(&out.join("frame.png"), capture)?;
+    write_diffuse_exr(&out.join("diffuse.exr"), capture)?;
+    if dump {
+        let dir = out.join("passes");
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (i, d) in capture.dumps.iter().enumerate() {
+            write_exr(
+                &dir.join(format!("{:02}_{}_{}.exr", i, slug(&d.pass), slug(&d.image))),
+                d,
+            )?;
+        }
+    }
+    let json = serde_json::to_string_pretty(&output.report)?;
+    std::fs::write(out.join("report.json"), json)
+        .with_context(|| format!("writing {}", out.join("report.json").display()))?;
+    print_header(&ctx, &output.report);
+    print!(
+        "{}",
+        dermis::report::table(&output.report.passes, output.report.frame.as_ref())
+    );
+    println!(
+        "wrote {}, {} and {}",
+        out.join("frame.png").display(),
+        out.join("diffuse.exr").display(),
+        out.join("report.json").display()
+    );
+    Ok(())
+}
+
+/// `dermis eval`: the sweep, its CSV and JSON, and the chart.
+fn eval(
+    common: &Common,
+    out: &std::path::Path,
+    scenes: &str,
+    warmup: usize,
+    frames: usize,
+) -> Result<()> {
+    use dermis::eval::{chart, pareto, sweep};
+    let base = common.settings()?;
+    let specs = match scenes {
+        "thesis" => {
+            let head = match &common.scene {
+                Some(p) => p.clone(),
+                None => {
+                    std::path::PathBuf::from("../shared/assets/lee-perry-smith/LeePerrySmith.glb")
+                }
+            };
+            if !head.exists() {
+                bail!("the thesis scene set needs the head scan: {} not found (give --scene PATH.glb, or --scenes quick)", head.display());
+            }
+            sweep::thesis_scenes(Some(head))
+        }
+        "quick" => vec![sweep::SceneSpec {
+            distance_heads: base.distance_heads,
+            ..sweep::procedural_scene()
+        }],
+        other => bail!("unknown scene set '{other}' (valid: thesis, quick)"),
+    };
+    let ctx = common.context()?;
+    let rows = sweep::sweep(
+        &ctx,
+        &specs,
+        &sweep::registry(),
+        &sweep::EvalOptions {
+            base,
+            warmup,
+            measured: frames,
+            progress: true,
+        },
+    )?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let points: Vec<pareto::EvalPoint> = rows.iter().map(|r| r.point.clone()).collect();
+    pareto::write_csv(&out.join("eval.csv"), &points)?;
+    let summary = sweep::summarise(&rows);
+    let report = serde_json::json!({
+        "device": ctx.facts.name, "driver": ctx.facts.driver, "command": command_line(),
+        "scenes": specs, "rows": rows, "summary": summary,
+        "pareto_front": pareto::pareto_front(&summary).iter().map(|&i| &summary[i]).collect::<Vec<_>>(),
+    });
+    std::fs::write(
+        out.join("eval.json"),
+        serde_json::to_string_pretty(&report)?,
+    )?;
+    chart::cost_error_chart(
+        &summary,
+        &format!(
+            "SSS cost vs error ({}, {} scene(s))",
+            ctx.facts.name,
+            specs.len()
+        ),
+        "GPU ms (SSS passes, median)",
+        &out.join("chart.png"),
+        &out.join("chart.svg"),
+    )?;
+    println!(
+        "{:<12} {:<26} {:>10} {:>12}",
+        "method", "setting", "SSS ms", "rel. RMSE"
+    );
+    for p in &summary {
+        println!(
+            "{:<12} {:<26} {:>10.4} {:>12.4e}",
+            p.method, p.setting, p.gpu_ms, p.error
+        );
+    }
+    println!(
+        "wrote eval.csv, eval.json, chart.png and chart.svg in {}",
+        out.display()
+    );
+    Ok(())
+}
+
+/// `dermis compare A B`: metrics of A against the reference B.
+fn compare(a: &std::path::Path, b: &std::path::Path, out: &std::path::Path) -> Result<()> {
+    use dermis::eval::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
+    let (wa, ha, da) = read_exr(&a.join("diffuse.exr"))?;
+    let (wb, hb, db) = read_exr(&b.join("diffuse.exr"))?;
+    if (wa, ha) != (wb, hb) {
+        bail!(
+            "{} is {wa}x{ha} but {} is {wb}x{hb}",
+            a.display(),
+            b.display()
+        );
+    }
+    let load_png = |d: &std::path::Path| -> Result<Vec<u8>> {
+        let p = d.join("frame.png");
+        Ok(image::open(&p)
+            .with_context(|| format!("reading {}", p.display()))?
+            .to_rgba8()
+            .into_raw())
+    };
+    let (fa, fb) = (load_png(a)?, load_png(b)?);
+    let mask: Vec<bool> = db.iter().map(|p| p[3] > 0.0).collect();
+    let rmse = relative_rmse(&da, &db, &mask)?;
+    let flip = flip_ldr(&fa, &fb, wa, ha)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let save = |name: &str, rgba: Vec<u8>| -> Result<()> {
+        let p = out.join(name);
+        image::RgbaImage::from_raw(wa, ha, rgba)
+            .context("error image size")?
+            .save(&p)
+            .with_context(|| format!("writing {}", p.display()))
+    };
+    // Relative diffuse error, 0..10% mapped onto the colour ramp.
+    save(
+        "error_diffuse.png",
+        false_colour(&abs_error_map(&da, &db, &mask), wa, ha, 0.1),
+    )?;
+    save("error_flip.png", false_colour(&flip.error_map, wa, ha, 1.0))?;
+    let report = serde_json::json!({
+        "test": a.display().to_string(),
+        "reference": b.display().to_string(),
+        "skin_pixels": mask.iter().filter(|&&m| m).count(),
+        "relative_rmse": rmse,
+        "flip_mean": flip.mean,
+    });
+    std::fs::write(
+        out.join("compare.json"),
+        serde_json::to_string_pretty(&report)?,
+    )?;
+    println!("relative RMSE (linear diffuse, skin) {rmse:.4e} | FLIP (tone-mapped) {:.4} | error images in {}", flip.mean, out.display());
     Ok(())
 }
 

@@ -241,6 +241,29 @@ pub fn write_exr(path: &Path, d: &DumpedImage) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// Writes the diffuse light after SSS (linear, alpha = SSS strength) as EXR.
+pub fn write_diffuse_exr(path: &Path, c: &Capture) -> Result<()> {
+    write_exr(
+        path,
+        &DumpedImage {
+            pass: "final".into(),
+            image: "diffuse".into(),
+            width: c.width,
+            height: c.height,
+            rgba: c.diffuse.clone(),
+        },
+    )
+}
+
+/// Reads an RGBA EXR written by dermis.
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+    let img = image::open(path)
+        .with_context(|| format!("reading {}", path.display()))?
+        .to_rgba32f();
+    let (w, h) = img.dimensions();
+    Ok((w, h, img.pixels().map(|p| p.0).collect()))
+}
+
 /// A file-name-safe version of a pass or image name.
 pub fn slug(s: &str) -> String {
     s.chars()

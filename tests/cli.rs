@@ -279,3 +279,121 @@ fn kernel_prints_json() {
         .unwrap();
     assert!(!o.status.success());
 }
+
+fn run_ok(args: &[&str]) -> String {
+    let o = dermis().args(args).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}{}",
+        out,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
+#[test]
+fn reference_and_compare() {
+    let d = tmp("cmp");
+    let (a, r) = (d.join("sep"), d.join("ref"));
+    let common = [
+        "--validate",
+        "--device",
+        "llvmpipe",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--density",
+        "8",
+    ];
+    let mut args = vec![
+        "render",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--out",
+        a.to_str().unwrap(),
+    ];
+    args.extend(common);
+    run_ok(&args);
+    let mut args = vec!["reference", "--out", r.to_str().unwrap()];
+    args.extend(common);
+    run_ok(&args);
+    let out = run_ok(&["compare", a.to_str().unwrap(), r.to_str().unwrap()]);
+    assert!(out.contains("relative RMSE"), "{out}");
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("compare.json")).unwrap()).unwrap();
+    let e = v["relative_rmse"].as_f64().unwrap();
+    assert!(e > 1e-4 && e < 0.2, "separable vs reference: {e}");
+    assert!(a.join("error_diffuse.png").exists() && a.join("error_flip.png").exists());
+    // The reference against itself is exact.
+    run_ok(&[
+        "compare",
+        r.to_str().unwrap(),
+        r.to_str().unwrap(),
+        "--out",
+        d.join("self").to_str().unwrap(),
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("self").join("compare.json")).unwrap())
+            .unwrap();
+    assert_eq!(v["relative_rmse"].as_f64().unwrap(), 0.0);
+    // A missing input is one clear error.
+    let o = dermis()
+        .args(["compare", "/nonexistent/a", r.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).starts_with("error: "));
+}
+
+#[test]
+fn eval_writes_csv_json_and_chart() {
+    let d = tmp("eval");
+    run_ok(&[
+        "eval",
+        "--validate",
+        "--device",
+        "llvmpipe",
+        "--scenes",
+        "quick",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--warmup",
+        "0",
+        "--frames",
+        "1",
+        "--density",
+        "8",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    let csv = std::fs::read_to_string(d.join("eval.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), dermis::eval::sweep::registry().len(), "{csv}");
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("eval.json")).unwrap()).unwrap();
+    let summary = v["summary"].as_array().unwrap();
+    let error = |m: &str, s: &str| {
+        summary
+            .iter()
+            .find(|p| p["method"] == m && p["setting"] == s)
+            .unwrap()["error"]
+            .as_f64()
+            .unwrap()
+    };
+    // Scattering moves the frame toward the ground truth: separable beats no SSS.
+    assert!(
+        error("separable", "33 samples") < error("none", "-"),
+        "{summary:?}"
+    );
+    assert!(!v["pareto_front"].as_array().unwrap().is_empty());
+    let png = image::open(d.join("chart.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (1200, 800));
+    assert!(std::fs::read_to_string(d.join("chart.svg"))
+        .unwrap()
+        .contains("<svg"));
+}

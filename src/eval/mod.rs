@@ -7,7 +7,9 @@
 //!   radiance, NVIDIA FLIP on the tone-mapped sRGB frame, per-pixel error maps and
 //!   their false-colour visualisation, masked energy for halo/leak checks);
 //! - `pareto`: cost/error points, their Pareto front and CSV export;
-//! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows.
+//! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows;
+//! - `sweep`: `dermis eval`, the registry of methods and settings, the scene set.
 pub mod chart;
 pub mod metrics;
 pub mod pareto;
+pub mod sweep;

@@ -336,6 +336,9 @@ pub struct Capture {
     /// Every pass output (with `dump`), linear float.
     pub dumps: Vec<DumpedImage>,
     pub samples: Vec<PassSample>,
+    /// The diffuse light after SSS (what the composite reads), linear float;
+    /// alpha is the SSS strength, so alpha > 0 marks skin.
+    pub diffuse: Vec<[f32; 4]>,
 }
 
 impl<'c> Renderer<'c> {
@@ -786,13 +789,35 @@ impl<'c> Renderer<'c> {
             .into_iter()
             .filter(|s| !ReadbackPlan::is_readback_pass(&s.name))
             .collect();
+        let diffuse = self.read_back(self.gpu.final_diffuse().0)?;
         Ok(Capture {
             ldr,
             width: self.gpu.extent.width,
             height: self.gpu.extent.height,
             dumps,
             samples,
+            diffuse,
         })
+    }
+
+    /// Reads one frame image back as linear float RGBA (after a frame: its
+    /// contents stay until the next frame writes them).
+    pub fn read_back(&mut self, id: ImageId) -> Result<Vec<[f32; 4]>> {
+        let ctx = self.ctx;
+        let mut plan = ReadbackPlan::single(id);
+        let passes = plan.interleave(ctx, &mut self.resources, Vec::new(), &self.gpu)?;
+        let cmd = self.cmd;
+        unsafe {
+            ctx.device
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())?;
+            ctx.device
+                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
+        }
+        record_passes(ctx, cmd, &mut self.resources, &passes, None);
+        drop(passes);
+        ctx.submit_and_wait(cmd)?;
+        ctx.check_validation("while reading back an image")?;
+        plan.finish_single(ctx, &mut self.resources, &self.gpu)
     }
 
     /// The depth-buffer value of a surface at linear view depth `d` (this camera).

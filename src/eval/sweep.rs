@@ -1,0 +1,320 @@
+//! `dermis eval`: every registered method and quality setting, on a scene set,
+//! timed by the same run's timestamps and scored against the ground truth.
+//!
+//! A method joins the chart by adding its settings to [`registry`].
+
+use std::path::PathBuf;
+
+use anyhow::{Context as _, Result};
+use serde::Serialize;
+
+use super::metrics::relative_rmse;
+use super::pareto::EvalPoint;
+use crate::render::screen::MaskMode;
+use crate::render::{Method, RenderSettings};
+use crate::run::{run, RunOptions};
+use crate::scene::gltf_load::TextureOverrides;
+use crate::scene::{default_scene, load_gltf_scene, Scene};
+use crate::skin::ssg::GaussianFit;
+use crate::vk::context::Context;
+
+/// One point of the sweep: a method at one quality setting.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub method: Method,
+    pub setting: String,
+    pub apply: fn(&mut RenderSettings),
+}
+
+fn config(method: Method, setting: &str, apply: fn(&mut RenderSettings)) -> Config {
+    Config {
+        method,
+        setting: setting.to_string(),
+        apply,
+    }
+}
+
+/// The registry: every method and the knobs it registers.
+pub fn registry() -> Vec<Config> {
+    vec![
+        config(Method::None, "-", |_| {}),
+        config(Method::Separable, "9 samples", |s| s.samples = 9),
+        config(Method::Separable, "17 samples", |s| s.samples = 17),
+        config(Method::Separable, "33 samples", |s| s.samples = 33),
+        config(Method::Ssg, "6 Gaussians, LOD", |s| {
+            s.fit = GaussianFit::Six
+        }),
+        config(Method::Ssg, "4 Gaussians, LOD", |s| {
+            s.fit = GaussianFit::Four
+        }),
+        config(Method::Ssg, "6 Gaussians, no LOD", |s| {
+            s.fit = GaussianFit::Six;
+            s.lod = false
+        }),
+        config(Method::Ssg, "6 Gaussians, branch mask", |s| {
+            s.mask = MaskMode::Branch
+        }),
+        config(Method::SsJittered, "13 taps", |_| {}),
+        config(Method::Poisson, "8-32 taps", |_| {}),
+    ]
+}
+
+/// A view of the scene set.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneSpec {
+    pub name: String,
+    /// `None`: the embedded procedural head.
+    pub gltf: Option<PathBuf>,
+    pub distance_heads: f32,
+    pub azimuth_deg: f32,
+    pub elevation_deg: f32,
+}
+
+/// The thesis' perceptual study (section 4.3.2): zoom, near and far (28, 50 and
+/// 132 units for a 27-unit head, so 1.04, 1.85 and 4.89 head heights) x light at
+/// 0, 60, 110 and 150 degrees azimuth, 45 elevation, on the given head, plus the
+/// procedural default scene.
+pub fn thesis_scenes(head: Option<PathBuf>) -> Vec<SceneSpec> {
+    let mut v = Vec::new();
+    if let Some(h) = head {
+        for (shot, d) in [
+            ("zoom", 28.0 / 27.0),
+            ("near", 50.0 / 27.0),
+            ("far", 132.0 / 27.0),
+        ] {
+            for az in [0.0, 60.0, 110.0, 150.0] {
+                v.push(SceneSpec {
+                    name: format!("head {shot} {az:.0}deg"),
+                    gltf: Some(h.clone()),
+                    distance_heads: d,
+                    azimuth_deg: az,
+                    elevation_deg: 45.0,
+                });
+            }
+        }
+    }
+    v.push(procedural_scene());
+    v
+}
+
+/// The embedded scene at its default view.
+pub fn procedural_scene() -> SceneSpec {
+    let d = RenderSettings::default();
+    SceneSpec {
+        name: "procedural".into(),
+        gltf: None,
+        distance_heads: d.distance_heads,
+        azimuth_deg: d.light.azimuth_deg,
+        elevation_deg: d.light.elevation_deg,
+    }
+}
+
+/// One row of the detailed report.
+#[derive(Clone, Debug, Serialize)]
+pub struct EvalRow {
+    #[serde(flatten)]
+    pub point: EvalPoint,
+    pub skin_pixels: usize,
+    pub frame_ms: f64,
+}
+
+pub struct EvalOptions {
+    pub base: RenderSettings,
+    pub warmup: usize,
+    pub measured: usize,
+    pub progress: bool,
+}
+
+fn load(spec: &SceneSpec) -> Result<Scene> {
+    match &spec.gltf {
+        None => Ok(default_scene()),
+        Some(p) => load_gltf_scene(p, &TextureOverrides::default(), None),
+    }
+}
+
+/// Runs the sweep; returns one row per (scene, config).
+pub fn sweep(
+    ctx: &Context,
+    scenes: &[SceneSpec],
+    configs: &[Config],
+    opts: &EvalOptions,
+) -> Result<Vec<EvalRow>> {
+    let total = (scenes.len() * (configs.len() + 1)) as u64;
+    let bar = opts.progress.then(|| {
+        let b = indicatif::ProgressBar::new(total);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    let mut rows = Vec::new();
+    for spec in scenes {
+        let scene = load(spec).with_context(|| format!("loading scene '{}'", spec.name))?;
+        let mut base = opts.base.clone();
+        base.distance_heads = spec.distance_heads;
+        base.light.azimuth_deg = spec.azimuth_deg;
+        base.light.elevation_deg = spec.elevation_deg;
+        let once = RunOptions {
+            warmup: 0,
+            measured: 1,
+            capture: true,
+            dump: false,
+            ceilings: false,
+            command: "eval".into(),
+            progress: false,
+        };
+        if let Some(b) = &bar {
+            b.set_message(format!("{}: reference", spec.name));
+        }
+        let reference = run(
+            ctx,
+            &scene,
+            &RenderSettings {
+                method: Method::Reference,
+                ..base.clone()
+            },
+            &once,
+        )?;
+        let ref_diffuse = reference.capture.context("reference capture")?.diffuse;
+        let mask: Vec<bool> = ref_diffuse.iter().map(|p| p[3] > 0.0).collect();
+        let skin = mask.iter().filter(|&&m| m).count();
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+        for c in configs {
+            if let Some(b) = &bar {
+                b.set_message(format!("{}: {} {}", spec.name, c.method.name(), c.setting));
+            }
+            let mut s = RenderSettings {
+                method: c.method,
+                ..base.clone()
+            };
+            (c.apply)(&mut s);
+            let o = RunOptions {
+                warmup: opts.warmup,
+                measured: opts.measured,
+                capture: true,
+                ..once.clone()
+            };
+            let out = run(ctx, &scene, &s, &o)
+                .with_context(|| format!("{} {} on '{}'", c.method.name(), c.setting, spec.name))?;
+            let diffuse = out.capture.context("capture")?.diffuse;
+            // With no skin in view there is nothing to score.
+            let error = if skin > 0 {
+                relative_rmse(&diffuse, &ref_diffuse, &mask)?
+            } else {
+                0.0
+            };
+            rows.push(EvalRow {
+                point: EvalPoint {
+                    method: c.method.name().to_string(),
+                    setting: c.setting.clone(),
+                    scene: spec.name.clone(),
+                    gpu_ms: out.report.sss_total_ms.map_or(0.0, |s| s.median),
+                    error,
+                },
+                skin_pixels: skin,
+                frame_ms: out.report.frame.map_or(0.0, |f| f.gpu_ms.median),
+            });
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    Ok(rows)
+}
+
+/// Mean cost and error of each (method, setting) over the scenes, for the chart.
+pub fn summarise(rows: &[EvalRow]) -> Vec<EvalPoint> {
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.point.method.clone(), r.point.setting.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.into_iter()
+        .map(|(method, setting)| {
+            let sel: Vec<&EvalRow> = rows
+                .iter()
+                .filter(|r| r.point.method == method && r.point.setting == setting)
+                .collect();
+            let n = sel.len() as f64;
+            EvalPoint {
+                gpu_ms: sel.iter().map(|r| r.point.gpu_ms).sum::<f64>() / n,
+                error: sel.iter().map(|r| r.point.error).sum::<f64>() / n,
+                scene: "mean over scenes".into(),
+                method,
+                setting,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registry_covers_every_method_with_distinct_settings() {
+        let r = registry();
+        for m in [
+            Method::None,
+            Method::Separable,
+            Method::Ssg,
+            Method::SsJittered,
+            Method::Poisson,
+        ] {
+            assert!(r.iter().any(|c| c.method == m), "{m:?} missing");
+        }
+        let mut names: Vec<String> = r
+            .iter()
+            .map(|c| format!("{} {}", c.method.name(), c.setting))
+            .collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), r.len());
+        // The separable sample counts of the thesis are all there.
+        for n in [9, 17, 33] {
+            let mut s = RenderSettings::default();
+            let c = r
+                .iter()
+                .find(|c| c.setting == format!("{n} samples"))
+                .unwrap();
+            (c.apply)(&mut s);
+            assert_eq!(s.samples, n);
+        }
+    }
+
+    #[test]
+    fn thesis_scene_set_is_three_distances_by_four_lights_plus_default() {
+        let s = thesis_scenes(Some(PathBuf::from("head.glb")));
+        assert_eq!(s.len(), 13);
+        assert!((s[0].distance_heads - 28.0 / 27.0).abs() < 1e-6);
+        assert_eq!(s.iter().filter(|x| x.azimuth_deg == 110.0).count(), 3);
+        assert!(s.iter().all(|x| x.gltf.is_some() || x.name == "procedural"));
+        assert_eq!(thesis_scenes(None).len(), 1);
+    }
+
+    #[test]
+    fn summary_averages_per_setting() {
+        let row = |scene: &str, ms: f64, e: f64| EvalRow {
+            point: EvalPoint {
+                method: "m".into(),
+                setting: "s".into(),
+                scene: scene.into(),
+                gpu_ms: ms,
+                error: e,
+            },
+            skin_pixels: 1,
+            frame_ms: 0.0,
+        };
+        let s = summarise(&[row("a", 1.0, 0.1), row("b", 3.0, 0.3)]);
+        assert_eq!(s.len(), 1);
+        assert!((s[0].gpu_ms - 2.0).abs() < 1e-12 && (s[0].error - 0.2).abs() < 1e-12);
+    }
+}
