@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::floor::Ceilings;
 use crate::graph::{record_passes, ImageId, Pass, PassContext, Resources};
-use crate::render::separable::set_viewport;
+use crate::render::draw::begin_color_rendering;
 use crate::render::upload;
 use crate::report::Stats;
 use crate::vk::barrier::{AccessKind, ResourceState};
@@ -149,27 +149,20 @@ pub fn measure(
                 pass = pass
                     .image(id_target, AccessKind::ColorAttachmentWrite)
                     .record(move |pc: &PassContext| {
-                        let att = [vk::RenderingAttachmentInfo::default()
-                            .image_view(target_view)
-                            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                            .load_op(vk::AttachmentLoadOp::DONT_CARE)
-                            .store_op(vk::AttachmentStoreOp::STORE)];
-                        let info = vk::RenderingInfo::default()
-                            .render_area(vk::Rect2D {
-                                offset: vk::Offset2D::default(),
-                                extent,
-                            })
-                            .layer_count(1)
-                            .color_attachments(&att);
                         let (c, cmd) = (pc.ctx, pc.cmd);
+                        begin_color_rendering(
+                            c,
+                            cmd,
+                            &[target_view],
+                            extent,
+                            vk::AttachmentLoadOp::DONT_CARE,
+                        );
                         unsafe {
-                            c.device.cmd_begin_rendering(cmd, &info);
                             c.device.cmd_bind_pipeline(
                                 cmd,
                                 vk::PipelineBindPoint::GRAPHICS,
                                 pipeline.raw,
                             );
-                            set_viewport(c, cmd, extent);
                             if let Some(s) = set {
                                 c.device.cmd_bind_descriptor_sets(
                                     cmd,

@@ -1,6 +1,7 @@
 //! The frame: shadow map -> geometry MRTs -> separable SSS (stencil-masked) ->
 //! composite -> Hable tone map, recorded through the pass graph.
 
+pub mod draw;
 pub mod poisson;
 pub mod readback;
 pub mod reference;
@@ -29,12 +30,13 @@ use crate::vk::context::Context;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput};
 use crate::vk::profiler::{PassSample, Profiler};
+use draw::{begin_color_rendering, set_viewport};
 use poisson::{levels_for, Chains, PoissonSss};
 use readback::{DumpedImage, ReadbackPlan};
 use reference::{ReferenceInit, ReferenceSss};
 use scene_gpu::GpuObject;
 use screen::{JitteredSss, ScreenTargets, SsgInit, SsgSss};
-use separable::{set_viewport, SeparableSss, SssTargets, SssView, STENCIL_SKIN};
+use separable::{SeparableSss, SssTargets, SssView, STENCIL_SKIN};
 pub use settings::{Method, RenderSettings};
 
 pub const DIFFUSE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -1219,26 +1221,19 @@ impl FrameGpu {
             .record(move |pc: &PassContext| {
                 let ctx = pc.ctx;
                 let cmd = pc.cmd;
-                let att = [vk::RenderingAttachmentInfo::default()
-                    .image_view(target.1)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::DONT_CARE)
-                    .store_op(vk::AttachmentStoreOp::STORE)];
-                let info = vk::RenderingInfo::default()
-                    .render_area(vk::Rect2D {
-                        offset: vk::Offset2D::default(),
-                        extent,
-                    })
-                    .layer_count(1)
-                    .color_attachments(&att);
+                begin_color_rendering(
+                    ctx,
+                    cmd,
+                    &[target.1],
+                    extent,
+                    vk::AttachmentLoadOp::DONT_CARE,
+                );
                 unsafe {
-                    ctx.device.cmd_begin_rendering(cmd, &info);
                     ctx.device.cmd_bind_pipeline(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,
                         pipeline.raw,
                     );
-                    set_viewport(ctx, cmd, extent);
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,

@@ -10,8 +10,9 @@
 use anyhow::Result;
 use ash::vk;
 
+use super::draw::{begin_color_rendering, fullscreen_stencil_draw};
 use super::screen::{seed_copy, ScreenTargets};
-use super::separable::{fullscreen_stencil_draw, set_viewport, skin_stencil_test, STENCIL_SKIN};
+use super::separable::{skin_stencil_test, STENCIL_SKIN};
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::poisson::{poisson_disk_32, PoissonParams};
 use crate::vk::barrier::AccessKind;
@@ -142,7 +143,12 @@ impl PoissonSss {
         fovy_rad: f32,
         mm_per_unit: f32,
     ) -> Vec<Pass<'a>> {
-        let mut passes = vec![seed_copy("poisson seed copy", &t, &[(t.rt1.0, t.rt1.1)])];
+        let mut passes = vec![seed_copy(
+            "poisson seed copy",
+            (t.diffuse.0, t.diffuse.1),
+            t.extent,
+            &[(t.rt1.0, t.rt1.1)],
+        )];
         for l in 1..self.levels as usize {
             let extent = chains.extents[l];
             let targets = [chains.color[l].1, chains.depth[l].1, chains.normal[l].1];
@@ -155,31 +161,13 @@ impl PoissonSss {
             }
             passes.push(pass.record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
-                let att: Vec<vk::RenderingAttachmentInfo> = targets
-                    .iter()
-                    .map(|&v| {
-                        vk::RenderingAttachmentInfo::default()
-                            .image_view(v)
-                            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                            .load_op(vk::AttachmentLoadOp::DONT_CARE)
-                            .store_op(vk::AttachmentStoreOp::STORE)
-                    })
-                    .collect();
-                let info = vk::RenderingInfo::default()
-                    .render_area(vk::Rect2D {
-                        offset: vk::Offset2D::default(),
-                        extent,
-                    })
-                    .layer_count(1)
-                    .color_attachments(&att);
+                begin_color_rendering(ctx, cmd, &targets, extent, vk::AttachmentLoadOp::DONT_CARE);
                 unsafe {
-                    ctx.device.cmd_begin_rendering(cmd, &info);
                     ctx.device.cmd_bind_pipeline(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,
                         self.mip_pipeline.raw,
                     );
-                    set_viewport(ctx, cmd, extent);
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,

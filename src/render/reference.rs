@@ -13,7 +13,7 @@ use anyhow::{bail, Result};
 use ash::vk;
 use glam::Mat4;
 
-use super::separable::set_viewport;
+use super::draw::begin_color_rendering;
 use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
 use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface, Grid, SurfaceSample};
 use crate::scene::mesh::Mesh;
@@ -291,24 +291,17 @@ impl ReferenceSss {
             .image(self.radiance_id, AccessKind::ColorAttachmentWrite)
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
-                let att = [vk::RenderingAttachmentInfo::default()
-                    .image_view(r_view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::DONT_CARE)
-                    .store_op(vk::AttachmentStoreOp::STORE)];
-                let info = vk::RenderingInfo::default()
-                    .render_area(vk::Rect2D {
-                        offset: vk::Offset2D::default(),
-                        extent: r_extent,
-                    })
-                    .layer_count(1)
-                    .color_attachments(&att);
+                begin_color_rendering(
+                    ctx,
+                    cmd,
+                    &[r_view],
+                    r_extent,
+                    vk::AttachmentLoadOp::DONT_CARE,
+                );
                 let p = &self.irradiance;
                 unsafe {
-                    ctx.device.cmd_begin_rendering(cmd, &info);
                     ctx.device
                         .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, p.raw);
-                    set_viewport(ctx, cmd, r_extent);
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,

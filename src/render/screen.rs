@@ -11,7 +11,8 @@
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::separable::{fullscreen_stencil_draw, skin_stencil_test, STENCIL_SKIN};
+use super::draw::fullscreen_stencil_draw;
+use super::separable::{skin_stencil_test, STENCIL_SKIN};
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::jittered::JitteredKernel;
 use crate::skin::ssg::{lod_depth, SsgGaussian, Stretch};
@@ -70,13 +71,20 @@ pub struct ScreenTargets {
     pub extent: vk::Extent2D,
 }
 
-/// A pass that copies the diffuse target into each of `dsts` (the seeds).
-pub fn seed_copy<'a>(name: &str, t: &ScreenTargets, dsts: &[(ImageId, vk::Image)]) -> Pass<'a> {
-    let mut pass = Pass::new(name).image(t.diffuse.0, AccessKind::TransferRead);
+/// A pass that copies `src` (the diffuse target) into each of `dsts`: the seeds
+/// every method's intermediates start from, so taps on non-skin texels read what a
+/// full-screen blur would have read.
+pub fn seed_copy<'a>(
+    name: &str,
+    src: (ImageId, vk::Image),
+    extent: vk::Extent2D,
+    dsts: &[(ImageId, vk::Image)],
+) -> Pass<'a> {
+    let mut pass = Pass::new(name).image(src.0, AccessKind::TransferRead);
     for d in dsts {
         pass = pass.image(d.0, AccessKind::TransferWrite);
     }
-    let (src, extent) = (t.diffuse.1, t.extent);
+    let src = src.1;
     let dsts: Vec<vk::Image> = dsts.iter().map(|d| d.1).collect();
     pass.record(move |pc: &PassContext| {
         let layers = vk::ImageSubresourceLayers::default()
@@ -219,7 +227,8 @@ impl SsgSss {
     pub fn passes<'a>(&'a self, t: ScreenTargets) -> Vec<Pass<'a>> {
         let mut passes = vec![seed_copy(
             "ssg seed copy",
-            &t,
+            (t.diffuse.0, t.diffuse.1),
+            t.extent,
             &[(t.rt1.0, t.rt1.1), (t.rt2.0, t.rt2.1)],
         )];
         let extent = t.extent;
@@ -345,7 +354,12 @@ impl JitteredSss {
         };
         let ds = t.depth_stencil;
         vec![
-            seed_copy("ss-jittered seed copy", &t, &[(t.rt1.0, t.rt1.1)]),
+            seed_copy(
+                "ss-jittered seed copy",
+                (t.diffuse.0, t.diffuse.1),
+                t.extent,
+                &[(t.rt1.0, t.rt1.1)],
+            ),
             Pass::new("ss-jittered")
                 .image(t.rt1.0, AccessKind::FragmentSampledRead)
                 .image(t.linear_depth, AccessKind::FragmentSampledRead)

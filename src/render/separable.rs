@@ -11,6 +11,7 @@
 use anyhow::Result;
 use ash::vk;
 
+use super::draw::fullscreen_stencil_draw;
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::kernel::SeparableKernel;
 use crate::vk::barrier::AccessKind;
@@ -145,32 +146,12 @@ impl SeparableSss {
     /// The three passes, in order: seed copy, horizontal, vertical.
     pub fn passes<'a>(&'a self, t: SssTargets, view: SssView) -> Vec<Pass<'a>> {
         let extent = t.extent;
-        let seed = Pass::new("sss seed copy")
-            .image(t.diffuse.0, AccessKind::TransferRead)
-            .image(t.tmp.0, AccessKind::TransferWrite)
-            .record(move |pc: &PassContext| {
-                let layers = vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(1);
-                let region = vk::ImageCopy::default()
-                    .src_subresource(layers)
-                    .dst_subresource(layers)
-                    .extent(vk::Extent3D {
-                        width: extent.width,
-                        height: extent.height,
-                        depth: 1,
-                    });
-                unsafe {
-                    pc.ctx.device.cmd_copy_image(
-                        pc.cmd,
-                        t.diffuse.1,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        t.tmp.1,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &[region],
-                    )
-                };
-            });
+        let seed = super::screen::seed_copy(
+            "sss seed copy",
+            (t.diffuse.0, t.diffuse.1),
+            extent,
+            &[(t.tmp.0, t.tmp.1)],
+        );
         let blur = |name: &str,
                     src: ImageId,
                     dst: (ImageId, vk::Image, vk::ImageView),
@@ -205,98 +186,5 @@ impl SeparableSss {
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
         self.kernel_buffer.destroy(ctx);
-    }
-}
-
-/// Viewport and scissor covering `extent`.
-pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
-    unsafe {
-        ctx.device.cmd_set_viewport(
-            cmd,
-            0,
-            &[vk::Viewport {
-                x: 0.0,
-                y: 0.0,
-                width: extent.width as f32,
-                height: extent.height as f32,
-                min_depth: 0.0,
-                max_depth: 1.0,
-            }],
-        );
-        ctx.device.cmd_set_scissor(
-            cmd,
-            0,
-            &[vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent,
-            }],
-        );
-    }
-}
-
-/// A full-screen triangle into `colors` (loaded, stored), tested against a
-/// read-only depth/stencil attachment (stencil reference `stencil_ref`, used when
-/// the pipeline tests stencil). `state` sets push constants and other dynamic state.
-#[allow(clippy::too_many_arguments)]
-pub fn fullscreen_stencil_draw(
-    pc: &PassContext,
-    pipeline: &Pipeline,
-    set: vk::DescriptorSet,
-    colors: &[vk::ImageView],
-    depth_stencil: vk::ImageView,
-    extent: vk::Extent2D,
-    stencil_ref: u32,
-    state: impl Fn(&Context, vk::CommandBuffer),
-) {
-    let ctx = pc.ctx;
-    let cmd = pc.cmd;
-    let color_att: Vec<vk::RenderingAttachmentInfo> = colors
-        .iter()
-        .map(|&v| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(v)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::LOAD)
-                .store_op(vk::AttachmentStoreOp::STORE)
-        })
-        .collect();
-    // Read-only depth/stencil: loaded for the tests, never stored.
-    let ds_att = vk::RenderingAttachmentInfo::default()
-        .image_view(depth_stencil)
-        .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)
-        .load_op(vk::AttachmentLoadOp::LOAD)
-        .store_op(vk::AttachmentStoreOp::NONE);
-    let info = vk::RenderingInfo::default()
-        .render_area(vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent,
-        })
-        .layer_count(1)
-        .color_attachments(&color_att)
-        .depth_attachment(&ds_att)
-        .stencil_attachment(&ds_att);
-    unsafe {
-        ctx.device.cmd_begin_rendering(cmd, &info);
-        ctx.device
-            .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
-        set_viewport(ctx, cmd, extent);
-        if pipeline.has_stencil {
-            ctx.device.cmd_set_stencil_reference(
-                cmd,
-                vk::StencilFaceFlags::FRONT_AND_BACK,
-                stencil_ref,
-            );
-        }
-        ctx.device.cmd_bind_descriptor_sets(
-            cmd,
-            vk::PipelineBindPoint::GRAPHICS,
-            pipeline.layout,
-            0,
-            &[set],
-            &[],
-        );
-        state(ctx, cmd);
-        ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
-        ctx.device.cmd_end_rendering(cmd);
     }
 }

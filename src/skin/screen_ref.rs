@@ -44,9 +44,9 @@ impl ScreenInput<'_> {
     }
 }
 
-/// Bilinear taps along one axis, Vulkan's rule with CLAMP_TO_EDGE (the same
-/// rule as `separable_ref`): `t = coord * size - 0.5`, `i0 = floor(t)`,
-/// `frac = t - i0`, indices `i0`, `i0 + 1` clamped into `[0, size - 1]`.
+/// Bilinear taps along one axis, Vulkan's rule with CLAMP_TO_EDGE: the one
+/// place every CPU reference takes it from: `t = coord * size - 0.5`,
+/// `i0 = floor(t)`, `frac = t - i0`, indices `i0`, `i0 + 1` clamped into `[0, size - 1]`.
 fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
     let t = coord * size as f32 - 0.5;
     let t0 = t.floor();
@@ -62,11 +62,18 @@ fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
 }
 
 /// `a + (b - a) * s`, the lerp form used by every reference here.
-fn lerp(a: f32, b: f32, s: f32) -> f32 {
+pub(crate) fn lerp(a: f32, b: f32, s: f32) -> f32 {
     a + (b - a) * s
 }
 
-fn bilinear<const C: usize>(tex: &[[f32; C]], w: usize, h: usize, u: f32, v: f32) -> [f32; C] {
+/// Bilinear fetch of `C` channels at `(u, v)`.
+pub(crate) fn bilinear<const C: usize>(
+    tex: &[[f32; C]],
+    w: usize,
+    h: usize,
+    u: f32,
+    v: f32,
+) -> [f32; C] {
     let (x0, x1, fx) = axis_taps(u, w);
     let (y0, y1, fy) = axis_taps(v, h);
     let (t00, t10) = (tex[y0 * w + x0], tex[y0 * w + x1]);

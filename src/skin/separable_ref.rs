@@ -51,43 +51,16 @@ pub struct SssView {
     pub follow_tolerance_mm: f32,
 }
 
-/// Bilinear taps along one axis with Vulkan's rule and CLAMP_TO_EDGE:
-/// `t = coord * size - 0.5`, `i0 = floor(t)`, `frac = t - i0`, indices
-/// `i0` and `i0 + 1` clamped into `[0, size - 1]`.
-fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
-    let t = coord * size as f32 - 0.5;
-    let t0 = t.floor();
-    let frac = t - t0;
-    let max = size as i64 - 1;
-    // `as i64` saturates (NaN -> 0), so out-of-range coords stay in bounds.
-    let i0 = t0 as i64;
-    (
-        i0.clamp(0, max) as usize,
-        (i0 + 1).clamp(0, max) as usize,
-        frac,
-    )
-}
+use super::screen_ref::{bilinear as bilinear_uv, lerp};
 
-fn lerp(a: f32, b: f32, s: f32) -> f32 {
-    a + (b - a) * s
-}
-
-/// Bilinear fetch of `C` channels at `uv`.
+/// Bilinear fetch of `C` channels at `uv` (the rule of `screen_ref`).
 fn bilinear<const C: usize>(
     tex: &[[f32; C]],
     width: usize,
     height: usize,
     uv: [f32; 2],
 ) -> [f32; C] {
-    let (x0, x1, fx) = axis_taps(uv[0], width);
-    let (y0, y1, fy) = axis_taps(uv[1], height);
-    let (t00, t10) = (tex[y0 * width + x0], tex[y0 * width + x1]);
-    let (t01, t11) = (tex[y1 * width + x0], tex[y1 * width + x1]);
-    let mut out = [0.0; C];
-    for c in 0..C {
-        out[c] = lerp(lerp(t00[c], t10[c], fx), lerp(t01[c], t11[c], fx), fy);
-    }
-    out
+    bilinear_uv(tex, width, height, uv[0], uv[1])
 }
 
 /// One separable pass (horizontal or vertical) from `input_color` into
