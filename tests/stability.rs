@@ -247,3 +247,77 @@ fn halo_across_a_depth_discontinuity() {
         "ssg {ssg}, ss-jittered {jittered}"
     );
 }
+
+/// 3. Thin parts: the procedural head lit from behind, so the ear flaps glow.
+/// Screen space cannot see light arriving from the back; transmittance
+/// (thesis ch. 5) adds it in the geometry pass. Errors are relative RMSE of the
+/// diffuse after SSS against the reference over skin pixels.
+#[test]
+fn thin_parts_need_transmittance() {
+    use dermis::eval::metrics::relative_rmse;
+    let ctx = common::ctx();
+    let scene = default_scene();
+    let backlit = |method: Method, transmittance: bool| {
+        let mut s = RenderSettings {
+            width: 160,
+            height: 96,
+            shadow_size: 1024,
+            method,
+            transmittance,
+            reference_density: 8.0,
+            ambient: 0.0,
+            distance_heads: 2.0,
+            ..RenderSettings::default()
+        };
+        s.light.azimuth_deg = 165.0;
+        s.light.elevation_deg = 5.0;
+        s
+    };
+    let (direct, reference) = before_after(&ctx, &scene, &backlit(Method::Reference, false));
+    let skin: Vec<bool> = reference.iter().map(|p| p[3] > 0.0).collect();
+    // Thin parts: where the reference receives light from behind, i.e. its red is
+    // well above the unscattered direct light (transmittance off in its geometry pass).
+    let thin: Vec<bool> = reference
+        .iter()
+        .zip(&direct)
+        .map(|(r, d)| r[3] > 0.0 && r[0] > 1.5 * d[0] + 0.005)
+        .collect();
+    let n_thin = thin.iter().filter(|&&t| t).count();
+    assert!(
+        n_thin > 10,
+        "the back-lit ears show transmission in the reference ({n_thin} pixels)"
+    );
+    let mut report = Vec::new();
+    for method in [
+        Method::Separable,
+        Method::Ssg,
+        Method::SsJittered,
+        Method::Poisson,
+    ] {
+        let (_, off) = before_after(&ctx, &scene, &backlit(method, false));
+        let (_, on) = before_after(&ctx, &scene, &backlit(method, true));
+        let e = |img: &[[f32; 4]], m: &[bool]| relative_rmse(img, &reference, m).unwrap();
+        report.push((
+            method,
+            e(&off, &thin),
+            e(&on, &thin),
+            e(&off, &skin),
+            e(&on, &skin),
+        ));
+    }
+    println!("back-lit head, {n_thin} thin-part pixels; relative RMSE (thin without, thin with, all skin without, all skin with transmittance): {report:?}");
+    for (method, thin_off, thin_on, _, _) in report {
+        // Without transmittance the light through the ears is missing: the known
+        // failure (measured 0.99-1.0 relative RMSE on the thin parts at 160x96).
+        assert!(
+            thin_off > 0.9,
+            "{method:?} without transmittance on thin parts: {thin_off}"
+        );
+        // With it, every method comes closer there (measured: separable 0.97, ssg 0.81,
+        // ss-jittered 0.74, poisson 0.94), but not close: see docs/accuracy.md on eq. 5.12.
+        assert!(
+            thin_on < thin_off,
+            "{method:?}: transmittance did not help on thin parts ({thin_on} vs {thin_off})"
+        );
+    }
+}
