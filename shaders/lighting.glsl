@@ -20,8 +20,10 @@ layout(set = 1, binding = 3) uniform MaterialUniforms {
 } material;
 
 // Thesis eq. 5.12 with the six-Gaussian weights (Listing 5.1); s in millimetres.
+// frame.shadowParams.z scales the exponent: 1 for eq. 5.12 as published, 0.5 for
+// the plane integral of the profile (src/skin/transmittance.rs says why).
 vec3 transmittanceProfile(float s) {
-    float s2 = s * s;
+    float s2 = s * s * frame.shadowParams.z;
     return vec3(0.233, 0.455, 0.649) * exp(-s2 / 0.0064) +
            vec3(0.1, 0.336, 0.344) * exp(-s2 / 0.0484) +
            vec3(0.118, 0.198, 0.0) * exp(-s2 / 0.187) +

@@ -166,6 +166,10 @@ struct Common {
     falloff: Option<Vec<f32>>,
     #[arg(long)]
     no_follow_surface: bool,
+    /// Transmittance T(s): thesis (eq. 5.12 as published) or integral (the profile
+    /// integrated over a plane: exp(-s^2 / 2v), see docs/accuracy.md).
+    #[arg(long, default_value = "thesis")]
+    transmittance_profile: String,
     /// reference: surface samples per mm^2 (32 is converged: doubling it changes
     /// the image by 5e-4 relative RMSE).
     #[arg(long, default_value_t = 32.0)]
@@ -250,6 +254,7 @@ impl Common {
             lod: !self.no_lod,
             mask: self.mask.parse()?,
             reference_density: self.density,
+            transmittance_profile: self.transmittance_profile.parse()?,
             heads: self.heads,
             distance_heads: distance,
             fovy_deg: self.fovy,

@@ -43,6 +43,7 @@ pub struct Report {
     pub sss_params: SssParams,
     pub follow_surface: bool,
     pub transmittance: bool,
+    pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
     /// ssg settings (reported for every method; only ssg reads them).
     pub fit: crate::skin::ssg::GaussianFit,
     pub lod: bool,
@@ -192,6 +193,7 @@ pub fn run(
         sss_params: settings.params,
         follow_surface: settings.follow_surface,
         transmittance: settings.transmittance,
+        transmittance_profile: settings.transmittance_profile,
         fit: settings.fit,
         lod: settings.lod,
         mask: settings.mask,

@@ -512,7 +512,12 @@ impl<'c> Renderer<'c> {
                     0.0
                 },
             ],
-            shadow_params: [1.0 / settings.shadow_size as f32, bias, 0.0, 0.0],
+            shadow_params: [
+                1.0 / settings.shadow_size as f32,
+                bias,
+                settings.transmittance_profile.exponent_scale(),
+                0.0,
+            ],
         };
         let frame_ubo = Buffer::with_data(
             ctx,

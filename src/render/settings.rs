@@ -72,6 +72,8 @@ pub struct RenderSettings {
     pub lod: bool,
     /// ssg: stencil test or dynamic branch.
     pub mask: MaskMode,
+    /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
+    pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
     /// reference: surface samples per mm^2.
     pub reference_density: f32,
     pub heads: u32,
@@ -100,6 +102,7 @@ impl Default for RenderSettings {
             lod: true,
             mask: MaskMode::Stencil,
             reference_density: 32.0,
+            transmittance_profile: crate::skin::transmittance::TransmittanceProfile::Thesis,
             heads: 1,
             distance_heads: 4.0,
             fovy_deg: 20.0,

@@ -12,7 +12,49 @@ use super::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 /// the six-Gaussian weights and variances (mm^2) of Table 4.2 / Listing 5.1.
 /// `T(0)` is the sum of the weights, i.e. (1, 1, 1).
 pub fn transmittance_rgb(s_mm: f32) -> [f32; 3] {
-    let s2 = s_mm * s_mm;
+    transmittance_rgb_with(s_mm, TransmittanceProfile::Thesis)
+}
+
+/// Which T(s) the geometry pass uses.
+///
+/// The thesis' eq. 5.12 is T(s) = sum_i w_i exp(-s^2 / v_i). Integrating d'Eon's
+/// profile, with G(v, r) = exp(-r^2 / 2v) / (2 pi v) as in eq. 5.3, over a plane at
+/// distance d gives sum_i w_i exp(-d^2 / (2 v_i)) instead (the step from eq. 5.9 to
+/// 5.10 drops the 2). That is the same function at s / sqrt(2). `Thesis` is
+/// the default, since it is the published method; `Integral` is the consistent one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TransmittanceProfile {
+    Thesis,
+    Integral,
+}
+
+impl std::str::FromStr for TransmittanceProfile {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> anyhow::Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "thesis" | "eq5.12" => Ok(TransmittanceProfile::Thesis),
+            "integral" => Ok(TransmittanceProfile::Integral),
+            other => {
+                anyhow::bail!("unknown transmittance profile '{other}' (valid: thesis, integral)")
+            }
+        }
+    }
+}
+
+impl TransmittanceProfile {
+    /// The factor k in exp(-k s^2 / v): 1 for eq. 5.12, 1/2 for the integral.
+    pub fn exponent_scale(self) -> f32 {
+        match self {
+            TransmittanceProfile::Thesis => 1.0,
+            TransmittanceProfile::Integral => 0.5,
+        }
+    }
+}
+
+/// T(s) of the given profile, per channel.
+pub fn transmittance_rgb_with(s_mm: f32, profile: TransmittanceProfile) -> [f32; 3] {
+    let s2 = s_mm * s_mm * profile.exponent_scale();
     let mut t = [0.0f32; 3];
     for (&v, w) in SIX_GAUSSIAN_VARIANCES_MM2
         .iter()
@@ -51,6 +93,25 @@ pub fn shrink_units(mm_per_unit: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_integral_profile_is_eq_5_12_at_s_over_sqrt2() {
+        for s in [0.0f32, 0.5, 1.0, 2.0, 3.0, 5.0] {
+            let a = transmittance_rgb_with(s, TransmittanceProfile::Integral);
+            let b = transmittance_rgb_with(s / 2f32.sqrt(), TransmittanceProfile::Thesis);
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() < 1e-6, "s {s}: {a:?} vs {b:?}");
+            }
+        }
+        // At an ear's 3 mm the integral transmits several times more red.
+        let t = transmittance_rgb_with(3.0, TransmittanceProfile::Thesis)[0];
+        let i = transmittance_rgb_with(3.0, TransmittanceProfile::Integral)[0];
+        assert!(i > 2.0 * t, "{i} vs {t}");
+        assert!(
+            "integral".parse::<TransmittanceProfile>().is_ok()
+                && "x".parse::<TransmittanceProfile>().is_err()
+        );
+    }
 
     #[test]
     fn zero_distance_is_sum_of_weights() {
