@@ -71,14 +71,7 @@ fn render(s: &RenderSettings) -> Run {
 #[test]
 fn gpu_gather_matches_f64_cpu_gather() {
     // Tiny: 48x32 pixels, 0.5 samples per mm^2 (~60k samples).
-    let run = render(&settings(
-        48,
-        32,
-        std::env::var("GDENSITY")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0.5),
-    ));
+    let run = render(&settings(48, 32, 0.5));
     let cpu = gather_f64(
         &run.view,
         &run.diffuse,
@@ -109,10 +102,7 @@ fn gpu_gather_matches_f64_cpu_gather() {
 
 #[test]
 fn surface_sampling_has_converged_at_the_default_density() {
-    let d = std::env::var("DENSITY")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(RenderSettings::default().reference_density);
+    let d = RenderSettings::default().reference_density;
     let a = render(&settings(64, 40, d));
     let b = render(&settings(64, 40, 2.0 * d));
     let mask: Vec<bool> = a.diffuse.iter().map(|p| p[3] > 0.0).collect();

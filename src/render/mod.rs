@@ -36,7 +36,7 @@ use readback::{DumpedImage, ReadbackPlan};
 use reference::{ReferenceInit, ReferenceSss};
 use scene_gpu::GpuObject;
 use screen::{JitteredSss, ScreenTargets, SsgInit, SsgSss};
-use separable::{SeparableSss, SssTargets, SssView, STENCIL_SKIN};
+use separable::{SeparableSss, SssView, STENCIL_SKIN};
 pub use settings::{Method, RenderSettings};
 
 pub const DIFFUSE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -109,9 +109,10 @@ pub struct Targets {
     pub normals: Option<(ImageId, Image)>,
     /// The ground truth's output (RGBA32F storage image; reference only).
     pub reference_out: Option<(ImageId, Image)>,
-    /// Graph ids of mip levels 1.. of the diffuse, linear-depth and normal targets
-    /// (each level is tracked apart: the mip passes read one level and write the next).
-    pub extra_levels: Vec<(ImageId, String)>,
+    /// Graph ids of mip levels 1.. of each mipped target (diffuse, linear depth,
+    /// normals), keyed by the target's id: each level is tracked apart, since the
+    /// mip passes read one level and write the next.
+    pub mip_levels: std::collections::HashMap<ImageId, Vec<ImageId>>,
 }
 
 impl Targets {
@@ -138,7 +139,7 @@ impl Targets {
             );
         }
         let ds_format = depth_stencil_format(ctx)?;
-        let mut extra_levels = Vec::new();
+        let mut mip_levels = std::collections::HashMap::new();
         let mut add_levels = |name: &str,
                               ext: vk::Extent2D,
                               format: vk::Format,
@@ -147,12 +148,11 @@ impl Targets {
          -> Result<(ImageId, Image)> {
             let img = Image::with_levels(ctx, name, ext, format, usage, levels)?;
             let id = res.add_image(name, img.raw, img.subresource_range());
-            for l in 1..img.levels {
-                let level_name = format!("{name} mip {l}");
-                extra_levels.push((
-                    res.add_image(&level_name, img.raw, img.level_range(l)),
-                    level_name,
-                ));
+            if img.levels > 1 {
+                let ids = (1..img.levels)
+                    .map(|l| res.add_image(&format!("{name} mip {l}"), img.raw, img.level_range(l)))
+                    .collect::<Vec<_>>();
+                mip_levels.insert(id, ids);
             }
             Ok((id, img))
         };
@@ -227,7 +227,7 @@ impl Targets {
             )?,
             normals,
             reference_out,
-            extra_levels,
+            mip_levels,
         })
     }
 
@@ -385,7 +385,7 @@ impl<'c> Renderer<'c> {
                 depth_compare: vk::CompareOp::LESS,
                 stencil: None,
                 depth_bias: Some((0.0, 1.5)),
-                blend: pipeline_blend_none(),
+                blend: crate::vk::pipeline::Blend::None,
             },
         )?;
         let geometry_pipeline = Pipeline::graphics(
@@ -426,7 +426,7 @@ impl<'c> Renderer<'c> {
                     reference: 0,
                 }),
                 depth_bias: None,
-                blend: pipeline_blend_none(),
+                blend: crate::vk::pipeline::Blend::None,
             },
         )?;
         let composite_pipeline = Pipeline::graphics(
@@ -737,38 +737,15 @@ impl<'c> Renderer<'c> {
         if let Some(plan) = plan {
             passes = plan.interleave(ctx, &mut self.resources, passes, &self.gpu)?;
         }
-        let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
-        unsafe {
-            ctx.device
-                .reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
-            ctx.device.begin_command_buffer(
-                self.cmd,
-                &vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )?;
-        }
-        record_passes(
+        submit_passes(
             ctx,
             self.cmd,
+            self.fence,
             &mut self.resources,
             &passes,
             Some(&self.profiler),
-        );
-        drop(passes);
-        unsafe {
-            ctx.device.end_command_buffer(self.cmd)?;
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(self.cmd)];
-            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-            ctx.device
-                .queue_submit2(ctx.queue, &submit, self.fence)
-                .context("submitting the frame")?;
-            ctx.device
-                .wait_for_fences(&[self.fence], true, u64::MAX)
-                .context("waiting for the frame (device lost?)")?;
-            ctx.device.reset_fences(&[self.fence])?;
-        }
-        ctx.check_validation("during the frame")?;
-        self.profiler.read(ctx, &names)
+            "during the frame",
+        )
     }
 
     /// Renders `n` frames and returns each frame's pass samples.
@@ -813,17 +790,16 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         let mut plan = ReadbackPlan::single(id);
         let passes = plan.interleave(ctx, &mut self.resources, Vec::new(), &self.gpu)?;
-        let cmd = self.cmd;
-        unsafe {
-            ctx.device
-                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())?;
-            ctx.device
-                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
-        }
-        record_passes(ctx, cmd, &mut self.resources, &passes, None);
+        submit_passes(
+            ctx,
+            self.cmd,
+            self.fence,
+            &mut self.resources,
+            &passes,
+            None,
+            "while reading back an image",
+        )?;
         drop(passes);
-        ctx.submit_and_wait(cmd)?;
-        ctx.check_validation("while reading back an image")?;
         plan.finish_single(ctx, &mut self.resources, &self.gpu)
     }
 
@@ -913,19 +889,16 @@ impl<'c> Renderer<'c> {
         let mut plan = ReadbackPlan::single(self.gpu.final_diffuse().0);
         let passes = plan.interleave(self.ctx, &mut self.resources, passes, &self.gpu)?;
         let ctx = self.ctx;
-        let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
-        let cmd = self.cmd;
-        unsafe {
-            ctx.device
-                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())?;
-            ctx.device
-                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())?;
-        }
-        record_passes(ctx, cmd, &mut self.resources, &passes, Some(&self.profiler));
+        let samples = submit_passes(
+            ctx,
+            self.cmd,
+            self.fence,
+            &mut self.resources,
+            &passes,
+            Some(&self.profiler),
+            "during the SSS-only run",
+        )?;
         drop(passes);
-        ctx.submit_and_wait(cmd)?;
-        ctx.check_validation("during the SSS-only run")?;
-        let samples = self.profiler.read(ctx, &names)?;
         let img = plan.finish_single(ctx, &mut self.resources, &self.gpu)?;
         Ok((
             img,
@@ -937,22 +910,49 @@ impl<'c> Renderer<'c> {
     }
 }
 
-fn pipeline_blend_none() -> crate::vk::pipeline::Blend {
-    crate::vk::pipeline::Blend::None
+/// Records `passes` into `cmd`, submits them, waits on `fence` and checks the
+/// validation log: the one submission path of the renderer. Returns the pass
+/// samples (empty without a profiler).
+fn submit_passes(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    resources: &mut Resources,
+    passes: &[Pass],
+    profiler: Option<&Profiler>,
+    when: &str,
+) -> Result<Vec<PassSample>> {
+    let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
+    unsafe {
+        ctx.device
+            .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())?;
+        ctx.device.begin_command_buffer(
+            cmd,
+            &vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+        )?;
+    }
+    record_passes(ctx, cmd, resources, passes, profiler);
+    unsafe {
+        ctx.device.end_command_buffer(cmd)?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        ctx.device
+            .queue_submit2(ctx.queue, &submit, fence)
+            .with_context(|| format!("submitting {when}"))?;
+        ctx.device
+            .wait_for_fences(&[fence], true, u64::MAX)
+            .with_context(|| format!("waiting {when} (device lost?)"))?;
+        ctx.device.reset_fences(&[fence])?;
+    }
+    ctx.check_validation(when)?;
+    match profiler {
+        Some(p) => p.read(ctx, &names),
+        None => Ok(Vec::new()),
+    }
 }
 
 impl FrameGpu {
-    pub fn sss_targets(&self) -> SssTargets {
-        let t = &self.targets;
-        SssTargets {
-            diffuse: (t.diffuse.0, t.diffuse.1.raw, t.diffuse.1.view),
-            tmp: (t.sss_tmp.0, t.sss_tmp.1.raw, t.sss_tmp.1.view),
-            linear_depth: t.linear_depth.0,
-            depth_stencil: (t.depth_stencil.0, t.depth_stencil.1.view),
-            extent: self.extent,
-        }
-    }
-
     /// Any image of the frame by graph id: the targets, and images a method owns.
     pub fn image_by_id(&self, id: ImageId) -> Option<&Image> {
         self.targets.by_id(id).or(match &self.sss {
@@ -964,28 +964,21 @@ impl FrameGpu {
     /// The per-level ids of the diffuse, depth and normal mip chains (poisson).
     pub fn chains(&self) -> Chains {
         let t = &self.targets;
-        let chain = |main: &(ImageId, Image), name: &str| -> Vec<(ImageId, vk::ImageView)> {
-            let mut v = vec![(main.0, main.1.level_views[0])];
-            for l in 1..main.1.levels {
-                let level_name = format!("{name} mip {l}");
-                let id = t
-                    .extra_levels
-                    .iter()
-                    .find(|(_, n)| *n == level_name)
-                    .map(|(i, _)| *i)
-                    .expect("mip level registered");
-                v.push((id, main.1.level_views[l as usize]));
-            }
-            v
+        let chain = |main: &(ImageId, Image)| -> Vec<(ImageId, vk::ImageView)> {
+            let above = t.mip_levels.get(&main.0).map(Vec::as_slice).unwrap_or(&[]);
+            std::iter::once(main.0)
+                .chain(above.iter().copied())
+                .zip(main.1.level_views.iter().copied())
+                .collect()
         };
         let normals = t
             .normals
             .as_ref()
             .expect("poisson allocates the normal target");
         Chains {
-            color: chain(&t.diffuse, "diffuse"),
-            depth: chain(&t.linear_depth, "linear depth"),
-            normal: chain(normals, "normals"),
+            color: chain(&t.diffuse),
+            depth: chain(&t.linear_depth),
+            normal: chain(normals),
             extents: (0..t.diffuse.1.levels)
                 .map(|l| t.diffuse.1.level_extent(l))
                 .collect(),
@@ -1017,7 +1010,7 @@ impl FrameGpu {
     /// The SSS method's passes (none without a method).
     pub fn sss_passes(&self) -> Vec<Pass<'_>> {
         match &self.sss {
-            Some(SssMethod::Separable(s)) => s.passes(self.sss_targets(), self.sss_view()),
+            Some(SssMethod::Separable(s)) => s.passes(self.screen_targets(), self.sss_view()),
             Some(SssMethod::Ssg(s)) => s.passes(self.screen_targets()),
             Some(SssMethod::Jittered(s)) => s.passes(self.screen_targets()),
             Some(SssMethod::Poisson(s)) => s.passes(

@@ -180,13 +180,7 @@ impl ReferenceSss {
         if row_bytes % align != 0 {
             bail!("a radiance row ({row_bytes} bytes) is not aligned to the storage-buffer offset alignment ({align})");
         }
-        // DERMIS_REFERENCE_CHUNK_BYTES lowers the chunk size (tests exercise chunking
-        // on small scenes with it).
-        let chunk_limit = std::env::var("DERMIS_REFERENCE_CHUNK_BYTES")
-            .ok()
-            .and_then(|v| v.parse::<u64>().ok())
-            .map_or(limit, |v| v.min(limit));
-        let rows_per_chunk = (chunk_limit / row_bytes).max(1) as u32;
+        let rows_per_chunk = (limit / row_bytes).max(1) as u32;
         let mut chunks = Vec::new();
         let mut row = 0;
         while row < rows {

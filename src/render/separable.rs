@@ -12,6 +12,7 @@ use anyhow::Result;
 use ash::vk;
 
 use super::draw::fullscreen_stencil_draw;
+use super::screen::ScreenTargets;
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::kernel::SeparableKernel;
 use crate::vk::barrier::AccessKind;
@@ -38,16 +39,6 @@ pub struct SssView {
     pub fovy_rad: f32,
     pub mm_per_unit: f32,
     pub follow_surface: bool,
-}
-
-/// The targets the SSS passes use, as graph ids plus raw handles.
-#[derive(Clone, Copy, Debug)]
-pub struct SssTargets {
-    pub diffuse: (ImageId, vk::Image, vk::ImageView),
-    pub tmp: (ImageId, vk::Image, vk::ImageView),
-    pub linear_depth: ImageId,
-    pub depth_stencil: (ImageId, vk::ImageView),
-    pub extent: vk::Extent2D,
 }
 
 pub struct SeparableSss {
@@ -144,13 +135,13 @@ impl SeparableSss {
     }
 
     /// The three passes, in order: seed copy, horizontal, vertical.
-    pub fn passes<'a>(&'a self, t: SssTargets, view: SssView) -> Vec<Pass<'a>> {
+    pub fn passes<'a>(&'a self, t: ScreenTargets, view: SssView) -> Vec<Pass<'a>> {
         let extent = t.extent;
         let seed = super::screen::seed_copy(
             "sss seed copy",
             (t.diffuse.0, t.diffuse.1),
             extent,
-            &[(t.tmp.0, t.tmp.1)],
+            &[(t.rt1.0, t.rt1.1)],
         );
         let blur = |name: &str,
                     src: ImageId,
@@ -178,8 +169,8 @@ impl SeparableSss {
         };
         vec![
             seed,
-            blur("sss horizontal", t.diffuse.0, t.tmp, self.set_h, [1.0, 0.0]),
-            blur("sss vertical", t.tmp.0, t.diffuse, self.set_v, [0.0, 1.0]),
+            blur("sss horizontal", t.diffuse.0, t.rt1, self.set_h, [1.0, 0.0]),
+            blur("sss vertical", t.rt1.0, t.diffuse, self.set_v, [0.0, 1.0]),
         ]
     }
 
