@@ -1,51 +1,142 @@
 #!/usr/bin/env bash
-# Every device-machine measurement of docs/perf/ and docs/accuracy.md, as one
-# command (one device call). Run it on the device machine from the repository
-# root with these carried (see /work/.library/device/README.md):
-#   .gl      Vulkan loader debs (apt-get download libvulkan1 ... as the README says)
+# Every device-machine measurement of docs/perf/ and docs/accuracy.md.
+#
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 eval issue3-1080
+#                                          (default: all, in that order)
+#
+# Run it on the device machine from the repository root with these carried (see
+# /work/.library/device/README.md and docs/perf/README.md):
+#   .gl      Vulkan loader debs (apt-get download libvulkan1 ...), unpacked into /
+#   .vvl     vulkan-validationlayers deb, unpacked under /tmp (smoke part only)
 #   .bin     a stripped release build:  strip -o .bin/dermis target/release/dermis
+#            and a font for the chart:  cp /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf .bin/
 #   .assets  a copy of ../shared/assets: cp -r ../shared/assets .assets
+#
+# A call may run at most 10 minutes, so the script stops starting runs after
+# DEADLINE seconds (default 540) and writes what it has. Results accumulate in
+# $STORE (default /tmp/dermis-perf) and a run whose report exists is skipped, so
+# a second call on the still-warm machine resumes where the first stopped.
 # Everything lands in $OUT/perf.tgz (the device tool returns at most 8 files).
-set -euo pipefail
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-B=.bin/dermis
-A=.assets/lee-perry-smith/LeePerrySmith.glb
+#
+# DRY=1 checks the script here on lavapipe: tiny sizes, 1+2 frames, no .gl.
+set -uo pipefail
+START=$SECONDS
+DEADLINE=${DEADLINE:-540}
 OUT=${OUT:-out}
-P=$OUT/perf
-mkdir -p "$P"
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$P/gpu.txt" || true
-if ! "$B" devices 2>&1 | grep -qi nvidia; then
-  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+STORE=${STORE:-/tmp/dermis-perf}
+P=$STORE/perf
+B=${B:-.bin/dermis}
+A=.assets/lee-perry-smith/LeePerrySmith.glb
+mkdir -p "$P" "$OUT"
+DRY=${DRY:-0}
+if [ "$DRY" = 1 ]; then
+  EXTRA=(--device llvmpipe --warmup 1 --frames 2)
+  EVAL_FRAMES=(--density 8)
+  A=../shared/assets/lee-perry-smith/LeePerrySmith.glb
+else
+  EXTRA=()
+  EVAL_FRAMES=(--warmup 5 --frames 30)
+  for f in .gl/*.deb; do dpkg -x "$f" /; done
+  ldconfig
+  # The chart needs a TrueType font; the device machine may have none.
+  [ -f .bin/DejaVuSans.ttf ] && export DERMIS_FONT=$PWD/.bin/DejaVuSans.ttf
+  if ! "$B" devices 2>&1 | grep -qi nvidia; then
+    export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+  fi
 fi
-"$B" devices | tee -a "$P/gpu.txt"
-run() { echo "+ dermis $*" >> "$P/commands.txt"; "$B" "$@" >> "$P/log.txt" 2>&1 || echo "FAILED: $*" >> "$P/commands.txt"; }
+# In dry mode every size is divided by 8.
+w() { if [ "$DRY" = 1 ]; then echo $(($1 / 8)); else echo "$1"; fi; }
 
-# Issue 2: separable SSS, 1080p, close-up and mid shot, 17 samples (and 9, 33).
-run bench --scene "$A" --width 1920 --height 1080 --shot close --samples 17 --report "$P/sep_1080p_close_s17.json"
-run bench --scene "$A" --width 1920 --height 1080 --shot mid --samples 17 --report "$P/sep_1080p_mid_s17.json"
-run bench --scene "$A" --width 1920 --height 1080 --shot close --samples 9 --report "$P/sep_1080p_close_s9.json"
-run bench --scene "$A" --width 1920 --height 1080 --shot close --samples 33 --report "$P/sep_1080p_close_s33.json"
-run render --scene "$A" --width 1920 --height 1080 --shot close --frames 20 --out "$P/close_render"
+# run NAME OUTPUT dermis-args...: skipped when OUTPUT exists or the deadline has passed.
+run() {
+  local name=$1 output=$2
+  shift 2
+  if [ -e "$output" ]; then return; fi
+  if (( SECONDS - START > DEADLINE )); then
+    echo "SKIPPED (deadline): dermis $*" >> "$P/commands.txt"
+    return
+  fi
+  echo "+ dermis $*" >> "$P/commands.txt"
+  local t0=$SECONDS
+  echo "=== $name: dermis $*" >> "$P/log.txt"
+  # Nothing may outlive the call: the last run is cut at START + DEADLINE + 50 s.
+  local left=$((DEADLINE + 50 - (SECONDS - START)))
+  if timeout $((left < 300 ? left : 300)) "$B" "$@" >> "$P/log.txt" 2>&1; then
+    echo "    ok in $((SECONDS - t0)) s" >> "$P/commands.txt"
+  else
+    echo "    FAILED (rc $?) after $((SECONDS - t0)) s" >> "$P/commands.txt"
+  fi
+}
 
-# Issue 3: the thesis' three distances (zoom 28, near 50, far 132 units for a
-# 27-unit head = 1.037, 1.852, 4.889 head heights) x 1/3/5 heads x methods, 720p and 1080p.
-for res in "1280 720" "1920 1080"; do
-  set -- $res
+smoke() {
+  { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader || true; "$B" devices; } > "$P/gpu.txt" 2>&1
+  # The same renderer under the Khronos validation layer (synchronization
+  # validation on; any message is an error) on a real GPU: the default scene
+  # with every method, and the head with the reference.
+  if [ "$DRY" != 1 ] && ls .vvl/*.deb > /dev/null 2>&1; then
+    mkdir -p /tmp/vvl && for f in .vvl/*.deb; do dpkg -x "$f" /tmp/vvl; done
+    export VK_LAYER_PATH=/tmp/vvl/usr/share/vulkan/explicit_layer.d
+    export LD_LIBRARY_PATH=/tmp/vvl/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+  fi
+  for m in separable ssg ss-jittered poisson reference none; do
+    run "validate $m" "$P/validate/$m/report.json" render --validate "${EXTRA[@]}" --method "$m" \
+      --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/$m"
+  done
+  run "validate head ssg" "$P/validate/head_ssg/report.json" render --validate "${EXTRA[@]}" --scene "$A" \
+    --method ssg --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/head_ssg"
+  unset VK_LAYER_PATH
+}
+
+issue2() {
+  # Separable SSS, 1080p, close-up and mid shot, 17 samples (and 9, 33 at close-up).
+  for s in 17 9 33; do
+    run "sep close s$s" "$P/sep_1080p_close_s$s.json" bench "${EXTRA[@]}" --scene "$A" \
+      --width "$(w 1920)" --height "$(w 1080)" --shot close --samples "$s" --report "$P/sep_1080p_close_s$s.json"
+  done
+  run "sep mid s17" "$P/sep_1080p_mid_s17.json" bench "${EXTRA[@]}" --scene "$A" \
+    --width "$(w 1920)" --height "$(w 1080)" --shot mid --samples 17 --report "$P/sep_1080p_mid_s17.json"
+  run "render close" "$P/close_render/frame.png" render "${EXTRA[@]}" --scene "$A" \
+    --width "$(w 1920)" --height "$(w 1080)" --shot close --out "$P/close_render"
+}
+
+# The thesis' three distances (zoom 28, near 50, far 132 units for a 27-unit head
+# = 1.037, 1.852, 4.889 head heights) x 1/3/5 heads x methods.
+issue3() {
+  local W=$1 H=$2
   for d in zoom:1.037 near:1.852 far:4.889; do
     for h in 1 3 5; do
-      tag="${1}x${2}_${d%%:*}_${h}h"
-      run bench --scene "$A" --width "$1" --height "$2" --distance "${d##*:}" --heads "$h" --method ssg --report "$P/ssg_lod_$tag.json"
-      run bench --scene "$A" --width "$1" --height "$2" --distance "${d##*:}" --heads "$h" --method ssg --no-lod --report "$P/ssg_nolod_$tag.json"
-      run bench --scene "$A" --width "$1" --height "$2" --distance "${d##*:}" --heads "$h" --method ss-jittered --report "$P/jittered_$tag.json"
-      run bench --scene "$A" --width "$1" --height "$2" --distance "${d##*:}" --heads "$h" --method poisson --report "$P/poisson_$tag.json"
-      run bench --scene "$A" --width "$1" --height "$2" --distance "${d##*:}" --heads "$h" --method separable --report "$P/separable_$tag.json"
+      local tag="${W}x${H}_${d%%:*}_${h}h"
+      local args=(bench "${EXTRA[@]}" --scene "$A" --width "$(w "$W")" --height "$(w "$H")" --distance "${d##*:}" --heads "$h")
+      run "ssg lod $tag" "$P/ssg_lod_$tag.json" "${args[@]}" --method ssg --report "$P/ssg_lod_$tag.json"
+      run "ssg nolod $tag" "$P/ssg_nolod_$tag.json" "${args[@]}" --method ssg --no-lod --report "$P/ssg_nolod_$tag.json"
+      run "separable $tag" "$P/separable_$tag.json" "${args[@]}" --method separable --report "$P/separable_$tag.json"
+      run "jittered $tag" "$P/jittered_$tag.json" "${args[@]}" --method ss-jittered --report "$P/jittered_$tag.json"
+      run "poisson $tag" "$P/poisson_$tag.json" "${args[@]}" --method poisson --report "$P/poisson_$tag.json"
     done
   done
+  run "ssg branch ${W}x${H}" "$P/ssg_branch_${W}x${H}_zoom_1h.json" bench "${EXTRA[@]}" --scene "$A" \
+    --width "$(w "$W")" --height "$(w "$H")" --distance 1.037 --method ssg --mask branch \
+    --report "$P/ssg_branch_${W}x${H}_zoom_1h.json"
+}
+
+eval_chart() {
+  # The cost/error chart on the thesis' scene set at 720p.
+  run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
+    --width "$(w 1280)" --height "$(w 720)" "${EVAL_FRAMES[@]}" --out "$P/eval"
+}
+
+parts=("$@")
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 eval issue3-1080)
+for part in "${parts[@]}"; do
+  case $part in
+    smoke) smoke ;;
+    issue2) issue2 ;;
+    issue3-720) issue3 1280 720 ;;
+    issue3-1080) issue3 1920 1080 ;;
+    eval) eval_chart ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 eval)" >&2; exit 2 ;;
+  esac
 done
-run bench --scene "$A" --width 1920 --height 1080 --distance 1.037 --method ssg --mask branch --report "$P/ssg_branch_1080p_zoom.json"
-
-# Issue 4: the cost/error chart on the thesis' scene set at 720p.
-run eval --scene "$A" --scenes thesis --width 1280 --height 720 --warmup 5 --frames 30 --out "$P/eval"
-
-tar czf "$OUT/perf.tgz" -C "$OUT" perf
+echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"
+tar czf "$OUT/perf.tgz" -C "$STORE" perf
+cat "$P/commands.txt"
