@@ -183,6 +183,10 @@ struct Common {
     /// ssg: keep non-skin pixels out with the stencil test or a shader branch: stencil | branch.
     #[arg(long, default_value = "stencil")]
     mask: String,
+    /// Where the SSS passes run: skin (the skin's projected bounds widened by the
+    /// kernel's reach: seed copies and draws limited to them) | screen (everywhere).
+    #[arg(long, default_value = "skin")]
+    sss_region: String,
     #[arg(long)]
     no_transmittance: bool,
     /// Number of heads in a grid (multi-character stress).
@@ -253,6 +257,7 @@ impl Common {
             fit: self.fit.parse()?,
             lod: !self.no_lod,
             mask: self.mask.parse()?,
+            sss_region: self.sss_region.parse()?,
             reference_density: self.density,
             transmittance_profile: self.transmittance_profile.parse()?,
             heads: self.heads,
@@ -379,8 +384,8 @@ fn main_result() -> Result<()> {
             );
             if let Some(c) = &output.report.ceilings {
                 println!(
-                    "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, fill rgba16f {:.2} Gpix/s",
-                    c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.fill_rgba16f_gpix
+                    "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {:.2}, blended rgba16f {:.2}",
+                    c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.fill_rgba16f_gpix, c.fill_rgba8_gpix, c.blend_rgba16f_gpix
                 );
             }
             println!("wrote {}", report.display());

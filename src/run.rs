@@ -48,6 +48,10 @@ pub struct Report {
     pub fit: crate::skin::ssg::GaussianFit,
     pub lod: bool,
     pub mask: crate::render::screen::MaskMode,
+    pub sss_region: crate::render::region::RegionMode,
+    /// Pixels inside the region the SSS passes worked in (the screen without one).
+    pub sss_region_pixels: u64,
+    pub sss_region_rects: usize,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,
@@ -158,6 +162,9 @@ pub fn run(
         .unwrap_or(false);
     let extent = renderer.gpu.extent;
     let mm_per_unit = renderer.gpu.mm_per_unit;
+    let region = &renderer.gpu.region_px;
+    let (sss_region_pixels, sss_region_rects) =
+        (region.iter().map(|r| r.area()).sum(), region.len());
     drop(renderer);
 
     let (ceilings, probes) = if opts.ceilings {
@@ -197,6 +204,9 @@ pub fn run(
         fit: settings.fit,
         lod: settings.lod,
         mask: settings.mask,
+        sss_region: settings.sss_region,
+        sss_region_pixels,
+        sss_region_rects,
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -1,6 +1,7 @@
 //! Micro-passes that measure the device's own fragment-shader ceilings in the
 //! same run as the benchmark: bilinear and point fetch rates for each format the
-//! SSS passes read (RGBA16F colour, R32F depth) and the RGBA16F fill rate.
+//! SSS passes read (RGBA16F colour, R32F depth), and the fill rates of the writes
+//! the frame makes (RGBA16F, RGBA16F blended, RGBA8).
 
 use anyhow::Result;
 use ash::vk;
@@ -10,11 +11,12 @@ use super::floor::Ceilings;
 use crate::graph::{record_passes, ImageId, Pass, PassContext, Resources};
 use crate::render::draw::begin_color_rendering;
 use crate::render::upload;
+use crate::render::LDR_FORMAT;
 use crate::report::Stats;
 use crate::vk::barrier::{AccessKind, ResourceState};
 use crate::vk::context::Context;
 use crate::vk::memory::Image;
-use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
+use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
 use crate::vk::profiler::Profiler;
 
 /// Fetches per fragment in the fetch probes: enough that fetches, not fill, bound them.
@@ -26,6 +28,15 @@ struct ProbePush {
     texel: [f32; 2],
     taps: i32,
     pad: i32,
+}
+
+/// One probe: a pipeline drawn full-screen into a target, reading a source
+/// texture (fetch probes) or nothing (fill probes).
+struct Probe<'p> {
+    pipeline: &'p Pipeline,
+    src: Option<(vk::DescriptorSet, ImageId)>,
+    target: (ImageId, vk::ImageView),
+    access: AccessKind,
 }
 
 /// One probe's measurement.
@@ -76,6 +87,14 @@ pub fn measure(
         vk::Format::R16G16B16A16_SFLOAT,
         vk::ImageUsageFlags::COLOR_ATTACHMENT,
     )?;
+    // The tone map writes 32 bpp: ROPs fill those at their own rate.
+    let mut target_ldr = Image::new(
+        ctx,
+        "probe target rgba8",
+        extent,
+        LDR_FORMAT,
+        vk::ImageUsageFlags::COLOR_ATTACHMENT,
+    )?;
     let samplers = Samplers::new(ctx)?;
     let mut pool = DescriptorPool::new(ctx, 8)?;
     let mut fetch = Pipeline::graphics(
@@ -94,12 +113,31 @@ pub fn measure(
             vk::Format::R16G16B16A16_SFLOAT,
         ),
     )?;
+    let mut fill_ldr = Pipeline::graphics(
+        ctx,
+        &GraphicsDesc::fullscreen("probe fill rgba8", "probe_fill.frag", LDR_FORMAT),
+    )?;
+    // The ssg vertical pass blends RTF (eq. 4.9): a read-modify-write per pixel.
+    let mut fill_blend = Pipeline::graphics(ctx, &{
+        let mut d = GraphicsDesc::fullscreen(
+            "probe blend",
+            "probe_fill.frag",
+            vk::Format::R16G16B16A16_SFLOAT,
+        );
+        d.blend = Blend::ConstantMix(0);
+        d
+    })?;
 
     let result = (|| -> Result<(Ceilings, Vec<ProbeResult>)> {
         let mut res = Resources::default();
         let id_rgba = res.add_image("probe rgba16f", src_rgba.raw, src_rgba.subresource_range());
         let id_r32 = res.add_image("probe r32f", src_r32.raw, src_r32.subresource_range());
         let id_target = res.add_image("probe target", target.raw, target.subresource_range());
+        let id_ldr = res.add_image(
+            "probe target rgba8",
+            target_ldr.raw,
+            target_ldr.subresource_range(),
+        );
         res.images[id_rgba.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
         res.images[id_r32.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
         let set = |img: &Image, sampler| {
@@ -113,56 +151,90 @@ pub fn measure(
                 ],
             )
         };
-        let probes: Vec<(&str, Option<(vk::DescriptorSet, ImageId)>)> = vec![
+        let fetch_probe = |s, id| Probe {
+            pipeline: &fetch,
+            src: Some((s, id)),
+            target: (id_target, target.view),
+            access: AccessKind::ColorAttachmentWrite,
+        };
+        let fill_probe = |pipeline, target, access| Probe {
+            pipeline,
+            src: None,
+            target,
+            access,
+        };
+        let probes: Vec<(&str, Probe)> = vec![
             (
                 "bilinear rgba16f",
-                Some((set(&src_rgba, samplers.linear_clamp)?, id_rgba)),
+                fetch_probe(set(&src_rgba, samplers.linear_clamp)?, id_rgba),
             ),
             (
                 "point rgba16f",
-                Some((set(&src_rgba, samplers.nearest_clamp)?, id_rgba)),
+                fetch_probe(set(&src_rgba, samplers.nearest_clamp)?, id_rgba),
             ),
             (
                 "bilinear r32f",
-                Some((set(&src_r32, samplers.linear_clamp)?, id_r32)),
+                fetch_probe(set(&src_r32, samplers.linear_clamp)?, id_r32),
             ),
             (
                 "point r32f",
-                Some((set(&src_r32, samplers.nearest_clamp)?, id_r32)),
+                fetch_probe(set(&src_r32, samplers.nearest_clamp)?, id_r32),
             ),
-            ("fill rgba16f", None),
+            (
+                "fill rgba16f",
+                fill_probe(
+                    &fill,
+                    (id_target, target.view),
+                    AccessKind::ColorAttachmentWrite,
+                ),
+            ),
+            (
+                "fill rgba8",
+                fill_probe(
+                    &fill_ldr,
+                    (id_ldr, target_ldr.view),
+                    AccessKind::ColorAttachmentWrite,
+                ),
+            ),
+            (
+                "blend rgba16f",
+                fill_probe(
+                    &fill_blend,
+                    (id_target, target.view),
+                    AccessKind::ColorAttachmentLoadWrite,
+                ),
+            ),
         ];
         let texel = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
-        let target_view = target.view;
         let mut passes = Vec::new();
         // One untimed-in-effect warm-up round, then `reps` measured rounds.
         for round in 0..=reps {
-            for (name, src) in &probes {
-                let (pipeline, set) = match src {
-                    Some((s, _)) => (&fetch, Some(*s)),
-                    None => (&fill, None),
+            for (name, probe) in &probes {
+                let (pipeline, set) = (probe.pipeline, probe.src.map(|(s, _)| s));
+                let (target_id, target_view) = probe.target;
+                let load = if probe.access == AccessKind::ColorAttachmentLoadWrite {
+                    vk::AttachmentLoadOp::LOAD
+                } else {
+                    vk::AttachmentLoadOp::DONT_CARE
                 };
                 let mut pass = Pass::new(format!("{name} #{round}"));
-                if let Some((_, id)) = src {
-                    pass = pass.image(*id, AccessKind::FragmentSampledRead);
+                if let Some((_, id)) = probe.src {
+                    pass = pass.image(id, AccessKind::FragmentSampledRead);
                 }
                 pass = pass
-                    .image(id_target, AccessKind::ColorAttachmentWrite)
+                    .image(target_id, probe.access)
                     .record(move |pc: &PassContext| {
                         let (c, cmd) = (pc.ctx, pc.cmd);
-                        begin_color_rendering(
-                            c,
-                            cmd,
-                            &[target_view],
-                            extent,
-                            vk::AttachmentLoadOp::DONT_CARE,
-                        );
+                        begin_color_rendering(c, cmd, &[target_view], extent, load);
                         unsafe {
                             c.device.cmd_bind_pipeline(
                                 cmd,
                                 vk::PipelineBindPoint::GRAPHICS,
                                 pipeline.raw,
                             );
+                            if pipeline.has_blend_constants {
+                                c.device.cmd_set_blend_constants(cmd, &[0.5; 4]);
+                            }
                             if let Some(s) = set {
                                 c.device.cmd_bind_descriptor_sets(
                                     cmd,
@@ -199,12 +271,12 @@ pub fn measure(
         let samples = samples?;
         ctx.check_validation("during the ceiling probes")?;
         let mut results = Vec::new();
-        for (pi, (name, src)) in probes.iter().enumerate() {
+        for (pi, (name, probe)) in probes.iter().enumerate() {
             let times: Vec<f64> = (1..=reps)
                 .map(|r| samples[r * probes.len() + pi].gpu_ms)
                 .collect();
             let stats = Stats::of(&times).expect("reps >= 1");
-            let taps = if src.is_some() { PROBE_TAPS } else { 1 };
+            let taps = if probe.src.is_some() { PROBE_TAPS } else { 1 };
             let ops = n as f64 * taps as f64;
             results.push(ProbeResult {
                 name: name.to_string(),
@@ -222,6 +294,8 @@ pub fn measure(
                 bilinear_r32f_gtaps: r(2),
                 point_r32f_gtaps: r(3),
                 fill_rgba16f_gpix: r(4),
+                fill_rgba8_gpix: r(5),
+                blend_rgba16f_gpix: r(6),
             },
             results,
         ))
@@ -231,10 +305,13 @@ pub fn measure(
     }
     fetch.destroy(ctx);
     fill.destroy(ctx);
+    fill_ldr.destroy(ctx);
+    fill_blend.destroy(ctx);
     pool.destroy(ctx);
     samplers.destroy(ctx);
     src_rgba.destroy(ctx);
     src_r32.destroy(ctx);
     target.destroy(ctx);
+    target_ldr.destroy(ctx);
     result
 }

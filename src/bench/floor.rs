@@ -12,6 +12,9 @@ pub struct Ceilings {
     pub bilinear_r32f_gtaps: f64,
     pub point_r32f_gtaps: f64,
     pub fill_rgba16f_gpix: f64,
+    pub fill_rgba8_gpix: f64,
+    /// RGBA16F with constant-factor blending (read-modify-write).
+    pub blend_rgba16f_gpix: f64,
 }
 
 /// A kind of fetch the passes make.
@@ -23,11 +26,19 @@ pub enum Fetch {
     PointR32f,
 }
 
+/// A kind of pixel write the passes make.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Write {
+    Rgba16f,
+    Rgba16fBlend,
+    Rgba8,
+}
+
 /// What one fragment of a pass does.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassCost {
     pub fetches: Vec<(Fetch, f64)>,
-    pub writes: f64,
+    pub writes: Vec<(Write, f64)>,
 }
 
 impl Ceilings {
@@ -37,6 +48,14 @@ impl Ceilings {
             Fetch::PointRgba16f => self.point_rgba16f_gtaps,
             Fetch::BilinearR32f => self.bilinear_r32f_gtaps,
             Fetch::PointR32f => self.point_r32f_gtaps,
+        }
+    }
+
+    fn fill(&self, w: Write) -> f64 {
+        match w {
+            Write::Rgba16f => self.fill_rgba16f_gpix,
+            Write::Rgba16fBlend => self.blend_rgba16f_gpix,
+            Write::Rgba8 => self.fill_rgba8_gpix,
         }
     }
 }
@@ -50,7 +69,12 @@ pub fn floor_ms(cost: &PassCost, invocations: u64, c: &Ceilings) -> f64 {
         .iter()
         .map(|&(f, per)| n * per / (c.rate(f) * 1e9))
         .sum();
-    let fill_s = n * cost.writes / (c.fill_rgba16f_gpix * 1e9);
+    // Attachments of one MRT pass go through the ROPs one after another.
+    let fill_s: f64 = cost
+        .writes
+        .iter()
+        .map(|&(w, per)| n * per / (c.fill(w) * 1e9))
+        .sum();
     fetch_s.max(fill_s) * 1e3
 }
 
@@ -69,7 +93,7 @@ pub fn separable_pass_cost(n_samples: usize, follow_surface: bool) -> PassCost {
     }
     PassCost {
         fetches,
-        writes: 1.0,
+        writes: vec![(Write::Rgba16f, 1.0)],
     }
 }
 
@@ -83,7 +107,11 @@ pub fn ssg_pass_cost(vertical: bool) -> PassCost {
             (Fetch::PointR32f, 3.0),
             (Fetch::BilinearRgba16f, 7.0),
         ],
-        writes: if vertical { 2.0 } else { 1.0 },
+        writes: if vertical {
+            vec![(Write::Rgba16f, 1.0), (Write::Rgba16fBlend, 1.0)]
+        } else {
+            vec![(Write::Rgba16f, 1.0)]
+        },
     }
 }
 
@@ -96,7 +124,7 @@ pub fn jittered_cost() -> PassCost {
             (Fetch::PointR32f, 5.0),
             (Fetch::BilinearRgba16f, 12.0),
         ],
-        writes: 1.0,
+        writes: vec![(Write::Rgba16f, 1.0)],
     }
 }
 
@@ -104,14 +132,14 @@ pub fn jittered_cost() -> PassCost {
 pub fn composite_cost() -> PassCost {
     PassCost {
         fetches: vec![(Fetch::PointRgba16f, 2.0)],
-        writes: 1.0,
+        writes: vec![(Write::Rgba16f, 1.0)],
     }
 }
 
 pub fn tonemap_cost() -> PassCost {
     PassCost {
         fetches: vec![(Fetch::PointRgba16f, 1.0)],
-        writes: 1.0,
+        writes: vec![(Write::Rgba8, 1.0)],
     }
 }
 
@@ -126,6 +154,8 @@ mod tests {
             bilinear_r32f_gtaps: 31.0,
             point_r32f_gtaps: 31.0,
             fill_rgba16f_gpix: 7.0,
+            fill_rgba8_gpix: 14.0,
+            blend_rgba16f_gpix: 3.5,
         }
     }
 
@@ -140,9 +170,23 @@ mod tests {
     #[test]
     fn fill_bound_pass() {
         // One fetch and one write: the 7 Gpix/s fill dominates.
-        let ms = floor_ms(&tonemap_cost(), 7_000_000, &h100_like());
+        let ms = floor_ms(&composite_cost(), 7_000_000, &h100_like());
         assert!((ms - 1.0).abs() < 1e-9);
-        assert_eq!(floor_ms(&tonemap_cost(), 0, &h100_like()), 0.0);
+        assert_eq!(floor_ms(&composite_cost(), 0, &h100_like()), 0.0);
+        // The tone map writes 32 bpp, at its own (here twice the) rate.
+        let ms = floor_ms(&tonemap_cost(), 7_000_000, &h100_like());
+        assert!((ms - 0.5).abs() < 1e-9, "{ms}");
+    }
+
+    #[test]
+    fn mrt_writes_add_up() {
+        // ssg vertical: one plain and one blended RGBA16F write per pixel:
+        // 1/7 + 1/3.5 ns per pixel, more than its 11 fetches at 31 Gtap/s.
+        let ms = floor_ms(&ssg_pass_cost(true), 1_000_000, &h100_like());
+        let fill = 1e6 / 7e9 + 1e6 / 3.5e9;
+        assert!((ms - fill * 1e3).abs() < 1e-9, "{ms}");
+        let h = floor_ms(&ssg_pass_cost(false), 1_000_000, &h100_like());
+        assert!((h - 11.0 * 1e6 / 31e9 * 1e3).abs() < 1e-9, "{h}");
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use ash::vk;
 
+use super::region::PixelRect;
 use crate::graph::PassContext;
 use crate::vk::context::Context;
 use crate::vk::pipeline::Pipeline;
@@ -37,6 +38,23 @@ pub fn begin_color_rendering(
     set_viewport(ctx, cmd, extent);
 }
 
+/// The rectangles of a pixel region as scissors.
+pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
+    region
+        .iter()
+        .map(|r| vk::Rect2D {
+            offset: vk::Offset2D {
+                x: r.x0 as i32,
+                y: r.y0 as i32,
+            },
+            extent: vk::Extent2D {
+                width: r.width(),
+                height: r.height(),
+            },
+        })
+        .collect()
+}
+
 /// Viewport and scissor covering `extent`.
 pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
     unsafe {
@@ -65,7 +83,9 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
 
 /// A full-screen triangle into `colors` (loaded, stored), tested against a
 /// read-only depth/stencil attachment (stencil reference `stencil_ref`, used when
-/// the pipeline tests stencil). `state` sets push constants and other dynamic state.
+/// the pipeline tests stencil), drawn once per rectangle of `region` (disjoint,
+/// so no pixel is shaded twice; empty: nothing is drawn). `state` sets push
+/// constants and other dynamic state.
 #[allow(clippy::too_many_arguments)]
 pub fn fullscreen_stencil_draw(
     pc: &PassContext,
@@ -74,6 +94,7 @@ pub fn fullscreen_stencil_draw(
     colors: &[vk::ImageView],
     depth_stencil: vk::ImageView,
     extent: vk::Extent2D,
+    region: &[vk::Rect2D],
     stencil_ref: u32,
     state: impl Fn(&Context, vk::CommandBuffer),
 ) {
@@ -125,7 +146,11 @@ pub fn fullscreen_stencil_draw(
             &[],
         );
         state(ctx, cmd);
-        ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+        for rect in region {
+            ctx.device
+                .cmd_set_scissor(cmd, 0, std::slice::from_ref(rect));
+            ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+        }
         ctx.device.cmd_end_rendering(cmd);
     }
 }

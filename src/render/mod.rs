@@ -5,6 +5,7 @@ pub mod draw;
 pub mod poisson;
 pub mod readback;
 pub mod reference;
+pub mod region;
 pub mod scene_gpu;
 pub mod screen;
 pub mod separable;
@@ -297,6 +298,10 @@ pub struct FrameGpu {
     objects: Vec<GpuObject>,
     instances: Vec<Mat4>,
     pub sss: Option<SssMethod>,
+    /// Where the SSS passes work (see `region.rs`), as pixels and as scissors.
+    pub region_px: Vec<region::PixelRect>,
+    sss_region: Vec<vk::Rect2D>,
+    screen_rect: Vec<vk::Rect2D>,
 }
 
 /// The SSS step of the frame, one variant per method.
@@ -680,6 +685,76 @@ impl<'c> Renderer<'c> {
             Method::None => None,
         };
 
+        // Where the SSS passes have work: near the skin's projected bounds.
+        let full = region::PixelRect::full(extent.width, extent.height);
+        let region_px = match (&sss, settings.sss_region) {
+            (None | Some(SssMethod::Reference(_)), _) | (_, region::RegionMode::Screen) => {
+                vec![full]
+            }
+            (Some(method), region::RegionMode::Skin) => {
+                let rv = region::RegionView {
+                    view: camera.view(),
+                    proj,
+                    near: camera.near,
+                    width: extent.width,
+                    height: extent.height,
+                };
+                let skin: Vec<&crate::scene::mesh::Object> = scene
+                    .backdrop
+                    .iter()
+                    .chain(std::iter::once(&scene.head))
+                    .filter(|o| o.material.skin)
+                    .collect();
+                let scale = region::ReachScale {
+                    height_px: extent.height,
+                    tan_half_fovy: (0.5 * settings.fovy_deg.to_radians()).tan(),
+                    mm_per_unit: mm,
+                    max_strength: skin
+                        .iter()
+                        .map(|o| o.material.sss_strength)
+                        .fold(0.0, f32::max),
+                };
+                // Skin objects are drawn once per instance (see the geometry pass).
+                let boxes: Vec<crate::scene::mesh::Aabb> = skin
+                    .iter()
+                    .flat_map(|o| {
+                        let b = o.mesh.bounds();
+                        instances.iter().map(move |m| b.transformed(m))
+                    })
+                    .collect();
+                match method {
+                    SssMethod::Separable(s) => {
+                        region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale))
+                    }
+                    SssMethod::Ssg(s) => region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale)),
+                    SssMethod::Jittered(s) => {
+                        region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale))
+                    }
+                    // Poisson reads the complete diffuse chain, never a seed: its
+                    // region only has to hold the skin pixels it shades.
+                    SssMethod::Poisson(_) => region::skin_region(&rv, boxes, |_| 0.0),
+                    SssMethod::Reference(_) => unreachable!("handled above"),
+                }
+            }
+        };
+
+        // Texels of the intermediates outside the region are never written: zero
+        // them once so a dump of an intermediate shows black there, not old memory.
+        if region_px != [full] {
+            let zeros = vec![0u8; extent.width as usize * extent.height as usize * 8];
+            for (id, img) in [&targets.sss_tmp, &targets.sss_tmp2] {
+                upload::fill_image(
+                    ctx,
+                    img,
+                    vk::ImageAspectFlags::COLOR,
+                    &zeros,
+                    AccessKind::FragmentSampledRead,
+                )?;
+                resources.images[id.0].state =
+                    ResourceState::uploaded(AccessKind::FragmentSampledRead);
+            }
+        }
+
         let profiler = Profiler::new(ctx, 64)?;
         let cmd = unsafe {
             ctx.device.allocate_command_buffers(
@@ -717,6 +792,9 @@ impl<'c> Renderer<'c> {
             objects,
             instances,
             sss,
+            sss_region: draw::scissors(&region_px),
+            region_px,
+            screen_rect: draw::scissors(&[full]),
         };
         ctx.check_validation("while setting up the renderer")?;
         Ok(Renderer {
@@ -855,6 +933,10 @@ impl<'c> Renderer<'c> {
             ResourceState::uploaded(AccessKind::FragmentSampledRead);
         self.resources.images[t.depth_stencil.0 .0].state =
             ResourceState::uploaded(AccessKind::DepthStencilReadOnly);
+        // The skin is wherever the upload says, not where the scene's boxes project.
+        let full = region::PixelRect::full(self.gpu.extent.width, self.gpu.extent.height);
+        self.gpu.region_px = vec![full];
+        self.gpu.sss_region = draw::scissors(&[full]);
         Ok(())
     }
 
@@ -995,7 +1077,7 @@ impl FrameGpu {
         }
     }
 
-    pub fn screen_targets(&self) -> ScreenTargets {
+    pub fn screen_targets(&self) -> ScreenTargets<'_> {
         let t = &self.targets;
         ScreenTargets {
             diffuse: (t.diffuse.0, t.diffuse.1.raw, t.diffuse.1.view),
@@ -1004,6 +1086,8 @@ impl FrameGpu {
             linear_depth: t.linear_depth.0,
             depth_stencil: (t.depth_stencil.0, t.depth_stencil.1.view),
             extent: self.extent,
+            region: &self.sss_region,
+            screen: &self.screen_rect,
         }
     }
 

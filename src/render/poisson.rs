@@ -138,7 +138,7 @@ impl PoissonSss {
 
     pub fn passes<'a>(
         &'a self,
-        t: ScreenTargets,
+        t: ScreenTargets<'a>,
         chains: &Chains,
         fovy_rad: f32,
         mm_per_unit: f32,
@@ -146,7 +146,8 @@ impl PoissonSss {
         let mut passes = vec![seed_copy(
             "poisson seed copy",
             (t.diffuse.0, t.diffuse.1),
-            t.extent,
+            // The composite reads this target on every pixel: seed all of it.
+            t.screen,
             &[(t.rt1.0, t.rt1.1)],
         )];
         for l in 1..self.levels as usize {
@@ -210,6 +211,7 @@ impl PoissonSss {
                         &[t.rt1.2],
                         ds.1,
                         extent,
+                        t.region,
                         STENCIL_SKIN,
                         |c, cmd| self.pipeline.push(c, cmd, &push),
                     )

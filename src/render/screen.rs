@@ -12,6 +12,7 @@ use anyhow::{bail, Result};
 use ash::vk;
 
 use super::draw::fullscreen_stencil_draw;
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::separable::{skin_stencil_test, STENCIL_SKIN};
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::jittered::JitteredKernel;
@@ -60,24 +61,31 @@ pub struct ScreenPush {
     pub wide: [f32; 4],
 }
 
-/// Graph ids and handles of the targets the screen-space passes use.
+/// Graph ids and handles of the targets the screen-space passes use, and where
+/// on screen they have work.
 #[derive(Clone, Copy, Debug)]
-pub struct ScreenTargets {
+pub struct ScreenTargets<'a> {
     pub diffuse: (ImageId, vk::Image, vk::ImageView),
     pub rt1: (ImageId, vk::Image, vk::ImageView),
     pub rt2: (ImageId, vk::Image, vk::ImageView),
     pub linear_depth: ImageId,
     pub depth_stencil: (ImageId, vk::ImageView),
     pub extent: vk::Extent2D,
+    /// Disjoint rectangles holding every skin pixel and every texel the method's
+    /// taps read from one (see `region.rs`): the seed copies and the stencil-
+    /// tested draws are limited to them.
+    pub region: &'a [vk::Rect2D],
+    /// One rectangle covering the screen.
+    pub screen: &'a [vk::Rect2D],
 }
 
-/// A pass that copies `src` (the diffuse target) into each of `dsts`: the seeds
-/// every method's intermediates start from, so taps on non-skin texels read what a
-/// full-screen blur would have read.
+/// A pass that copies `src` (the diffuse target) into each of `dsts` within
+/// `region`: the seeds every method's intermediates start from, so taps on
+/// non-skin texels read what a full-screen blur would have read.
 pub fn seed_copy<'a>(
     name: &str,
     src: (ImageId, vk::Image),
-    extent: vk::Extent2D,
+    region: &'a [vk::Rect2D],
     dsts: &[(ImageId, vk::Image)],
 ) -> Pass<'a> {
     let mut pass = Pass::new(name).image(src.0, AccessKind::TransferRead);
@@ -90,14 +98,29 @@ pub fn seed_copy<'a>(
         let layers = vk::ImageSubresourceLayers::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
             .layer_count(1);
-        let region = vk::ImageCopy::default()
-            .src_subresource(layers)
-            .dst_subresource(layers)
-            .extent(vk::Extent3D {
-                width: extent.width,
-                height: extent.height,
-                depth: 1,
-            });
+        let copies: Vec<vk::ImageCopy> = region
+            .iter()
+            .map(|r| {
+                let offset = vk::Offset3D {
+                    x: r.offset.x,
+                    y: r.offset.y,
+                    z: 0,
+                };
+                vk::ImageCopy::default()
+                    .src_subresource(layers)
+                    .dst_subresource(layers)
+                    .src_offset(offset)
+                    .dst_offset(offset)
+                    .extent(vk::Extent3D {
+                        width: r.extent.width,
+                        height: r.extent.height,
+                        depth: 1,
+                    })
+            })
+            .collect();
+        if copies.is_empty() {
+            return; // no skin on screen: nothing reads the seeds
+        }
         for &dst in &dsts {
             unsafe {
                 pc.ctx.device.cmd_copy_image(
@@ -106,7 +129,7 @@ pub fn seed_copy<'a>(
                     vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                     dst,
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[region],
+                    &copies,
                 )
             };
         }
@@ -224,11 +247,23 @@ impl SsgSss {
         })
     }
 
-    pub fn passes<'a>(&'a self, t: ScreenTargets) -> Vec<Pass<'a>> {
+    /// How far (pixels) the taps of a skin pixel at view depth `depth` reach:
+    /// 3 steps of std/3 stretched (eq. 4.1-4.4; the depth-gradient term only
+    /// narrows it) for the widest Gaussian.
+    pub fn reach_px(&self, depth: f32, scale: &ReachScale) -> f32 {
+        let widest = self
+            .gaussians
+            .iter()
+            .map(|g| g.incremental_std_mm)
+            .fold(0.0, f32::max);
+        self.stretch.alpha * scale.max_strength / depth * widest + BILINEAR_MARGIN_PX
+    }
+
+    pub fn passes<'a>(&'a self, t: ScreenTargets<'a>) -> Vec<Pass<'a>> {
         let mut passes = vec![seed_copy(
             "ssg seed copy",
             (t.diffuse.0, t.diffuse.1),
-            t.extent,
+            t.region,
             &[(t.rt1.0, t.rt1.1), (t.rt2.0, t.rt2.1)],
         )];
         let extent = t.extent;
@@ -267,6 +302,7 @@ impl SsgSss {
                             &[t.rt2.2],
                             ds.1,
                             extent,
+                            t.region,
                             STENCIL_SKIN,
                             |c, cmd| self.horizontal.push(c, cmd, &h),
                         )
@@ -287,6 +323,7 @@ impl SsgSss {
                             &[t.rt1.2, t.diffuse.2],
                             ds.1,
                             extent,
+                            t.region,
                             STENCIL_SKIN,
                             |c, cmd| {
                                 self.vertical.push(c, cmd, &v);
@@ -339,7 +376,14 @@ impl JitteredSss {
         })
     }
 
-    pub fn passes<'a>(&'a self, t: ScreenTargets) -> Vec<Pass<'a>> {
+    /// How far (pixels) the taps of a skin pixel at view depth `depth` reach:
+    /// the wider ring, stretched as the shader does (s / 3 pixels per mm).
+    pub fn reach_px(&self, depth: f32, scale: &ReachScale) -> f32 {
+        let ring = self.kernel.mid_radius_mm.max(self.kernel.wide_radius_mm);
+        self.stretch.alpha * scale.max_strength / depth * ring / 3.0 + BILINEAR_MARGIN_PX
+    }
+
+    pub fn passes<'a>(&'a self, t: ScreenTargets<'a>) -> Vec<Pass<'a>> {
         let extent = t.extent;
         let k = self.kernel;
         let push = ScreenPush {
@@ -357,7 +401,7 @@ impl JitteredSss {
             seed_copy(
                 "ss-jittered seed copy",
                 (t.diffuse.0, t.diffuse.1),
-                t.extent,
+                t.region,
                 &[(t.rt1.0, t.rt1.1)],
             ),
             Pass::new("ss-jittered")
@@ -373,6 +417,7 @@ impl JitteredSss {
                         &[t.diffuse.2],
                         ds.1,
                         extent,
+                        t.region,
                         STENCIL_SKIN,
                         |c, cmd| self.pipeline.push(c, cmd, &push),
                     )

@@ -12,6 +12,7 @@ use anyhow::Result;
 use ash::vk;
 
 use super::draw::fullscreen_stencil_draw;
+use super::region::{px_per_mm, ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::ScreenTargets;
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::kernel::SeparableKernel;
@@ -134,13 +135,33 @@ impl SeparableSss {
         }
     }
 
+    /// How far (pixels) the taps of a skin pixel at view depth `depth` reach:
+    /// the widest offset at the strongest strength, as the shader scales it.
+    pub fn reach_px(&self, depth: f32, scale: &ReachScale) -> f32 {
+        let widest_mm = self
+            .kernel
+            .samples
+            .iter()
+            .map(|s| s.offset_mm.abs())
+            .fold(0.0, f32::max);
+        widest_mm
+            * scale.max_strength
+            * px_per_mm(
+                depth,
+                scale.height_px,
+                scale.tan_half_fovy,
+                scale.mm_per_unit,
+            )
+            + BILINEAR_MARGIN_PX
+    }
+
     /// The three passes, in order: seed copy, horizontal, vertical.
-    pub fn passes<'a>(&'a self, t: ScreenTargets, view: SssView) -> Vec<Pass<'a>> {
+    pub fn passes<'a>(&'a self, t: ScreenTargets<'a>, view: SssView) -> Vec<Pass<'a>> {
         let extent = t.extent;
         let seed = super::screen::seed_copy(
             "sss seed copy",
             (t.diffuse.0, t.diffuse.1),
-            extent,
+            t.region,
             &[(t.rt1.0, t.rt1.1)],
         );
         let blur = |name: &str,
@@ -162,6 +183,7 @@ impl SeparableSss {
                         &[dst.2],
                         t.depth_stencil.1,
                         extent,
+                        t.region,
                         STENCIL_SKIN,
                         |c, cmd| self.pipeline.push(c, cmd, &push),
                     );

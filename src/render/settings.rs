@@ -72,6 +72,8 @@ pub struct RenderSettings {
     pub lod: bool,
     /// ssg: stencil test or dynamic branch.
     pub mask: MaskMode,
+    /// Limit the SSS passes to the skin's neighbourhood, or run them on the screen.
+    pub sss_region: super::region::RegionMode,
     /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
     pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
     /// reference: surface samples per mm^2.
@@ -101,6 +103,7 @@ impl Default for RenderSettings {
             fit: GaussianFit::Six,
             lod: true,
             mask: MaskMode::Stencil,
+            sss_region: super::region::RegionMode::Skin,
             reference_density: 32.0,
             transmittance_profile: crate::skin::transmittance::TransmittanceProfile::Thesis,
             heads: 1,

@@ -75,6 +75,8 @@ pub struct Pipeline {
     pub name: String,
     /// Whether the pipeline tests stencil (its reference is dynamic state).
     pub has_stencil: bool,
+    /// Whether it blends with a constant (the constant is dynamic state).
+    pub has_blend_constants: bool,
 }
 
 fn make_layout(
@@ -245,6 +247,7 @@ impl Pipeline {
             bind_point: vk::PipelineBindPoint::GRAPHICS,
             name: d.name.clone(),
             has_stencil: d.stencil.is_some(),
+            has_blend_constants: matches!(d.blend, Blend::ConstantMix(_)),
         })
     }
 
@@ -275,6 +278,7 @@ impl Pipeline {
             bind_point: vk::PipelineBindPoint::COMPUTE,
             name: name.to_string(),
             has_stencil: false,
+            has_blend_constants: false,
         })
     }
 

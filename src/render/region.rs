@@ -1,0 +1,379 @@
+//! Where on screen the SSS passes have work: the skin's projected bounds,
+//! widened by how far a method's taps reach. Pure math, no Vulkan.
+//!
+//! Two costs of the screen-space methods do not depend on how much skin is on
+//! screen, and this region removes both:
+//! - the seed copies of the diffuse target into the intermediates (a full-screen
+//!   copy each; the taps only ever read them near skin);
+//! - the full-screen triangle of each stencil-tested pass, whose non-skin pixels
+//!   are rejected by the stencil test one by one (measured on the H100: a 720p
+//!   pass with 18% skin cost 1.7x its fetch floor, see docs/perf/README.md).
+//!
+//! A region is a list of disjoint pixel rectangles: disjoint so that a pass
+//! drawn once per rectangle never blends a pixel twice.
+
+use anyhow::{bail, Result};
+use glam::{Mat4, Vec3};
+
+use crate::scene::mesh::Aabb;
+
+/// Whether the SSS passes work only near skin (the default) or on the whole
+/// screen (the demos' way; kept to measure what the region saves).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RegionMode {
+    Skin,
+    Screen,
+}
+
+impl std::str::FromStr for RegionMode {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "skin" => Ok(RegionMode::Skin),
+            "screen" => Ok(RegionMode::Screen),
+            other => bail!("unknown SSS region '{other}' (valid: skin, screen)"),
+        }
+    }
+}
+
+/// Pixels added to every reach for the bilinear footprint of a tap (one texel
+/// beyond its position) and rounding.
+pub const BILINEAR_MARGIN_PX: f32 = 2.0;
+
+/// What converts a kernel's millimetres into pixels at a depth.
+#[derive(Clone, Copy, Debug)]
+pub struct ReachScale {
+    pub height_px: u32,
+    pub tan_half_fovy: f32,
+    pub mm_per_unit: f32,
+    /// The largest per-pixel SSS strength any skin object writes (it scales
+    /// every kernel's footprint).
+    pub max_strength: f32,
+}
+
+/// A half-open pixel rectangle `[x0, x1) x [y0, y1)`, row 0 at the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    pub fn full(width: u32, height: u32) -> PixelRect {
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+
+    pub fn area(&self) -> u64 {
+        self.width() as u64 * self.height() as u64
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.x1 <= self.x0 || self.y1 <= self.y0
+    }
+
+    pub fn overlaps(&self, o: &PixelRect) -> bool {
+        self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
+    }
+
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
+    }
+
+    fn union(&self, o: &PixelRect) -> PixelRect {
+        PixelRect {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+}
+
+/// The camera as the region needs it.
+#[derive(Clone, Copy, Debug)]
+pub struct RegionView {
+    pub view: Mat4,
+    /// Projection with the renderer's conventions (y flipped: row 0 at the top).
+    pub proj: Mat4,
+    pub near: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// One skin object on screen: the pixel bounds of its projected box and the
+/// nearest view depth of any of its points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    pub rect: PixelRect,
+    pub nearest_depth: f32,
+}
+
+/// Projects a world-space box. `None` when it is entirely off screen. A box that
+/// reaches the near plane, where projection breaks down, covers the whole screen
+/// at the near depth: conservative, never wrong.
+pub fn footprint(v: &RegionView, bounds: &Aabb) -> Option<Footprint> {
+    let (w, h) = (v.width as f32, v.height as f32);
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    let mut nearest = f32::INFINITY;
+    for i in 0..8 {
+        let c = Vec3::new(
+            if i & 1 == 0 {
+                bounds.min.x
+            } else {
+                bounds.max.x
+            },
+            if i & 2 == 0 {
+                bounds.min.y
+            } else {
+                bounds.max.y
+            },
+            if i & 4 == 0 {
+                bounds.min.z
+            } else {
+                bounds.max.z
+            },
+        );
+        let depth = -(v.view * c.extend(1.0)).z;
+        nearest = nearest.min(depth);
+        if depth <= v.near {
+            return Some(Footprint {
+                rect: PixelRect::full(v.width, v.height),
+                nearest_depth: v.near,
+            });
+        }
+        let clip = v.proj * v.view * c.extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        let px = Vec3::new((ndc.x * 0.5 + 0.5) * w, (ndc.y * 0.5 + 0.5) * h, ndc.z);
+        lo = lo.min(px);
+        hi = hi.max(px);
+    }
+    // Outward to whole pixels; a pixel is covered when its centre is inside, so
+    // floor/ceil of the exact bounds holds every covered pixel.
+    let clamp = |x: f32, max: u32| x.clamp(0.0, max as f32) as u32;
+    let rect = PixelRect {
+        x0: clamp(lo.x.floor(), v.width),
+        y0: clamp(lo.y.floor(), v.height),
+        x1: clamp(hi.x.ceil(), v.width),
+        y1: clamp(hi.y.ceil(), v.height),
+    };
+    (!rect.is_empty()).then_some(Footprint {
+        rect,
+        nearest_depth: nearest,
+    })
+}
+
+/// Widens `f.rect` by `margin_px` pixels on every side (clamped to the screen).
+pub fn widen(f: &Footprint, margin_px: f32, width: u32, height: u32) -> PixelRect {
+    let m = if margin_px.is_finite() {
+        margin_px.max(0.0).ceil().min(u32::MAX as f32) as u32
+    } else {
+        u32::MAX
+    };
+    PixelRect {
+        x0: f.rect.x0.saturating_sub(m),
+        y0: f.rect.y0.saturating_sub(m),
+        x1: f.rect.x1.saturating_add(m).min(width),
+        y1: f.rect.y1.saturating_add(m).min(height),
+    }
+}
+
+/// Merges overlapping rectangles into their bounding rectangles until none
+/// overlap. Every input pixel stays covered; no pixel is covered twice.
+pub fn disjoint(mut rects: Vec<PixelRect>) -> Vec<PixelRect> {
+    rects.retain(|r| !r.is_empty());
+    loop {
+        let mut merged = false;
+        'outer: for i in 0..rects.len() {
+            for j in i + 1..rects.len() {
+                if rects[i].overlaps(&rects[j]) {
+                    rects[i] = rects[i].union(&rects[j]);
+                    rects.swap_remove(j);
+                    merged = true;
+                    break 'outer;
+                }
+            }
+        }
+        if !merged {
+            return rects;
+        }
+    }
+}
+
+/// The region of a set of skin boxes: each box's footprint widened by
+/// `reach_px(nearest_depth)` (how far the method's taps reach, in pixels, from
+/// a pixel at that depth; it must not grow with depth), made disjoint.
+pub fn skin_region(
+    v: &RegionView,
+    boxes: impl IntoIterator<Item = Aabb>,
+    reach_px: impl Fn(f32) -> f32,
+) -> Vec<PixelRect> {
+    disjoint(
+        boxes
+            .into_iter()
+            .filter_map(|b| footprint(v, &b))
+            .map(|f| widen(&f, reach_px(f.nearest_depth), v.width, v.height))
+            .collect(),
+    )
+}
+
+/// Pixels per millimetre on screen at view depth `depth` (scene units): the
+/// scale every screen-space kernel converts its millimetres with.
+pub fn px_per_mm(depth: f32, height_px: u32, tan_half_fovy: f32, mm_per_unit: f32) -> f32 {
+    height_px as f32 / (2.0 * depth * tan_half_fovy * mm_per_unit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::camera::Camera;
+
+    fn view(width: u32, height: u32, distance: f32) -> RegionView {
+        let cam = Camera::framing(Vec3::ZERO, Vec3::Z, 1.0, distance, 20.0);
+        RegionView {
+            view: cam.view(),
+            proj: cam.proj(width as f32 / height as f32),
+            near: cam.near,
+            width,
+            height,
+        }
+    }
+
+    fn unit_box(center: Vec3) -> Aabb {
+        Aabb {
+            min: center - Vec3::splat(0.5),
+            max: center + Vec3::splat(0.5),
+        }
+    }
+
+    #[test]
+    fn a_centred_box_projects_to_a_centred_rect_that_holds_its_corners() {
+        let v = view(640, 360, 10.0);
+        let f = footprint(&v, &unit_box(Vec3::ZERO)).unwrap();
+        // Nearest face at 10 - 0.5 view units.
+        assert!((f.nearest_depth - 9.5).abs() < 1e-4);
+        // 1 unit at 9.5 units with a 20 degree fovy on 360 rows: 360 / (2 * 9.5 * tan 10) px.
+        let ppu = 360.0 / (2.0 * 9.5 * 10f32.to_radians().tan());
+        let r = f.rect;
+        assert!((r.height() as f32 - ppu).abs() <= 2.0, "{r:?} vs {ppu}");
+        assert!((r.width() as f32 - ppu).abs() <= 2.0, "{r:?} vs {ppu}");
+        assert!(((r.x0 + r.x1) as i32 - 640).abs() <= 1);
+        assert!(((r.y0 + r.y1) as i32 - 360).abs() <= 1);
+    }
+
+    #[test]
+    fn up_in_the_world_is_up_on_screen() {
+        let v = view(640, 360, 10.0);
+        let up = footprint(&v, &unit_box(Vec3::new(0.0, 1.0, 0.0))).unwrap();
+        let centre = footprint(&v, &unit_box(Vec3::ZERO)).unwrap();
+        assert!(up.rect.y0 < centre.rect.y0, "row 0 is the top");
+    }
+
+    #[test]
+    fn boxes_at_the_near_plane_take_the_screen_and_boxes_behind_or_aside_take_nothing() {
+        let v = view(64, 36, 10.0);
+        let touching = footprint(&v, &unit_box(Vec3::new(0.0, 0.0, 10.0))).unwrap();
+        assert_eq!(touching.rect, PixelRect::full(64, 36));
+        assert_eq!(touching.nearest_depth, v.near);
+        assert!(footprint(&v, &unit_box(Vec3::new(100.0, 0.0, 0.0))).is_none());
+    }
+
+    #[test]
+    fn widening_clamps_to_the_screen() {
+        let f = Footprint {
+            rect: PixelRect {
+                x0: 2,
+                y0: 3,
+                x1: 10,
+                y1: 12,
+            },
+            nearest_depth: 1.0,
+        };
+        let r = widen(&f, 4.2, 16, 14);
+        assert_eq!(
+            r,
+            PixelRect {
+                x0: 0,
+                y0: 0,
+                x1: 15,
+                y1: 14
+            }
+        );
+        assert_eq!(widen(&f, f32::INFINITY, 16, 14), PixelRect::full(16, 14));
+        assert_eq!(widen(&f, f32::NAN, 16, 14), PixelRect::full(16, 14));
+    }
+
+    #[test]
+    fn disjoint_covers_every_input_pixel_exactly_once() {
+        let r = |x0, y0, x1, y1| PixelRect { x0, y0, x1, y1 };
+        let inputs = vec![
+            r(0, 0, 10, 10),
+            r(5, 5, 15, 15),
+            r(20, 0, 30, 5),
+            r(14, 14, 22, 16), // overlaps the union of the first two, which then reaches the third
+            r(40, 40, 40, 50), // empty
+            r(50, 0, 60, 10),
+        ];
+        let out = disjoint(inputs.clone());
+        for a in 0..out.len() {
+            for b in a + 1..out.len() {
+                assert!(!out[a].overlaps(&out[b]), "{:?} {:?}", out[a], out[b]);
+            }
+        }
+        for y in 0..64 {
+            for x in 0..64 {
+                let inside = inputs.iter().any(|i| i.contains(x, y));
+                let n = out.iter().filter(|o| o.contains(x, y)).count();
+                if inside {
+                    assert_eq!(n, 1, "({x},{y})");
+                }
+                assert!(n <= 1);
+            }
+        }
+        // {first, second, fourth, third} chain into one; the last stands alone.
+        assert_eq!(out.len(), 2);
+    }
+
+    #[test]
+    fn region_of_two_far_apart_heads_is_two_rects_and_nearer_means_wider() {
+        let v = view(640, 360, 10.0);
+        let boxes = [
+            unit_box(Vec3::new(-2.0, 0.0, 0.0)),
+            unit_box(Vec3::new(2.0, 0.0, 0.0)),
+        ];
+        let reach = |d: f32| 30.0 / d;
+        let region = skin_region(&v, boxes, reach);
+        assert_eq!(region.len(), 2);
+        let plain: Vec<PixelRect> = boxes
+            .iter()
+            .map(|b| footprint(&v, b).unwrap().rect)
+            .collect();
+        for (r, p) in region.iter().zip(&plain) {
+            // 30 / 9.5 = 3.2 -> 4 px on each side (clamped nowhere here).
+            assert_eq!(r.width(), p.width() + 8);
+            assert_eq!(r.height(), p.height() + 8);
+        }
+    }
+
+    #[test]
+    fn pixels_per_mm_match_the_screen_height() {
+        // 1 unit = 10 mm; a screen 2 * 5 * tan(45 deg) = 10 units = 100 mm tall on 500 rows.
+        assert!((px_per_mm(5.0, 500, 1.0, 10.0) - 5.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,298 @@
+//! The SSS region (render/region.rs) on lavapipe with validation: limiting the
+//! seed copies and the stencil-tested draws to the skin's widened bounds must
+//! change no pixel of any method's output, on one head, on many heads (several
+//! rectangles), on a head cut by the screen edge and on a camera inside the
+//! head's box (the whole-screen fallback), while the region really is smaller
+//! than the screen where it can be.
+
+mod common;
+
+use dermis::render::region::RegionMode;
+use dermis::render::screen::MaskMode;
+use dermis::render::{Method, RenderSettings};
+use dermis::run::{run, Report, RunOptions};
+use dermis::scene::gltf_load::TextureOverrides;
+use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
+use dermis::scene::{default_scene, load_gltf_scene, Scene};
+
+fn render(scene: &Scene, s: &RenderSettings) -> (Report, Vec<[f32; 4]>, Vec<u8>) {
+    let ctx = common::ctx();
+    let opts = RunOptions {
+        warmup: 0,
+        measured: 1,
+        capture: true,
+        dump: false,
+        ceilings: false,
+        command: "test".into(),
+        progress: false,
+    };
+    let out = run(&ctx, scene, s, &opts).expect("render");
+    let cap = out.capture.expect("capture");
+    (out.report, cap.diffuse, cap.ldr)
+}
+
+/// (samples passed, fragment invocations) of every SSS pass, by name.
+fn sss_counts(r: &Report) -> Vec<(String, u64, u64)> {
+    r.passes
+        .iter()
+        .filter(|p| {
+            ["sss ", "ssg ", "ss-jittered", "poisson"]
+                .iter()
+                .any(|m| p.name.starts_with(m))
+        })
+        .map(|p| {
+            (
+                p.name.clone(),
+                p.samples_passed,
+                p.fragment_invocations.unwrap_or(0),
+            )
+        })
+        .collect()
+}
+
+/// Every method variant with a region: same image as on the whole screen.
+fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: bool) {
+    let variants: Vec<(&str, RenderSettings)> = vec![
+        (
+            "separable",
+            RenderSettings {
+                method: Method::Separable,
+                ..base.clone()
+            },
+        ),
+        // Follow-surface hides what lies across a silhouette; without it every
+        // tap of the seeded texels counts.
+        (
+            "separable --no-follow-surface",
+            RenderSettings {
+                method: Method::Separable,
+                follow_surface: false,
+                ..base.clone()
+            },
+        ),
+        (
+            "ssg",
+            RenderSettings {
+                method: Method::Ssg,
+                ..base.clone()
+            },
+        ),
+        (
+            "ssg --no-lod",
+            RenderSettings {
+                method: Method::Ssg,
+                lod: false,
+                ..base.clone()
+            },
+        ),
+        (
+            "ssg --mask branch",
+            RenderSettings {
+                method: Method::Ssg,
+                mask: MaskMode::Branch,
+                ..base.clone()
+            },
+        ),
+        (
+            "ss-jittered",
+            RenderSettings {
+                method: Method::SsJittered,
+                ..base.clone()
+            },
+        ),
+        (
+            "poisson",
+            RenderSettings {
+                method: Method::Poisson,
+                ..base.clone()
+            },
+        ),
+    ];
+    let pixels = (base.width * base.height) as u64;
+    for (name, s) in variants {
+        let (rs, ds, ls) = render(
+            scene,
+            &RenderSettings {
+                sss_region: RegionMode::Skin,
+                ..s.clone()
+            },
+        );
+        let (rf, df, lf) = render(
+            scene,
+            &RenderSettings {
+                sss_region: RegionMode::Screen,
+                ..s.clone()
+            },
+        );
+        assert_eq!(rf.sss_region_pixels, pixels);
+        if expect_smaller {
+            assert!(
+                rs.sss_region_pixels < pixels,
+                "{name}: the region should be smaller than the screen here"
+            );
+        }
+        let skin = ds.iter().filter(|p| p[3] > 0.0).count();
+        assert!(skin > 0, "{name}: no skin on screen");
+        let differing = ds
+            .iter()
+            .zip(&df)
+            .filter(|(a, b)| {
+                a.iter()
+                    .zip(b.iter())
+                    .any(|(x, y)| x.to_bits() != y.to_bits())
+            })
+            .count();
+        assert_eq!(
+            differing, 0,
+            "{name}: {differing} diffuse pixels differ with the region"
+        );
+        assert_eq!(ls, lf, "{name}: the tone-mapped frames differ");
+        // The stencil-tested passes write exactly the skin either way (samples
+        // passed; llvmpipe counts invocations before the stencil test, so those
+        // only shrink); the branch variant shades the region, not the screen.
+        let (cs, cf) = (sss_counts(&rs), sss_counts(&rf));
+        assert_eq!(cs.len(), cf.len());
+        for ((n, passed_s, inv_s), (_, passed_f, inv_f)) in cs.iter().zip(&cf) {
+            assert_eq!(passed_s, passed_f, "{name}: {n} samples passed");
+            assert!(inv_s <= inv_f, "{name}: {n} {inv_s} > {inv_f} invocations");
+            // Without a stencil test every pixel of the region runs the shader:
+            // fewer than the screen's whenever the region is smaller.
+            if s.mask == MaskMode::Branch && n.starts_with("ssg g") && expect_smaller {
+                assert!(inv_s < inv_f, "{name}: {n} {inv_s} vs {inv_f}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_region_changes_no_pixel_on_the_default_scene() {
+    let base = RenderSettings {
+        width: 192,
+        height: 108,
+        shadow_size: 256,
+        ..RenderSettings::default()
+    };
+    region_changes_nothing(&default_scene(), base.clone(), true);
+    // Close and wide: taps reach far past the silhouette, where only the
+    // margin keeps them on seeded texels (a region 0.3x too narrow fails here).
+    let mut wide = RenderSettings {
+        width: 256,
+        height: 144,
+        distance_heads: 2.0,
+        ..base
+    };
+    wide.params.width_mm = 20.0;
+    region_changes_nothing(&default_scene(), wide, true);
+}
+
+#[test]
+fn the_region_changes_no_pixel_on_many_heads_and_cut_heads() {
+    let Some(path) = common::lps_path() else {
+        return;
+    };
+    let scene = load_gltf_scene(&path, &TextureOverrides::default(), None).unwrap();
+    let base = RenderSettings {
+        width: 192,
+        height: 108,
+        shadow_size: 256,
+        ..RenderSettings::default()
+    };
+    // Three heads at the thesis' far distance: several rectangles.
+    region_changes_nothing(
+        &scene,
+        RenderSettings {
+            heads: 3,
+            distance_heads: 4.889,
+            ..base.clone()
+        },
+        true,
+    );
+    // Zoom: the head overflows the screen, the region is clamped to it.
+    region_changes_nothing(
+        &scene,
+        RenderSettings {
+            distance_heads: 1.037,
+            ..base.clone()
+        },
+        false,
+    );
+}
+
+#[test]
+fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
+    let scene = default_scene();
+    let s = RenderSettings {
+        width: 96,
+        height: 64,
+        shadow_size: 256,
+        distance_heads: 0.3,
+        ..RenderSettings::default()
+    };
+    let (r, ..) = render(&scene, &s);
+    assert_eq!(r.sss_region_pixels, 96 * 64);
+    assert_eq!(r.sss_region_rects, 1);
+}
+
+#[test]
+fn many_heads_far_away_get_one_rectangle_each() {
+    let scene = default_scene();
+    let s = RenderSettings {
+        width: 320,
+        height: 180,
+        shadow_size: 256,
+        heads: 4,
+        distance_heads: 3.0,
+        ..RenderSettings::default()
+    };
+    let (r, ..) = render(&scene, &s);
+    assert_eq!(
+        r.sss_region_rects, 4,
+        "2x2 heads apart: 4 disjoint rectangles"
+    );
+    assert!(
+        r.sss_region_pixels < 320 * 180 / 2,
+        "{}",
+        r.sss_region_pixels
+    );
+}
+
+/// A flat skin card facing the camera in front of the (non-skin) backdrop: its
+/// box has no depth, so its footprint hugs its silhouette and only the reach
+/// margin keeps the taps that leave it on seeded texels.
+fn card_scene() -> Scene {
+    let mut scene = default_scene();
+    let v = |x: f32, y: f32| Vertex {
+        position: [x, y, 0.0],
+        normal: [0.0, 0.0, 1.0],
+        uv: [x + 0.5, 0.5 - y],
+        tangent: [1.0, 0.0, 0.0, 1.0],
+    };
+    let mesh = Mesh {
+        vertices: vec![v(-0.5, -0.5), v(0.5, -0.5), v(0.5, 0.5), v(-0.5, 0.5)],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    scene.head_bounds = mesh.bounds();
+    scene.head = Object {
+        mesh,
+        material: Material::skin([0.6, 0.45, 0.4]),
+    };
+    scene.mm_per_unit = 230.0;
+    scene.name = "card".into();
+    scene
+}
+
+#[test]
+fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
+    let mut base = RenderSettings {
+        width: 256,
+        height: 144,
+        shadow_size: 256,
+        distance_heads: 3.0,
+        follow_surface: false,
+        ..RenderSettings::default()
+    };
+    base.params.width_mm = 20.0;
+    region_changes_nothing(&card_scene(), base.clone(), true);
+    // Many cards: rectangles side by side.
+    region_changes_nothing(&card_scene(), RenderSettings { heads: 5, ..base }, true);
+}
