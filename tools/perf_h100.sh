@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every device-machine measurement of docs/perf/ and docs/accuracy.md.
 #
-#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 eval issue3-1080
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab eval
 #                                          (default: all, in that order)
 #
 # Run it on the device machine from the repository root with these carried (see
@@ -84,6 +84,9 @@ smoke() {
   done
   run "validate head ssg" "$P/validate/head_ssg/report.json" render --validate "${EXTRA[@]}" --scene "$A" \
     --method ssg --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/head_ssg"
+  # Several SSS-region rectangles (three heads far away).
+  run "validate 3 heads separable" "$P/validate/heads3_separable/report.json" render --validate "${EXTRA[@]}" --scene "$A" \
+    --heads 3 --distance 4.889 --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/heads3_separable"
   unset VK_LAYER_PATH
 }
 
@@ -119,6 +122,25 @@ issue3() {
     --report "$P/ssg_branch_${W}x${H}_zoom_1h.json"
 }
 
+# The same benches with the SSS passes on the whole screen (--sss-region screen):
+# what limiting the seed copies and the draws to the skin's region saves.
+screen_ab() {
+  for res in "1280 720" "1920 1080"; do
+    set -- $res
+    for d in zoom:1.037 near:1.852 far:4.889; do
+      for h in 1 3; do
+        local tag="${1}x${2}_${d%%:*}_${h}h"
+        local args=(bench "${EXTRA[@]}" --scene "$A" --width "$(w "$1")" --height "$(w "$2")" --distance "${d##*:}" --heads "$h" --sss-region screen)
+        run "screen ssg lod $tag" "$P/screen/ssg_lod_$tag.json" "${args[@]}" --method ssg --report "$P/screen/ssg_lod_$tag.json"
+        run "screen ssg nolod $tag" "$P/screen/ssg_nolod_$tag.json" "${args[@]}" --method ssg --no-lod --report "$P/screen/ssg_nolod_$tag.json"
+        run "screen separable $tag" "$P/screen/separable_$tag.json" "${args[@]}" --method separable --report "$P/screen/separable_$tag.json"
+      done
+    done
+  done
+  run "screen sep close s17" "$P/screen/sep_1080p_close_s17.json" bench "${EXTRA[@]}" --scene "$A" --sss-region screen \
+    --width "$(w 1920)" --height "$(w 1080)" --shot close --samples 17 --report "$P/screen/sep_1080p_close_s17.json"
+}
+
 eval_chart() {
   # The cost/error chart on the thesis' scene set at 720p.
   run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
@@ -126,15 +148,16 @@ eval_chart() {
 }
 
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 eval issue3-1080)
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab eval)
 for part in "${parts[@]}"; do
   case $part in
     smoke) smoke ;;
     issue2) issue2 ;;
     issue3-720) issue3 1280 720 ;;
     issue3-1080) issue3 1920 1080 ;;
+    screen-ab) screen_ab ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"
