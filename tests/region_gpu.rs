@@ -7,33 +7,31 @@
 
 mod common;
 
-use dermis::render::region::RegionMode;
+use dermis::render::region::{PixelRect, RegionMode};
 use dermis::render::screen::MaskMode;
-use dermis::render::{Method, RenderSettings};
-use dermis::run::{run, Report, RunOptions};
+use dermis::render::{Method, RenderSettings, Renderer};
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
 
-fn render(scene: &Scene, s: &RenderSettings) -> (Report, Vec<[f32; 4]>, Vec<u8>) {
-    let ctx = common::ctx();
-    let opts = RunOptions {
-        warmup: 0,
-        measured: 1,
-        capture: true,
-        dump: false,
-        ceilings: false,
-        command: "test".into(),
-        progress: false,
-    };
-    let out = run(&ctx, scene, s, &opts).expect("render");
-    let cap = out.capture.expect("capture");
-    (out.report, cap.diffuse, cap.ldr)
+/// What one frame gave: diffuse after SSS, the tone-mapped frame, per-pass
+/// (name, samples passed, fragment invocations), and the region's pixels.
+struct Frame {
+    diffuse: Vec<[f32; 4]>,
+    ldr: Vec<u8>,
+    counts: Vec<(String, u64, u64)>,
+    region_pixels: u64,
 }
 
-/// (samples passed, fragment invocations) of every SSS pass, by name.
-fn sss_counts(r: &Report) -> Vec<(String, u64, u64)> {
-    r.passes
+/// One frame with the intermediates poisoned first: a tap that reads a texel
+/// no seed copy wrote picks up 30000 and shows in the output.
+fn render(scene: &Scene, s: &RenderSettings) -> Frame {
+    let ctx = common::ctx();
+    let mut r = Renderer::new(&ctx, scene, s).expect("renderer");
+    r.poison_intermediates(30000.0).expect("poison");
+    let cap = r.capture(false).expect("frame");
+    let counts = cap
+        .samples
         .iter()
         .filter(|p| {
             ["sss ", "ssg ", "ss-jittered", "poisson"]
@@ -47,7 +45,13 @@ fn sss_counts(r: &Report) -> Vec<(String, u64, u64)> {
                 p.fragment_invocations.unwrap_or(0),
             )
         })
-        .collect()
+        .collect();
+    Frame {
+        diffuse: cap.diffuse,
+        ldr: cap.ldr,
+        counts,
+        region_pixels: r.gpu.region_px.iter().map(|t| t.area()).sum(),
+    }
 }
 
 /// Every method variant with a region: same image as on the whole screen.
@@ -110,24 +114,25 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
     ];
     let pixels = (base.width * base.height) as u64;
     for (name, s) in variants {
-        let (rs, ds, ls) = render(
+        let fs = render(
             scene,
             &RenderSettings {
                 sss_region: RegionMode::Skin,
                 ..s.clone()
             },
         );
-        let (rf, df, lf) = render(
+        let ff = render(
             scene,
             &RenderSettings {
                 sss_region: RegionMode::Screen,
                 ..s.clone()
             },
         );
-        assert_eq!(rf.sss_region_pixels, pixels);
+        let (ds, df) = (&fs.diffuse, &ff.diffuse);
+        assert_eq!(ff.region_pixels, pixels);
         if expect_smaller {
             assert!(
-                rs.sss_region_pixels < pixels,
+                fs.region_pixels < pixels,
                 "{name}: the region should be smaller than the screen here"
             );
         }
@@ -135,7 +140,7 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
         assert!(skin > 0, "{name}: no skin on screen");
         let differing = ds
             .iter()
-            .zip(&df)
+            .zip(df)
             .filter(|(a, b)| {
                 a.iter()
                     .zip(b.iter())
@@ -146,13 +151,13 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
             differing, 0,
             "{name}: {differing} diffuse pixels differ with the region"
         );
-        assert_eq!(ls, lf, "{name}: the tone-mapped frames differ");
+        assert!(fs.ldr == ff.ldr, "{name}: the tone-mapped frames differ");
         // The stencil-tested passes write exactly the skin either way (samples
         // passed; llvmpipe counts invocations before the stencil test, so those
         // only shrink); the branch variant shades the region, not the screen.
-        let (cs, cf) = (sss_counts(&rs), sss_counts(&rf));
+        let (cs, cf) = (&fs.counts, &ff.counts);
         assert_eq!(cs.len(), cf.len());
-        for ((n, passed_s, inv_s), (_, passed_f, inv_f)) in cs.iter().zip(&cf) {
+        for ((n, passed_s, inv_s), (_, passed_f, inv_f)) in cs.iter().zip(cf) {
             assert_eq!(passed_s, passed_f, "{name}: {n} samples passed");
             assert!(inv_s <= inv_f, "{name}: {n} {inv_s} > {inv_f} invocations");
             // Without a stencil test every pixel of the region runs the shader:
@@ -228,32 +233,29 @@ fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
         distance_heads: 0.3,
         ..RenderSettings::default()
     };
-    let (r, ..) = render(&scene, &s);
-    assert_eq!(r.sss_region_pixels, 96 * 64);
-    assert_eq!(r.sss_region_rects, 1);
+    let ctx = common::ctx();
+    let r = Renderer::new(&ctx, &scene, &s).expect("renderer");
+    assert_eq!(r.gpu.region_px, vec![PixelRect::full(96, 64)]);
 }
 
 #[test]
-fn many_heads_far_away_get_one_rectangle_each() {
-    let scene = default_scene();
+fn many_heads_far_away_get_rectangles_of_their_own() {
+    let ctx = common::ctx();
     let s = RenderSettings {
-        width: 320,
-        height: 180,
+        width: 960,
+        height: 540,
         shadow_size: 256,
         heads: 4,
         distance_heads: 3.0,
         ..RenderSettings::default()
     };
-    let (r, ..) = render(&scene, &s);
-    assert_eq!(
-        r.sss_region_rects, 4,
-        "2x2 heads apart: 4 disjoint rectangles"
-    );
-    assert!(
-        r.sss_region_pixels < 320 * 180 / 2,
-        "{}",
-        r.sss_region_pixels
-    );
+    let r = Renderer::new(&ctx, &default_scene(), &s).expect("renderer");
+    let region = &r.gpu.region_px;
+    // A 2x2 grid of heads centred on the screen: the centre lies between them.
+    assert!(region.iter().all(|t| !t.contains(480, 270)), "{region:?}");
+    assert!(region.len() >= 4, "{region:?}");
+    let area: u64 = region.iter().map(|t| t.area()).sum();
+    assert!(area < 960 * 540 / 2, "{area}");
 }
 
 /// A flat skin card facing the camera in front of the (non-skin) backdrop: its
@@ -284,14 +286,16 @@ fn card_scene() -> Scene {
 #[test]
 fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
     let mut base = RenderSettings {
-        width: 256,
-        height: 144,
+        width: 768,
+        height: 432,
         shadow_size: 256,
         distance_heads: 3.0,
         follow_surface: false,
         ..RenderSettings::default()
     };
-    base.params.width_mm = 20.0;
+    // Taps reach ~90 px (50 mm at 1.8 px/mm), far more than the up to 31 px a
+    // tile adds: a region built with 0.3x the reach fails here (checked).
+    base.params.width_mm = 50.0;
     region_changes_nothing(&card_scene(), base.clone(), true);
     // Many cards: rectangles side by side.
     region_changes_nothing(&card_scene(), RenderSettings { heads: 5, ..base }, true);

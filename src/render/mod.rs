@@ -44,6 +44,9 @@ pub const DIFFUSE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const LINEAR_DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 pub const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+/// Cells per axis of the grid that clusters skin triangles for the SSS region:
+/// 8^3 = at most 512 boxes per head, projected once per renderer.
+const REGION_CLUSTER_CELLS: u32 = 8;
 
 /// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
 #[repr(C)]
@@ -714,12 +717,15 @@ impl<'c> Renderer<'c> {
                         .map(|o| o.material.sss_strength)
                         .fold(0.0, f32::max),
                 };
-                // Skin objects are drawn once per instance (see the geometry pass).
+                // Skin objects are drawn once per instance (see the geometry pass);
+                // boxes per cluster of triangles, not per object (region.rs says why).
                 let boxes: Vec<crate::scene::mesh::Aabb> = skin
                     .iter()
                     .flat_map(|o| {
-                        let b = o.mesh.bounds();
-                        instances.iter().map(move |m| b.transformed(m))
+                        let clusters = region::cluster_bounds(&o.mesh, REGION_CLUSTER_CELLS);
+                        instances.iter().flat_map(move |m| {
+                            clusters.clone().into_iter().map(move |b| b.transformed(m))
+                        })
                     })
                     .collect();
                 match method {
@@ -741,18 +747,7 @@ impl<'c> Renderer<'c> {
         // Texels of the intermediates outside the region are never written: zero
         // them once so a dump of an intermediate shows black there, not old memory.
         if region_px != [full] {
-            let zeros = vec![0u8; extent.width as usize * extent.height as usize * 8];
-            for (id, img) in [&targets.sss_tmp, &targets.sss_tmp2] {
-                upload::fill_image(
-                    ctx,
-                    img,
-                    vk::ImageAspectFlags::COLOR,
-                    &zeros,
-                    AccessKind::FragmentSampledRead,
-                )?;
-                resources.images[id.0].state =
-                    ResourceState::uploaded(AccessKind::FragmentSampledRead);
-            }
+            fill_intermediates(ctx, &targets, &mut resources, 0.0)?;
         }
 
         let profiler = Profiler::new(ctx, 64)?;
@@ -860,6 +855,12 @@ impl<'c> Renderer<'c> {
             samples,
             diffuse,
         })
+    }
+
+    /// Fills the SSS intermediates with `value` (tests): texels the seed copies
+    /// skip keep it, so a tap that reads one shows in the output.
+    pub fn poison_intermediates(&mut self, value: f32) -> Result<()> {
+        fill_intermediates(self.ctx, &self.gpu.targets, &mut self.resources, value)
     }
 
     /// Reads one frame image back as linear float RGBA (after a frame: its
@@ -990,6 +991,31 @@ impl<'c> Renderer<'c> {
                 .collect(),
         ))
     }
+}
+
+/// Fills both SSS intermediates with `value` in every channel.
+fn fill_intermediates(
+    ctx: &Context,
+    targets: &Targets,
+    resources: &mut Resources,
+    value: f32,
+) -> Result<()> {
+    let e = targets.sss_tmp.1.extent;
+    let texel = half::f16::from_f32(value).to_bits().to_le_bytes();
+    let bytes: Vec<u8> = std::iter::repeat_n(texel, e.width as usize * e.height as usize * 4)
+        .flatten()
+        .collect();
+    for (id, img) in [&targets.sss_tmp, &targets.sss_tmp2] {
+        upload::fill_image(
+            ctx,
+            img,
+            vk::ImageAspectFlags::COLOR,
+            &bytes,
+            AccessKind::FragmentSampledRead,
+        )?;
+        resources.images[id.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
+    }
+    Ok(())
 }
 
 /// Records `passes` into `cmd`, submits them, waits on `fence` and checks the

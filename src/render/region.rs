@@ -9,13 +9,16 @@
 //!   are rejected by the stencil test one by one (measured on the H100: a 720p
 //!   pass with 18% skin cost 1.7x its fetch floor, see docs/perf/README.md).
 //!
-//! A region is a list of disjoint pixel rectangles: disjoint so that a pass
-//! drawn once per rectangle never blends a pixel twice.
+//! The skin is bounded per cluster of triangles (a box around a whole scan
+//! holds its shoulders), each cluster's footprint is widened by the method's
+//! reach, and the union is covered by 32-pixel screen tiles and returned as
+//! disjoint rectangles: disjoint so that a pass drawn once per rectangle never
+//! blends a pixel twice.
 
 use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
 
-use crate::scene::mesh::Aabb;
+use crate::scene::mesh::{Aabb, Mesh};
 
 /// Whether the SSS passes work only near skin (the default) or on the whole
 /// screen (the demos' way; kept to measure what the region saves).
@@ -93,15 +96,6 @@ impl PixelRect {
 
     pub fn contains(&self, x: u32, y: u32) -> bool {
         x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
-    }
-
-    fn union(&self, o: &PixelRect) -> PixelRect {
-        PixelRect {
-            x0: self.x0.min(o.x0),
-            y0: self.y0.min(o.y0),
-            x1: self.x1.max(o.x1),
-            y1: self.y1.max(o.y1),
-        }
     }
 }
 
@@ -194,43 +188,107 @@ pub fn widen(f: &Footprint, margin_px: f32, width: u32, height: u32) -> PixelRec
     }
 }
 
-/// Merges overlapping rectangles into their bounding rectangles until none
-/// overlap. Every input pixel stays covered; no pixel is covered twice.
-pub fn disjoint(mut rects: Vec<PixelRect>) -> Vec<PixelRect> {
-    rects.retain(|r| !r.is_empty());
-    loop {
-        let mut merged = false;
-        'outer: for i in 0..rects.len() {
-            for j in i + 1..rects.len() {
-                if rects[i].overlaps(&rects[j]) {
-                    rects[i] = rects[i].union(&rects[j]);
-                    rects.swap_remove(j);
-                    merged = true;
-                    break 'outer;
+/// Side of the screen tiles a region is built from, in pixels.
+pub const TILE_PX: u32 = 32;
+
+/// Covers `rects` with screen tiles of `tile` pixels and returns the marked
+/// tiles as disjoint rectangles: runs of tiles along each tile row, a run
+/// extended downward while the next row has the same run. Bounding boxes of
+/// overlapping rectangles would be simpler, but a head's clusters all overlap
+/// and their bounding box spans the shoulders' width on every row; tiles
+/// follow the silhouette, and rows of equal runs keep the count small.
+pub fn tile_cover(rects: &[PixelRect], width: u32, height: u32, tile: u32) -> Vec<PixelRect> {
+    let tile = tile.max(1);
+    let (gw, gh) = (
+        width.div_ceil(tile) as usize,
+        height.div_ceil(tile) as usize,
+    );
+    let mut marked = vec![false; gw * gh];
+    for r in rects.iter().filter(|r| !r.is_empty()) {
+        let (tx0, ty0) = ((r.x0 / tile) as usize, (r.y0 / tile) as usize);
+        let (tx1, ty1) = (r.x1.div_ceil(tile) as usize, r.y1.div_ceil(tile) as usize);
+        for ty in ty0..ty1.min(gh) {
+            marked[ty * gw + tx0..ty * gw + tx1.min(gw)].fill(true);
+        }
+    }
+    let px = |t: usize, max: u32| (t as u32 * tile).min(max);
+    let mut out: Vec<PixelRect> = Vec::new();
+    // Rectangles still open at the previous tile row, by run.
+    let mut open: Vec<(usize, usize, usize)> = Vec::new(); // (tx0, tx1, index in out)
+    for ty in 0..gh {
+        let row = &marked[ty * gw..(ty + 1) * gw];
+        let mut next_open = Vec::new();
+        let mut tx = 0;
+        while tx < gw {
+            if !row[tx] {
+                tx += 1;
+                continue;
+            }
+            let start = tx;
+            while tx < gw && row[tx] {
+                tx += 1;
+            }
+            let y1 = px(ty + 1, height);
+            match open.iter().find(|&&(a, b, _)| a == start && b == tx) {
+                Some(&(a, b, i)) => {
+                    out[i].y1 = y1;
+                    next_open.push((a, b, i));
+                }
+                None => {
+                    out.push(PixelRect {
+                        x0: px(start, width),
+                        y0: px(ty, height),
+                        x1: px(tx, width),
+                        y1,
+                    });
+                    next_open.push((start, tx, out.len() - 1));
                 }
             }
         }
-        if !merged {
-            return rects;
-        }
+        open = next_open;
     }
+    out
 }
 
 /// The region of a set of skin boxes: each box's footprint widened by
 /// `reach_px(nearest_depth)` (how far the method's taps reach, in pixels, from
-/// a pixel at that depth; it must not grow with depth), made disjoint.
+/// a pixel at that depth; it must not grow with depth), covered by tiles.
 pub fn skin_region(
     v: &RegionView,
     boxes: impl IntoIterator<Item = Aabb>,
     reach_px: impl Fn(f32) -> f32,
 ) -> Vec<PixelRect> {
-    disjoint(
-        boxes
-            .into_iter()
-            .filter_map(|b| footprint(v, &b))
-            .map(|f| widen(&f, reach_px(f.nearest_depth), v.width, v.height))
-            .collect(),
-    )
+    let widened: Vec<PixelRect> = boxes
+        .into_iter()
+        .filter_map(|b| footprint(v, &b))
+        .map(|f| widen(&f, reach_px(f.nearest_depth), v.width, v.height))
+        .collect();
+    tile_cover(&widened, v.width, v.height, TILE_PX)
+}
+
+/// Boxes around the triangles of `mesh` grouped by a `cells`^3 grid over its
+/// bounds (by centroid; each box holds its triangles whole). One box around a
+/// whole scan would hold its shoulders too, and on screen their width spans the
+/// face's rows; the union of the cells' footprints follows the silhouette.
+pub fn cluster_bounds(mesh: &Mesh, cells: u32) -> Vec<Aabb> {
+    let cells = cells.max(1);
+    let Some(all) = Aabb::from_points(mesh.vertices.iter().map(|v| Vec3::from(v.position))) else {
+        return Vec::new();
+    };
+    let size = all.size().max(Vec3::splat(1e-20));
+    let n = cells as usize;
+    let mut boxes: Vec<Option<Aabb>> = vec![None; n * n * n];
+    for tri in mesh.indices.chunks_exact(3) {
+        let p: [Vec3; 3] = [0, 1, 2].map(|k| Vec3::from(mesh.vertices[tri[k] as usize].position));
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        let cell = ((c - all.min) / size * cells as f32)
+            .floor()
+            .clamp(Vec3::ZERO, Vec3::splat((cells - 1) as f32));
+        let k = cell.x as usize + n * (cell.y as usize + n * cell.z as usize);
+        let t = Aabb::from_points(p).expect("three points");
+        boxes[k] = Some(boxes[k].map_or(t, |b| b.union(&t)));
+    }
+    boxes.into_iter().flatten().collect()
 }
 
 /// Pixels per millimetre on screen at view depth `depth` (scene units): the
@@ -320,34 +378,47 @@ mod tests {
     }
 
     #[test]
-    fn disjoint_covers_every_input_pixel_exactly_once() {
+    fn tiles_cover_every_input_pixel_exactly_once() {
         let r = |x0, y0, x1, y1| PixelRect { x0, y0, x1, y1 };
         let inputs = vec![
             r(0, 0, 10, 10),
             r(5, 5, 15, 15),
             r(20, 0, 30, 5),
-            r(14, 14, 22, 16), // overlaps the union of the first two, which then reaches the third
+            r(14, 14, 22, 16),
             r(40, 40, 40, 50), // empty
             r(50, 0, 60, 10),
+            r(61, 61, 70, 70), // cut by the screen edge
         ];
-        let out = disjoint(inputs.clone());
+        let out = tile_cover(&inputs, 64, 64, 8);
         for a in 0..out.len() {
+            assert!(!out[a].is_empty() && out[a].x1 <= 64 && out[a].y1 <= 64);
             for b in a + 1..out.len() {
                 assert!(!out[a].overlaps(&out[b]), "{:?} {:?}", out[a], out[b]);
             }
         }
+        let mut covered = 0;
         for y in 0..64 {
             for x in 0..64 {
-                let inside = inputs.iter().any(|i| i.contains(x, y));
                 let n = out.iter().filter(|o| o.contains(x, y)).count();
-                if inside {
+                assert!(n <= 1);
+                covered += n;
+                if inputs.iter().any(|i| i.contains(x, y)) {
                     assert_eq!(n, 1, "({x},{y})");
                 }
-                assert!(n <= 1);
             }
         }
-        // {first, second, fourth, third} chain into one; the last stands alone.
-        assert_eq!(out.len(), 2);
+        // Tile-rounded: no more than the tiles the inputs touch.
+        assert!(covered <= 21 * 64, "{covered}");
+        // Equal runs on consecutive tile rows make one rectangle.
+        assert_eq!(
+            tile_cover(&[r(0, 0, 64, 64)], 64, 64, 8),
+            vec![r(0, 0, 64, 64)]
+        );
+        assert_eq!(
+            tile_cover(&[r(0, 0, 100, 100)], 60, 50, 8),
+            vec![r(0, 0, 60, 50)]
+        );
+        assert!(tile_cover(&[], 64, 64, 8).is_empty());
     }
 
     #[test]
@@ -357,18 +428,42 @@ mod tests {
             unit_box(Vec3::new(-2.0, 0.0, 0.0)),
             unit_box(Vec3::new(2.0, 0.0, 0.0)),
         ];
-        let reach = |d: f32| 30.0 / d;
-        let region = skin_region(&v, boxes, reach);
-        assert_eq!(region.len(), 2);
-        let plain: Vec<PixelRect> = boxes
-            .iter()
-            .map(|b| footprint(&v, b).unwrap().rect)
-            .collect();
-        for (r, p) in region.iter().zip(&plain) {
-            // 30 / 9.5 = 3.2 -> 4 px on each side (clamped nowhere here).
-            assert_eq!(r.width(), p.width() + 8);
-            assert_eq!(r.height(), p.height() + 8);
+        let near = skin_region(&v, boxes, |d: f32| 30.0 / d);
+        let far = skin_region(&v, boxes, |_| 0.0);
+        let area = |rs: &[PixelRect]| rs.iter().map(|r| r.area()).sum::<u64>();
+        // Two separate heads: separate rectangles, one block of rows each.
+        assert_eq!(near.len(), 2, "{near:?}");
+        assert!(!near[0].overlaps(&near[1]));
+        // 30 / 9.5 = 3.2 -> 4 px more on each side, then rounded to tiles.
+        for b in &boxes {
+            let f = footprint(&v, b).unwrap();
+            let w = widen(&f, 30.0 / f.nearest_depth, 640, 360);
+            for (x, y) in [(w.x0, w.y0), (w.x1 - 1, w.y1 - 1)] {
+                assert!(near.iter().any(|r| r.contains(x, y)), "({x},{y})");
+            }
         }
+        assert!(area(&near) >= area(&far));
+    }
+
+    #[test]
+    fn clusters_hold_every_triangle_and_are_no_more_than_the_cells() {
+        let mesh = crate::scene::procedural::head_mesh();
+        let boxes = cluster_bounds(&mesh, 4);
+        assert!(boxes.len() > 8 && boxes.len() <= 64, "{}", boxes.len());
+        for tri in mesh.indices.chunks_exact(3) {
+            let inside = |b: &Aabb| {
+                tri.iter().all(|&i| {
+                    let p = Vec3::from(mesh.vertices[i as usize].position);
+                    p.cmpge(b.min).all() && p.cmple(b.max).all()
+                })
+            };
+            assert!(boxes.iter().any(inside), "a triangle outside every cluster");
+        }
+        // One cell is the mesh's box.
+        let one = cluster_bounds(&mesh, 1);
+        assert_eq!(one.len(), 1);
+        assert_eq!(one[0], mesh.bounds());
+        assert!(cluster_bounds(&Mesh::default(), 4).is_empty());
     }
 
     #[test]
