@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every device-machine measurement of docs/perf/ and docs/accuracy.md.
 #
-#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab eval
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval
 #                                          (default: all, in that order)
 #
 # Run it on the device machine from the repository root with these carried (see
@@ -141,6 +141,25 @@ screen_ab() {
     --width "$(w 1920)" --height "$(w 1080)" --shot close --samples 17 --report "$P/screen/sep_1080p_close_s17.json"
 }
 
+# Separable without follow-surface (the SSSS demo's default: no depth taps),
+# the configuration of the thesis' 1.05 ms, against ssg at the same shots.
+nofollow() {
+  for shot in close mid; do
+    run "sep nofollow $shot" "$P/nofollow/sep_1080p_${shot}_s17.json" bench "${EXTRA[@]}" --scene "$A" --no-follow-surface \
+      --width "$(w 1920)" --height "$(w 1080)" --shot "$shot" --samples 17 --report "$P/nofollow/sep_1080p_${shot}_s17.json"
+    run "ssg $shot" "$P/nofollow/ssg_1080p_${shot}.json" bench "${EXTRA[@]}" --scene "$A" --method ssg \
+      --width "$(w 1920)" --height "$(w 1080)" --shot "$shot" --report "$P/nofollow/ssg_1080p_${shot}.json"
+  done
+  for res in "1280 720" "1920 1080"; do
+    set -- $res
+    for d in zoom:1.037 near:1.852; do
+      local tag="${1}x${2}_${d%%:*}_1h"
+      run "sep nofollow $tag" "$P/nofollow/separable_$tag.json" bench "${EXTRA[@]}" --scene "$A" --no-follow-surface \
+        --width "$(w "$1")" --height "$(w "$2")" --distance "${d##*:}" --method separable --report "$P/nofollow/separable_$tag.json"
+    done
+  done
+}
+
 eval_chart() {
   # The cost/error chart on the thesis' scene set at 720p.
   run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
@@ -148,7 +167,7 @@ eval_chart() {
 }
 
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab eval)
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval)
 for part in "${parts[@]}"; do
   case $part in
     smoke) smoke ;;
@@ -156,8 +175,9 @@ for part in "${parts[@]}"; do
     issue3-720) issue3 1280 720 ;;
     issue3-1080) issue3 1920 1080 ;;
     screen-ab) screen_ab ;;
+    nofollow) nofollow ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"
