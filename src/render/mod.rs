@@ -317,6 +317,21 @@ pub enum SssMethod {
 }
 
 impl SssMethod {
+    /// How far (pixels) the taps of a skin pixel at view depth `depth` reach
+    /// into texels a seed copy must have written; `None` for a method that
+    /// works on the whole screen (the reference gathers in compute).
+    fn reach_px(&self, depth: f32, scale: &region::ReachScale) -> Option<f32> {
+        match self {
+            SssMethod::Separable(s) => Some(s.reach_px(depth, scale)),
+            SssMethod::Ssg(s) => Some(s.reach_px(depth, scale)),
+            SssMethod::Jittered(s) => Some(s.reach_px(depth, scale)),
+            // Poisson reads the complete diffuse chain, never a seed: its region
+            // only has to hold the skin pixels it shades.
+            SssMethod::Poisson(_) => Some(0.0),
+            SssMethod::Reference(_) => None,
+        }
+    }
+
     fn destroy(&mut self, ctx: &Context) {
         match self {
             SssMethod::Separable(s) => s.destroy(ctx),
@@ -690,58 +705,18 @@ impl<'c> Renderer<'c> {
 
         // Where the SSS passes have work: near the skin's projected bounds.
         let full = region::PixelRect::full(extent.width, extent.height);
-        let region_px = match (&sss, settings.sss_region) {
-            (None | Some(SssMethod::Reference(_)), _) | (_, region::RegionMode::Screen) => {
-                vec![full]
-            }
-            (Some(method), region::RegionMode::Skin) => {
-                let rv = region::RegionView {
+        let region_px = match &sss {
+            Some(method) if settings.sss_region == region::RegionMode::Skin => {
+                let view = region::RegionView {
                     view: camera.view(),
                     proj,
                     near: camera.near,
                     width: extent.width,
                     height: extent.height,
                 };
-                let skin: Vec<&crate::scene::mesh::Object> = scene
-                    .backdrop
-                    .iter()
-                    .chain(std::iter::once(&scene.head))
-                    .filter(|o| o.material.skin)
-                    .collect();
-                let scale = region::ReachScale {
-                    height_px: extent.height,
-                    tan_half_fovy: (0.5 * settings.fovy_deg.to_radians()).tan(),
-                    mm_per_unit: mm,
-                    max_strength: skin
-                        .iter()
-                        .map(|o| o.material.sss_strength)
-                        .fold(0.0, f32::max),
-                };
-                // Skin objects are drawn once per instance (see the geometry pass);
-                // boxes per cluster of triangles, not per object (region.rs says why).
-                let boxes: Vec<crate::scene::mesh::Aabb> = skin
-                    .iter()
-                    .flat_map(|o| {
-                        let clusters = region::cluster_bounds(&o.mesh, REGION_CLUSTER_CELLS);
-                        instances.iter().flat_map(move |m| {
-                            clusters.clone().into_iter().map(move |b| b.transformed(m))
-                        })
-                    })
-                    .collect();
-                match method {
-                    SssMethod::Separable(s) => {
-                        region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale))
-                    }
-                    SssMethod::Ssg(s) => region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale)),
-                    SssMethod::Jittered(s) => {
-                        region::skin_region(&rv, boxes, |d| s.reach_px(d, &scale))
-                    }
-                    // Poisson reads the complete diffuse chain, never a seed: its
-                    // region only has to hold the skin pixels it shades.
-                    SssMethod::Poisson(_) => region::skin_region(&rv, boxes, |_| 0.0),
-                    SssMethod::Reference(_) => unreachable!("handled above"),
-                }
+                skin_region(scene, &instances, &view, settings, method)
             }
+            _ => vec![full],
         };
 
         // Texels of the intermediates outside the region are never written: zero
@@ -991,6 +966,48 @@ impl<'c> Renderer<'c> {
                 .collect(),
         ))
     }
+}
+
+/// The SSS region of `method` in this scene and view (see `region.rs`): every
+/// skin object's triangle clusters, once per instance, widened by the reach.
+fn skin_region(
+    scene: &Scene,
+    instances: &[Mat4],
+    view: &region::RegionView,
+    settings: &RenderSettings,
+    method: &SssMethod,
+) -> Vec<region::PixelRect> {
+    let skin: Vec<&crate::scene::mesh::Object> = scene
+        .backdrop
+        .iter()
+        .chain(std::iter::once(&scene.head))
+        .filter(|o| o.material.skin)
+        .collect();
+    let scale = region::ReachScale {
+        height_px: view.height,
+        tan_half_fovy: (0.5 * settings.fovy_deg.to_radians()).tan(),
+        mm_per_unit: scene.mm_per_unit,
+        max_strength: skin
+            .iter()
+            .map(|o| o.material.sss_strength)
+            .fold(0.0, f32::max),
+    };
+    if method.reach_px(1.0, &scale).is_none() {
+        return vec![region::PixelRect::full(view.width, view.height)];
+    }
+    // Skin objects are drawn once per instance (see the geometry pass).
+    let boxes: Vec<crate::scene::mesh::Aabb> = skin
+        .iter()
+        .flat_map(|o| {
+            let clusters = region::cluster_bounds(&o.mesh, REGION_CLUSTER_CELLS);
+            instances
+                .iter()
+                .flat_map(move |m| clusters.clone().into_iter().map(move |b| b.transformed(m)))
+        })
+        .collect();
+    region::skin_region(view, boxes, |d| {
+        method.reach_px(d, &scale).unwrap_or(f32::INFINITY)
+    })
 }
 
 /// Fills both SSS intermediates with `value` in every channel.
