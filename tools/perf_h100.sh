@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every device-machine measurement of docs/perf/ and docs/accuracy.md.
 #
-#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval
 #                                          (default: all, in that order)
 #
 # Run it on the device machine from the repository root with these carried (see
@@ -160,6 +160,36 @@ nofollow() {
   done
 }
 
+# Pictures of the failure cases for docs/accuracy.md: each method and the
+# reference, rendered, then compared (false-colour error images); the .exr
+# dumps are deleted so the tarball stays small.
+images() {
+  local I=$P/images W=640 H=360
+  local head=(--scene "$A" --distance 1.852 --light-azimuth 150 --light-elevation 45)
+  local thin=(--light-azimuth 165 --light-elevation 5)
+  local band=(--light-azimuth 80 --light-elevation 10)
+  for case in head thin band; do
+    local -n args=$case
+    run "img $case reference" "$I/$case/reference/frame.png" render "${EXTRA[@]}" "${args[@]}" --width $W --height $H --method reference --out "$I/$case/reference"
+  done
+  for m in none separable ssg ss-jittered poisson; do
+    run "img head $m" "$I/head/$m/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --method "$m" --out "$I/head/$m"
+  done
+  run "img head separable nofollow" "$I/head/separable-nofollow/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --no-follow-surface --out "$I/head/separable-nofollow"
+  for m in separable ssg; do
+    run "img thin $m" "$I/thin/$m/frame.png" render "${EXTRA[@]}" "${thin[@]}" --width $W --height $H --method "$m" --out "$I/thin/$m"
+    run "img thin $m notrans" "$I/thin/$m-notrans/frame.png" render "${EXTRA[@]}" "${thin[@]}" --width $W --height $H --method "$m" --no-transmittance --out "$I/thin/$m-notrans"
+  done
+  for n in 9 33; do
+    run "img band s$n" "$I/band/separable-s$n/frame.png" render "${EXTRA[@]}" "${band[@]}" --width $W --height $H --samples $n --out "$I/band/separable-s$n"
+  done
+  for d in "$I"/*/*/; do
+    case $d in */reference/) continue ;; esac
+    run "compare $d" "$d/compare.json" compare "$d" "$(dirname "$d")/reference"
+  done
+  find "$I" -name '*.exr' -delete
+}
+
 eval_chart() {
   # The cost/error chart on the thesis' scene set at 720p.
   run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
@@ -167,7 +197,7 @@ eval_chart() {
 }
 
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval)
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval)
 for part in "${parts[@]}"; do
   case $part in
     smoke) smoke ;;
@@ -176,8 +206,9 @@ for part in "${parts[@]}"; do
     issue3-1080) issue3 1920 1080 ;;
     screen-ab) screen_ab ;;
     nofollow) nofollow ;;
+    images) images ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"
