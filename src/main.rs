@@ -83,7 +83,9 @@ enum Command {
         #[arg(long, default_value = "out/eval")]
         out: PathBuf,
         /// Scene set: thesis (the Lee Perry-Smith head at the perceptual study's 3
-        /// distances x 4 lights, plus the procedural scene) or quick (procedural only).
+        /// distances x 4 lights, plus the procedural scene), dolly (the head from 1 to
+        /// 24 head heights in 12 steps; adds distance.png/svg, error against distance)
+        /// or quick (procedural only).
         #[arg(long, default_value = "thesis")]
         scenes: String,
         #[arg(long, default_value_t = 2)]
@@ -491,24 +493,24 @@ fn eval(
 ) -> Result<()> {
     use dermis::eval::{chart, pareto, sweep};
     let base = common.settings()?;
-    let specs = match scenes {
-        "thesis" => {
-            let head = match &common.scene {
-                Some(p) => p.clone(),
-                None => {
-                    std::path::PathBuf::from("../shared/assets/lee-perry-smith/LeePerrySmith.glb")
-                }
-            };
-            if !head.exists() {
-                bail!("the thesis scene set needs the head scan: {} not found (give --scene PATH.glb, or --scenes quick)", head.display());
-            }
-            sweep::thesis_scenes(Some(head))
+    let head = || -> Result<std::path::PathBuf> {
+        let head = match &common.scene {
+            Some(p) => p.clone(),
+            None => std::path::PathBuf::from("../shared/assets/lee-perry-smith/LeePerrySmith.glb"),
+        };
+        if !head.exists() {
+            bail!("the '{scenes}' scene set needs the head scan: {} not found (give --scene PATH.glb, or --scenes quick)", head.display());
         }
+        Ok(head)
+    };
+    let specs = match scenes {
+        "thesis" => sweep::thesis_scenes(Some(head()?)),
+        "dolly" => sweep::dolly_scenes(head()?),
         "quick" => vec![sweep::SceneSpec {
             distance_heads: base.distance_heads,
             ..sweep::procedural_scene()
         }],
-        other => bail!("unknown scene set '{other}' (valid: thesis, quick)"),
+        other => bail!("unknown scene set '{other}' (valid: thesis, dolly, quick)"),
     };
     let ctx = common.context()?;
     let rows = sweep::sweep(
@@ -556,8 +558,53 @@ fn eval(
             p.method, p.setting, p.gpu_ms, p.error
         );
     }
+    if scenes == "dolly" {
+        // Error against distance, one line per (method, setting): where a
+        // distance-driven switch changes the image, the line steps.
+        // One line per method at its default setting (eval.csv has them all).
+        const LINES: [(&str, &str); 6] = [
+            ("none", "-"),
+            ("separable", "17 samples"),
+            ("ssg", "6 Gaussians, LOD"),
+            ("ssg", "6 Gaussians, no LOD"),
+            ("ss-jittered", "13 taps"),
+            ("poisson", "8-32 taps"),
+        ];
+        let mut series: Vec<chart::Series> = Vec::new();
+        for r in &rows {
+            let p = &r.point;
+            if !LINES.contains(&(p.method.as_str(), p.setting.as_str())) {
+                continue;
+            }
+            let Some(spec) = specs.iter().find(|s| s.name == p.scene) else {
+                continue;
+            };
+            let label = format!("{} {}", p.method, p.setting);
+            let point = (spec.distance_heads as f64, p.error);
+            match series.iter_mut().find(|s| s.label == label) {
+                Some(s) => s.points.push(point),
+                None => series.push(chart::Series {
+                    label,
+                    points: vec![point],
+                }),
+            }
+        }
+        chart::series_chart(
+            &series,
+            &format!("SSS error along a dolly ({})", ctx.facts.name),
+            "camera distance (head heights)",
+            "relative RMSE against the reference",
+            &out.join("distance.png"),
+            &out.join("distance.svg"),
+        )?;
+    }
     println!(
-        "wrote eval.csv, eval.json, chart.png and chart.svg in {}",
+        "wrote eval.csv, eval.json, chart.png and chart.svg{} in {}",
+        if scenes == "dolly" {
+            ", distance.png and distance.svg"
+        } else {
+            ""
+        },
         out.display()
     );
     Ok(())

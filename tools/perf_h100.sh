@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every device-machine measurement of docs/perf/ and docs/accuracy.md.
 #
-#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval
 #                                          (default: all, in that order)
 #
 # Run it on the device machine from the repository root with these carried (see
@@ -190,6 +190,12 @@ images() {
   find "$I" -name '*.exr' -delete
 }
 
+# Error along a camera dolly (1 to 24 head heights), 720p: where LOD steps.
+dolly() {
+  run "eval dolly 720p" "$P/dolly/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes dolly \
+    --width "$(w 1280)" --height "$(w 720)" "${EVAL_FRAMES[@]}" --out "$P/dolly"
+}
+
 eval_chart() {
   # The cost/error chart on the thesis' scene set at 720p.
   run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
@@ -197,7 +203,7 @@ eval_chart() {
 }
 
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval)
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval)
 for part in "${parts[@]}"; do
   case $part in
     smoke) smoke ;;
@@ -207,8 +213,9 @@ for part in "${parts[@]}"; do
     screen-ab) screen_ab ;;
     nofollow) nofollow ;;
     images) images ;;
+    dolly) dolly ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"

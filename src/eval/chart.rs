@@ -226,6 +226,133 @@ where
     Ok(())
 }
 
+/// One line of a [`series_chart`]: a label and its (x, y) points.
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Lines of y against x (x logarithmic, y linear from 0), one colour and marker
+/// per series, with a legend: e.g. each method's error along a camera dolly,
+/// where a distance-driven switch (Gaussian LOD) would show as a step. Writes
+/// `png_path` and `svg_path` like [`cost_error_chart`].
+///
+/// Errors on no series, an empty series, a non-positive or non-finite x, a
+/// negative or non-finite y, a missing font, or a path that cannot be written.
+pub fn series_chart(
+    series: &[Series],
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    png_path: &Path,
+    svg_path: &Path,
+) -> Result<()> {
+    ensure!(!series.is_empty(), "line chart: no series to draw");
+    for s in series {
+        ensure!(
+            !s.points.is_empty(),
+            "line chart: series '{}' has no points",
+            s.label
+        );
+        for &(x, y) in &s.points {
+            ensure!(
+                x.is_finite() && x > 0.0 && y.is_finite() && y >= 0.0,
+                "line chart: series '{}' has the point ({x}, {y}); x must be > 0 and y >= 0",
+                s.label
+            );
+        }
+    }
+    ensure_font()?;
+    let all = series.iter().flat_map(|s| s.points.iter());
+    let (x_lo, x_hi, y_hi) = all.fold((f64::INFINITY, 0.0f64, 0.0f64), |(a, b, c), &(x, y)| {
+        (a.min(x), b.max(x), c.max(y))
+    });
+    let x = (x_lo / 1.05)..(x_hi * 1.05);
+    let y = 0.0..(if y_hi > 0.0 { y_hi * 1.1 } else { 1.0 });
+    let labels = (title, x_label, y_label);
+    let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw_lines(&root, series, labels, x.clone(), y.clone())
+            .context("drawing the PNG line chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the PNG line chart")?;
+    }
+    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb)
+        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", SIZE.0, SIZE.1))?;
+    create_parent(png_path)?;
+    image
+        .save_with_format(png_path, image::ImageFormat::Png)
+        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw_lines(&root, series, labels, x, y).context("drawing the SVG line chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the SVG line chart")?;
+    }
+    create_parent(svg_path)?;
+    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
+}
+
+/// Everything of a [`series_chart`] on one backend.
+fn draw_lines<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    series: &[Series],
+    (title, x_label, y_label): (&str, &str, &str),
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<()> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 30))
+        .margin(24)
+        .x_label_area_size(60)
+        .y_label_area_size(100)
+        .build_cartesian_2d(x.clone().log_scale(), y.clone())
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(plot_err)?;
+    for (i, s) in series.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        let style = ShapeStyle::from(&colour).stroke_width(2);
+        let shape = outline(SHAPES[i % SHAPES.len()]);
+        let legend_shape = shape.clone();
+        chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), style))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(
+                s.points
+                    .iter()
+                    .map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), colour.filled())),
+            )
+            .map_err(plot_err)?
+            .label(s.label.as_str())
+            .legend(move |c| {
+                EmptyElement::at(c) + Polygon::new(legend_shape.clone(), colour.filled())
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 18))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
+}
+
 /// The outline of a marker in pixels around its point. Every shape is a polygon
 /// so that all markers share one element type and one drawing path, in the plot
 /// and in the legend alike.
@@ -386,6 +513,54 @@ mod tests {
                 .unwrap()
                 .log_y
         );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn line_chart_writes_png_and_svg_and_rejects_bad_points() {
+        let dir = temp_dir("lines");
+        let (png, svg) = (dir.join("d.png"), dir.join("d.svg"));
+        let series = vec![
+            Series {
+                label: "separable 17".into(),
+                points: vec![(1.0, 0.03), (2.0, 0.025), (4.0, 0.02), (8.0, 0.018)],
+            },
+            Series {
+                label: "ssg 6, LOD".into(),
+                points: vec![(1.0, 0.02), (2.0, 0.03), (4.0, 0.05), (8.0, 0.02)],
+            },
+        ];
+        series_chart(
+            &series,
+            "error along a dolly",
+            "head heights",
+            "error",
+            &png,
+            &svg,
+        )
+        .unwrap();
+        assert_png_has_content(&png);
+        let text = fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("<svg") && text.contains("ssg 6, LOD"));
+        let bad = |points: Vec<(f64, f64)>| {
+            series_chart(
+                &[Series {
+                    label: "x".into(),
+                    points,
+                }],
+                "t",
+                "x",
+                "y",
+                &png,
+                &svg,
+            )
+            .is_err()
+        };
+        assert!(bad(vec![]));
+        assert!(bad(vec![(0.0, 0.1)]), "log x needs x > 0");
+        assert!(bad(vec![(1.0, f64::NAN)]));
+        assert!(bad(vec![(1.0, -0.1)]));
+        assert!(series_chart(&[], "t", "x", "y", &png, &svg).is_err());
         fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -97,6 +97,27 @@ pub fn thesis_scenes(head: Option<PathBuf>) -> Vec<SceneSpec> {
     v
 }
 
+/// A camera dolly on the given head from a close-up (1 head height) to a far
+/// shot (24), in 12 steps of equal ratio, light at 60 degrees azimuth and 45
+/// elevation: each method's error along it shows where a distance-driven
+/// switch (Gaussian LOD, poisson's sample count) changes the image.
+pub fn dolly_scenes(head: PathBuf) -> Vec<SceneSpec> {
+    const STEPS: usize = 12;
+    let (near, far) = (1.0f32, 24.0f32);
+    (0..STEPS)
+        .map(|i| {
+            let d = near * (far / near).powf(i as f32 / (STEPS - 1) as f32);
+            SceneSpec {
+                name: format!("head dolly {d:.2}"),
+                gltf: Some(head.clone()),
+                distance_heads: d,
+                azimuth_deg: 60.0,
+                elevation_deg: 45.0,
+            }
+        })
+        .collect()
+}
+
 /// The embedded scene at its default view.
 pub fn procedural_scene() -> SceneSpec {
     let d = RenderSettings::default();
@@ -288,6 +309,25 @@ mod tests {
             (c.apply)(&mut s);
             assert_eq!(s.samples, n);
         }
+    }
+
+    #[test]
+    fn dolly_goes_from_one_to_twenty_four_head_heights_in_equal_ratios() {
+        let d = dolly_scenes(PathBuf::from("head.glb"));
+        assert_eq!(d.len(), 12);
+        assert!((d[0].distance_heads - 1.0).abs() < 1e-6);
+        assert!((d[11].distance_heads - 24.0).abs() < 1e-3);
+        let r = d[1].distance_heads / d[0].distance_heads;
+        for w in d.windows(2) {
+            assert!((w[1].distance_heads / w[0].distance_heads - r).abs() < 1e-4);
+        }
+        let mut names: Vec<&str> = d.iter().map(|s| s.name.as_str()).collect();
+        names.dedup();
+        assert_eq!(
+            names.len(),
+            12,
+            "scene names must be unique: rows are matched by name"
+        );
     }
 
     #[test]
