@@ -189,6 +189,10 @@ struct Common {
     /// kernel's reach: seed copies and draws limited to them) | screen (everywhere).
     #[arg(long, default_value = "skin")]
     sss_region: String,
+    /// Side of the SSS region's screen tiles in pixels (1..=1024): smaller hugs the
+    /// skin closer but draws more rectangles.
+    #[arg(long, default_value_t = dermis::render::region::TILE_PX)]
+    sss_region_tile: u32,
     #[arg(long)]
     no_transmittance: bool,
     /// Number of heads in a grid (multi-character stress).
@@ -260,6 +264,7 @@ impl Common {
             lod: !self.no_lod,
             mask: self.mask.parse()?,
             sss_region: self.sss_region.parse()?,
+            sss_region_tile: self.sss_region_tile,
             reference_density: self.density,
             transmittance_profile: self.transmittance_profile.parse()?,
             heads: self.heads,

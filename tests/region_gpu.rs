@@ -297,6 +297,16 @@ fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
     // tile adds: a region built with 0.3x the reach fails here (checked).
     base.params.width_mm = 50.0;
     region_changes_nothing(&card_scene(), base.clone(), true);
+    // One-pixel tiles leave no slack at all, so the ssg and ss-jittered reaches
+    // (fixed by the profile, ~15 and ~6 px here) are held to their formulas too.
+    region_changes_nothing(
+        &card_scene(),
+        RenderSettings {
+            sss_region_tile: 1,
+            ..base.clone()
+        },
+        true,
+    );
     // Many cards: rectangles side by side.
     region_changes_nothing(&card_scene(), RenderSettings { heads: 5, ..base }, true);
 }

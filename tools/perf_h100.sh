@@ -196,6 +196,16 @@ dolly() {
     --width "$(w 1280)" --height "$(w 720)" "${EVAL_FRAMES[@]}" --out "$P/dolly"
 }
 
+# A few benches again after a change that should not move them.
+recheck() {
+  run "recheck sep close" "$P/recheck/sep_1080p_close_s17.json" bench "${EXTRA[@]}" --scene "$A" \
+    --width "$(w 1920)" --height "$(w 1080)" --shot close --samples 17 --report "$P/recheck/sep_1080p_close_s17.json"
+  run "recheck ssg far 3h" "$P/recheck/ssg_lod_1280x720_far_3h.json" bench "${EXTRA[@]}" --scene "$A" \
+    --width "$(w 1280)" --height "$(w 720)" --distance 4.889 --heads 3 --method ssg --report "$P/recheck/ssg_lod_1280x720_far_3h.json"
+  run "recheck ssg far 1h 1080p" "$P/recheck/ssg_lod_1920x1080_far_1h.json" bench "${EXTRA[@]}" --scene "$A" \
+    --width "$(w 1920)" --height "$(w 1080)" --distance 4.889 --method ssg --report "$P/recheck/ssg_lod_1920x1080_far_1h.json"
+}
+
 eval_chart() {
   # The cost/error chart on the thesis' scene set at 720p.
   run "eval thesis 720p" "$P/eval/eval.csv" eval "${EXTRA[@]}" --scene "$A" --scenes thesis \
@@ -214,8 +224,9 @@ for part in "${parts[@]}"; do
     nofollow) nofollow ;;
     images) images ;;
     dolly) dolly ;;
+    recheck) recheck ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly recheck eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"

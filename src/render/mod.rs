@@ -1005,9 +1005,12 @@ fn skin_region(
                 .flat_map(move |m| clusters.clone().into_iter().map(move |b| b.transformed(m)))
         })
         .collect();
-    region::skin_region(view, boxes, |d| {
-        method.reach_px(d, &scale).unwrap_or(f32::INFINITY)
-    })
+    region::skin_region(
+        view,
+        boxes,
+        |d| method.reach_px(d, &scale).unwrap_or(f32::INFINITY),
+        settings.sss_region_tile,
+    )
 }
 
 /// Fills both SSS intermediates with `value` in every channel.

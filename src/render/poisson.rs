@@ -148,6 +148,7 @@ impl PoissonSss {
             (t.diffuse.0, t.diffuse.1),
             // The composite reads this target on every pixel: seed all of it.
             t.screen,
+            t.extent,
             &[(t.rt1.0, t.rt1.1)],
         )];
         for l in 1..self.levels as usize {

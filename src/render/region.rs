@@ -188,7 +188,8 @@ pub fn widen(f: &Footprint, margin_px: f32, width: u32, height: u32) -> PixelRec
     }
 }
 
-/// Side of the screen tiles a region is built from, in pixels.
+/// Default side of the screen tiles a region is built from, in pixels: coarse
+/// enough that a head is a few dozen rectangles (one draw each per pass).
 pub const TILE_PX: u32 = 32;
 
 /// Covers `rects` with screen tiles of `tile` pixels and returns the marked
@@ -252,18 +253,19 @@ pub fn tile_cover(rects: &[PixelRect], width: u32, height: u32, tile: u32) -> Ve
 
 /// The region of a set of skin boxes: each box's footprint widened by
 /// `reach_px(nearest_depth)` (how far the method's taps reach, in pixels, from
-/// a pixel at that depth; it must not grow with depth), covered by tiles.
+/// a pixel at that depth; it must not grow with depth), covered by `tile`-pixel tiles.
 pub fn skin_region(
     v: &RegionView,
     boxes: impl IntoIterator<Item = Aabb>,
     reach_px: impl Fn(f32) -> f32,
+    tile: u32,
 ) -> Vec<PixelRect> {
     let widened: Vec<PixelRect> = boxes
         .into_iter()
         .filter_map(|b| footprint(v, &b))
         .map(|f| widen(&f, reach_px(f.nearest_depth), v.width, v.height))
         .collect();
-    tile_cover(&widened, v.width, v.height, TILE_PX)
+    tile_cover(&widened, v.width, v.height, tile)
 }
 
 /// Boxes around the triangles of `mesh` grouped by a `cells`^3 grid over its
@@ -428,8 +430,8 @@ mod tests {
             unit_box(Vec3::new(-2.0, 0.0, 0.0)),
             unit_box(Vec3::new(2.0, 0.0, 0.0)),
         ];
-        let near = skin_region(&v, boxes, |d: f32| 30.0 / d);
-        let far = skin_region(&v, boxes, |_| 0.0);
+        let near = skin_region(&v, boxes, |d: f32| 30.0 / d, TILE_PX);
+        let far = skin_region(&v, boxes, |_| 0.0, TILE_PX);
         let area = |rs: &[PixelRect]| rs.iter().map(|r| r.area()).sum::<u64>();
         // Two separate heads: separate rectangles, one block of rows each.
         assert_eq!(near.len(), 2, "{near:?}");

@@ -86,11 +86,22 @@ pub fn seed_copy<'a>(
     name: &str,
     src: (ImageId, vk::Image),
     region: &'a [vk::Rect2D],
+    extent: vk::Extent2D,
     dsts: &[(ImageId, vk::Image)],
 ) -> Pass<'a> {
+    let whole = region.len() == 1
+        && region[0].offset == vk::Offset2D::default()
+        && region[0].extent == extent;
+    // A copy of part of the image keeps the rest (the zeros written at set-up):
+    // its barrier must not discard the old contents.
+    let write = if whole {
+        AccessKind::TransferWrite
+    } else {
+        AccessKind::TransferWritePartial
+    };
     let mut pass = Pass::new(name).image(src.0, AccessKind::TransferRead);
     for d in dsts {
-        pass = pass.image(d.0, AccessKind::TransferWrite);
+        pass = pass.image(d.0, write);
     }
     let src = src.1;
     let dsts: Vec<vk::Image> = dsts.iter().map(|d| d.1).collect();
@@ -264,6 +275,7 @@ impl SsgSss {
             "ssg seed copy",
             (t.diffuse.0, t.diffuse.1),
             t.region,
+            t.extent,
             &[(t.rt1.0, t.rt1.1), (t.rt2.0, t.rt2.1)],
         )];
         let extent = t.extent;
@@ -402,6 +414,7 @@ impl JitteredSss {
                 "ss-jittered seed copy",
                 (t.diffuse.0, t.diffuse.1),
                 t.region,
+                t.extent,
                 &[(t.rt1.0, t.rt1.1)],
             ),
             Pass::new("ss-jittered")

@@ -162,6 +162,7 @@ impl SeparableSss {
             "sss seed copy",
             (t.diffuse.0, t.diffuse.1),
             t.region,
+            extent,
             &[(t.rt1.0, t.rt1.1)],
         );
         let blur = |name: &str,

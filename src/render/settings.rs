@@ -74,6 +74,8 @@ pub struct RenderSettings {
     pub mask: MaskMode,
     /// Limit the SSS passes to the skin's neighbourhood, or run them on the screen.
     pub sss_region: super::region::RegionMode,
+    /// Side of the region's screen tiles in pixels (smaller: tighter, more draws).
+    pub sss_region_tile: u32,
     /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
     pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
     /// reference: surface samples per mm^2.
@@ -104,6 +106,7 @@ impl Default for RenderSettings {
             lod: true,
             mask: MaskMode::Stencil,
             sss_region: super::region::RegionMode::Skin,
+            sss_region_tile: super::region::TILE_PX,
             reference_density: 32.0,
             transmittance_profile: crate::skin::transmittance::TransmittanceProfile::Thesis,
             heads: 1,
@@ -148,6 +151,12 @@ impl RenderSettings {
             );
         }
         self.params.validate()?;
+        if !(1..=1024).contains(&self.sss_region_tile) {
+            bail!(
+                "the SSS region's tile must be 1..=1024 pixels, got {}",
+                self.sss_region_tile
+            );
+        }
         if self.heads == 0 || self.heads > 1024 {
             bail!("heads must be within 1..=1024, got {}", self.heads);
         }
@@ -195,6 +204,11 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("device limit"));
+        for tile in [0, 2000] {
+            let mut b = s.clone();
+            b.sss_region_tile = tile;
+            assert!(b.validate(16384).unwrap_err().to_string().contains("tile"));
+        }
         let mut b = s.clone();
         b.distance_heads = f32::NAN;
         assert!(b

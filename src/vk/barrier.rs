@@ -49,6 +49,9 @@ pub enum AccessKind {
     TransferRead,
     /// Destination of a copy or clear (whole contents produced).
     TransferWrite,
+    /// Destination of a copy into part of the resource: the rest keeps its
+    /// contents, so neither they nor the layout may be discarded.
+    TransferWritePartial,
     /// Read by the host after the GPU is done (buffers only).
     HostRead,
     /// Written by the host before the GPU uses it (buffers only).
@@ -128,7 +131,9 @@ impl AccessKind {
                 (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
             }
             AccessKind::TransferRead => (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
-            AccessKind::TransferWrite => (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+            AccessKind::TransferWrite | AccessKind::TransferWritePartial => {
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL)
+            }
             AccessKind::HostRead => (S::HOST, A::HOST_READ, L::UNDEFINED),
             AccessKind::HostWrite => (S::HOST, A::HOST_WRITE, L::UNDEFINED),
             AccessKind::UniformRead => (
@@ -159,6 +164,7 @@ impl AccessKind {
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::ComputeStorageReadWrite
                 | AccessKind::TransferWrite
+                | AccessKind::TransferWritePartial
                 | AccessKind::HostWrite
         )
     }
@@ -352,7 +358,7 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 18] = [
+    const ALL: [AccessKind; 19] = [
         AccessKind::ComputeStorageReadWrite,
         AccessKind::FragmentStorageRead,
         AccessKind::AnyShaderSampledRead,
@@ -367,11 +373,27 @@ mod tests {
         AccessKind::ComputeStorageWrite,
         AccessKind::TransferRead,
         AccessKind::TransferWrite,
+        AccessKind::TransferWritePartial,
         AccessKind::HostRead,
         AccessKind::HostWrite,
         AccessKind::UniformRead,
         AccessKind::VertexInputRead,
     ];
+
+    // A copy into part of an image after it was sampled: the layout moves from
+    // the sampled one, not from UNDEFINED, so the texels outside the copy keep.
+    #[test]
+    fn partial_copy_keeps_the_rest() {
+        let b = plan_image(
+            AccessKind::FragmentSampledRead,
+            AccessKind::TransferWritePartial,
+        )
+        .unwrap();
+        assert_eq!(b.old_layout, L::SHADER_READ_ONLY_OPTIMAL);
+        assert_eq!(b.new_layout, L::TRANSFER_DST_OPTIMAL);
+        let whole = plan_image(AccessKind::FragmentSampledRead, AccessKind::TransferWrite).unwrap();
+        assert_eq!(whole.old_layout, L::UNDEFINED);
+    }
 
     // Khronos synchronization examples: "Render to a colour attachment, then sample it
     // in a fragment shader".
