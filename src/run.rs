@@ -91,7 +91,7 @@ pub struct RunOptions {
 }
 
 /// The passes of every SSS method (their names start with the method's prefix).
-fn is_sss_pass(name: &str) -> bool {
+pub fn is_sss_pass(name: &str) -> bool {
     ["sss ", "ssg ", "ss-jittered", "poisson"]
         .iter()
         .any(|p| name.starts_with(p))

@@ -10,6 +10,7 @@ mod common;
 use dermis::render::region::{PixelRect, RegionMode};
 use dermis::render::screen::MaskMode;
 use dermis::render::{Method, RenderSettings, Renderer};
+use dermis::run::is_sss_pass;
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
@@ -33,11 +34,7 @@ fn render(scene: &Scene, s: &RenderSettings) -> Frame {
     let counts = cap
         .samples
         .iter()
-        .filter(|p| {
-            ["sss ", "ssg ", "ss-jittered", "poisson"]
-                .iter()
-                .any(|m| p.name.starts_with(m))
-        })
+        .filter(|p| is_sss_pass(&p.name))
         .map(|p| {
             (
                 p.name.clone(),

@@ -66,12 +66,41 @@ pub fn cost_error_chart(
     svg_path: &Path,
 ) -> Result<()> {
     let layout = Layout::new(points)?;
-    ensure_font()?;
+    let plot = CostErrorPlot {
+        points,
+        layout: &layout,
+        title,
+        x_label,
+    };
+    write_png_svg(&plot, png_path, svg_path)
+}
 
+/// A chart that can draw itself on any plotters backend: the PNG and the SVG
+/// of one chart come from the same code.
+trait Plot {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
+}
+
+struct CostErrorPlot<'a> {
+    points: &'a [EvalPoint],
+    layout: &'a Layout,
+    title: &'a str,
+    x_label: &'a str,
+}
+
+impl Plot for CostErrorPlot<'_> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        draw(root, self.points, self.layout, self.title, self.x_label)
+    }
+}
+
+/// Draws `plot` into a `SIZE` PNG and SVG, creating their folders.
+fn write_png_svg(plot: &impl Plot, png_path: &Path, svg_path: &Path) -> Result<()> {
+    ensure_font()?;
     let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw(&root, points, &layout, title, x_label).context("drawing the PNG chart")?;
+        plot.draw_on(&root).context("drawing the PNG chart")?;
         root.present()
             .map_err(plot_err)
             .context("finishing the PNG chart")?;
@@ -86,7 +115,7 @@ pub fn cost_error_chart(
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        draw(&root, points, &layout, title, x_label).context("drawing the SVG chart")?;
+        plot.draw_on(&root).context("drawing the SVG chart")?;
         root.present()
             .map_err(plot_err)
             .context("finishing the SVG chart")?;
@@ -262,39 +291,36 @@ pub fn series_chart(
             );
         }
     }
-    ensure_font()?;
     let all = series.iter().flat_map(|s| s.points.iter());
     let (x_lo, x_hi, y_hi) = all.fold((f64::INFINITY, 0.0f64, 0.0f64), |(a, b, c), &(x, y)| {
         (a.min(x), b.max(x), c.max(y))
     });
-    let x = (x_lo / 1.05)..(x_hi * 1.05);
-    let y = 0.0..(if y_hi > 0.0 { y_hi * 1.1 } else { 1.0 });
-    let labels = (title, x_label, y_label);
-    let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw_lines(&root, series, labels, x.clone(), y.clone())
-            .context("drawing the PNG line chart")?;
-        root.present()
-            .map_err(plot_err)
-            .context("finishing the PNG line chart")?;
+    let plot = LinePlot {
+        series,
+        labels: (title, x_label, y_label),
+        x: (x_lo / 1.05)..(x_hi * 1.05),
+        y: 0.0..(if y_hi > 0.0 { y_hi * 1.1 } else { 1.0 }),
+    };
+    write_png_svg(&plot, png_path, svg_path)
+}
+
+struct LinePlot<'a> {
+    series: &'a [Series],
+    labels: (&'a str, &'a str, &'a str),
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+}
+
+impl Plot for LinePlot<'_> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        draw_lines(
+            root,
+            self.series,
+            self.labels,
+            self.x.clone(),
+            self.y.clone(),
+        )
     }
-    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb)
-        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", SIZE.0, SIZE.1))?;
-    create_parent(png_path)?;
-    image
-        .save_with_format(png_path, image::ImageFormat::Png)
-        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        draw_lines(&root, series, labels, x, y).context("drawing the SVG line chart")?;
-        root.present()
-            .map_err(plot_err)
-            .context("finishing the SVG line chart")?;
-    }
-    create_parent(svg_path)?;
-    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
 }
 
 /// Everything of a [`series_chart`] on one backend.

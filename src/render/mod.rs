@@ -301,7 +301,8 @@ pub struct FrameGpu {
     objects: Vec<GpuObject>,
     instances: Vec<Mat4>,
     pub sss: Option<SssMethod>,
-    /// Where the SSS passes work (see `region.rs`), as pixels and as scissors.
+    /// Where the SSS passes work (see `region.rs`); change it with `set_region`,
+    /// which keeps the scissors that the passes read in step.
     pub region_px: Vec<region::PixelRect>,
     sss_region: Vec<vk::Rect2D>,
     screen_rect: Vec<vk::Rect2D>,
@@ -706,6 +707,8 @@ impl<'c> Renderer<'c> {
         // Where the SSS passes have work: near the skin's projected bounds.
         let full = region::PixelRect::full(extent.width, extent.height);
         let region_px = match &sss {
+            // The reference gathers in compute over the whole screen.
+            Some(SssMethod::Reference(_)) | None => vec![full],
             Some(method) if settings.sss_region == region::RegionMode::Skin => {
                 let view = region::RegionView {
                     view: camera.view(),
@@ -740,7 +743,7 @@ impl<'c> Renderer<'c> {
         }?;
         ctx.name(fence, "frame fence");
 
-        let gpu = FrameGpu {
+        let mut gpu = FrameGpu {
             settings: settings.clone(),
             extent,
             mm_per_unit: mm,
@@ -762,10 +765,11 @@ impl<'c> Renderer<'c> {
             objects,
             instances,
             sss,
-            sss_region: draw::scissors(&region_px),
-            region_px,
+            sss_region: Vec::new(),
+            region_px: Vec::new(),
             screen_rect: draw::scissors(&[full]),
         };
+        gpu.set_region(region_px);
         ctx.check_validation("while setting up the renderer")?;
         Ok(Renderer {
             ctx,
@@ -911,8 +915,7 @@ impl<'c> Renderer<'c> {
             ResourceState::uploaded(AccessKind::DepthStencilReadOnly);
         // The skin is wherever the upload says, not where the scene's boxes project.
         let full = region::PixelRect::full(self.gpu.extent.width, self.gpu.extent.height);
-        self.gpu.region_px = vec![full];
-        self.gpu.sss_region = draw::scissors(&[full]);
+        self.gpu.set_region(vec![full]);
         Ok(())
     }
 
@@ -992,9 +995,6 @@ fn skin_region(
             .map(|o| o.material.sss_strength)
             .fold(0.0, f32::max),
     };
-    if method.reach_px(1.0, &scale).is_none() {
-        return vec![region::PixelRect::full(view.width, view.height)];
-    }
     // Skin objects are drawn once per instance (see the geometry pass).
     let boxes: Vec<crate::scene::mesh::Aabb> = skin
         .iter()
@@ -1081,6 +1081,11 @@ fn submit_passes(
 }
 
 impl FrameGpu {
+    fn set_region(&mut self, px: Vec<region::PixelRect>) {
+        self.sss_region = draw::scissors(&px);
+        self.region_px = px;
+    }
+
     /// Any image of the frame by graph id: the targets, and images a method owns.
     pub fn image_by_id(&self, id: ImageId) -> Option<&Image> {
         self.targets.by_id(id).or(match &self.sss {
