@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Hashes of every image, pass dump and count that dermis produces for every
+# method on two scenes, so a restructuring can be shown to change nothing:
+#
+#   tools/golden_hashes.sh OUTFILE [PROCEDURAL_SCENE_ARGS...]
+#
+# Renders each configuration once on lavapipe with validation at 256x144 with
+# --dump, and writes one line per file (sha256 of frame.png, diffuse.exr and
+# every pass dump) and one line per pass of report.json (fragment invocations,
+# samples passed). Times are left out: they are the only thing allowed to move.
+# PROCEDURAL_SCENE_ARGS name the procedural scene (default: none, the embedded
+# default; after the default head changed: --scene builtin:egg).
+set -euo pipefail
+out=$1; shift
+proc=("$@")
+B=${B:-target/release/dermis}
+HEAD=${HEAD:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+common=(--device llvmpipe --validate --width 256 --height 144)
+configs=(
+  "none|--method none"
+  "separable 9|--method separable --samples 9"
+  "separable 17|--method separable"
+  "separable 17 demo nofollow|--method separable --preset demo --no-follow-surface"
+  "ssg 6 lod|--method ssg"
+  "ssg 4 lod|--method ssg --fit 4"
+  "ssg 6 nolod|--method ssg --no-lod"
+  "ssg 6 branch|--method ssg --mask branch"
+  "ss-jittered|--method ss-jittered"
+  "poisson|--method poisson"
+  "separable screen region|--method separable --sss-region screen"
+  "separable 3 heads|--method separable --heads 3"
+  "reference|--method reference --density 8"
+)
+: > "$out"
+for scene in procedural head; do
+  if [ $scene = head ]; then sargs=(--scene "$HEAD" --shot close); else sargs=("${proc[@]}"); fi
+  for c in "${configs[@]}"; do
+    name=${c%%|*}; args=${c#*|}
+    d=$tmp/run
+    rm -rf "$d"
+    # shellcheck disable=SC2086
+    "$B" render "${common[@]}" "${sargs[@]}" $args --warmup 0 --frames 1 --dump --out "$d" >/dev/null
+    ( cd "$d"; for f in frame.png diffuse.exr passes/*.exr; do
+        echo "$scene | $name | $(basename "$f" | sed 's/^[0-9]*_//') | $(sha256sum "$f" | cut -c1-16)"
+      done ) >> "$out"
+    python3 - "$d/report.json" "$scene" "$name" >> "$out" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+for p in r["passes"]:
+    print(f'{sys.argv[2]} | {sys.argv[3]} | counts {p["name"]} | inv {p.get("fragment_invocations")} samples {p.get("samples_passed")}')
+PY
+    echo "done: $scene $name" >&2
+  done
+done
