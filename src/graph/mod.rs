@@ -4,6 +4,8 @@
 //! `vk::barrier`, batches them into one call per pass, and wraps each pass in a
 //! debug label, timestamps and a fragment-invocation query.
 
+pub mod work;
+
 use ash::vk;
 
 use crate::vk::barrier::{AccessKind, ResourceState};

@@ -1,0 +1,243 @@
+//! What a pass is for and what it costs, declared by the pass itself: its role in
+//! the frame and its work per unit (per fragment of a draw, per invocation of a
+//! dispatch, per texel of a copy): texture fetches by format and filter,
+//! render-target writes by format and blending, depth/stencil use, and an
+//! arithmetic estimate. Pure data, carried in every report: bench floors, the SSS
+//! totals, readback filtering and the budget model read these declarations;
+//! nothing in dermis matches a pass by its name.
+
+use serde::{Deserialize, Serialize};
+
+/// Why a pass is in the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PassRole {
+    /// Depth from the key light.
+    Shadow,
+    /// The scene into the G-buffer-like targets (lighting, specular, depth, stencil).
+    Geometry,
+    /// Subsurface scattering: every pass an SSS method records (seed copies,
+    /// blurs, mip chains, the ground truth's passes).
+    Sss,
+    /// After SSS: composite, tone map.
+    Post,
+    /// Copies of targets to the host (captures, dumps): bookkeeping, not frame cost.
+    Readback,
+    /// Micro-passes that measure the device (bench ceilings).
+    Probe,
+    /// One-time or test-only work outside the frame (uploads, fills).
+    Setup,
+}
+
+impl PassRole {
+    /// Whether the pass is part of the frame's cost (tables, totals, budgets).
+    pub fn is_frame_cost(self) -> bool {
+        !matches!(self, PassRole::Readback | PassRole::Probe | PassRole::Setup)
+    }
+}
+
+/// Texel formats the passes read and write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Format {
+    Rgba8Unorm,
+    Rgba8Srgb,
+    R16Float,
+    Rgba16Float,
+    R32Float,
+    Rgba32Float,
+    D32Float,
+    D24UnormS8Uint,
+    D32FloatS8Uint,
+}
+
+impl Format {
+    /// Bytes of one texel as stored (D24S8 is 4; D32S8 is taken as 5: 4 + 1, as
+    /// most hardware stores the stencil plane apart).
+    pub fn bytes_per_texel(self) -> u32 {
+        match self {
+            Format::R16Float => 2,
+            Format::Rgba8Unorm
+            | Format::Rgba8Srgb
+            | Format::R32Float
+            | Format::D32Float
+            | Format::D24UnormS8Uint => 4,
+            Format::D32FloatS8Uint => 5,
+            Format::Rgba16Float => 8,
+            Format::Rgba32Float => 16,
+        }
+    }
+
+    pub fn is_depth(self) -> bool {
+        matches!(
+            self,
+            Format::D32Float | Format::D24UnormS8Uint | Format::D32FloatS8Uint
+        )
+    }
+}
+
+/// How a fetch filters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Filter {
+    /// `texelFetch` or a nearest sampler: one texel.
+    Point,
+    /// A linear sampler on one mip level: four texels weighted.
+    Bilinear,
+    /// A linear sampler across two mip levels (`textureLod` between levels, or
+    /// mipmapped material textures).
+    Trilinear,
+    /// A depth-compare sampler (hardware 2x2 percentage-closer filtering).
+    DepthCompare,
+}
+
+/// One kind of texture fetch a unit of work makes, `count` times on average.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fetch {
+    /// The shader's texture variable (what the fetch-counting build counts by).
+    pub texture: String,
+    pub format: Format,
+    pub filter: Filter,
+    pub count: f64,
+}
+
+/// One colour attachment written by every shaded fragment.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ColorWrite {
+    pub format: Format,
+    /// Blended (a read-modify-write of the target).
+    pub blend: bool,
+}
+
+/// How a draw uses its depth/stencil attachment.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DepthStencilUse {
+    pub format: Format,
+    pub depth_test: bool,
+    pub depth_write: bool,
+    pub stencil_test: bool,
+    pub stencil_write: bool,
+}
+
+/// What one shader invocation does.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ShaderWork {
+    pub fetches: Vec<Fetch>,
+    /// Arithmetic instructions executed per invocation (SPIR-V arithmetic, loops
+    /// at their trip counts): an estimate, for ALU-bound pricing.
+    pub alu: f64,
+    /// Bytes read from and written to storage buffers/images per invocation.
+    pub storage_read_bytes: f64,
+    pub storage_write_bytes: f64,
+}
+
+/// The work of a pass.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Work {
+    /// Draws: `shader` runs per shaded fragment (`None`: depth-only), writing
+    /// every colour attachment once.
+    Raster {
+        shader: Option<ShaderWork>,
+        color: Vec<ColorWrite>,
+        depth_stencil: Option<DepthStencilUse>,
+        /// Render area in pixels.
+        width: u32,
+        height: u32,
+        /// Triangles submitted per frame (3 vertices each; a full-screen pass
+        /// draws one per rectangle of its region).
+        triangles: u64,
+        /// Samples per pixel.
+        msaa: u32,
+    },
+    /// Dispatches: `shader` runs `invocations` times per frame.
+    Compute { shader: ShaderWork, invocations: u64 },
+    /// Image or buffer copies: `texels` texels of `bytes_per_texel` per frame.
+    Copy { texels: u64, bytes_per_texel: u32 },
+    /// Clears of `texels` texels of `bytes_per_texel`.
+    Clear { texels: u64, bytes_per_texel: u32 },
+}
+
+/// How a pass uses one image (derived from its declared access and the image's
+/// description; what the budget model needs for render-target footprints and
+/// the resolves a later read forces).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImageUseKind {
+    /// Sampled or fetched by a shader.
+    Sampled,
+    /// Colour attachment, old contents discarded.
+    ColorTarget,
+    /// Colour attachment loaded (or blended): old contents kept.
+    ColorTargetLoad,
+    /// Depth/stencil attachment written.
+    DepthTarget,
+    /// Depth/stencil attachment tested only.
+    DepthTest,
+    /// Storage image or buffer, read and/or written by a shader.
+    Storage,
+    CopySource,
+    CopyDestination,
+    /// Read by the host.
+    Host,
+}
+
+/// One image a pass touches.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageUse {
+    pub image: String,
+    pub format: Format,
+    pub width: u32,
+    pub height: u32,
+    pub kind: ImageUseKind,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn roles_that_cost_frame_time() {
+        for r in [
+            PassRole::Shadow,
+            PassRole::Geometry,
+            PassRole::Sss,
+            PassRole::Post,
+        ] {
+            assert!(r.is_frame_cost());
+        }
+        for r in [PassRole::Readback, PassRole::Probe, PassRole::Setup] {
+            assert!(!r.is_frame_cost());
+        }
+    }
+
+    #[test]
+    fn work_round_trips_through_json() {
+        let w = Work::Raster {
+            shader: Some(ShaderWork {
+                fetches: vec![Fetch {
+                    texture: "colorTex".into(),
+                    format: Format::Rgba16Float,
+                    filter: Filter::Bilinear,
+                    count: 16.0,
+                }],
+                alu: 120.0,
+                ..Default::default()
+            }),
+            color: vec![ColorWrite {
+                format: Format::Rgba16Float,
+                blend: false,
+            }],
+            depth_stencil: None,
+            width: 1280,
+            height: 720,
+            triangles: 1,
+            msaa: 1,
+        };
+        let json = serde_json::to_string(&w).unwrap();
+        assert!(json.contains("\"kind\":\"raster\""), "{json}");
+        assert_eq!(serde_json::from_str::<Work>(&json).unwrap(), w);
+        assert_eq!(Format::Rgba16Float.bytes_per_texel(), 8);
+        assert!(Format::D24UnormS8Uint.is_depth() && !Format::R32Float.is_depth());
+    }
+}
