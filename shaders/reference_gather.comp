@@ -22,8 +22,10 @@ layout(set = 0, binding = 6) uniform GatherParams {
 } params;
 // One row of 3 cells of the 3x3x3 neighbourhood per dispatch (dy, dz in -1..1),
 // summed into the output: splitting keeps each invocation's loop count a ninth of
-// the whole (llvmpipe cuts shader loops after 65535 iterations).
-layout(push_constant) uniform Push { int dy; int dz; } pc;
+// the whole (llvmpipe cuts shader loops after 65535 iterations). One chunk of the
+// samples per dispatch, [first, first + count) in grid order: Positions and
+// radianceTex hold that chunk only (binding ranges and image sizes are limited).
+layout(push_constant) uniform Push { int dy; int dz; uint first; uint count; } pc;
 
 // Six-Gaussian skin profile (thesis Table 4.2), variances in mm^2.
 const vec3 W_NARROW = vec3(0.233 + 0.1 + 0.118, 0.455 + 0.336 + 0.198, 0.649 + 0.344 + 0.0);
@@ -45,7 +47,7 @@ void main() {
     if (p.x >= size.x || p.y >= size.y) return;
     vec4 d0 = texelFetch(diffuseTex, p, 0);
     if (d0.a <= 0.0) {
-        if (pc.dy == -1 && pc.dz == -1) imageStore(outImage, p, d0);
+        if (pc.dy == -1 && pc.dz == -1 && pc.first == 0u) imageStore(outImage, p, d0);
         return;
     }
     float z = texelFetch(depthTex, p, 0).r;
@@ -57,19 +59,22 @@ void main() {
     ivec3 c = ivec3(floor((xo - params.gridOrigin.xyz) / params.gridOrigin.w));
     ivec3 dims = ivec3(params.gridDims.xyz);
     // The first slab starts the sum with the analytic narrow part.
-    vec3 acc = (pc.dy == -1 && pc.dz == -1) ? W_NARROW * d0.rgb : imageLoad(outImage, p).rgb;
+    bool first = pc.dy == -1 && pc.dz == -1 && pc.first == 0u;
+    vec3 acc = first ? W_NARROW * d0.rgb : imageLoad(outImage, p).rgb;
     int dz = pc.dz;
     int dy = pc.dy;
     for (int dx = -1; dx <= 1; dx++) {
         ivec3 q = c + ivec3(dx, dy, dz);
         if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, dims))) continue;
         uint cell = uint((q.z * dims.y + q.y) * dims.x + q.x);
-        for (uint j = cellStart[cell]; j < cellStart[cell + 1u]; j++) {
-            vec4 pa = positions[j];
+        uint end = min(cellStart[cell + 1u], pc.first + pc.count);
+        for (uint j = max(cellStart[cell], pc.first); j < end; j++) {
+            uint k = j - pc.first;
+            vec4 pa = positions[k];
             vec3 dv = (pa.xyz - xo) * mm;
             float r2 = dot(dv, dv);
             if (r2 > cutoff2) continue;
-            vec3 radiance = texelFetch(radianceTex, ivec2(j % params.gridDims.w, j / params.gridDims.w), 0).rgb;
+            vec3 radiance = texelFetch(radianceTex, ivec2(k % params.gridDims.w, k / params.gridDims.w), 0).rgb;
             acc += pa.w * radiance * wideProfile(r2);
         }
     }

@@ -1,14 +1,19 @@
 //! dermis: a hand-written Vulkan (ash) renderer for real-time human skin that
 //! measures what every pass costs on the GPU.
 //!
-//! Layers, bottom up: `vk` (device, barrier table, memory, shaders, profiler),
-//! `graph` (passes with declared accesses; barriers derived, never written at
-//! call sites), `scene` (procedural head, glTF, camera, light), `skin` (pure
-//! math: profiles, kernels, CPU references), `render` (the frame), `bench`
-//! (ceilings and floors), `report` (statistics, tables, JSON).
+//! Layers, bottom up (a module uses only the ones before it):
+//! `vk` (device, barrier table, memory, shaders and their statistics, uploads,
+//! profiler) -> `graph` (declared images, passes with their role, work and
+//! accesses; barriers and usages derived, never written at call sites) ->
+//! `scene`, `skin`, `reference` (pure CPU: meshes, framing, profiles, kernels,
+//! CPU references, the ground truth's sampling) -> `method` (the SSS methods,
+//! one module each behind one trait, and their registry) -> `render` (the frame
+//! around a method) -> `report`, `bench`, `run` (runs, statistics, floors) ->
+//! `eval` (ground-truth comparisons, charts). `main.rs` parses arguments only.
 pub mod bench;
 pub mod eval;
 pub mod graph;
+pub mod method;
 pub mod reference;
 pub mod render;
 pub mod report;

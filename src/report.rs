@@ -2,7 +2,8 @@
 
 use serde::Serialize;
 
-use crate::vk::profiler::PassSample;
+use crate::graph::work::{ImageUse, PassRole, Work};
+use crate::graph::PassSample;
 
 /// Median, minimum and 95th percentile of a set of times (ms).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -35,9 +36,17 @@ impl Stats {
     }
 }
 
+/// What a pass declares of itself, for the report.
+#[derive(Clone, Debug, Default)]
+pub struct PassDecl {
+    pub work: Option<Work>,
+    pub images: Vec<ImageUse>,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct PassReport {
     pub name: String,
+    pub role: PassRole,
     pub gpu_ms: Stats,
     /// Time of the barriers before the pass, kept out of `gpu_ms`.
     pub barrier_ms: Stats,
@@ -50,6 +59,10 @@ pub struct PassReport {
     pub floor_ms: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub floor_ratio: Option<f64>,
+    /// The pass's declared work per unit (see `graph::work`).
+    pub work: Option<Work>,
+    /// The images it touches and how.
+    pub images: Vec<ImageUse>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -58,8 +71,12 @@ pub struct FrameReport {
     pub gpu_ms: Stats,
 }
 
-/// Aggregates frames of pass samples (every frame has the same passes in order).
-pub fn aggregate(frames: &[Vec<PassSample>]) -> (Vec<PassReport>, Option<FrameReport>) {
+/// Aggregates frames of pass samples (every frame has the same passes in
+/// order), with each pass's declaration (`decls[i]` for pass `i`).
+pub fn aggregate(
+    frames: &[Vec<PassSample>],
+    decls: &[PassDecl],
+) -> (Vec<PassReport>, Option<FrameReport>) {
     let Some(first) = frames.first() else {
         return (Vec::new(), None);
     };
@@ -69,8 +86,12 @@ pub fn aggregate(frames: &[Vec<PassSample>]) -> (Vec<PassReport>, Option<FrameRe
         .map(|(i, s)| {
             let gpu: Vec<f64> = frames.iter().map(|f| f[i].gpu_ms).collect();
             let bar: Vec<f64> = frames.iter().map(|f| f[i].barrier_ms).collect();
+            let decl = decls.get(i).cloned().unwrap_or_default();
             PassReport {
                 name: s.name.clone(),
+                role: s.role,
+                work: decl.work,
+                images: decl.images,
                 gpu_ms: Stats::of(&gpu).expect("non-empty"),
                 barrier_ms: Stats::of(&bar).expect("non-empty"),
                 fragment_invocations: frames.last().and_then(|f| f[i].fragment_invocations),
@@ -164,6 +185,7 @@ mod tests {
             vec![
                 PassSample {
                     name: "a".into(),
+                    role: PassRole::Sss,
                     barrier_ms: 0.0,
                     gpu_ms: a,
                     fragment_invocations: Some(5),
@@ -171,6 +193,7 @@ mod tests {
                 },
                 PassSample {
                     name: "b".into(),
+                    role: PassRole::Post,
                     barrier_ms: 0.5,
                     gpu_ms: b,
                     fragment_invocations: None,
@@ -178,11 +201,12 @@ mod tests {
                 },
             ]
         };
-        let (p, frame) = aggregate(&[f(1.0, 2.0), f(3.0, 4.0), f(2.0, 3.0)]);
+        let (p, frame) = aggregate(&[f(1.0, 2.0), f(3.0, 4.0), f(2.0, 3.0)], &[]);
         assert_eq!(p.len(), 2);
         assert_eq!(p[0].gpu_ms.median, 2.0);
         assert_eq!(p[1].gpu_ms.min, 2.0);
         assert_eq!(p[0].fragment_invocations, Some(5));
+        assert_eq!(p[1].role, PassRole::Post);
         assert_eq!(frame.unwrap().gpu_ms.median, 5.5);
         let t = table(&p, None);
         assert!(t.contains("median ms") && t.lines().count() == 3);

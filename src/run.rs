@@ -7,15 +7,15 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use crate::bench::ceilings::{self, ProbeResult};
-use crate::bench::floor::{
-    composite_cost, floor_ms, jittered_cost, separable_pass_cost, ssg_pass_cost, tonemap_cost,
-    Ceilings, PassCost,
-};
+use crate::bench::floor::{floor_ms, Ceilings};
+use crate::graph::work::PassRole;
+use crate::method::region::RegionMode;
 use crate::render::readback::DumpedImage;
 use crate::render::{Capture, RenderSettings, Renderer};
-use crate::report::{aggregate, FrameReport, PassReport, Stats};
+use crate::report::{aggregate, FrameReport, PassDecl, PassReport, Stats};
+use crate::scene::layout::Layout;
 use crate::scene::Scene;
-use crate::skin::kernel::SssParams;
+use crate::skin::transmittance::TransmittanceProfile;
 use crate::vk::context::Context;
 
 #[derive(Clone, Debug, Serialize)]
@@ -38,23 +38,20 @@ pub struct Report {
     pub width: u32,
     pub height: u32,
     pub method: &'static str,
-    pub samples: usize,
-    pub preset: &'static str,
-    pub sss_params: SssParams,
-    pub follow_surface: bool,
+    /// Every option of the method, given or default.
+    pub method_options: std::collections::BTreeMap<&'static str, String>,
+    /// What the method reports of itself (kernel, fit, stretch, samples...).
+    pub method_details: serde_json::Value,
     pub transmittance: bool,
-    pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
-    /// ssg settings (reported for every method; only ssg reads them).
-    pub fit: crate::skin::ssg::GaussianFit,
-    pub lod: bool,
-    pub mask: crate::render::screen::MaskMode,
-    pub sss_region: crate::render::region::RegionMode,
+    pub transmittance_profile: TransmittanceProfile,
+    pub sss_region: RegionMode,
     /// Pixels inside the region the SSS passes worked in (the screen without one).
     pub sss_region_pixels: u64,
     pub sss_region_rects: usize,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,
+    pub layout: Layout,
     pub distance_heads: f32,
     pub fovy_deg: f32,
     pub light: LightReport,
@@ -62,7 +59,7 @@ pub struct Report {
     pub measured_frames: usize,
     pub passes: Vec<PassReport>,
     pub frame: Option<FrameReport>,
-    /// Sum of the SSS passes (seed copy, horizontal, vertical) per frame.
+    /// Sum of the SSS passes (every pass of role `sss`) per frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sss_total_ms: Option<Stats>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -90,23 +87,18 @@ pub struct RunOptions {
     pub progress: bool,
 }
 
-/// The passes of every SSS method (their names start with the method's prefix).
-pub fn is_sss_pass(name: &str) -> bool {
-    ["sss ", "ssg ", "ss-jittered", "poisson"]
-        .iter()
-        .any(|p| name.starts_with(p))
-}
-
-/// The cost model of a pass by name, where one exists.
-fn pass_cost(name: &str, s: &RenderSettings) -> Option<PassCost> {
-    match name {
-        "sss horizontal" | "sss vertical" => Some(separable_pass_cost(s.samples, s.follow_surface)),
-        "ss-jittered" => Some(jittered_cost()),
-        n if n.starts_with("ssg g") => Some(ssg_pass_cost(n.ends_with("vertical"))),
-        // poisson's sample count varies per pixel (8/16/32 by radius): no single floor.
-        "composite" => Some(composite_cost()),
-        "tonemap" => Some(tonemap_cost()),
-        _ => None,
+impl RunOptions {
+    /// One captured frame, no warm-up, quiet: what comparisons need.
+    pub fn capture_once(command: &str) -> Self {
+        RunOptions {
+            warmup: 0,
+            measured: 1,
+            capture: true,
+            dump: false,
+            ceilings: false,
+            command: command.into(),
+            progress: false,
+        }
     }
 }
 
@@ -146,36 +138,43 @@ pub fn run(
     } else {
         None
     };
-    let (mut passes, frame) = aggregate(&frames);
+    let decls: Vec<PassDecl> = renderer
+        .passes()
+        .iter()
+        .map(|p| PassDecl {
+            work: p.work.clone(),
+            images: renderer.resources.image_uses(&p.images),
+        })
+        .collect();
+    let (mut passes, frame) = aggregate(&frames, &decls);
     let sss_totals: Vec<f64> = frames
         .iter()
         .map(|f| {
             f.iter()
-                .filter(|s| is_sss_pass(&s.name))
+                .filter(|s| s.role == PassRole::Sss)
                 .map(|s| s.gpu_ms + s.barrier_ms)
                 .sum()
         })
         .collect();
     let has_sss = frames
         .first()
-        .map(|f| f.iter().any(|s| is_sss_pass(&s.name)))
-        .unwrap_or(false);
-    let extent = renderer.gpu.extent;
-    let mm_per_unit = renderer.gpu.mm_per_unit;
-    let region = &renderer.gpu.region_px;
+        .is_some_and(|f| f.iter().any(|s| s.role == PassRole::Sss));
+    let extent = renderer.frame.extent;
+    let mm_per_unit = renderer.frame.mm_per_unit;
+    let region = &renderer.frame.region_px;
     let (sss_region_pixels, sss_region_rects) =
         (region.iter().map(|r| r.area()).sum(), region.len());
+    let method_details = renderer.method.details();
     drop(renderer);
 
     let (ceilings, probes) = if opts.ceilings {
         let (c, p) = ceilings::measure(ctx, extent, 7).context("measuring device ceilings")?;
         for pass in &mut passes {
-            if let (Some(cost), Some(inv)) =
-                (pass_cost(&pass.name, settings), pass.fragment_invocations)
-            {
-                let f = floor_ms(&cost, inv, &c);
-                pass.floor_ms = Some(f);
-                pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
+            if let (Some(work), Some(inv)) = (&pass.work, pass.fragment_invocations) {
+                if let Some(f) = floor_ms(work, inv, &c) {
+                    pass.floor_ms = Some(f);
+                    pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
+                }
             }
         }
         (Some(c), Some(p))
@@ -184,6 +183,7 @@ pub fn run(
     };
 
     let f = &ctx.facts;
+    let m = settings.method;
     let report = Report {
         dermis_version: env!("CARGO_PKG_VERSION"),
         command: opts.command.clone(),
@@ -194,22 +194,18 @@ pub fn run(
         validation: ctx.validation,
         width: settings.width,
         height: settings.height,
-        method: settings.method.name(),
-        samples: settings.samples,
-        preset: settings.preset.name(),
-        sss_params: settings.params,
-        follow_surface: settings.follow_surface,
+        method: m.name,
+        method_options: m.opts(&settings.options).resolved(),
+        method_details,
         transmittance: settings.transmittance,
         transmittance_profile: settings.transmittance_profile,
-        fit: settings.fit,
-        lod: settings.lod,
-        mask: settings.mask,
         sss_region: settings.sss_region,
         sss_region_pixels,
         sss_region_rects,
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,
+        layout: settings.layout,
         distance_heads: settings.distance_heads,
         fovy_deg: settings.fovy_deg,
         light: LightReport {
@@ -230,6 +226,81 @@ pub fn run(
         probes,
     };
     Ok(RunOutput { report, capture })
+}
+
+/// Makes sure `dir` exists and can be written, before any GPU work: a bad
+/// `--out` is reported at once, not after the render.
+pub fn prepare_out_dir(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("--out {} exists and is not a directory", dir.display());
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let probe = dir.join(".dermis-write-test");
+    std::fs::write(&probe, b"").with_context(|| format!("{} is not writable", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// The one-line header of a run's table.
+pub fn header(r: &Report) -> String {
+    format!(
+        "dermis {} | {} ({}) | {}x{} | method {} | scene '{}' ({:.1} mm/unit) | {} head(s) | {} measured frames",
+        r.dermis_version, r.device, r.driver, r.width, r.height, r.method, r.scene, r.mm_per_unit, r.heads, r.measured_frames
+    )
+}
+
+/// Renders and writes frame.png, diffuse.exr and report.json (with `dump`,
+/// every pass output as EXR under passes/) into `out`.
+pub fn render_to_dir(
+    ctx: &Context,
+    scene: &Scene,
+    settings: &RenderSettings,
+    out: &Path,
+    opts: &RunOptions,
+) -> Result<RunOutput> {
+    prepare_out_dir(out)?;
+    let output = run(ctx, scene, settings, opts)?;
+    let capture = output.capture.as_ref().context("no frame was captured")?;
+    write_png(&out.join("frame.png"), capture)?;
+    write_diffuse_exr(&out.join("diffuse.exr"), capture)?;
+    if opts.dump {
+        let dir = out.join("passes");
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (i, d) in capture.dumps.iter().enumerate() {
+            write_exr(
+                &dir.join(format!("{:02}_{}_{}.exr", i, slug(&d.pass), slug(&d.image))),
+                d,
+            )?;
+        }
+    }
+    write_report(&out.join("report.json"), &output.report)?;
+    Ok(output)
+}
+
+/// Measures many frames and the device ceilings, writes the report to `path`.
+pub fn bench_run(
+    ctx: &Context,
+    scene: &Scene,
+    settings: &RenderSettings,
+    opts: &RunOptions,
+    path: &Path,
+) -> Result<Report> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        prepare_out_dir(parent)?;
+    }
+    let output = run(ctx, scene, settings, opts)?;
+    write_report(path, &output.report)?;
+    Ok(output.report)
+}
+
+/// Writes a report as pretty JSON, creating its folder.
+pub fn write_report(path: &Path, report: &Report) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    std::fs::write(path, serde_json::to_string_pretty(report)?)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// Writes the tone-mapped frame as an sRGB PNG.
@@ -301,12 +372,5 @@ mod tests {
     fn slugs_are_file_safe() {
         assert_eq!(slug("sss horizontal -> diffuse"), "sss_horizontal_diffuse");
         assert_eq!(slug("Shadow Map"), "shadow_map");
-    }
-
-    #[test]
-    fn only_modelled_passes_get_floors() {
-        let s = RenderSettings::default();
-        assert!(pass_cost("sss horizontal", &s).is_some());
-        assert!(pass_cost("geometry", &s).is_none());
     }
 }

@@ -5,8 +5,9 @@
 mod common;
 
 use dermis::eval::metrics::relative_rmse;
+use dermis::method::reference::Reference;
 use dermis::reference::cpu::{gather_f64, GatherView};
-use dermis::render::{Method, RenderSettings, Renderer, SssMethod};
+use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::default_scene;
 
 fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
@@ -14,11 +15,10 @@ fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
         width,
         height,
         shadow_size: 256,
-        method: Method::Reference,
-        reference_density: density,
         distance_heads: 3.0,
         ..RenderSettings::default()
     }
+    .with(common::m("reference"), &[("density", &density.to_string())])
 }
 
 struct Run {
@@ -43,10 +43,7 @@ fn render(s: &RenderSettings) -> Run {
             .rgba
             .clone()
     };
-    let (samples, _) = match &r.gpu.sss {
-        Some(SssMethod::Reference(m)) => (m.surface.clone(), m.sample_count),
-        _ => unreachable!(),
-    };
+    let samples = r.method_as::<Reference>().unwrap().surface.clone();
     let aspect = s.width as f32 / s.height as f32;
     Run {
         output: find("reference gather 9/9", "reference"),
@@ -60,7 +57,7 @@ fn render(s: &RenderSettings) -> Run {
         view: GatherView {
             width: s.width as usize,
             height: s.height as usize,
-            inv_view: r.gpu.camera.view().inverse(),
+            inv_view: r.frame.camera.view().inverse(),
             tan_half_fovy: (0.5 * s.fovy_deg.to_radians()).tan(),
             aspect,
             mm_per_unit: scene.mm_per_unit,
@@ -102,7 +99,11 @@ fn gpu_gather_matches_f64_cpu_gather() {
 
 #[test]
 fn surface_sampling_has_converged_at_the_default_density() {
-    let d = RenderSettings::default().reference_density;
+    // The registry's default density.
+    let d: f32 = common::m("reference")
+        .opts(&Default::default())
+        .parse("density")
+        .unwrap();
     let a = render(&settings(64, 40, d));
     let b = render(&settings(64, 40, 2.0 * d));
     let mask: Vec<bool> = a.diffuse.iter().map(|p| p[3] > 0.0).collect();

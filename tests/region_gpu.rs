@@ -7,11 +7,11 @@
 
 mod common;
 
-use dermis::render::region::{PixelRect, RegionMode};
-use dermis::render::screen::MaskMode;
-use dermis::render::{Method, RenderSettings, Renderer};
-use dermis::run::is_sss_pass;
+use dermis::graph::work::PassRole;
+use dermis::method::region::{PixelRect, RegionMode};
+use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::gltf_load::TextureOverrides;
+use dermis::scene::layout::Layout;
 use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
 
@@ -34,7 +34,7 @@ fn render(scene: &Scene, s: &RenderSettings) -> Frame {
     let counts = cap
         .samples
         .iter()
-        .filter(|p| is_sss_pass(&p.name))
+        .filter(|p| p.role == PassRole::Sss)
         .map(|p| {
             (
                 p.name.clone(),
@@ -47,7 +47,7 @@ fn render(scene: &Scene, s: &RenderSettings) -> Frame {
         diffuse: cap.diffuse,
         ldr: cap.ldr,
         counts,
-        region_pixels: r.gpu.region_px.iter().map(|t| t.area()).sum(),
+        region_pixels: r.frame.region_px.iter().map(|t| t.area()).sum(),
     }
 }
 
@@ -57,7 +57,7 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
         (
             "separable",
             RenderSettings {
-                method: Method::Separable,
+                method: common::m("separable"),
                 ..base.clone()
             },
         ),
@@ -65,46 +65,35 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
         // tap of the seeded texels counts.
         (
             "separable --no-follow-surface",
-            RenderSettings {
-                method: Method::Separable,
-                follow_surface: false,
-                ..base.clone()
-            },
+            base.clone()
+                .with(common::m("separable"), &[("follow-surface", "false")]),
         ),
         (
             "ssg",
             RenderSettings {
-                method: Method::Ssg,
+                method: common::m("ssg"),
                 ..base.clone()
             },
         ),
         (
             "ssg --no-lod",
-            RenderSettings {
-                method: Method::Ssg,
-                lod: false,
-                ..base.clone()
-            },
+            base.clone().with(common::m("ssg"), &[("lod", "false")]),
         ),
         (
             "ssg --mask branch",
-            RenderSettings {
-                method: Method::Ssg,
-                mask: MaskMode::Branch,
-                ..base.clone()
-            },
+            base.clone().with(common::m("ssg"), &[("mask", "branch")]),
         ),
         (
             "ss-jittered",
             RenderSettings {
-                method: Method::SsJittered,
+                method: common::m("ss-jittered"),
                 ..base.clone()
             },
         ),
         (
             "poisson",
             RenderSettings {
-                method: Method::Poisson,
+                method: common::m("poisson"),
                 ..base.clone()
             },
         ),
@@ -159,7 +148,8 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
             assert!(inv_s <= inv_f, "{name}: {n} {inv_s} > {inv_f} invocations");
             // Without a stencil test every pixel of the region runs the shader:
             // fewer than the screen's whenever the region is smaller.
-            if s.mask == MaskMode::Branch && n.starts_with("ssg g") && expect_smaller {
+            if s.options.given("mask") == Some("branch") && n.starts_with("ssg g") && expect_smaller
+            {
                 assert!(inv_s < inv_f, "{name}: {n} {inv_s} vs {inv_f}");
             }
         }
@@ -183,7 +173,7 @@ fn the_region_changes_no_pixel_on_the_default_scene() {
         distance_heads: 2.0,
         ..base
     };
-    wide.params.width_mm = 20.0;
+    wide.options.set("sss-width-mm", "20");
     region_changes_nothing(&default_scene(), wide, true);
 }
 
@@ -232,7 +222,7 @@ fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
     };
     let ctx = common::ctx();
     let r = Renderer::new(&ctx, &scene, &s).expect("renderer");
-    assert_eq!(r.gpu.region_px, vec![PixelRect::full(96, 64)]);
+    assert_eq!(r.frame.region_px, vec![PixelRect::full(96, 64)]);
 }
 
 #[test]
@@ -243,11 +233,12 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
         height: 540,
         shadow_size: 256,
         heads: 4,
+        layout: Layout::Grid,
         distance_heads: 3.0,
         ..RenderSettings::default()
     };
     let r = Renderer::new(&ctx, &default_scene(), &s).expect("renderer");
-    let region = &r.gpu.region_px;
+    let region = &r.frame.region_px;
     // A 2x2 grid of heads centred on the screen: the centre lies between them.
     assert!(region.iter().all(|t| !t.contains(480, 270)), "{region:?}");
     assert!(region.len() >= 4, "{region:?}");
@@ -287,12 +278,12 @@ fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
         height: 432,
         shadow_size: 256,
         distance_heads: 3.0,
-        follow_surface: false,
         ..RenderSettings::default()
     };
+    base.options.set("follow-surface", "false");
     // Taps reach ~90 px (50 mm at 1.8 px/mm), far more than the up to 31 px a
     // tile adds: a region built with 0.3x the reach fails here (checked).
-    base.params.width_mm = 50.0;
+    base.options.set("sss-width-mm", "50");
     region_changes_nothing(&card_scene(), base.clone(), true);
     // One-pixel tiles leave no slack at all, so the ssg and ss-jittered reaches
     // (fixed by the profile, ~15 and ~6 px here) are held to their formulas too.

@@ -4,7 +4,7 @@
 
 mod common;
 
-use dermis::render::{Method, RenderSettings};
+use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
@@ -168,7 +168,7 @@ fn method_none_has_no_sss_passes() {
     let r = render_and_check(
         &default_scene(),
         &RenderSettings {
-            method: Method::None,
+            method: common::m("none"),
             ..small()
         },
     );

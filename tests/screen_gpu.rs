@@ -4,15 +4,17 @@
 
 mod common;
 
-use dermis::render::screen::MaskMode;
-use dermis::render::{Method, RenderSettings, Renderer, SssMethod};
+use dermis::graph::PassSample;
+use dermis::method::lookup;
+use dermis::method::poisson::Poisson;
+use dermis::method::ssg::{MaskMode, Ssg};
+use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::default_scene;
 use dermis::skin::jittered::hable_kernel;
 use dermis::skin::screen_ref::{jittered, ScreenInput};
-use dermis::skin::separable_ref::{round_f16, F16Rounding};
 use dermis::skin::ssg::{GaussianFit, Stretch};
 use dermis::skin::ssg_ref::{ssg_with_rounding, SsgInput};
-use dermis::vk::profiler::PassSample;
+use dermis::skin::texel::{round_f16, F16Rounding};
 
 const W: usize = 96;
 const H: usize = 64;
@@ -43,12 +45,12 @@ fn synthetic() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
 
 /// One head height away: the near plane (0.01 of the distance) is in front of the
 /// whole synthetic depth ramp, so every depth maps into the depth buffer's range.
-fn settings(method: Method) -> RenderSettings {
+fn settings(method: &str) -> RenderSettings {
     RenderSettings {
         width: W as u32,
         height: H as u32,
         shadow_size: 64,
-        method,
+        method: lookup(method).unwrap(),
         distance_heads: 1.0,
         ..RenderSettings::default()
     }
@@ -101,16 +103,17 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         (GaussianFit::Six, false),
         (GaussianFit::Four, true),
     ] {
-        let s = RenderSettings {
-            fit,
-            lod,
-            ..settings(Method::Ssg)
-        };
+        let fit_key = if fit == GaussianFit::Six { "6" } else { "4" };
+        let s = settings("ssg").with(
+            lookup("ssg").unwrap(),
+            &[
+                ("fit", fit_key),
+                ("lod", if lod { "true" } else { "false" }),
+            ],
+        );
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let (quad_depths, lod_distances) = match &r.gpu.sss {
-            Some(SssMethod::Ssg(g)) => (g.quad_depths.clone(), g.lod_distances.clone()),
-            _ => unreachable!(),
-        };
+        let g = r.method_as::<Ssg>().unwrap();
+        let (quad_depths, lod_distances) = (g.quad_depths.clone(), g.lod_distances.clone());
         let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
         let ndc: Vec<f32> = depth
             .iter()
@@ -190,11 +193,15 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
     let (diffuse, depth, skin) = synthetic();
     let mut images = Vec::new();
     for mask in [MaskMode::Stencil, MaskMode::Branch] {
-        let s = RenderSettings {
-            lod: false,
-            mask,
-            ..settings(Method::Ssg)
+        let mask_key = if mask == MaskMode::Stencil {
+            "stencil"
+        } else {
+            "branch"
         };
+        let s = settings("ssg").with(
+            lookup("ssg").unwrap(),
+            &[("lod", "false"), ("mask", mask_key)],
+        );
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         let (img, passes) = run(&mut r, &diffuse, &depth, &skin);
         let skin_n = skin.iter().filter(|&&b| b).count() as u64;
@@ -239,7 +246,7 @@ fn jittered_matches_cpu_reference() {
     let ctx = common::ctx();
     let scene = default_scene();
     let (diffuse, depth, skin) = synthetic();
-    let s = settings(Method::SsJittered);
+    let s = settings("ss-jittered");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
     let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
@@ -288,16 +295,15 @@ fn gaussian_lod_by_counts_on_a_dolly() {
                 width: 128,
                 height: 80,
                 shadow_size: 128,
-                method: Method::Ssg,
-                lod,
                 distance_heads: distance,
                 ..RenderSettings::default()
-            };
+            }
+            .with(
+                lookup("ssg").unwrap(),
+                &[("lod", if lod { "true" } else { "false" })],
+            );
             let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-            let lod_distances = match &r.gpu.sss {
-                Some(SssMethod::Ssg(g)) => g.lod_distances.clone(),
-                _ => unreachable!(),
-            };
+            let lod_distances = r.method_as::<Ssg>().unwrap().lod_distances.clone();
             let cap = r.capture(true).unwrap();
             let find = |pass: &str, image: &str| {
                 cap.dumps
@@ -367,12 +373,9 @@ fn poisson_matches_cpu_reference() {
             round_f16([n[0] / l, n[1] / l, n[2] / l, 0.0])
         })
         .collect();
-    let s = settings(Method::Poisson);
+    let s = settings("poisson");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-    let levels = match &r.gpu.sss {
-        Some(SssMethod::Poisson(p)) => p.levels,
-        _ => unreachable!(),
-    };
+    let levels = r.method_as::<Poisson>().unwrap().levels;
     let n16: Vec<u16> = normals
         .iter()
         .flatten()

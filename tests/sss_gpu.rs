@@ -3,10 +3,11 @@
 
 mod common;
 
+use dermis::method::separable::Separable;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::default_scene;
-use dermis::skin::kernel::SeparableKernel;
-use dermis::skin::separable_ref::{round_f16, separable_sss, SssInput, SssView};
+use dermis::skin::separable_ref::{separable_sss, SssInput, SssView};
+use dermis::skin::texel::round_f16;
 
 const W: usize = 96;
 const H: usize = 64;
@@ -62,10 +63,10 @@ fn gpu_matches_cpu_reference() {
     let settings = renderer_settings();
     let (diffuse, depth, skin) = synthetic();
     for follow in [true, false] {
-        let s = RenderSettings {
-            follow_surface: follow,
-            ..settings.clone()
-        };
+        let s = settings.clone().with(
+            common::m("separable"),
+            &[("follow-surface", if follow { "true" } else { "false" })],
+        );
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         let f16: Vec<u16> = diffuse
             .iter()
@@ -75,7 +76,8 @@ fn gpu_matches_cpu_reference() {
         r.upload_sss_inputs(&f16, &depth, &skin).unwrap();
         let (gpu, samples) = r.run_sss_only().unwrap();
 
-        let kernel = SeparableKernel::build(s.params, s.samples).unwrap();
+        // The kernel the method built for these options.
+        let kernel = r.method_as::<Separable>().unwrap().kernel.clone();
         let view = SssView {
             fovy_rad: s.fovy_deg.to_radians(),
             mm_per_unit: scene.mm_per_unit,

@@ -5,27 +5,29 @@
 
 mod common;
 
-use dermis::render::{Method, RenderSettings, Renderer};
+use dermis::method::{MethodEntry, MethodOptions};
+use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::mesh::{Aabb, Material, Mesh, Object, Vertex};
 use dermis::scene::{default_scene, Scene};
 use dermis::vk::context::Context;
 use glam::Vec3;
 
-const METHODS: [Method; 5] = [
-    Method::Separable,
-    Method::Ssg,
-    Method::SsJittered,
-    Method::Poisson,
-    Method::Reference,
-];
+fn methods() -> [&'static MethodEntry; 5] {
+    ["separable", "ssg", "ss-jittered", "poisson", "reference"].map(common::m)
+}
 
-fn small(method: Method) -> RenderSettings {
+/// Options with the reference's surface-sample density set.
+fn density(d: f32) -> MethodOptions {
+    MethodOptions::default().with(&[("density", &d.to_string())])
+}
+
+fn small(method: &'static MethodEntry) -> RenderSettings {
     RenderSettings {
         width: 64,
         height: 40,
         shadow_size: 128,
         method,
-        reference_density: 4.0,
+        options: density(4.0),
         ..RenderSettings::default()
     }
 }
@@ -62,10 +64,10 @@ fn extremes_stay_finite_and_non_negative() {
             s.light.elevation_deg = 0.5
         }),
         ("light from behind", |s| s.light.azimuth_deg = 180.0),
-        ("zero SSS width", |s| s.params.width_mm = 0.0),
-        ("huge SSS width", |s| s.params.width_mm = 1000.0),
+        ("zero SSS width", |s| s.options.set("sss-width-mm", "0")),
+        ("huge SSS width", |s| s.options.set("sss-width-mm", "1000")),
     ];
-    for method in METHODS {
+    for method in methods() {
         for (name, tweak) in cases {
             let mut s = small(method);
             tweak(&mut s);
@@ -85,7 +87,7 @@ fn extremes_stay_finite_and_non_negative() {
 fn non_skin_pixels_are_untouched_by_every_method() {
     let ctx = common::ctx();
     let scene = default_scene();
-    for method in METHODS {
+    for method in methods() {
         let (before, after) = before_after(
             &ctx,
             &scene,
@@ -173,13 +175,13 @@ fn halo_scene() -> Scene {
 fn halo_across_a_depth_discontinuity() {
     let ctx = common::ctx();
     let scene = halo_scene();
-    let base = |method: Method| {
+    let base = |method: &'static MethodEntry| {
         let mut s = RenderSettings {
             width: 96,
             height: 64,
             shadow_size: 256,
             method,
-            reference_density: 4.0,
+            options: density(4.0),
             distance_heads: 1.6,
             ambient: 0.0,
             transmittance: false,
@@ -208,18 +210,17 @@ fn halo_across_a_depth_discontinuity() {
             .map(|(p, _)| (p[0] + p[1] + p[2]) as f64)
             .sum()
     };
-    let (before, _) = before_after(&ctx, &scene, &base(Method::None));
+    let (before, _) = before_after(&ctx, &scene, &base(common::m("none")));
     assert!(before.iter().any(|p| p[0] > 0.05), "the ball is lit");
-    let reference = leak(&base(Method::Reference));
-    let none = leak(&base(Method::None));
-    let sep_follow = leak(&base(Method::Separable));
-    let sep_no_follow = leak(&RenderSettings {
-        follow_surface: false,
-        ..base(Method::Separable)
-    });
-    let ssg = leak(&base(Method::Ssg));
-    let jittered = leak(&base(Method::SsJittered));
-    let poisson = leak(&base(Method::Poisson));
+    let reference = leak(&base(common::m("reference")));
+    let none = leak(&base(common::m("none")));
+    let sep_follow = leak(&base(common::m("separable")));
+    let sep_no_follow = leak(
+        &base(common::m("separable")).with(common::m("separable"), &[("follow-surface", "false")]),
+    );
+    let ssg = leak(&base(common::m("ssg")));
+    let jittered = leak(&base(common::m("ss-jittered")));
+    let poisson = leak(&base(common::m("poisson")));
     println!(
         "energy on the unlit wall: reference {reference:.4}, none {none:.4}, separable {sep_follow:.4} (no follow-surface {sep_no_follow:.4}), ssg {ssg:.4}, ss-jittered {jittered:.4}, poisson {poisson:.4}"
     );
@@ -257,14 +258,14 @@ fn thin_parts_need_transmittance() {
     use dermis::eval::metrics::relative_rmse;
     let ctx = common::ctx();
     let scene = default_scene();
-    let backlit = |method: Method, transmittance: bool| {
+    let backlit = |method: &'static MethodEntry, transmittance: bool| {
         let mut s = RenderSettings {
             width: 160,
             height: 96,
             shadow_size: 1024,
             method,
             transmittance,
-            reference_density: 8.0,
+            options: density(8.0),
             ambient: 0.0,
             distance_heads: 2.0,
             ..RenderSettings::default()
@@ -273,7 +274,7 @@ fn thin_parts_need_transmittance() {
         s.light.elevation_deg = 5.0;
         s
     };
-    let (direct, reference) = before_after(&ctx, &scene, &backlit(Method::Reference, false));
+    let (direct, reference) = before_after(&ctx, &scene, &backlit(common::m("reference"), false));
     let skin: Vec<bool> = reference.iter().map(|p| p[3] > 0.0).collect();
     // Thin parts: where the reference receives light from behind, i.e. its red is
     // well above the unscattered direct light (transmittance off in its geometry pass).
@@ -290,10 +291,10 @@ fn thin_parts_need_transmittance() {
     let mut report = Vec::new();
     let mut integral = Vec::new();
     for method in [
-        Method::Separable,
-        Method::Ssg,
-        Method::SsJittered,
-        Method::Poisson,
+        common::m("separable"),
+        common::m("ssg"),
+        common::m("ss-jittered"),
+        common::m("poisson"),
     ] {
         let (_, off) = before_after(&ctx, &scene, &backlit(method, false));
         let (_, on) = before_after(&ctx, &scene, &backlit(method, true));
@@ -350,10 +351,10 @@ fn distance_sweep_does_not_pop() {
     let ctx = common::ctx();
     let scene = default_scene();
     let methods = [
-        Method::Separable,
-        Method::Ssg,
-        Method::SsJittered,
-        Method::Poisson,
+        common::m("separable"),
+        common::m("ssg"),
+        common::m("ss-jittered"),
+        common::m("poisson"),
     ];
     let mut curves: Vec<Vec<f64>> = vec![Vec::new(); methods.len()];
     for k in 0..11 {
@@ -361,15 +362,15 @@ fn distance_sweep_does_not_pop() {
             width: 96,
             height: 64,
             distance_heads: 2.0 * 1.15f32.powi(k),
-            reference_density: 8.0,
+            options: density(8.0),
             ..small(method)
         };
-        let (_, reference) = before_after(&ctx, &scene, &s(Method::Reference));
+        let (_, reference) = before_after(&ctx, &scene, &s(common::m("reference")));
         let mask: Vec<bool> = reference.iter().map(|p| p[3] > 0.0).collect();
-        let e = |m: Method| {
+        let e = |m: &'static MethodEntry| {
             relative_rmse(&before_after(&ctx, &scene, &s(m)).1, &reference, &mask).unwrap()
         };
-        let none = e(Method::None);
+        let none = e(common::m("none"));
         for (c, &m) in curves.iter_mut().zip(&methods) {
             c.push(e(m) - none);
         }
@@ -399,7 +400,7 @@ fn slow_orbit_does_not_flicker() {
             s
         })
         .collect();
-    let change = |method: Method| -> f64 {
+    let change = |method: &'static MethodEntry| -> f64 {
         let imgs: Vec<Vec<[f32; 4]>> = frames
             .iter()
             .map(|sc| {
@@ -409,7 +410,7 @@ fn slow_orbit_does_not_flicker() {
                     &RenderSettings {
                         width: 96,
                         height: 64,
-                        reference_density: 8.0,
+                        options: density(8.0),
                         ..small(method)
                     },
                 )
@@ -432,13 +433,13 @@ fn slow_orbit_does_not_flicker() {
         }
         total / (imgs.len() - 1) as f64
     };
-    let reference = change(Method::Reference);
+    let reference = change(common::m("reference"));
     let mut out = Vec::new();
     for method in [
-        Method::Separable,
-        Method::Ssg,
-        Method::SsJittered,
-        Method::Poisson,
+        common::m("separable"),
+        common::m("ssg"),
+        common::m("ss-jittered"),
+        common::m("poisson"),
     ] {
         out.push((method, change(method) - reference));
     }
@@ -457,15 +458,14 @@ fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
     use dermis::eval::metrics::relative_rmse;
     let ctx = common::ctx();
     let scene = default_scene();
-    let side = |method: Method, samples: usize| {
+    let side = |method: &'static MethodEntry, samples: usize| {
         let mut s = RenderSettings {
             width: 128,
             height: 80,
             shadow_size: 2048,
             method,
-            samples,
+            options: density(8.0).with(&[("samples", &samples.to_string())]),
             ambient: 0.02,
-            reference_density: 8.0,
             distance_heads: 2.5,
             ..small(method)
         };
@@ -473,7 +473,7 @@ fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
         s.light.elevation_deg = 10.0;
         s
     };
-    let (direct, reference) = before_after(&ctx, &scene, &side(Method::Reference, 17));
+    let (direct, reference) = before_after(&ctx, &scene, &side(common::m("reference"), 17));
     // The penumbra band: skin pixels whose direct light differs strongly from a
     // horizontal neighbour's (the shadow edge), where banding shows.
     let w = 128;
@@ -494,7 +494,7 @@ fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
             (
                 k,
                 relative_rmse(
-                    &before_after(&ctx, &scene, &side(Method::Separable, k)).1,
+                    &before_after(&ctx, &scene, &side(common::m("separable"), k)).1,
                     &reference,
                     &band,
                 )
@@ -509,16 +509,13 @@ fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
     // The other methods have no sample-count knob: their band error at their
     // widest setting (ssg: all 6 Gaussians everywhere, no LOD).
     let others: Vec<(&str, f64)> = [
-        ("ssg --no-lod", Method::Ssg),
-        ("ss-jittered", Method::SsJittered),
-        ("poisson", Method::Poisson),
+        ("ssg --no-lod", common::m("ssg")),
+        ("ss-jittered", common::m("ss-jittered")),
+        ("poisson", common::m("poisson")),
     ]
     .iter()
     .map(|&(name, m)| {
-        let s = RenderSettings {
-            lod: false,
-            ..side(m, 17)
-        };
+        let s = side(m, 17).with(m, &[("lod", "false")]);
         (
             name,
             relative_rmse(&before_after(&ctx, &scene, &s).1, &reference, &band).unwrap(),
@@ -535,8 +532,13 @@ fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
     // preset width (9.7 mm, where stepping shows first) against itself at 63
     // samples, in the same band.
     let wide = |k: usize| {
-        let mut s = side(Method::Separable, k);
-        s.params.width_mm *= 3.0;
+        let mut s = side(common::m("separable"), k);
+        let opts = common::m("separable").opts(&s.options);
+        let width = dermis::method::separable::Config::parse(&opts)
+            .unwrap()
+            .params
+            .width_mm;
+        s.options.set("sss-width-mm", (3.0 * width).to_string());
         before_after(&ctx, &scene, &s).1
     };
     let converged = wide(63);

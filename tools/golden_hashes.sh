@@ -9,7 +9,8 @@
 # every pass dump) and one line per pass of report.json (fragment invocations,
 # samples passed). Times are left out: they are the only thing allowed to move.
 # PROCEDURAL_SCENE_ARGS name the procedural scene (default: none, the embedded
-# default; after the default head changed: --scene builtin:egg).
+# default; after the default head changed: --scene builtin:egg). GRID="--layout grid"
+# keeps the 3-head case on the grid layout once the crowd became the default.
 set -euo pipefail
 out=$1; shift
 proc=("$@")
@@ -30,7 +31,7 @@ configs=(
   "ss-jittered|--method ss-jittered"
   "poisson|--method poisson"
   "separable screen region|--method separable --sss-region screen"
-  "separable 3 heads|--method separable --heads 3"
+  "separable 3 heads|--method separable --heads 3 ${GRID:-}"
   "reference|--method reference --density 8"
 )
 : > "$out"

@@ -8,16 +8,17 @@ use ash::vk;
 use serde::Serialize;
 
 use super::floor::Ceilings;
-use crate::graph::{record_passes, ImageId, Pass, PassContext, Resources};
-use crate::render::draw::begin_color_rendering;
-use crate::render::upload;
-use crate::render::LDR_FORMAT;
+use crate::graph::draw::{begin_rendering, Load};
+use crate::graph::work::{ColorWrite, Fetch, Filter, Format, PassRole, ShaderWork, Work};
+use crate::graph::{record_passes, work_format, ImageDesc, ImageId, Pass, PassContext, Resources};
+use crate::render::targets::LDR_FORMAT;
 use crate::report::Stats;
-use crate::vk::barrier::{AccessKind, ResourceState};
+use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::memory::Image;
 use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
 use crate::vk::profiler::Profiler;
+use crate::vk::upload;
 
 /// Fetches per fragment in the fetch probes: enough that fetches, not fill, bound them.
 pub const PROBE_TAPS: i32 = 16;
@@ -34,8 +35,10 @@ struct ProbePush {
 /// texture (fetch probes) or nothing (fill probes).
 struct Probe<'p> {
     pipeline: &'p Pipeline,
-    src: Option<(vk::DescriptorSet, ImageId)>,
-    target: (ImageId, vk::ImageView),
+    /// The source's set, and what a fetch of it is (the uploaded sources are
+    /// not frame images: their barriers were made by the upload).
+    src: Option<(vk::DescriptorSet, (Format, Filter))>,
+    target: ImageId,
     access: AccessKind,
 }
 
@@ -73,245 +76,281 @@ pub fn measure(
         vk::Format::R16G16B16A16_SFLOAT,
         bytemuck::cast_slice(&rgba),
     )?;
-    let mut src_r32 = upload::texture(
+    let mut src_r32 = match upload::texture(
         ctx,
         "probe r32f",
         extent,
         vk::Format::R32_SFLOAT,
         bytemuck::cast_slice(&r32),
-    )?;
-    let mut target = Image::new(
-        ctx,
-        "probe target",
-        extent,
-        vk::Format::R16G16B16A16_SFLOAT,
-        vk::ImageUsageFlags::COLOR_ATTACHMENT,
-    )?;
-    // The tone map writes 32 bpp: ROPs fill those at their own rate.
-    let mut target_ldr = Image::new(
-        ctx,
-        "probe target rgba8",
-        extent,
-        LDR_FORMAT,
-        vk::ImageUsageFlags::COLOR_ATTACHMENT,
-    )?;
-    let samplers = Samplers::new(ctx)?;
-    let mut pool = DescriptorPool::new(ctx, 8)?;
-    let mut fetch = Pipeline::graphics(
-        ctx,
-        &GraphicsDesc::fullscreen(
-            "probe fetch",
-            "probe_fetch.frag",
-            vk::Format::R16G16B16A16_SFLOAT,
-        ),
-    )?;
-    let mut fill = Pipeline::graphics(
-        ctx,
-        &GraphicsDesc::fullscreen(
-            "probe fill",
-            "probe_fill.frag",
-            vk::Format::R16G16B16A16_SFLOAT,
-        ),
-    )?;
-    let mut fill_ldr = Pipeline::graphics(
-        ctx,
-        &GraphicsDesc::fullscreen("probe fill rgba8", "probe_fill.frag", LDR_FORMAT),
-    )?;
-    // The ssg vertical pass blends RTF (eq. 4.9): a read-modify-write per pixel.
-    let mut fill_blend = Pipeline::graphics(ctx, &{
-        let mut d = GraphicsDesc::fullscreen(
-            "probe blend",
-            "probe_fill.frag",
-            vk::Format::R16G16B16A16_SFLOAT,
-        );
-        d.blend = Blend::ConstantMix(0);
-        d
-    })?;
-
-    let result = (|| -> Result<(Ceilings, Vec<ProbeResult>)> {
-        let mut res = Resources::default();
-        let id_rgba = res.add_image("probe rgba16f", src_rgba.raw, src_rgba.subresource_range());
-        let id_r32 = res.add_image("probe r32f", src_r32.raw, src_r32.subresource_range());
-        let id_target = res.add_image("probe target", target.raw, target.subresource_range());
-        let id_ldr = res.add_image(
-            "probe target rgba8",
-            target_ldr.raw,
-            target_ldr.subresource_range(),
-        );
-        res.images[id_rgba.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
-        res.images[id_r32.0].state = ResourceState::uploaded(AccessKind::FragmentSampledRead);
-        let set = |img: &Image, sampler| {
-            pool.write_set(
-                ctx,
-                &fetch,
-                0,
-                &[
-                    ("srcTex", Bind::Texture(img.view)),
-                    ("srcSampler", Bind::Sampler(sampler)),
-                ],
-            )
-        };
-        let fetch_probe = |s, id| Probe {
-            pipeline: &fetch,
-            src: Some((s, id)),
-            target: (id_target, target.view),
-            access: AccessKind::ColorAttachmentWrite,
-        };
-        let fill_probe = |pipeline, target, access| Probe {
-            pipeline,
-            src: None,
-            target,
-            access,
-        };
-        let probes: Vec<(&str, Probe)> = vec![
-            (
-                "bilinear rgba16f",
-                fetch_probe(set(&src_rgba, samplers.linear_clamp)?, id_rgba),
-            ),
-            (
-                "point rgba16f",
-                fetch_probe(set(&src_rgba, samplers.nearest_clamp)?, id_rgba),
-            ),
-            (
-                "bilinear r32f",
-                fetch_probe(set(&src_r32, samplers.linear_clamp)?, id_r32),
-            ),
-            (
-                "point r32f",
-                fetch_probe(set(&src_r32, samplers.nearest_clamp)?, id_r32),
-            ),
-            (
-                "fill rgba16f",
-                fill_probe(
-                    &fill,
-                    (id_target, target.view),
-                    AccessKind::ColorAttachmentWrite,
-                ),
-            ),
-            (
-                "fill rgba8",
-                fill_probe(
-                    &fill_ldr,
-                    (id_ldr, target_ldr.view),
-                    AccessKind::ColorAttachmentWrite,
-                ),
-            ),
-            (
-                "blend rgba16f",
-                fill_probe(
-                    &fill_blend,
-                    (id_target, target.view),
-                    AccessKind::ColorAttachmentLoadWrite,
-                ),
-            ),
-        ];
-        let texel = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
-        let mut passes = Vec::new();
-        // One untimed-in-effect warm-up round, then `reps` measured rounds.
-        for round in 0..=reps {
-            for (name, probe) in &probes {
-                let (pipeline, set) = (probe.pipeline, probe.src.map(|(s, _)| s));
-                let (target_id, target_view) = probe.target;
-                let load = if probe.access == AccessKind::ColorAttachmentLoadWrite {
-                    vk::AttachmentLoadOp::LOAD
-                } else {
-                    vk::AttachmentLoadOp::DONT_CARE
-                };
-                let mut pass = Pass::new(format!("{name} #{round}"));
-                if let Some((_, id)) = probe.src {
-                    pass = pass.image(id, AccessKind::FragmentSampledRead);
-                }
-                pass = pass
-                    .image(target_id, probe.access)
-                    .record(move |pc: &PassContext| {
-                        let (c, cmd) = (pc.ctx, pc.cmd);
-                        begin_color_rendering(c, cmd, &[target_view], extent, load);
-                        unsafe {
-                            c.device.cmd_bind_pipeline(
-                                cmd,
-                                vk::PipelineBindPoint::GRAPHICS,
-                                pipeline.raw,
-                            );
-                            if pipeline.has_blend_constants {
-                                c.device.cmd_set_blend_constants(cmd, &[0.5; 4]);
-                            }
-                            if let Some(s) = set {
-                                c.device.cmd_bind_descriptor_sets(
-                                    cmd,
-                                    vk::PipelineBindPoint::GRAPHICS,
-                                    pipeline.layout,
-                                    0,
-                                    &[s],
-                                    &[],
-                                );
-                                pipeline.push(
-                                    c,
-                                    cmd,
-                                    &ProbePush {
-                                        texel,
-                                        taps: PROBE_TAPS,
-                                        pad: 0,
-                                    },
-                                );
-                            }
-                            c.device.cmd_draw(cmd, 3, 1, 0, 0);
-                            c.device.cmd_end_rendering(cmd);
-                        }
-                    });
-                passes.push(pass);
-            }
+    ) {
+        Ok(t) => t,
+        Err(e) => {
+            src_rgba.destroy(ctx);
+            return Err(e);
         }
-        let profiler = Profiler::new(ctx, passes.len() as u32)?;
-        let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
-        let run = ctx.one_shot("ceiling probes", |cmd| {
-            record_passes(ctx, cmd, &mut res, &passes, Some(&profiler))
-        });
-        let samples = run.and_then(|_| profiler.read(ctx, &names));
-        profiler.destroy(ctx);
-        let samples = samples?;
-        ctx.check_validation("during the ceiling probes")?;
-        let mut results = Vec::new();
-        for (pi, (name, probe)) in probes.iter().enumerate() {
-            let times: Vec<f64> = (1..=reps)
-                .map(|r| samples[r * probes.len() + pi].gpu_ms)
-                .collect();
-            let stats = Stats::of(&times).expect("reps >= 1");
-            let taps = if probe.src.is_some() { PROBE_TAPS } else { 1 };
-            let ops = n as f64 * taps as f64;
-            results.push(ProbeResult {
-                name: name.to_string(),
-                taps_per_fragment: taps,
-                fragments: n as u64,
-                gpu_ms: stats,
-                rate_g_per_s: ops / (stats.median.max(1e-9) * 1e-3) / 1e9,
-            });
-        }
-        let r = |i: usize| results[i].rate_g_per_s;
-        Ok((
-            Ceilings {
-                bilinear_rgba16f_gtaps: r(0),
-                point_rgba16f_gtaps: r(1),
-                bilinear_r32f_gtaps: r(2),
-                point_r32f_gtaps: r(3),
-                fill_rgba16f_gpix: r(4),
-                fill_rgba8_gpix: r(5),
-                blend_rgba16f_gpix: r(6),
-            },
-            results,
-        ))
-    })();
+    };
+    let mut res = Resources::default();
+    let result = probe_all(ctx, &mut res, extent, reps, [&src_rgba, &src_r32]);
     unsafe {
         let _ = ctx.device.device_wait_idle();
     }
-    fetch.destroy(ctx);
-    fill.destroy(ctx);
-    fill_ldr.destroy(ctx);
-    fill_blend.destroy(ctx);
-    pool.destroy(ctx);
-    samplers.destroy(ctx);
+    res.destroy(ctx);
     src_rgba.destroy(ctx);
     src_r32.destroy(ctx);
-    target.destroy(ctx);
-    target_ldr.destroy(ctx);
     result
+}
+
+/// The probes proper, on the uploaded sources (rgba16f, r32f).
+fn probe_all(
+    ctx: &Context,
+    res: &mut Resources,
+    extent: vk::Extent2D,
+    reps: usize,
+    sources: [&Image; 2],
+) -> Result<(Ceilings, Vec<ProbeResult>)> {
+    let n = (extent.width * extent.height) as u64;
+    let id_target = res.declare(ImageDesc::new(
+        "probe target",
+        extent,
+        vk::Format::R16G16B16A16_SFLOAT,
+    ));
+    // The tone map writes 32 bpp: ROPs fill those at their own rate.
+    let id_ldr = res.declare(ImageDesc::new("probe target rgba8", extent, LDR_FORMAT));
+    res.allow(&[
+        (id_target, AccessKind::ColorAttachmentWrite),
+        (id_target, AccessKind::ColorAttachmentLoadWrite),
+        (id_ldr, AccessKind::ColorAttachmentWrite),
+    ]);
+    res.create(ctx)?;
+    let mut owned = Owned {
+        ctx,
+        samplers: Some(Samplers::new(ctx)?),
+        pool: None,
+        pipelines: Vec::new(),
+    };
+    owned.pool = Some(DescriptorPool::new(ctx, 8)?);
+    let rgba16f = vk::Format::R16G16B16A16_SFLOAT;
+    let mut blend = GraphicsDesc::fullscreen("probe blend", "probe_fill.frag", rgba16f);
+    // The ssg vertical pass blends RTF (eq. 4.9): a read-modify-write per pixel.
+    blend.blend = Blend::ConstantMix(0);
+    for d in [
+        GraphicsDesc::fullscreen("probe fetch", "probe_fetch.frag", rgba16f),
+        GraphicsDesc::fullscreen("probe fill", "probe_fill.frag", rgba16f),
+        GraphicsDesc::fullscreen("probe fill rgba8", "probe_fill.frag", LDR_FORMAT),
+        blend,
+    ] {
+        let p = Pipeline::graphics(ctx, &d)?;
+        owned.pipelines.push(p);
+    }
+    let samplers = owned.samplers.as_ref().expect("created above");
+    let pool = owned.pool.as_ref().expect("created above");
+    let [fetch, fill, fill_ldr, fill_blend] = [0, 1, 2, 3].map(|i| &owned.pipelines[i]);
+    let set = |img: &Image, sampler| {
+        pool.write_set(
+            ctx,
+            fetch,
+            0,
+            &[
+                ("srcTex", Bind::Texture(img.view)),
+                ("srcSampler", Bind::Sampler(sampler)),
+            ],
+        )
+    };
+    let [rgba, r32] = sources;
+    let fetch_probe = |s, format| Probe {
+        pipeline: fetch,
+        src: Some((s, format)),
+        target: id_target,
+        access: AccessKind::ColorAttachmentWrite,
+    };
+    let fill_probe = |pipeline, target, access| Probe {
+        pipeline,
+        src: None,
+        target,
+        access,
+    };
+    let probes: Vec<(&str, Probe)> = vec![
+        (
+            "bilinear rgba16f",
+            fetch_probe(
+                set(rgba, samplers.linear_clamp)?,
+                (Format::Rgba16Float, Filter::Bilinear),
+            ),
+        ),
+        (
+            "point rgba16f",
+            fetch_probe(
+                set(rgba, samplers.nearest_clamp)?,
+                (Format::Rgba16Float, Filter::Point),
+            ),
+        ),
+        (
+            "bilinear r32f",
+            fetch_probe(
+                set(r32, samplers.linear_clamp)?,
+                (Format::R32Float, Filter::Bilinear),
+            ),
+        ),
+        (
+            "point r32f",
+            fetch_probe(
+                set(r32, samplers.nearest_clamp)?,
+                (Format::R32Float, Filter::Point),
+            ),
+        ),
+        (
+            "fill rgba16f",
+            fill_probe(fill, id_target, AccessKind::ColorAttachmentWrite),
+        ),
+        (
+            "fill rgba8",
+            fill_probe(fill_ldr, id_ldr, AccessKind::ColorAttachmentWrite),
+        ),
+        (
+            "blend rgba16f",
+            fill_probe(fill_blend, id_target, AccessKind::ColorAttachmentLoadWrite),
+        ),
+    ];
+    let texel = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
+    let mut passes = Vec::new();
+    // One warm-up round, then `reps` measured rounds.
+    for round in 0..=reps {
+        for (name, probe) in &probes {
+            passes.push(probe.pass(res, &format!("{name} #{round}"), texel));
+        }
+    }
+    let profiler = Profiler::new(ctx, passes.len() as u32)?;
+    let run = ctx.one_shot("ceiling probes", |cmd| {
+        record_passes(ctx, cmd, res, &passes, Some(&profiler))
+    });
+    let samples = run.and_then(|_| profiler.read(ctx, passes.len()));
+    profiler.destroy(ctx);
+    let samples = samples?;
+    ctx.check_validation("during the ceiling probes")?;
+    let mut results = Vec::new();
+    for (pi, (name, probe)) in probes.iter().enumerate() {
+        let times: Vec<f64> = (1..=reps)
+            .map(|r| samples[r * probes.len() + pi].gpu_ms)
+            .collect();
+        let stats = Stats::of(&times).expect("reps >= 1");
+        let taps = if probe.src.is_some() { PROBE_TAPS } else { 1 };
+        let ops = n as f64 * taps as f64;
+        results.push(ProbeResult {
+            name: name.to_string(),
+            taps_per_fragment: taps,
+            fragments: n,
+            gpu_ms: stats,
+            rate_g_per_s: ops / (stats.median.max(1e-9) * 1e-3) / 1e9,
+        });
+    }
+    let r = |i: usize| results[i].rate_g_per_s;
+    Ok((
+        Ceilings {
+            bilinear_rgba16f_gtaps: r(0),
+            point_rgba16f_gtaps: r(1),
+            bilinear_r32f_gtaps: r(2),
+            point_r32f_gtaps: r(3),
+            fill_rgba16f_gpix: r(4),
+            fill_rgba8_gpix: r(5),
+            blend_rgba16f_gpix: r(6),
+        },
+        results,
+    ))
+}
+
+/// The probes' pipelines, pool and samplers, destroyed whatever happens.
+struct Owned<'c> {
+    ctx: &'c Context,
+    samplers: Option<Samplers>,
+    pool: Option<DescriptorPool>,
+    pipelines: Vec<Pipeline>,
+}
+
+impl Drop for Owned<'_> {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+        }
+        for p in &mut self.pipelines {
+            p.destroy(self.ctx);
+        }
+        if let Some(mut p) = self.pool.take() {
+            p.destroy(self.ctx);
+        }
+        if let Some(s) = self.samplers.take() {
+            s.destroy(self.ctx);
+        }
+    }
+}
+
+impl<'p> Probe<'p> {
+    fn pass(&self, res: &Resources, name: &str, texel: [f32; 2]) -> Pass<'p> {
+        let (pipeline, set) = (self.pipeline, self.src.map(|(s, _)| s));
+        let target = self.target;
+        let load = if self.access == AccessKind::ColorAttachmentLoadWrite {
+            Load::Keep
+        } else {
+            Load::Discard
+        };
+        let fetches = match self.src {
+            Some((_, (format, filter))) => vec![Fetch {
+                texture: "srcTex".into(),
+                format,
+                filter,
+                count: PROBE_TAPS as f64,
+                exact: true,
+            }],
+            None => Vec::new(),
+        };
+        let e = res.extent(target);
+        let work = Work::Raster {
+            shader: Some(ShaderWork {
+                shader: if set.is_some() {
+                    "probe_fetch.frag"
+                } else {
+                    "probe_fill.frag"
+                }
+                .into(),
+                fetches,
+                ..Default::default()
+            }),
+            color: vec![ColorWrite {
+                format: work_format(res.format(target)).expect("probe formats"),
+                blend: load == Load::Keep,
+            }],
+            depth_stencil: None,
+            width: e.width,
+            height: e.height,
+            triangles: 1,
+            msaa: 1,
+        };
+        Pass::new(name, PassRole::Probe)
+            .image(target, self.access)
+            .work(work)
+            .record(move |pc: &PassContext| {
+                let (c, cmd) = (pc.ctx, pc.cmd);
+                begin_rendering(pc, &[(target, load)], None);
+                pipeline.bind(c, cmd, set.as_slice());
+                unsafe {
+                    if pipeline.has_blend_constants {
+                        c.device.cmd_set_blend_constants(cmd, &[0.5; 4]);
+                    }
+                }
+                if set.is_some() {
+                    pipeline.push(
+                        c,
+                        cmd,
+                        &ProbePush {
+                            texel,
+                            taps: PROBE_TAPS,
+                            pad: 0,
+                        },
+                    );
+                }
+                unsafe {
+                    c.device.cmd_draw(cmd, 3, 1, 0, 0);
+                    c.device.cmd_end_rendering(cmd);
+                }
+            })
+    }
 }

@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use crate::graph::work::{ColorWrite, Fetch, Filter, Format, Work};
+
 /// Rates measured by the ceiling probes, in giga-operations per second.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Ceilings {
@@ -17,135 +19,73 @@ pub struct Ceilings {
     pub blend_rgba16f_gpix: f64,
 }
 
-/// A kind of fetch the passes make.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fetch {
-    BilinearRgba16f,
-    PointRgba16f,
-    BilinearR32f,
-    PointR32f,
-}
-
-/// A kind of pixel write the passes make.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Write {
-    Rgba16f,
-    Rgba16fBlend,
-    Rgba8,
-}
-
-/// What one fragment of a pass does.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PassCost {
-    pub fetches: Vec<(Fetch, f64)>,
-    pub writes: Vec<(Write, f64)>,
-}
-
 impl Ceilings {
-    fn rate(&self, f: Fetch) -> f64 {
-        match f {
-            Fetch::BilinearRgba16f => self.bilinear_rgba16f_gtaps,
-            Fetch::PointRgba16f => self.point_rgba16f_gtaps,
-            Fetch::BilinearR32f => self.bilinear_r32f_gtaps,
-            Fetch::PointR32f => self.point_r32f_gtaps,
-        }
-    }
-
-    fn fill(&self, w: Write) -> f64 {
-        match w {
-            Write::Rgba16f => self.fill_rgba16f_gpix,
-            Write::Rgba16fBlend => self.blend_rgba16f_gpix,
-            Write::Rgba8 => self.fill_rgba8_gpix,
-        }
+    /// One line of the measured rates, for the bench printout.
+    pub fn summary(&self) -> String {
+        format!(
+            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {:.2}, blended rgba16f {:.2}",
+            self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, self.fill_rgba8_gpix, self.blend_rgba16f_gpix
+        )
     }
 }
 
-/// Floor in milliseconds for `invocations` fragments.
-pub fn floor_ms(cost: &PassCost, invocations: u64, c: &Ceilings) -> f64 {
+/// Fetch rate of a declared fetch, if a probe measured that kind.
+fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
+    Some(match (f.format, f.filter) {
+        (Format::Rgba16Float, Filter::Bilinear) => c.bilinear_rgba16f_gtaps,
+        (Format::Rgba16Float, Filter::Point) => c.point_rgba16f_gtaps,
+        (Format::R32Float, Filter::Bilinear) => c.bilinear_r32f_gtaps,
+        (Format::R32Float, Filter::Point) => c.point_r32f_gtaps,
+        _ => return None,
+    })
+}
+
+/// Fill rate of a declared colour write, if a probe measured that kind.
+fn fill_rate(c: &Ceilings, w: &ColorWrite) -> Option<f64> {
+    Some(match (w.format, w.blend) {
+        (Format::Rgba16Float, false) => c.fill_rgba16f_gpix,
+        (Format::Rgba16Float, true) => c.blend_rgba16f_gpix,
+        (Format::Rgba8Srgb | Format::Rgba8Unorm, false) => c.fill_rgba8_gpix,
+        _ => return None,
+    })
+}
+
+/// Floor in milliseconds of a pass that shaded `invocations` fragments: its
+/// declared fetches at the probed fetch rates against its writes at the probed
+/// fill rates, the larger of the two. `None` where the floor would not be a
+/// floor: a pass whose declared counts are upper bounds (branches), or one that
+/// fetches or writes a kind no probe measured (the geometry pass's RGBA8 maps
+/// and depth compares, depth-only and copy passes).
+pub fn floor_ms(work: &Work, invocations: u64, c: &Ceilings) -> Option<f64> {
+    let Work::Raster {
+        shader: Some(shader),
+        color,
+        ..
+    } = work
+    else {
+        return None;
+    };
     let n = invocations as f64;
-    // giga-ops / (giga-ops per second) = seconds; x1e3 for ms.
-    let fetch_s: f64 = cost
-        .fetches
-        .iter()
-        .map(|&(f, per)| n * per / (c.rate(f) * 1e9))
-        .sum();
+    let mut fetch_s = 0.0;
+    for f in &shader.fetches {
+        if !f.exact {
+            return None;
+        }
+        // giga-ops / (giga-ops per second) = seconds.
+        fetch_s += n * f.count / (fetch_rate(c, f)? * 1e9);
+    }
     // Attachments of one MRT pass go through the ROPs one after another.
-    let fill_s: f64 = cost
-        .writes
-        .iter()
-        .map(|&(w, per)| n * per / (c.fill(w) * 1e9))
-        .sum();
-    fetch_s.max(fill_s) * 1e3
-}
-
-/// Cost of one separable SSS pass with `n_samples` taps: centre colour and depth
-/// by texelFetch, then n-1 bilinear colour taps and, with follow-surface, n-1
-/// bilinear depth taps; one RGBA16F write.
-pub fn separable_pass_cost(n_samples: usize, follow_surface: bool) -> PassCost {
-    let taps = n_samples.saturating_sub(1) as f64;
-    let mut fetches = vec![
-        (Fetch::PointRgba16f, 1.0),
-        (Fetch::PointR32f, 1.0),
-        (Fetch::BilinearRgba16f, taps),
-    ];
-    if follow_surface {
-        fetches.push((Fetch::BilinearR32f, taps));
+    let mut fill_s = 0.0;
+    for w in color {
+        fill_s += n / (fill_rate(c, w)? * 1e9);
     }
-    PassCost {
-        fetches,
-        writes: vec![(Write::Rgba16f, 1.0)],
-    }
-}
-
-/// One pass of an ssg Gaussian (Listing 4.1): centre colour and depth plus two
-/// depth texels for the gradient by texelFetch, 7 bilinear colour taps; the
-/// vertical pass writes two targets (RT1 and the blended RTF).
-pub fn ssg_pass_cost(vertical: bool) -> PassCost {
-    PassCost {
-        fetches: vec![
-            (Fetch::PointRgba16f, 1.0),
-            (Fetch::PointR32f, 3.0),
-            (Fetch::BilinearRgba16f, 7.0),
-        ],
-        writes: if vertical {
-            vec![(Write::Rgba16f, 1.0), (Write::Rgba16fBlend, 1.0)]
-        } else {
-            vec![(Write::Rgba16f, 1.0)]
-        },
-    }
-}
-
-/// ss-jittered: centre colour, centre depth and four gradient texels by
-/// texelFetch, 12 bilinear ring taps, one write.
-pub fn jittered_cost() -> PassCost {
-    PassCost {
-        fetches: vec![
-            (Fetch::PointRgba16f, 1.0),
-            (Fetch::PointR32f, 5.0),
-            (Fetch::BilinearRgba16f, 12.0),
-        ],
-        writes: vec![(Write::Rgba16f, 1.0)],
-    }
-}
-
-/// Composite: two point fetches, one write. Tone map: one fetch, one write.
-pub fn composite_cost() -> PassCost {
-    PassCost {
-        fetches: vec![(Fetch::PointRgba16f, 2.0)],
-        writes: vec![(Write::Rgba16f, 1.0)],
-    }
-}
-
-pub fn tonemap_cost() -> PassCost {
-    PassCost {
-        fetches: vec![(Fetch::PointRgba16f, 1.0)],
-        writes: vec![(Write::Rgba8, 1.0)],
-    }
+    Some(fetch_s.max(fill_s) * 1e3)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::graph::work::ShaderWork;
 
     fn h100_like() -> Ceilings {
         Ceilings {
@@ -159,22 +99,73 @@ mod tests {
         }
     }
 
+    fn fetch(format: Format, filter: Filter, count: f64) -> Fetch {
+        Fetch {
+            texture: "t".into(),
+            format,
+            filter,
+            count,
+            exact: true,
+        }
+    }
+
+    fn raster(fetches: Vec<Fetch>, color: Vec<ColorWrite>) -> Work {
+        Work::Raster {
+            shader: Some(ShaderWork {
+                shader: "s".into(),
+                fetches,
+                ..Default::default()
+            }),
+            color,
+            depth_stencil: None,
+            width: 1920,
+            height: 1080,
+            triangles: 1,
+            msaa: 1,
+        }
+    }
+
+    const RGBA16F: ColorWrite = ColorWrite {
+        format: Format::Rgba16Float,
+        blend: false,
+    };
+
     #[test]
     fn fetch_bound_pass() {
         // 1080p, 17 taps of colour + 17 of depth with follow-surface:
         // (1 + 1 + 16 + 16) fetches x 2073600 / 31e9 = 2.274 ms.
-        let ms = floor_ms(&separable_pass_cost(17, true), 1920 * 1080, &h100_like());
+        let w = raster(
+            vec![
+                fetch(Format::Rgba16Float, Filter::Point, 1.0),
+                fetch(Format::R32Float, Filter::Point, 1.0),
+                fetch(Format::Rgba16Float, Filter::Bilinear, 16.0),
+                fetch(Format::R32Float, Filter::Bilinear, 16.0),
+            ],
+            vec![RGBA16F],
+        );
+        let ms = floor_ms(&w, 1920 * 1080, &h100_like()).unwrap();
         assert!((ms - 34.0 * 2073600.0 / 31e9 * 1e3).abs() < 1e-9, "{ms}");
     }
 
     #[test]
     fn fill_bound_pass() {
-        // One fetch and one write: the 7 Gpix/s fill dominates.
-        let ms = floor_ms(&composite_cost(), 7_000_000, &h100_like());
+        // Two fetches and one write: the 7 Gpix/s fill dominates.
+        let composite = raster(
+            vec![fetch(Format::Rgba16Float, Filter::Point, 2.0)],
+            vec![RGBA16F],
+        );
+        let ms = floor_ms(&composite, 7_000_000, &h100_like()).unwrap();
         assert!((ms - 1.0).abs() < 1e-9);
-        assert_eq!(floor_ms(&composite_cost(), 0, &h100_like()), 0.0);
+        assert_eq!(floor_ms(&composite, 0, &h100_like()), Some(0.0));
         // The tone map writes 32 bpp, at its own (here twice the) rate.
-        let ms = floor_ms(&tonemap_cost(), 7_000_000, &h100_like());
+        let tonemap = raster(
+            vec![fetch(Format::Rgba16Float, Filter::Point, 1.0)],
+            vec![ColorWrite {
+                format: Format::Rgba8Srgb,
+                blend: false,
+            }],
+        );
+        let ms = floor_ms(&tonemap, 7_000_000, &h100_like()).unwrap();
         assert!((ms - 0.5).abs() < 1e-9, "{ms}");
     }
 
@@ -182,18 +173,41 @@ mod tests {
     fn mrt_writes_add_up() {
         // ssg vertical: one plain and one blended RGBA16F write per pixel:
         // 1/7 + 1/3.5 ns per pixel, more than its 11 fetches at 31 Gtap/s.
-        let ms = floor_ms(&ssg_pass_cost(true), 1_000_000, &h100_like());
+        let fetches = vec![
+            fetch(Format::Rgba16Float, Filter::Point, 1.0),
+            fetch(Format::R32Float, Filter::Point, 3.0),
+            fetch(Format::Rgba16Float, Filter::Bilinear, 7.0),
+        ];
+        let blended = ColorWrite {
+            blend: true,
+            ..RGBA16F
+        };
+        let v = raster(fetches.clone(), vec![RGBA16F, blended]);
+        let ms = floor_ms(&v, 1_000_000, &h100_like()).unwrap();
         let fill = 1e6 / 7e9 + 1e6 / 3.5e9;
         assert!((ms - fill * 1e3).abs() < 1e-9, "{ms}");
-        let h = floor_ms(&ssg_pass_cost(false), 1_000_000, &h100_like());
+        let h = floor_ms(&raster(fetches, vec![RGBA16F]), 1_000_000, &h100_like()).unwrap();
         assert!((h - 11.0 * 1e6 / 31e9 * 1e3).abs() < 1e-9, "{h}");
     }
 
+    // No floor where it would not bound the pass from below.
     #[test]
-    fn follow_surface_adds_depth_taps() {
-        let a = separable_pass_cost(9, false);
-        let b = separable_pass_cost(9, true);
-        assert_eq!(b.fetches.len(), a.fetches.len() + 1);
-        assert_eq!(b.fetches.last(), Some(&(Fetch::BilinearR32f, 8.0)));
+    fn no_floor_for_upper_bounds_or_unprobed_kinds() {
+        let mut f = fetch(Format::Rgba16Float, Filter::Bilinear, 32.0);
+        f.exact = false;
+        assert_eq!(
+            floor_ms(&raster(vec![f], vec![RGBA16F]), 100, &h100_like()),
+            None
+        );
+        let rgba8 = fetch(Format::Rgba8Unorm, Filter::Bilinear, 1.0);
+        assert_eq!(
+            floor_ms(&raster(vec![rgba8], vec![RGBA16F]), 100, &h100_like()),
+            None
+        );
+        let copy = Work::Copy {
+            texels: 10,
+            bytes_per_texel: 8,
+        };
+        assert_eq!(floor_ms(&copy, 100, &h100_like()), None);
     }
 }

@@ -8,8 +8,10 @@
 //!   their false-colour visualisation, masked energy for halo/leak checks);
 //! - `pareto`: cost/error points, their Pareto front and CSV export;
 //! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows;
-//! - `sweep`: `dermis eval`, the registry of methods and settings, the scene set.
+//! - `sweep`: the sweep of every registered method and setting over a scene set;
+//! - `study`: `dermis eval` and `dermis compare`: scene sets, outputs, charts.
 pub mod chart;
 pub mod metrics;
 pub mod pareto;
+pub mod study;
 pub mod sweep;

@@ -10,53 +10,33 @@ use serde::Serialize;
 
 use super::metrics::relative_rmse;
 use super::pareto::EvalPoint;
-use crate::render::screen::MaskMode;
-use crate::render::{Method, RenderSettings};
+use crate::method::{ground_truth, EvalSetting, MethodEntry, METHODS};
+use crate::render::RenderSettings;
 use crate::run::{run, RunOptions};
 use crate::scene::gltf_load::TextureOverrides;
 use crate::scene::{default_scene, load_gltf_scene, Scene};
-use crate::skin::ssg::GaussianFit;
 use crate::vk::context::Context;
 
 /// One point of the sweep: a method at one quality setting.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Config {
-    pub method: Method,
-    pub setting: String,
-    pub apply: fn(&mut RenderSettings),
+    pub method: &'static MethodEntry,
+    pub setting: &'static EvalSetting,
 }
 
-fn config(method: Method, setting: &str, apply: fn(&mut RenderSettings)) -> Config {
-    Config {
-        method,
-        setting: setting.to_string(),
-        apply,
-    }
-}
-
-/// The registry: every method and the knobs it registers.
+/// Every method's eval settings, in registry order (the ground truth is what
+/// they are scored against, not a point).
 pub fn registry() -> Vec<Config> {
-    vec![
-        config(Method::None, "-", |_| {}),
-        config(Method::Separable, "9 samples", |s| s.samples = 9),
-        config(Method::Separable, "17 samples", |s| s.samples = 17),
-        config(Method::Separable, "33 samples", |s| s.samples = 33),
-        config(Method::Ssg, "6 Gaussians, LOD", |s| {
-            s.fit = GaussianFit::Six
-        }),
-        config(Method::Ssg, "4 Gaussians, LOD", |s| {
-            s.fit = GaussianFit::Four
-        }),
-        config(Method::Ssg, "6 Gaussians, no LOD", |s| {
-            s.fit = GaussianFit::Six;
-            s.lod = false
-        }),
-        config(Method::Ssg, "6 Gaussians, branch mask", |s| {
-            s.mask = MaskMode::Branch
-        }),
-        config(Method::SsJittered, "13 taps", |_| {}),
-        config(Method::Poisson, "8-32 taps", |_| {}),
-    ]
+    METHODS
+        .iter()
+        .filter(|m| !m.ground_truth)
+        .flat_map(|m| {
+            m.eval.iter().map(move |s| Config {
+                method: m,
+                setting: s,
+            })
+        })
+        .collect()
 }
 
 /// A view of the scene set.
@@ -176,15 +156,7 @@ pub fn sweep(
         base.distance_heads = spec.distance_heads;
         base.light.azimuth_deg = spec.azimuth_deg;
         base.light.elevation_deg = spec.elevation_deg;
-        let once = RunOptions {
-            warmup: 0,
-            measured: 1,
-            capture: true,
-            dump: false,
-            ceilings: false,
-            command: "eval".into(),
-            progress: false,
-        };
+        let once = RunOptions::capture_once("eval");
         if let Some(b) = &bar {
             b.set_message(format!("{}: reference", spec.name));
         }
@@ -192,7 +164,7 @@ pub fn sweep(
             ctx,
             &scene,
             &RenderSettings {
-                method: Method::Reference,
+                method: ground_truth(),
                 ..base.clone()
             },
             &once,
@@ -205,21 +177,21 @@ pub fn sweep(
         }
         for c in configs {
             if let Some(b) = &bar {
-                b.set_message(format!("{}: {} {}", spec.name, c.method.name(), c.setting));
+                b.set_message(format!(
+                    "{}: {} {}",
+                    spec.name, c.method.name, c.setting.label
+                ));
             }
-            let mut s = RenderSettings {
-                method: c.method,
-                ..base.clone()
-            };
-            (c.apply)(&mut s);
+            let s = base.clone().with(c.method, c.setting.options);
             let o = RunOptions {
                 warmup: opts.warmup,
                 measured: opts.measured,
                 capture: true,
                 ..once.clone()
             };
-            let out = run(ctx, &scene, &s, &o)
-                .with_context(|| format!("{} {} on '{}'", c.method.name(), c.setting, spec.name))?;
+            let out = run(ctx, &scene, &s, &o).with_context(|| {
+                format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
+            })?;
             let diffuse = out.capture.context("capture")?.diffuse;
             // With no skin in view there is nothing to score.
             let error = if skin > 0 {
@@ -229,8 +201,8 @@ pub fn sweep(
             };
             rows.push(EvalRow {
                 point: EvalPoint {
-                    method: c.method.name().to_string(),
-                    setting: c.setting.clone(),
+                    method: c.method.name.to_string(),
+                    setting: c.setting.label.to_string(),
                     scene: spec.name.clone(),
                     gpu_ms: out.report.sss_total_ms.map_or(0.0, |s| s.median),
                     error,
@@ -247,6 +219,21 @@ pub fn sweep(
         b.finish_and_clear();
     }
     Ok(rows)
+}
+
+/// The summary as the CLI prints it.
+pub fn summary_table(summary: &[EvalPoint]) -> String {
+    let mut s = format!(
+        "{:<12} {:<26} {:>10} {:>12}\n",
+        "method", "setting", "SSS ms", "rel. RMSE"
+    );
+    for p in summary {
+        s.push_str(&format!(
+            "{:<12} {:<26} {:>10.4} {:>12.4e}\n",
+            p.method, p.setting, p.gpu_ms, p.error
+        ));
+    }
+    s
 }
 
 /// Mean cost and error of each (method, setting) over the scenes, for the chart.
@@ -281,33 +268,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn registry_covers_every_method_with_distinct_settings() {
+    fn registry_covers_every_method_but_the_ground_truth() {
         let r = registry();
-        for m in [
-            Method::None,
-            Method::Separable,
-            Method::Ssg,
-            Method::SsJittered,
-            Method::Poisson,
-        ] {
-            assert!(r.iter().any(|c| c.method == m), "{m:?} missing");
+        for m in METHODS {
+            assert_eq!(
+                r.iter().any(|c| c.method == *m),
+                !m.ground_truth,
+                "{}",
+                m.name
+            );
         }
-        let mut names: Vec<String> = r
-            .iter()
-            .map(|c| format!("{} {}", c.method.name(), c.setting))
-            .collect();
-        names.sort();
-        names.dedup();
-        assert_eq!(names.len(), r.len());
         // The separable sample counts of the thesis are all there.
-        for n in [9, 17, 33] {
-            let mut s = RenderSettings::default();
+        for n in ["9", "17", "33"] {
             let c = r
                 .iter()
-                .find(|c| c.setting == format!("{n} samples"))
+                .find(|c| c.setting.label == format!("{n} samples"))
                 .unwrap();
-            (c.apply)(&mut s);
-            assert_eq!(s.samples, n);
+            let s = RenderSettings::default().with(c.method, c.setting.options);
+            assert_eq!(s.method.opts(&s.options).raw("samples"), n);
         }
     }
 

@@ -91,7 +91,9 @@ pub enum Filter {
     DepthCompare,
 }
 
-/// One kind of texture fetch a unit of work makes, `count` times on average.
+/// One kind of texture fetch a unit of work makes, `count` times per invocation
+/// (where a shader branches, the count of the path every invocation may take:
+/// an upper bound; `exact` says whether it is also the count every invocation makes).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fetch {
     /// The shader's texture variable (what the fetch-counting build counts by).
@@ -99,6 +101,12 @@ pub struct Fetch {
     pub format: Format,
     pub filter: Filter,
     pub count: f64,
+    #[serde(default = "yes")]
+    pub exact: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// One colour attachment written by every shaded fragment.
@@ -122,6 +130,9 @@ pub struct DepthStencilUse {
 /// What one shader invocation does.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ShaderWork {
+    /// The shader file this describes (its fetch-counting build and its SPIR-V
+    /// are what the declaration is tested against).
+    pub shader: String,
     pub fetches: Vec<Fetch>,
     /// Arithmetic instructions executed per invocation (SPIR-V arithmetic, loops
     /// at their trip counts): an estimate, for ALU-bound pricing.
@@ -151,7 +162,10 @@ pub enum Work {
         msaa: u32,
     },
     /// Dispatches: `shader` runs `invocations` times per frame.
-    Compute { shader: ShaderWork, invocations: u64 },
+    Compute {
+        shader: ShaderWork,
+        invocations: u64,
+    },
     /// Image or buffer copies: `texels` texels of `bytes_per_texel` per frame.
     Copy { texels: u64, bytes_per_texel: u32 },
     /// Clears of `texels` texels of `bytes_per_texel`.
@@ -220,6 +234,7 @@ mod tests {
                     format: Format::Rgba16Float,
                     filter: Filter::Bilinear,
                     count: 16.0,
+                    exact: true,
                 }],
                 alu: 120.0,
                 ..Default::default()

@@ -6,7 +6,7 @@ use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::FrameGpu;
+use crate::graph::work::{PassRole, Work};
 use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
@@ -37,6 +37,7 @@ pub struct ReadbackPlan {
     buffers_before: usize,
 }
 
+/// Label prefix of the readback passes (a label only: they are found by role).
 const PREFIX: &str = "readback";
 
 /// Bytes per texel copied out of `format`, with the aspect to copy, or `None`
@@ -127,27 +128,23 @@ impl ReadbackPlan {
         Self::new(false, image)
     }
 
-    pub fn is_readback_pass(name: &str) -> bool {
-        name.starts_with(PREFIX)
-    }
-
     fn copy_pass<'a>(
         &mut self,
         ctx: &Context,
         res: &mut Resources,
-        targets: &FrameGpu,
         pass: &str,
         id: ImageId,
     ) -> Result<Option<Pass<'a>>> {
         // Mip levels above 0 are tracked as their own resources but not dumped.
-        let Some(img) = targets.image_by_id(id) else {
+        if res.level_of(id) > 0 {
+            return Ok(None);
+        }
+        let Some((bpt, aspect)) = copy_format(res.format(id)) else {
             return Ok(None);
         };
-        let Some((bpt, aspect)) = copy_format(img.format) else {
-            return Ok(None);
-        };
-        let size = img.extent.width as u64 * img.extent.height as u64 * bpt as u64;
-        let name = format!("{PREFIX} {pass} -> {}", img.name);
+        let extent = res.extent(id);
+        let size = extent.width as u64 * extent.height as u64 * bpt as u64;
+        let name = format!("{PREFIX} {pass} -> {}", res.name(id));
         let buffer = Buffer::new(
             ctx,
             &name,
@@ -156,7 +153,7 @@ impl ReadbackPlan {
             MemoryLocation::GpuToCpu,
         )?;
         let buffer_id = res.add_buffer(&name, buffer.raw);
-        let (raw_img, raw_buf, extent) = (img.raw, buffer.raw, img.extent);
+        let raw_buf = buffer.raw;
         self.pending.push(Pending {
             pass: pass.to_string(),
             image: id,
@@ -164,9 +161,13 @@ impl ReadbackPlan {
             buffer_id,
         });
         Ok(Some(
-            Pass::new(name)
+            Pass::new(name, PassRole::Readback)
                 .image(id, AccessKind::TransferRead)
                 .buffer(buffer_id, AccessKind::TransferWrite)
+                .work(Work::Copy {
+                    texels: extent.width as u64 * extent.height as u64,
+                    bytes_per_texel: bpt as u32,
+                })
                 .record(move |pc: &PassContext| {
                     let region = vk::BufferImageCopy::default()
                         .image_subresource(
@@ -182,8 +183,8 @@ impl ReadbackPlan {
                     unsafe {
                         pc.ctx.device.cmd_copy_image_to_buffer(
                             pc.cmd,
-                            raw_img,
-                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            pc.image(id).raw,
+                            pc.layout(id),
                             raw_buf,
                             &[region],
                         )
@@ -199,9 +200,8 @@ impl ReadbackPlan {
         ctx: &Context,
         res: &mut Resources,
         passes: Vec<Pass<'a>>,
-        targets: &FrameGpu,
     ) -> Result<Vec<Pass<'a>>> {
-        self.buffers_before = res.buffers.len();
+        self.buffers_before = res.buffer_count();
         let mut out = Vec::with_capacity(passes.len() * 2 + 2);
         for p in passes {
             let written: Vec<ImageId> = p
@@ -214,7 +214,7 @@ impl ReadbackPlan {
             out.push(p);
             if self.dump {
                 for id in written {
-                    if let Some(c) = self.copy_pass(ctx, res, targets, &name, id)? {
+                    if let Some(c) = self.copy_pass(ctx, res, &name, id)? {
                         out.push(c);
                     }
                 }
@@ -222,11 +222,11 @@ impl ReadbackPlan {
         }
         if !self.dump || !self.pending.iter().any(|p| p.image == self.final_image) {
             let c = self
-                .copy_pass(ctx, res, targets, "final", self.final_image)?
+                .copy_pass(ctx, res, "final", self.final_image)?
                 .context("the final image's format cannot be read back")?;
             out.push(c);
         }
-        let mut host = Pass::new(format!("{PREFIX} to host"));
+        let mut host = Pass::new(format!("{PREFIX} to host"), PassRole::Readback);
         for p in &self.pending {
             host = host.buffer(p.buffer_id, AccessKind::HostRead);
         }
@@ -234,14 +234,12 @@ impl ReadbackPlan {
         Ok(out)
     }
 
-    fn read(&self, p: &Pending, targets: &FrameGpu) -> Result<(u32, u32, vk::Format, Vec<u8>)> {
-        let img = targets
-            .image_by_id(p.image)
-            .context("readback image vanished")?;
+    fn read(&self, p: &Pending, res: &Resources) -> Result<(u32, u32, vk::Format, Vec<u8>)> {
+        let e = res.extent(p.image);
         Ok((
-            img.extent.width,
-            img.extent.height,
-            img.format,
+            e.width,
+            e.height,
+            res.format(p.image),
             p.buffer.read()?.to_vec(),
         ))
     }
@@ -251,20 +249,16 @@ impl ReadbackPlan {
         mut self,
         ctx: &Context,
         res: &mut Resources,
-        targets: &FrameGpu,
     ) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
         let mut final_bytes = None;
         let mut dumps = Vec::new();
         for p in &self.pending {
-            let (w, h, format, bytes) = self.read(p, targets)?;
+            let (w, h, format, bytes) = self.read(p, res)?;
             if p.image == self.final_image {
                 final_bytes = Some(bytes.clone());
             }
             if self.dump {
-                let image = targets
-                    .image_by_id(p.image)
-                    .map(|i| i.name.clone())
-                    .unwrap_or_default();
+                let image = res.name(p.image).to_string();
                 dumps.push(DumpedImage {
                     pass: p.pass.clone(),
                     image,
@@ -282,14 +276,9 @@ impl ReadbackPlan {
     }
 
     /// After the fence: the single image as float RGBA.
-    pub fn finish_single(
-        mut self,
-        ctx: &Context,
-        res: &mut Resources,
-        targets: &FrameGpu,
-    ) -> Result<Vec<[f32; 4]>> {
+    pub fn finish_single(mut self, ctx: &Context, res: &mut Resources) -> Result<Vec<[f32; 4]>> {
         let p = self.pending.first().context("nothing was read back")?;
-        let (_, _, format, bytes) = self.read(p, targets)?;
+        let (_, _, format, bytes) = self.read(p, res)?;
         let out = to_rgba_f32(format, &bytes);
         self.release(ctx, res);
         out
@@ -299,7 +288,7 @@ impl ReadbackPlan {
         for mut p in self.pending.drain(..) {
             p.buffer.destroy(ctx);
         }
-        res.buffers.truncate(self.buffers_before);
+        res.truncate_buffers(self.buffers_before);
     }
 }
 

@@ -3,12 +3,12 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::upload::{device_buffer, texture};
 use crate::scene::mesh::{Material, Object, Texture};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
+use crate::vk::upload::{device_buffer, texture};
 
 /// std140 layout of `MaterialUniforms` in geometry.frag.
 #[repr(C)]

@@ -1,87 +1,38 @@
-//! What a render is asked to do, validated before any GPU work.
+//! What a render is asked to do, validated before any GPU work: the frame's
+//! settings, the SSS method (a registry entry) and the options given to it.
 
-use anyhow::{bail, Result};
-use serde::Serialize;
+use anyhow::{bail, Context as _, Result};
 
-use super::screen::MaskMode;
+use crate::method::region::{RegionMode, TILE_PX};
+use crate::method::{default_method, MethodEntry, MethodOptions};
+use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
-use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
-use crate::skin::ssg::GaussianFit;
+use crate::skin::transmittance::TransmittanceProfile;
 
-/// The SSS method of a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Separable SSS (thesis ch. 6).
-    Separable,
-    /// Screen-space sum of Gaussians (thesis ch. 4, "SS Full").
-    Ssg,
-    /// Hable et al.'s 13-tap jittered kernel in screen space ("SS Jittered").
-    SsJittered,
-    /// Poisson-disk screen-space SSS weighted by depth and normal (seed 003).
-    Poisson,
-    /// The ground truth: brute-force integral over the skin surface (compute).
-    Reference,
-    /// No subsurface scattering: the baseline every method is compared to.
-    None,
-}
-
-impl std::str::FromStr for Method {
-    type Err = anyhow::Error;
-    fn from_str(s: &str) -> Result<Self> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "separable" | "ssss" => Ok(Method::Separable),
-            "ssg" => Ok(Method::Ssg),
-            "ss-jittered" | "jittered" => Ok(Method::SsJittered),
-            "poisson" => Ok(Method::Poisson),
-            "reference" | "ground-truth" => Ok(Method::Reference),
-            "none" | "off" => Ok(Method::None),
-            other => bail!(
-                "unknown method '{other}' (valid: separable, ssg, ss-jittered, poisson, reference, none)"
-            ),
-        }
-    }
-}
-
-impl Method {
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Separable => "separable",
-            Method::Ssg => "ssg",
-            Method::SsJittered => "ss-jittered",
-            Method::Poisson => "poisson",
-            Method::Reference => "reference",
-            Method::None => "none",
-        }
-    }
-}
+/// Largest frame side and shadow map dermis accepts before the device says
+/// more (its maxImageDimension2D is checked once it is open).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most characters a scene may hold.
+pub const MAX_HEADS: u32 = 1024;
 
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
-    pub method: Method,
-    pub samples: usize,
-    pub preset: Preset,
-    pub params: SssParams,
-    pub follow_surface: bool,
+    pub method: &'static MethodEntry,
+    /// Options given to the methods (each reads its own; see `method::options`).
+    pub options: MethodOptions,
     pub transmittance: bool,
-    /// ssg: the Gaussian fit of Table 4.2.
-    pub fit: GaussianFit,
-    /// ssg: depth-based Gaussian level of detail (section 4.2.1).
-    pub lod: bool,
-    /// ssg: stencil test or dynamic branch.
-    pub mask: MaskMode,
+    /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
+    pub transmittance_profile: TransmittanceProfile,
     /// Limit the SSS passes to the skin's neighbourhood, or run them on the screen.
-    pub sss_region: super::region::RegionMode,
+    pub sss_region: RegionMode,
     /// Side of the region's screen tiles in pixels (smaller: tighter, more draws).
     pub sss_region_tile: u32,
-    /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
-    pub transmittance_profile: crate::skin::transmittance::TransmittanceProfile,
-    /// reference: surface samples per mm^2.
-    pub reference_density: f32,
     pub heads: u32,
-    /// Camera distance from the head centre, in head heights.
+    /// How the characters stand when there are several.
+    pub layout: Layout,
+    /// Camera distance from the (first) head's centre, in head heights.
     pub distance_heads: f32,
     pub fovy_deg: f32,
     pub light: KeyLight,
@@ -96,20 +47,14 @@ impl Default for RenderSettings {
         RenderSettings {
             width: 1280,
             height: 720,
-            method: Method::Separable,
-            samples: 17,
-            preset: Preset::Table61,
-            params: Preset::Table61.params(),
-            follow_surface: true,
+            method: default_method(),
+            options: MethodOptions::default(),
             transmittance: true,
-            fit: GaussianFit::Six,
-            lod: true,
-            mask: MaskMode::Stencil,
-            sss_region: super::region::RegionMode::Skin,
-            sss_region_tile: super::region::TILE_PX,
-            reference_density: 32.0,
-            transmittance_profile: crate::skin::transmittance::TransmittanceProfile::Thesis,
+            transmittance_profile: TransmittanceProfile::Thesis,
+            sss_region: RegionMode::Skin,
+            sss_region_tile: TILE_PX,
             heads: 1,
+            layout: Layout::Crowd,
             distance_heads: 4.0,
             fovy_deg: 20.0,
             light: KeyLight {
@@ -126,6 +71,13 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// These settings with `method` and option `key` set to `value` (tests, eval).
+    pub fn with(mut self, method: &'static MethodEntry, options: &[(&str, &str)]) -> Self {
+        self.method = method;
+        self.options = self.options.with(options);
+        self
+    }
+
     /// Rejects settings that would give a bad frame or a driver error, with one
     /// clear message each.
     pub fn validate(&self, max_image_dimension: u32) -> Result<()> {
@@ -143,22 +95,16 @@ impl RenderSettings {
                 self.shadow_size
             );
         }
-        if self.samples % 2 == 0 || !(3..=SeparableKernel::MAX_SAMPLES).contains(&self.samples) {
-            bail!(
-                "samples must be odd and within 3..={}, got {}",
-                SeparableKernel::MAX_SAMPLES,
-                self.samples
-            );
-        }
-        self.params.validate()?;
+        (self.method.check)(&self.method.opts(&self.options))
+            .with_context(|| format!("method {}", self.method.name))?;
         if !(1..=1024).contains(&self.sss_region_tile) {
             bail!(
                 "the SSS region's tile must be 1..=1024 pixels, got {}",
                 self.sss_region_tile
             );
         }
-        if self.heads == 0 || self.heads > 1024 {
-            bail!("heads must be within 1..=1024, got {}", self.heads);
+        if self.heads == 0 || self.heads > MAX_HEADS {
+            bail!("heads must be within 1..={MAX_HEADS}, got {}", self.heads);
         }
         if !self.distance_heads.is_finite() || self.distance_heads <= 0.0 {
             bail!(
@@ -189,6 +135,7 @@ impl RenderSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::method::lookup;
 
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
@@ -216,29 +163,17 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("distance"));
-        let mut b = s.clone();
-        b.params.width_mm = -1.0;
+        let sep = lookup("separable").unwrap();
+        let b = s.clone().with(sep, &[("sss-width-mm", "-1")]);
         assert!(b.validate(16384).is_err());
-        let mut b = s.clone();
-        b.samples = 16;
-        assert!(b.validate(16384).unwrap_err().to_string().contains("odd"));
+        let b = s.clone().with(sep, &[("samples", "16")]);
+        let e = format!("{:#}", b.validate(16384).unwrap_err());
+        assert!(e.contains("odd"), "{e}");
+        // An option of another method is not this method's business.
+        let b = s.clone().with(lookup("ssg").unwrap(), &[("samples", "16")]);
+        b.validate(16384).unwrap();
         let mut b = s;
         b.light.intensity = f32::NAN;
         assert!(b.validate(16384).is_err());
-    }
-
-    #[test]
-    fn method_names_round_trip() {
-        for m in [
-            Method::Separable,
-            Method::Ssg,
-            Method::SsJittered,
-            Method::Poisson,
-            Method::Reference,
-            Method::None,
-        ] {
-            assert_eq!(m.name().parse::<Method>().unwrap(), m);
-        }
-        assert!("ssg-typo".parse::<Method>().is_err());
     }
 }

@@ -3,9 +3,10 @@
 //! independent of Vulkan so it can be tested without a GPU.
 
 pub mod camera;
+pub mod framing;
 pub mod gltf_load;
 pub mod head_measure;
-pub mod instancing;
+pub mod layout;
 pub mod light;
 pub mod mesh;
 pub mod procedural;

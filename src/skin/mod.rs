@@ -16,4 +16,5 @@ pub mod screen_ref;
 pub mod separable_ref;
 pub mod ssg;
 pub mod ssg_ref;
+pub mod texel;
 pub mod transmittance;

@@ -51,7 +51,7 @@ pub struct SssView {
     pub follow_tolerance_mm: f32,
 }
 
-use super::screen_ref::{bilinear as bilinear_uv, lerp};
+use super::texel::{bilinear as bilinear_uv, lerp, round_f16};
 
 /// Bilinear fetch of `C` channels at `uv` (the rule of `screen_ref`).
 fn bilinear<const C: usize>(
@@ -138,33 +138,6 @@ pub fn sss_pass(
             dst[p] = [acc[0], acc[1], acc[2], color_m[3]];
         }
     }
-}
-
-/// Rounds each component through IEEE half precision (RGBA16F storage).
-pub fn round_f16(v: [f32; 4]) -> [f32; 4] {
-    v.map(|c| half::f16::from_f32(c).to_f32())
-}
-
-/// How a device rounds f32 to a 16-bit float target. Vulkan allows either
-/// round-to-nearest-even or round-toward-zero; lavapipe truncates (measured by
-/// `tests/screen_gpu.rs`: its stores are never above the nearest-even values).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum F16Rounding {
-    NearestEven,
-    TowardZero,
-}
-
-/// `round_f16` with an explicit rounding mode.
-pub fn round_f16_with(v: [f32; 4], mode: F16Rounding) -> [f32; 4] {
-    v.map(|c| {
-        let h = half::f16::from_f32(c);
-        if mode == F16Rounding::NearestEven || !c.is_finite() || h.to_f32().abs() <= c.abs() {
-            return h.to_f32();
-        }
-        // Rounded away from zero: step one ulp back toward zero (the magnitude
-        // bits of an IEEE half are ordered, so the previous pattern is one ulp less).
-        half::f16::from_bits(h.to_bits() - 1).to_f32()
-    })
 }
 
 /// Both passes as the GPU runs them: the intermediate target starts as a

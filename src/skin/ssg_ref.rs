@@ -23,9 +23,8 @@
 //! their target held, including stale values from earlier Gaussians, which
 //! the next pass may sample: that is the GPU's behaviour too.
 
-use super::screen_ref::{bilinear4, pixel_uv};
-use super::separable_ref::{round_f16_with, F16Rounding};
 use super::ssg::{ssg_gaussians, GaussianFit, Stretch, LISTING_4_1_WEIGHTS};
+use super::texel::{bilinear4, pixel_uv, round_f16_with, F16Rounding};
 
 /// Inputs of the chain (all slices row-major, `width * height`).
 #[derive(Clone, Copy, Debug)]
@@ -169,7 +168,7 @@ pub fn ssg_with_rounding(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skin::separable_ref::round_f16;
+    use crate::skin::texel::round_f16;
 
     fn noise_image(n: usize, alpha: f32) -> Vec<[f32; 4]> {
         let mut state = 0x1234_5678_u32;

@@ -53,6 +53,11 @@ pub struct DeviceFacts {
     pub max_storage_buffer_range: u32,
     pub min_storage_buffer_offset_alignment: u64,
     pub sub_texel_precision_bits: u32,
+    /// Size of the largest device-local memory heap, bytes.
+    pub device_local_bytes: u64,
+    /// Whether fragment shaders may write storage buffers (enabled when present:
+    /// the fetch-counting build of the shaders needs it).
+    pub fragment_stores_and_atomics: bool,
 }
 
 /// Validation messages collected by the debug messenger. Any message is an error:
@@ -270,6 +275,8 @@ impl Context {
             .occlusion_query_precise(features.occlusion_query_precise == vk::TRUE)
             // Sum-of-Gaussians SSS writes RT1 unblended and blends RTF in one MRT pass.
             .independent_blend(features.independent_blend == vk::TRUE)
+            // The fetch-counting build of the shaders counts with atomics.
+            .fragment_stores_and_atomics(features.fragment_stores_and_atomics == vk::TRUE)
             .sampler_anisotropy(false);
         let mut features2 = vk::PhysicalDeviceFeatures2::default().features(base_features);
         let device_info = vk::DeviceCreateInfo::default()
@@ -325,6 +332,16 @@ impl Context {
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             min_storage_buffer_offset_alignment: props.limits.min_storage_buffer_offset_alignment,
             sub_texel_precision_bits: props.limits.sub_texel_precision_bits,
+            device_local_bytes: {
+                let m = unsafe { instance.get_physical_device_memory_properties(physical) };
+                m.memory_heaps_as_slice()
+                    .iter()
+                    .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+                    .map(|h| h.size)
+                    .max()
+                    .unwrap_or(0)
+            },
+            fragment_stores_and_atomics: features.fragment_stores_and_atomics == vk::TRUE,
         };
 
         let ctx = Context {
@@ -346,6 +363,23 @@ impl Context {
         ctx.name(ctx.queue, "main queue");
         ctx.name(ctx.command_pool, "main command pool");
         Ok(ctx)
+    }
+
+    /// Every Vulkan device the instance sees: index, name, type.
+    pub fn devices(&self) -> Result<Vec<(usize, String, String)>> {
+        let devices = unsafe { self.instance.enumerate_physical_devices() }?;
+        Ok(devices
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let p = unsafe { self.instance.get_physical_device_properties(*d) };
+                let name = p
+                    .device_name_as_c_str()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                (i, name, format!("{:?}", p.device_type))
+            })
+            .collect())
     }
 
     /// Names a Vulkan object for validation messages and captures.

@@ -1,8 +1,10 @@
 //! The Vulkan layer: one file per concept (context, barrier table, memory,
-//! shaders and reflection, pipelines, profiler).
+//! shaders and reflection, pipelines, profiler, set-up uploads).
 pub mod barrier;
 pub mod context;
 pub mod memory;
 pub mod pipeline;
 pub mod profiler;
 pub mod shader;
+pub mod shader_stats;
+pub mod upload;

@@ -292,6 +292,31 @@ impl Pipeline {
         }
     }
 
+    /// Binds the pipeline and `sets` as sets 0.. (the one place passes bind).
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, sets: &[vk::DescriptorSet]) {
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, self.bind_point, self.raw);
+        }
+        self.bind_sets(ctx, cmd, 0, sets);
+    }
+
+    /// Binds `sets` from set number `first` on.
+    pub fn bind_sets(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        first: u32,
+        sets: &[vk::DescriptorSet],
+    ) {
+        if sets.is_empty() {
+            return;
+        }
+        unsafe {
+            ctx.device
+                .cmd_bind_descriptor_sets(cmd, self.bind_point, self.layout, first, sets, &[])
+        };
+    }
+
     /// Pushes constants to every stage of the reflected range.
     pub fn push<T: bytemuck::Pod>(&self, ctx: &Context, cmd: vk::CommandBuffer, value: &T) {
         let (offset, size, stages) = self

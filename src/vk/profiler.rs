@@ -23,10 +23,9 @@ pub struct Profiler {
     valid_mask: u64,
 }
 
-/// What the GPU measured for one pass in one frame.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PassSample {
-    pub name: String,
+/// What the GPU measured for one pass (by its query slot) in one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassTiming {
     pub barrier_ms: f64,
     pub gpu_ms: f64,
     pub fragment_invocations: Option<u64>,
@@ -142,9 +141,9 @@ impl Profiler {
         }
     }
 
-    /// Reads the results of `names.len()` passes after the frame's fence.
-    pub fn read(&self, ctx: &Context, names: &[String]) -> Result<Vec<PassSample>> {
-        let n = names.len() as u32;
+    /// Reads the results of the first `n` query slots after the frame's fence.
+    pub fn read(&self, ctx: &Context, n: usize) -> Result<Vec<PassTiming>> {
+        let n = n as u32;
         let mut ts = vec![0u64; (n * 3) as usize];
         unsafe {
             ctx.device.get_query_pool_results(
@@ -181,11 +180,8 @@ impl Profiler {
             let d = (b & self.valid_mask).wrapping_sub(a & self.valid_mask) & self.valid_mask;
             d as f64 * self.period_ns * 1e-6
         };
-        Ok(names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| PassSample {
-                name: name.clone(),
+        Ok((0..n as usize)
+            .map(|i| PassTiming {
                 barrier_ms: ms(ts[i * 3], ts[i * 3 + 1]),
                 gpu_ms: ms(ts[i * 3 + 1], ts[i * 3 + 2]),
                 fragment_invocations: self.stats.map(|_| inv[i]),

@@ -38,3 +38,8 @@ pub fn lps_path() -> Option<PathBuf> {
     }
     None
 }
+
+/// A registered method by CLI name.
+pub fn m(name: &str) -> &'static dermis::method::MethodEntry {
+    dermis::method::lookup(name).expect("a registered method")
+}

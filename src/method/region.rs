@@ -293,6 +293,54 @@ pub fn cluster_bounds(mesh: &Mesh, cells: u32) -> Vec<Aabb> {
     boxes.into_iter().flatten().collect()
 }
 
+/// Cells per axis of the grid that clusters skin triangles: 8^3 = at most 512
+/// boxes per head, projected once per renderer.
+pub const CLUSTER_CELLS: u32 = 8;
+
+/// The SSS region of a method in a scene: every skin object's triangle
+/// clusters, once per character (`instances`), widened by `reach` (the
+/// method's reach in pixels at a depth; `None`: the whole screen).
+pub fn scene_region(
+    scene: &crate::scene::Scene,
+    instances: &[Mat4],
+    v: &RegionView,
+    tan_half_fovy: f32,
+    tile: u32,
+    reach: impl Fn(f32, &ReachScale) -> Option<f32>,
+) -> Vec<PixelRect> {
+    let skin: Vec<&crate::scene::mesh::Object> = scene
+        .backdrop
+        .iter()
+        .chain(std::iter::once(&scene.head))
+        .filter(|o| o.material.skin)
+        .collect();
+    let scale = ReachScale {
+        height_px: v.height,
+        tan_half_fovy,
+        mm_per_unit: scene.mm_per_unit,
+        max_strength: skin
+            .iter()
+            .map(|o| o.material.sss_strength)
+            .fold(0.0, f32::max),
+    };
+    // Skin objects are drawn once per character (see the geometry pass).
+    let boxes: Vec<Aabb> = skin
+        .iter()
+        .flat_map(|o| {
+            let clusters = cluster_bounds(&o.mesh, CLUSTER_CELLS);
+            instances
+                .iter()
+                .flat_map(move |m| clusters.clone().into_iter().map(move |b| b.transformed(m)))
+        })
+        .collect();
+    skin_region(
+        v,
+        boxes,
+        |d| reach(d, &scale).unwrap_or(f32::INFINITY),
+        tile,
+    )
+}
+
 /// Pixels per millimetre on screen at view depth `depth` (scene units): the
 /// scale every screen-space kernel converts its millimetres with.
 pub fn px_per_mm(depth: f32, height_px: u32, tan_half_fovy: f32, mm_per_unit: f32) -> f32 {

@@ -1,0 +1,445 @@
+//! Declared images and tracked buffers, their last access, and the barriers
+//! between accesses.
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+
+use super::work::{Format, ImageUse, ImageUseKind};
+use crate::vk::barrier::{image_barrier, AccessKind, ResourceState};
+use crate::vk::context::Context;
+use crate::vk::memory::Image;
+
+/// A tracked image subresource: one mip level of a declared image (level 0 for
+/// single-level images). Levels are tracked apart because passes read one level
+/// and write the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ImageId(pub usize);
+/// A tracked buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BufferId(pub usize);
+
+/// What an image is, before it exists. Its usage is not part of it: it follows
+/// from the accesses the passes declare.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageDesc {
+    pub name: String,
+    pub extent: vk::Extent2D,
+    pub format: vk::Format,
+    pub levels: u32,
+}
+
+impl ImageDesc {
+    pub fn new(name: &str, extent: vk::Extent2D, format: vk::Format) -> Self {
+        ImageDesc {
+            name: name.into(),
+            extent,
+            format,
+            levels: 1,
+        }
+    }
+
+    pub fn with_levels(mut self, levels: u32) -> Self {
+        self.levels = levels.max(1);
+        self
+    }
+}
+
+struct Slot {
+    desc: ImageDesc,
+    usage: vk::ImageUsageFlags,
+    image: Option<Image>,
+}
+
+struct ImageEntry {
+    name: String,
+    slot: usize,
+    level: u32,
+    state: ResourceState,
+}
+
+struct BufferEntry {
+    name: String,
+    raw: vk::Buffer,
+    state: ResourceState,
+}
+
+/// Every declared image (the graph owns them), every tracked buffer (their
+/// owners keep them), and their last access. Lives as long as the renderer, so
+/// the state carries over from frame to frame.
+#[derive(Default)]
+pub struct Resources {
+    slots: Vec<Slot>,
+    images: Vec<ImageEntry>,
+    buffers: Vec<BufferEntry>,
+}
+
+impl Resources {
+    /// Declares an image; returns the id of level 0 (level `l` is
+    /// [`Resources::level`]). It is created by [`Resources::create`].
+    pub fn declare(&mut self, desc: ImageDesc) -> ImageId {
+        let slot = self.slots.len();
+        let first = ImageId(self.images.len());
+        for level in 0..desc.levels.max(1) {
+            let name = if level == 0 {
+                desc.name.clone()
+            } else {
+                format!("{} mip {level}", desc.name)
+            };
+            self.images.push(ImageEntry {
+                name,
+                slot,
+                level,
+                state: ResourceState::default(),
+            });
+        }
+        self.slots.push(Slot {
+            desc,
+            usage: vk::ImageUsageFlags::empty(),
+            image: None,
+        });
+        first
+    }
+
+    /// The id of mip level `level` of the image whose level 0 is `id`.
+    pub fn level(&self, id: ImageId, level: u32) -> ImageId {
+        let e = &self.images[id.0];
+        assert!(
+            e.level == 0 && level < self.slots[e.slot].desc.levels,
+            "image '{}' has no mip level {level}",
+            e.name
+        );
+        ImageId(id.0 + level as usize)
+    }
+
+    /// Every level of the image whose level 0 is `id`, in order.
+    pub fn levels(&self, id: ImageId) -> Vec<ImageId> {
+        let n = self.slots[self.images[id.0].slot].desc.levels;
+        (0..n).map(|l| self.level(id, l)).collect()
+    }
+
+    /// Adds the usages that `accesses` need to their images. Any image a pass
+    /// writes may also be copied to the host (captures, `--dump`): that copy is
+    /// declared here, once, rather than by every pass that writes an image.
+    pub fn allow(&mut self, accesses: &[(ImageId, AccessKind)]) {
+        for &(id, access) in accesses {
+            let slot = self.images[id.0].slot;
+            let mut usage = access.image_usage();
+            if access.is_write() {
+                usage |= vk::ImageUsageFlags::TRANSFER_SRC;
+            }
+            let s = &mut self.slots[slot];
+            assert!(
+                s.image.is_none() || s.usage.contains(usage),
+                "image '{}' is used as {access:?} after it was created without that usage",
+                s.desc.name
+            );
+            s.usage |= usage;
+        }
+    }
+
+    /// Creates every declared image that does not exist yet, with the usage its
+    /// declared accesses need.
+    pub fn create(&mut self, ctx: &Context) -> Result<()> {
+        for s in &mut self.slots {
+            if s.image.is_some() {
+                continue;
+            }
+            anyhow::ensure!(
+                !s.usage.is_empty(),
+                "image '{}' is declared but no pass uses it",
+                s.desc.name
+            );
+            let d = &s.desc;
+            s.image = Some(
+                Image::with_levels(ctx, &d.name, d.extent, d.format, s.usage, d.levels)
+                    .with_context(|| format!("creating the frame image '{}'", d.name))?,
+            );
+        }
+        Ok(())
+    }
+
+    /// Destroys every image the graph created (after the GPU is done with them).
+    pub fn destroy(&mut self, ctx: &Context) {
+        for s in &mut self.slots {
+            if let Some(mut i) = s.image.take() {
+                i.destroy(ctx);
+            }
+        }
+    }
+
+    fn slot(&self, id: ImageId) -> &Slot {
+        &self.slots[self.images[id.0].slot]
+    }
+
+    /// The image behind `id` (any level). Panics before [`Resources::create`]:
+    /// a pass that records before set-up finished is a programmer error.
+    pub fn image(&self, id: ImageId) -> &Image {
+        let s = self.slot(id);
+        s.image
+            .as_ref()
+            .unwrap_or_else(|| panic!("image '{}' used before it was created", s.desc.name))
+    }
+
+    /// Whether the image behind `id` exists yet.
+    pub fn is_created(&self, id: ImageId) -> bool {
+        self.slot(id).image.is_some()
+    }
+
+    /// The view of exactly the level `id` names.
+    pub fn view(&self, id: ImageId) -> vk::ImageView {
+        self.image(id).level_views[self.images[id.0].level as usize]
+    }
+
+    /// The mip level `id` names.
+    pub fn level_of(&self, id: ImageId) -> u32 {
+        self.images[id.0].level
+    }
+
+    pub fn name(&self, id: ImageId) -> &str {
+        &self.images[id.0].name
+    }
+
+    pub fn format(&self, id: ImageId) -> vk::Format {
+        self.slot(id).desc.format
+    }
+
+    /// The size of the level `id` names.
+    pub fn extent(&self, id: ImageId) -> vk::Extent2D {
+        let d = &self.slot(id).desc;
+        let l = self.images[id.0].level;
+        vk::Extent2D {
+            width: (d.extent.width >> l).max(1),
+            height: (d.extent.height >> l).max(1),
+        }
+    }
+
+    /// The usage `id`'s image is (or will be) created with.
+    pub fn usage(&self, id: ImageId) -> vk::ImageUsageFlags {
+        self.slot(id).usage
+    }
+
+    /// Every tracked image subresource.
+    pub fn image_ids(&self) -> impl Iterator<Item = ImageId> {
+        (0..self.images.len()).map(ImageId)
+    }
+
+    /// Marks `id` as filled by a finished upload that left it in `access`.
+    pub fn set_uploaded(&mut self, id: ImageId, access: AccessKind) {
+        self.images[id.0].state = ResourceState::uploaded(access);
+    }
+
+    pub fn add_buffer(&mut self, name: &str, raw: vk::Buffer) -> BufferId {
+        self.buffers.push(BufferEntry {
+            name: name.into(),
+            raw,
+            state: ResourceState::default(),
+        });
+        BufferId(self.buffers.len() - 1)
+    }
+
+    /// Marks buffer `id` as filled by a finished upload that left it in `access`.
+    pub fn set_buffer_uploaded(&mut self, id: BufferId, access: AccessKind) {
+        self.buffers[id.0].state = ResourceState::uploaded(access);
+    }
+
+    pub fn buffer_name(&self, id: BufferId) -> &str {
+        &self.buffers[id.0].name
+    }
+
+    /// Number of tracked buffers (temporary ones are dropped with `truncate_buffers`).
+    pub fn buffer_count(&self) -> usize {
+        self.buffers.len()
+    }
+
+    pub fn truncate_buffers(&mut self, n: usize) {
+        self.buffers.truncate(n);
+    }
+
+    /// How a pass uses each image it declares, for reports and the budget model.
+    pub fn image_uses(&self, accesses: &[(ImageId, AccessKind)]) -> Vec<ImageUse> {
+        accesses
+            .iter()
+            .filter_map(|&(id, a)| {
+                let kind = match a {
+                    AccessKind::ColorAttachmentWrite => ImageUseKind::ColorTarget,
+                    AccessKind::ColorAttachmentLoadWrite => ImageUseKind::ColorTargetLoad,
+                    AccessKind::DepthStencilWrite => ImageUseKind::DepthTarget,
+                    AccessKind::DepthStencilReadOnly => ImageUseKind::DepthTest,
+                    AccessKind::FragmentSampledRead
+                    | AccessKind::ComputeSampledRead
+                    | AccessKind::AnyShaderSampledRead => ImageUseKind::Sampled,
+                    AccessKind::ComputeStorageWrite
+                    | AccessKind::ComputeStorageRead
+                    | AccessKind::ComputeStorageReadWrite
+                    | AccessKind::FragmentStorageRead => ImageUseKind::Storage,
+                    AccessKind::TransferRead => ImageUseKind::CopySource,
+                    AccessKind::TransferWrite
+                    | AccessKind::TransferWritePartial
+                    | AccessKind::ClearWrite => ImageUseKind::CopyDestination,
+                    AccessKind::HostRead | AccessKind::HostWrite => ImageUseKind::Host,
+                    AccessKind::Nothing | AccessKind::UniformRead | AccessKind::VertexInputRead => {
+                        return None
+                    }
+                };
+                let e = self.extent(id);
+                Some(ImageUse {
+                    image: self.name(id).to_string(),
+                    format: work_format(self.format(id))?,
+                    width: e.width,
+                    height: e.height,
+                    kind,
+                })
+            })
+            .collect()
+    }
+
+    /// The barriers that take every listed resource from its last access to
+    /// the given one, and the state update.
+    pub fn plan(
+        &mut self,
+        images: &[(ImageId, AccessKind)],
+        buffers: &[(BufferId, AccessKind)],
+    ) -> (
+        Vec<vk::ImageMemoryBarrier2<'static>>,
+        Vec<vk::BufferMemoryBarrier2<'static>>,
+    ) {
+        let mut ib = Vec::new();
+        for &(id, next) in images {
+            let (slot, level) = (self.images[id.0].slot, self.images[id.0].level);
+            let (raw, range) = {
+                let img = self.slots[slot].image.as_ref().unwrap_or_else(|| {
+                    panic!(
+                        "image '{}' used before it was created",
+                        self.images[id.0].name
+                    )
+                });
+                (img.raw, img.level_range(level))
+            };
+            if let Some(p) = self.images[id.0].state.plan(next, true) {
+                ib.push(image_barrier(&p, raw, range));
+            }
+        }
+        let mut bb = Vec::new();
+        for &(id, next) in buffers {
+            let e = &mut self.buffers[id.0];
+            if let Some(p) = e.state.plan(next, false) {
+                bb.push(
+                    vk::BufferMemoryBarrier2::default()
+                        .src_stage_mask(p.src_stage)
+                        .src_access_mask(p.src_access)
+                        .dst_stage_mask(p.dst_stage)
+                        .dst_access_mask(p.dst_access)
+                        .buffer(e.raw)
+                        .offset(0)
+                        .size(vk::WHOLE_SIZE),
+                );
+            }
+        }
+        (ib, bb)
+    }
+
+    /// Emits the barriers for one set of accesses as a single call.
+    pub fn transition(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        images: &[(ImageId, AccessKind)],
+        buffers: &[(BufferId, AccessKind)],
+    ) {
+        let (ib, bb) = self.plan(images, buffers);
+        if ib.is_empty() && bb.is_empty() {
+            return;
+        }
+        let dep = vk::DependencyInfo::default()
+            .image_memory_barriers(&ib)
+            .buffer_memory_barriers(&bb);
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+}
+
+/// The work-declaration format of a Vulkan format dermis uses.
+pub fn work_format(f: vk::Format) -> Option<Format> {
+    Some(match f {
+        vk::Format::R8G8B8A8_UNORM => Format::Rgba8Unorm,
+        vk::Format::R8G8B8A8_SRGB => Format::Rgba8Srgb,
+        vk::Format::R16_SFLOAT => Format::R16Float,
+        vk::Format::R16G16B16A16_SFLOAT => Format::Rgba16Float,
+        vk::Format::R32_SFLOAT => Format::R32Float,
+        vk::Format::R32G32B32A32_SFLOAT => Format::Rgba32Float,
+        vk::Format::D32_SFLOAT => Format::D32Float,
+        vk::Format::D24_UNORM_S8_UINT => Format::D24UnormS8Uint,
+        vk::Format::D32_SFLOAT_S8_UINT => Format::D32FloatS8Uint,
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn desc(name: &str, format: vk::Format, levels: u32) -> ImageDesc {
+        ImageDesc::new(
+            name,
+            vk::Extent2D {
+                width: 64,
+                height: 32,
+            },
+            format,
+        )
+        .with_levels(levels)
+    }
+
+    #[test]
+    fn levels_are_tracked_apart_and_sized() {
+        let mut r = Resources::default();
+        let a = r.declare(desc("diffuse", vk::Format::R16G16B16A16_SFLOAT, 3));
+        let b = r.declare(desc("depth", vk::Format::R32_SFLOAT, 1));
+        assert_eq!(r.levels(a).len(), 3);
+        assert_eq!(r.level(a, 2), ImageId(a.0 + 2));
+        assert_eq!(r.name(r.level(a, 1)), "diffuse mip 1");
+        assert_eq!(r.extent(r.level(a, 2)).width, 16);
+        assert_eq!(r.extent(r.level(a, 2)).height, 8);
+        assert_eq!(r.levels(b), vec![b]);
+        assert!(!r.is_created(a));
+    }
+
+    // Usages come from the declared accesses; a written image may be read back.
+    #[test]
+    fn usage_is_derived_from_the_declared_accesses() {
+        let mut r = Resources::default();
+        let rt = r.declare(desc("rt", vk::Format::R16G16B16A16_SFLOAT, 2));
+        let ds = r.declare(desc("ds", vk::Format::D24_UNORM_S8_UINT, 1));
+        let mip1 = r.level(rt, 1);
+        r.allow(&[
+            (rt, AccessKind::ColorAttachmentWrite),
+            (mip1, AccessKind::FragmentSampledRead),
+            (ds, AccessKind::DepthStencilReadOnly),
+        ]);
+        type U = vk::ImageUsageFlags;
+        assert_eq!(
+            r.usage(rt),
+            U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC
+        );
+        assert_eq!(r.usage(ds), U::DEPTH_STENCIL_ATTACHMENT);
+        r.allow(&[(ds, AccessKind::TransferWrite)]);
+        assert_eq!(
+            r.usage(ds),
+            U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC
+        );
+    }
+
+    #[test]
+    fn image_uses_name_format_size_and_kind() {
+        let mut r = Resources::default();
+        let rt = r.declare(desc("rt", vk::Format::R16G16B16A16_SFLOAT, 2));
+        let uses = r.image_uses(&[
+            (r.level(rt, 1), AccessKind::ColorAttachmentLoadWrite),
+            (rt, AccessKind::FragmentSampledRead),
+        ]);
+        assert_eq!(uses[0].image, "rt mip 1");
+        assert_eq!(uses[0].kind, ImageUseKind::ColorTargetLoad);
+        assert_eq!((uses[0].width, uses[0].height), (32, 16));
+        assert_eq!(uses[1].kind, ImageUseKind::Sampled);
+        assert_eq!(uses[1].format, Format::Rgba16Float);
+    }
+}

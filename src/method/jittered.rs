@@ -1,0 +1,169 @@
+//! `ss-jittered`: Hable et al.'s jittered 13-tap kernel in screen space ("SS
+//! Jittered" of thesis ch. 4): one 2D pass with the centre, a ring of 6 mid
+//! samples and a ring of 6 wide red-only samples, rotated per pixel, scaled by
+//! the stretch factors of eq. 4.1-4.4. The kernel is `skin::jittered`.
+
+use std::any::Any;
+
+use anyhow::Result;
+use ash::vk;
+
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
+use super::screen::{color_write, declare_intermediate, fetch, masked_work, seed_copy, source_set};
+use super::ssg::ScreenPush;
+use super::{
+    skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
+    SssMethod, STENCIL_SKIN,
+};
+use crate::graph::draw::fullscreen_stencil_draw;
+use crate::graph::work::{Filter, PassRole};
+use crate::graph::{ImageId, Pass, PassContext};
+use crate::skin::jittered::{hable_kernel, JitteredKernel};
+use crate::skin::ssg::Stretch;
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::pipeline::{GraphicsDesc, Pipeline};
+
+const SHADER: &str = "jittered.frag";
+/// Samples per ring (the loop of the shader takes one mid and one wide per turn).
+const RING: u32 = 6;
+
+pub static ENTRY: MethodEntry = MethodEntry {
+    name: "ss-jittered",
+    aliases: &["jittered"],
+    summary: "Hable et al.'s 13-tap jittered kernel in screen space (thesis ch. 4)",
+    options: &[],
+    eval: &[EvalSetting {
+        label: "13 taps",
+        options: &[],
+    }],
+    ground_truth: false,
+    needs: |_, _| Needs::PLAIN,
+    check: |_| Ok(()),
+    build: |s| Ok(Box::new(Jittered::new(s)?)),
+};
+
+pub struct Jittered {
+    pipeline: Pipeline,
+    set: vk::DescriptorSet,
+    /// The seed the pass reads (the diffuse target is written).
+    src: ImageId,
+    diffuse: ImageId,
+    pub kernel: JitteredKernel,
+    pub stretch: Stretch,
+}
+
+impl Jittered {
+    fn new(s: &mut MethodSetup) -> Result<Self> {
+        let diffuse = s.targets.diffuse;
+        let src = declare_intermediate(s.res, diffuse, "sss intermediate");
+        let mut d = GraphicsDesc::fullscreen("ss-jittered", SHADER, s.res.format(diffuse));
+        d.depth_format = Some(s.depth_stencil_format);
+        d.stencil_format = Some(s.depth_stencil_format);
+        d.stencil = Some(skin_stencil_test());
+        Ok(Jittered {
+            pipeline: Pipeline::graphics(s.ctx, &d)?,
+            set: vk::DescriptorSet::null(),
+            src,
+            diffuse,
+            kernel: hable_kernel(),
+            stretch: Stretch::for_view(
+                s.view.extent.height,
+                s.view.camera.fovy_rad,
+                s.view.mm_per_unit,
+            ),
+        })
+    }
+}
+
+impl SssMethod for Jittered {
+    fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
+        let extent = f.extent;
+        let k = self.kernel;
+        let push = ScreenPush {
+            texel: [1.0 / extent.width as f32, 1.0 / extent.height as f32],
+            alpha: self.stretch.alpha,
+            beta: self.stretch.beta,
+            gamma: self.stretch.gamma,
+            center: [k.center[0], k.center[1], k.center[2], 0.0],
+            mid: [k.mid[0], k.mid[1], k.mid[2], 0.0],
+            wide: [k.wide[0], k.mid_radius_mm, k.wide_radius_mm, 0.0],
+            ..Default::default()
+        };
+        let (t, src, diffuse, region) = (f.targets, self.src, self.diffuse, f.region);
+        let ds = t.depth_stencil;
+        // Centre colour and depth and two depth texels per stretch axis by
+        // texel fetch, then both rings bilinear.
+        let work = masked_work(
+            f,
+            SHADER,
+            &[RING],
+            vec![
+                fetch(f.res, src, "colorTex", Filter::Point, 1.0),
+                fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
+                fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64),
+            ],
+            vec![color_write(f.res, diffuse, false)],
+            true,
+            false,
+        );
+        vec![
+            seed_copy("ss-jittered seed copy", f, diffuse, f.region, &[src]),
+            Pass::new("ss-jittered", PassRole::Sss)
+                .image(src, AccessKind::FragmentSampledRead)
+                .image(t.linear_depth, AccessKind::FragmentSampledRead)
+                .image(ds, AccessKind::DepthStencilReadOnly)
+                .image(diffuse, AccessKind::ColorAttachmentLoadWrite)
+                .work(work)
+                .record(move |pc: &PassContext| {
+                    fullscreen_stencil_draw(
+                        pc,
+                        &self.pipeline,
+                        self.set,
+                        &[diffuse],
+                        ds,
+                        region,
+                        STENCIL_SKIN,
+                        |c, cmd| self.pipeline.push(c, cmd, &push),
+                    )
+                }),
+        ]
+    }
+
+    fn output(&self) -> ImageId {
+        self.diffuse
+    }
+
+    /// The wider ring, stretched as the shader does (s / 3 pixels per mm).
+    fn reach_px(&self, depth: f32, scale: &ReachScale) -> Option<f32> {
+        let ring = self.kernel.mid_radius_mm.max(self.kernel.wide_radius_mm);
+        Some(self.stretch.alpha * scale.max_strength / depth * ring / 3.0 + BILINEAR_MARGIN_PX)
+    }
+
+    fn bind(&mut self, b: &MethodBind) -> Result<()> {
+        self.set = source_set(b, &self.pipeline, self.src)?;
+        Ok(())
+    }
+
+    fn intermediates(&self) -> Vec<ImageId> {
+        vec![self.src]
+    }
+
+    fn details(&self) -> serde_json::Value {
+        serde_json::json!({
+            "kernel": {
+                "center": self.kernel.center, "mid": self.kernel.mid, "wide_red": self.kernel.wide[0],
+                "mid_radius_mm": self.kernel.mid_radius_mm, "wide_radius_mm": self.kernel.wide_radius_mm,
+            },
+            "stretch": { "alpha": self.stretch.alpha, "beta": self.stretch.beta, "gamma": self.stretch.gamma },
+        })
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}

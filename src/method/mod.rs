@@ -1,0 +1,387 @@
+//! The subsurface-scattering methods: one module each, behind one trait, listed
+//! in one registry.
+//!
+//! Adding a method takes four files: its module here (the trait impl, its
+//! options and its `ENTRY`), its shader(s) in `shaders/`, one row in
+//! [`METHODS`], and its test. The frame (`render`) knows nothing of any method:
+//! it declares the targets the method says it [`Needs`], builds it from one
+//! [`MethodSetup`], records the passes it returns and composites whatever image
+//! it names as its output. The CLI, `eval`, the bench matrix and the tests
+//! iterate [`METHODS`].
+
+pub mod jittered;
+pub mod none;
+pub mod options;
+pub mod poisson;
+pub mod reference;
+pub mod region;
+pub mod screen;
+pub mod separable;
+pub mod ssg;
+
+use std::any::Any;
+
+use anyhow::{bail, Result};
+use ash::vk;
+use glam::Mat4;
+
+use crate::graph::{ImageId, Pass, Resources};
+use crate::scene::camera::Camera;
+use crate::scene::Scene;
+use crate::vk::context::Context;
+use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
+pub use options::{MethodOptions, OptKind, OptSpec, Opts};
+use region::ReachScale;
+
+/// The stencil bit the geometry pass sets on skin pixels; SSS passes test it.
+pub const STENCIL_SKIN: u32 = 1;
+
+/// Stencil state of every stencil-masked SSS pass: shade only where the skin bit is set.
+pub fn skin_stencil_test() -> vk::StencilOpState {
+    vk::StencilOpState {
+        fail_op: vk::StencilOp::KEEP,
+        pass_op: vk::StencilOp::KEEP,
+        depth_fail_op: vk::StencilOp::KEEP,
+        compare_op: vk::CompareOp::EQUAL,
+        compare_mask: STENCIL_SKIN,
+        write_mask: 0,
+        reference: STENCIL_SKIN,
+    }
+}
+
+/// The frame's targets, as graph ids (levels through `Resources::level`).
+#[derive(Clone, Copy, Debug)]
+pub struct FrameTargets {
+    pub shadow: ImageId,
+    /// Diffuse light (RGBA16F, alpha = per-pixel SSS strength): what SSS blurs.
+    pub diffuse: ImageId,
+    pub specular: ImageId,
+    /// Linear view depth (R32F, scene units).
+    pub linear_depth: ImageId,
+    /// View-space normals (only when a method needs them).
+    pub normals: Option<ImageId>,
+    /// Depth/stencil with the skin bit.
+    pub depth_stencil: ImageId,
+    pub hdr: ImageId,
+    pub ldr: ImageId,
+}
+
+/// What a method needs the frame to provide, known before anything is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Needs {
+    /// A view-space normal target written by the geometry pass (MRT).
+    pub normals: bool,
+    /// Mip levels of the diffuse, linear-depth (and normal) targets (1: none).
+    pub mip_levels: u32,
+    /// Transmittance (thesis eq. 5.12) added in the geometry pass. The ground
+    /// truth turns it off: its light through thin parts comes from the integral.
+    pub geometry_transmittance: bool,
+}
+
+impl Needs {
+    pub const PLAIN: Needs = Needs {
+        normals: false,
+        mip_levels: 1,
+        geometry_transmittance: true,
+    };
+}
+
+/// The view a method is built for.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewInfo {
+    pub extent: vk::Extent2D,
+    pub camera: Camera,
+    pub mm_per_unit: f32,
+}
+
+impl ViewInfo {
+    pub fn aspect(&self) -> f32 {
+        self.extent.width as f32 / self.extent.height as f32
+    }
+
+    pub fn tan_half_fovy(&self) -> f32 {
+        (0.5 * self.camera.fovy_rad).tan()
+    }
+
+    /// The depth-buffer value of a surface at linear view depth `d`.
+    pub fn ndc_depth(&self, d: f32) -> f32 {
+        let c = self.camera.proj(self.aspect()) * glam::Vec4::new(0.0, 0.0, -d, 1.0);
+        c.z / c.w
+    }
+}
+
+/// Everything a method is built from.
+pub struct MethodSetup<'a> {
+    pub ctx: &'a Context,
+    /// Declare the method's own images here (created after the usages are known).
+    pub res: &'a mut Resources,
+    pub targets: &'a FrameTargets,
+    pub samplers: &'a Samplers,
+    pub options: Opts<'a>,
+    pub view: ViewInfo,
+    pub depth_stencil_format: vk::Format,
+    /// The scene and the model matrix of every character (the ground truth
+    /// samples the skin surface itself).
+    pub scene: &'a Scene,
+    pub instances: &'a [Mat4],
+}
+
+/// What a method's descriptor sets are written from, once the images exist.
+pub struct MethodBind<'a> {
+    pub ctx: &'a Context,
+    pub res: &'a Resources,
+    pub pool: &'a DescriptorPool,
+    pub samplers: &'a Samplers,
+    pub targets: &'a FrameTargets,
+    /// Set 0 (frame: uniforms, shadow map, samplers, Beckmann) and set 1 (the
+    /// skin material) of `lighting.glsl`, for methods that shade surfaces.
+    pub frame_binds: Vec<(&'static str, Bind)>,
+    pub skin_material_binds: Vec<(&'static str, Bind)>,
+}
+
+/// What a method's passes are recorded against in a frame.
+/// (`'a`: what the passes may keep; `'r`: the graph's resources, read while
+/// the passes are built, for formats and sizes in their declarations.)
+#[derive(Clone, Copy)]
+pub struct FrameView<'a, 'r> {
+    pub targets: &'a FrameTargets,
+    pub res: &'r Resources,
+    pub extent: vk::Extent2D,
+    /// Disjoint rectangles holding every skin pixel and every texel the method's
+    /// taps read from one (see `region.rs`): seed copies and stencil-tested draws
+    /// are limited to them.
+    pub region: &'a [vk::Rect2D],
+    /// One rectangle covering the screen.
+    pub screen: &'a [vk::Rect2D],
+}
+
+/// An SSS method as the frame sees it.
+pub trait SssMethod {
+    /// The method's passes, in order.
+    fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>>;
+    /// The image holding the diffuse light after SSS: what the composite reads.
+    fn output(&self) -> ImageId;
+    /// How far (pixels) the taps of a skin pixel at view depth `depth` reach
+    /// into texels a seed copy must have written; `None` for a method that
+    /// works on the whole screen.
+    fn reach_px(&self, depth: f32, scale: &ReachScale) -> Option<f32>;
+    /// Writes the descriptor sets (the images exist by now).
+    fn bind(&mut self, b: &MethodBind) -> Result<()>;
+    /// Intermediates that seed copies fill only inside the region (the rest is
+    /// zeroed at set-up; tests poison it).
+    fn intermediates(&self) -> Vec<ImageId> {
+        Vec::new()
+    }
+    /// Facts of this instance for the report (kernel, fit, sample count...).
+    fn details(&self) -> serde_json::Value {
+        serde_json::Value::Null
+    }
+    /// Frees what the method created (the graph frees its images).
+    fn destroy(&mut self, ctx: &Context);
+    /// For tests that inspect one method's state.
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// One quality setting `eval` sweeps: a label and the options it sets.
+#[derive(Clone, Copy, Debug)]
+pub struct EvalSetting {
+    pub label: &'static str,
+    pub options: &'static [(&'static str, &'static str)],
+}
+
+/// A registry row: everything the CLI, `eval`, the bench matrix and the
+/// renderer need to know of a method.
+pub struct MethodEntry {
+    /// The CLI name (`--method NAME`).
+    pub name: &'static str,
+    pub aliases: &'static [&'static str],
+    pub summary: &'static str,
+    pub options: &'static [OptSpec],
+    /// The settings `eval` sweeps (empty for the ground truth).
+    pub eval: &'static [EvalSetting],
+    /// The ground truth the others are scored against.
+    pub ground_truth: bool,
+    pub needs: fn(&Opts, vk::Extent2D) -> Needs,
+    /// Parses and checks the options before any device opens.
+    pub check: fn(&Opts) -> Result<()>,
+    pub build: fn(&mut MethodSetup) -> Result<Box<dyn SssMethod>>,
+}
+
+impl MethodEntry {
+    pub fn opts<'a>(&self, given: &'a MethodOptions) -> Opts<'a> {
+        Opts {
+            specs: self.options,
+            given,
+        }
+    }
+}
+
+impl std::fmt::Debug for MethodEntry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+impl PartialEq for MethodEntry {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+impl serde::Serialize for MethodEntry {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name)
+    }
+}
+
+/// Every method, in the order the CLI lists them.
+pub static METHODS: &[&MethodEntry] = &[
+    &separable::ENTRY,
+    &ssg::ENTRY,
+    &jittered::ENTRY,
+    &poisson::ENTRY,
+    &reference::ENTRY,
+    &none::ENTRY,
+];
+
+/// The default method.
+pub fn default_method() -> &'static MethodEntry {
+    &separable::ENTRY
+}
+
+/// The ground truth's entry.
+pub fn ground_truth() -> &'static MethodEntry {
+    METHODS
+        .iter()
+        .copied()
+        .find(|m| m.ground_truth)
+        .expect("the registry has a ground truth")
+}
+
+/// A method by CLI name or alias (case-insensitive).
+pub fn lookup(name: &str) -> Result<&'static MethodEntry> {
+    let n = name.trim().to_ascii_lowercase();
+    match METHODS
+        .iter()
+        .find(|m| m.name == n || m.aliases.contains(&n.as_str()))
+    {
+        Some(m) => Ok(m),
+        None => bail!(
+            "unknown method '{name}' (valid: {})",
+            METHODS
+                .iter()
+                .map(|m| m.name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// Every option any method declares, once each (the CLI adds one flag per key).
+pub fn all_options() -> Vec<(&'static MethodEntry, &'static OptSpec)> {
+    let mut out: Vec<(&'static MethodEntry, &'static OptSpec)> = Vec::new();
+    for m in METHODS {
+        for o in m.options {
+            if !out.iter().any(|(_, p)| p.key == o.key) {
+                out.push((m, o));
+            }
+        }
+    }
+    out
+}
+
+/// Keys given in `options` that `method` does not read (the CLI warns about them).
+pub fn foreign_options(method: &MethodEntry, options: &MethodOptions) -> Vec<String> {
+    options
+        .keys()
+        .filter(|k| !method.options.iter().any(|o| o.key == *k))
+        .map(|k| {
+            let owner = METHODS
+                .iter()
+                .find(|m| m.options.iter().any(|o| o.key == k))
+                .map_or("no method", |m| m.name);
+            format!("--{k} (an option of {owner})")
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_found_by_alias() {
+        let mut names: Vec<&str> = METHODS
+            .iter()
+            .flat_map(|m| std::iter::once(m.name).chain(m.aliases.iter().copied()))
+            .collect();
+        let n = names.len();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), n, "a name or alias is used twice");
+        for m in METHODS {
+            assert_eq!(lookup(&m.name.to_uppercase()).unwrap(), *m);
+            for a in m.aliases {
+                assert_eq!(lookup(a).unwrap(), *m);
+            }
+        }
+        let e = lookup("ssg-typo").unwrap_err().to_string();
+        assert!(e.contains("valid: separable, ssg"), "{e}");
+        assert!(ground_truth().eval.is_empty());
+        assert_eq!(METHODS.iter().filter(|m| m.ground_truth).count(), 1);
+    }
+
+    // Two methods may share an option key only with the same meaning.
+    #[test]
+    fn shared_option_keys_agree_and_defaults_pass_their_own_checks() {
+        for (m, o) in all_options() {
+            for other in METHODS {
+                if let Some(p) = other.options.iter().find(|p| p.key == o.key) {
+                    assert_eq!(
+                        p, o,
+                        "{} and {} declare '{}' apart",
+                        m.name, other.name, o.key
+                    );
+                }
+            }
+        }
+        let none = MethodOptions::default();
+        for m in METHODS {
+            (m.check)(&m.opts(&none)).unwrap_or_else(|e| panic!("{}: {e:#}", m.name));
+        }
+    }
+
+    // Every eval setting names options of its own method, with values its
+    // checks accept, and labels are unique per method.
+    #[test]
+    fn eval_settings_are_valid() {
+        for m in METHODS {
+            let mut labels: Vec<&str> = m.eval.iter().map(|s| s.label).collect();
+            labels.sort();
+            labels.dedup();
+            assert_eq!(labels.len(), m.eval.len(), "{}", m.name);
+            for s in m.eval {
+                for (k, _) in s.options {
+                    assert!(
+                        m.options.iter().any(|o| o.key == *k),
+                        "{} '{}' sets '{k}', not an option of it",
+                        m.name,
+                        s.label
+                    );
+                }
+                let given = MethodOptions::default().with(s.options);
+                (m.check)(&m.opts(&given))
+                    .unwrap_or_else(|e| panic!("{} '{}': {e:#}", m.name, s.label));
+            }
+        }
+    }
+
+    #[test]
+    fn options_of_another_method_are_named() {
+        let mut o = MethodOptions::default();
+        o.set("samples", "9");
+        let f = foreign_options(lookup("ssg").unwrap(), &o);
+        assert_eq!(f, vec!["--samples (an option of separable)".to_string()]);
+        assert!(foreign_options(lookup("separable").unwrap(), &o).is_empty());
+    }
+}

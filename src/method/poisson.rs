@@ -1,0 +1,345 @@
+//! Poisson-disk screen-space SSS (seed 003, Agni's Philosophy): mip chains of
+//! the diffuse, linear-depth and normal targets (one 2x2-mean pass per level, all
+//! three through MRT), then one pass of up to 32 disk samples read from the level
+//! the kernel radius asks for, weighted by distance, depth and normal difference.
+//!
+//! The pass reads every level of the diffuse chain, so it writes into an
+//! intermediate (seeded with a copy of level 0, so non-skin pixels keep their
+//! colour) and the composite reads the intermediate.
+
+use std::any::Any;
+
+use anyhow::Result;
+use ash::vk;
+
+use super::region::ReachScale;
+use super::screen::{
+    color_write, declare_intermediate, fetch, fetch_at_most, masked_work, seed_copy,
+};
+use super::{
+    skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
+    SssMethod, STENCIL_SKIN,
+};
+use crate::graph::draw::{fullscreen_draw, fullscreen_stencil_draw};
+use crate::graph::work::{Filter, PassRole, ShaderWork, Work};
+use crate::graph::{ImageId, Pass, PassContext};
+use crate::skin::poisson::{poisson_disk_32, PoissonParams};
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::memory::Buffer;
+use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::shader_stats::alu_estimate;
+
+const SHADER: &str = "poisson.frag";
+const MIP_SHADER: &str = "mip_down.frag";
+/// Mip levels of the chains: enough for radii of 16 x 2^4 = 256 pixels.
+pub const MAX_LEVELS: u32 = 5;
+/// The most disk samples a pixel takes (8, 16 or 32 by its radius in pixels).
+const MAX_TAPS: u32 = 32;
+
+pub static ENTRY: MethodEntry = MethodEntry {
+    name: "poisson",
+    aliases: &[],
+    summary: "Poisson-disk screen-space SSS over mip chains (seed 003, Agni's Philosophy)",
+    options: &[],
+    eval: &[EvalSetting {
+        label: "8-32 taps",
+        options: &[],
+    }],
+    ground_truth: false,
+    needs: |_, extent| Needs {
+        normals: true,
+        mip_levels: levels_for(extent),
+        geometry_transmittance: true,
+    },
+    check: |_| Ok(()),
+    build: |s| Ok(Box::new(Poisson::new(s)?)),
+};
+
+/// Levels for a target of `extent` (every level at least one texel).
+pub fn levels_for(extent: vk::Extent2D) -> u32 {
+    let full = 32 - extent.width.max(extent.height).max(1).leading_zeros();
+    full.min(MAX_LEVELS)
+}
+
+/// Push constants of poisson.frag (std430, 48 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct PoissonPush {
+    size: [f32; 2],
+    tan_half_fovy: f32,
+    mm_per_unit: f32,
+    falloff: [f32; 4],
+    radius_mm: f32,
+    depth_sensitivity: f32,
+    normal_sensitivity: f32,
+    max_level: i32,
+}
+
+pub struct Poisson {
+    mip_pipeline: Pipeline,
+    pipeline: Pipeline,
+    mip_sets: Vec<vk::DescriptorSet>,
+    set: vk::DescriptorSet,
+    disk_buffer: Buffer,
+    /// The output (seeded with the diffuse target's level 0).
+    out: ImageId,
+    push: PoissonPush,
+    pub params: PoissonParams,
+    pub levels: u32,
+}
+
+impl Poisson {
+    fn new(s: &mut MethodSetup) -> Result<Self> {
+        let t = s.targets;
+        let normals = t
+            .normals
+            .expect("poisson declares that it needs the normal target");
+        let levels = s.res.levels(t.diffuse).len() as u32;
+        let out = declare_intermediate(s.res, t.diffuse, "sss intermediate");
+        let format = s.res.format(t.diffuse);
+        let mut mip = GraphicsDesc::fullscreen("poisson mip", MIP_SHADER, format);
+        mip.color_formats = vec![format, s.res.format(t.linear_depth), s.res.format(normals)];
+        let mut mip_pipeline = Pipeline::graphics(s.ctx, &mip)?;
+        let mut d = GraphicsDesc::fullscreen("poisson", SHADER, format);
+        d.depth_format = Some(s.depth_stencil_format);
+        d.stencil_format = Some(s.depth_stencil_format);
+        d.stencil = Some(skin_stencil_test());
+        let mut pipeline = match Pipeline::graphics(s.ctx, &d) {
+            Ok(p) => p,
+            Err(e) => {
+                mip_pipeline.destroy(s.ctx);
+                return Err(e);
+            }
+        };
+        let disk: Vec<[f32; 4]> = poisson_disk_32()
+            .iter()
+            .map(|p| [p[0], p[1], 0.0, 0.0])
+            .collect();
+        let disk_buffer = match Buffer::with_data(
+            s.ctx,
+            "poisson disk",
+            bytemuck::cast_slice(&disk),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        ) {
+            Ok(b) => b,
+            Err(e) => {
+                mip_pipeline.destroy(s.ctx);
+                pipeline.destroy(s.ctx);
+                return Err(e);
+            }
+        };
+        let p = PoissonParams::from_profile();
+        let push = PoissonPush {
+            size: [s.view.extent.width as f32, s.view.extent.height as f32],
+            tan_half_fovy: s.view.tan_half_fovy(),
+            mm_per_unit: s.view.mm_per_unit,
+            falloff: [p.falloff[0], p.falloff[1], p.falloff[2], 0.0],
+            radius_mm: p.radius_mm,
+            depth_sensitivity: p.depth_sensitivity,
+            normal_sensitivity: p.normal_sensitivity,
+            max_level: levels as i32 - 1,
+        };
+        Ok(Poisson {
+            mip_pipeline,
+            pipeline,
+            mip_sets: Vec::new(),
+            set: vk::DescriptorSet::null(),
+            disk_buffer,
+            out,
+            push,
+            params: p,
+            levels,
+        })
+    }
+
+    /// The per-level ids of the colour, depth and normal chains.
+    fn chains(&self, f: &FrameView) -> [Vec<ImageId>; 3] {
+        let t = f.targets;
+        let normals = t.normals.expect("poisson has the normal target");
+        [
+            f.res.levels(t.diffuse),
+            f.res.levels(t.linear_depth),
+            f.res.levels(normals),
+        ]
+    }
+}
+
+impl SssMethod for Poisson {
+    fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
+        let t = f.targets;
+        // The composite reads the output on every pixel: seed all of it.
+        let mut passes = vec![seed_copy(
+            "poisson seed copy",
+            f,
+            t.diffuse,
+            f.screen,
+            &[self.out],
+        )];
+        let chains = self.chains(f);
+        for l in 1..self.levels as usize {
+            let targets = [chains[0][l], chains[1][l], chains[2][l]];
+            let e = f.res.extent(targets[0]);
+            let mut fetches = Vec::new();
+            let mut pass = Pass::new(format!("poisson mip {l}"), PassRole::Sss);
+            for (c, texture) in chains.iter().zip(["srcColor", "srcDepth", "srcNormal"]) {
+                fetches.push(fetch(f.res, c[l - 1], texture, Filter::Point, 4.0));
+                pass = pass
+                    .image(c[l - 1], AccessKind::FragmentSampledRead)
+                    .image(c[l], AccessKind::ColorAttachmentWrite);
+            }
+            let work = Work::Raster {
+                shader: Some(ShaderWork {
+                    shader: MIP_SHADER.into(),
+                    fetches,
+                    alu: alu_estimate(MIP_SHADER, &[]),
+                    ..Default::default()
+                }),
+                color: targets
+                    .iter()
+                    .map(|&i| color_write(f.res, i, false))
+                    .collect(),
+                depth_stencil: None,
+                width: e.width,
+                height: e.height,
+                triangles: 1,
+                msaa: 1,
+            };
+            let set = self.mip_sets.get(l - 1).copied().unwrap_or_default();
+            passes.push(pass.work(work).record(move |pc: &PassContext| {
+                fullscreen_draw(pc, &self.mip_pipeline, set, &targets, |_, _| {})
+            }));
+        }
+        // Every level of the three chains is read; the disk's size (8, 16 or
+        // 32 taps) depends on each pixel's radius: the declared count is the most.
+        let mut pass = Pass::new("poisson", PassRole::Sss);
+        for c in &chains {
+            for &level in c {
+                pass = pass.image(level, AccessKind::FragmentSampledRead);
+            }
+        }
+        let taps = MAX_TAPS as f64;
+        let mut fetches = vec![];
+        for (c, texture) in chains
+            .iter()
+            .zip(["colorChain", "depthChain", "normalChain"])
+        {
+            fetches.push(fetch(f.res, c[0], texture, Filter::Point, 1.0));
+        }
+        for (c, texture) in chains
+            .iter()
+            .zip(["colorChain", "depthChain", "normalChain"])
+        {
+            // Whole levels (`textureLod` at an integer level): bilinear.
+            fetches.push(fetch_at_most(f.res, c[0], texture, Filter::Bilinear, taps));
+        }
+        let work = masked_work(
+            f,
+            SHADER,
+            &[MAX_TAPS],
+            fetches,
+            vec![color_write(f.res, self.out, false)],
+            true,
+            false,
+        );
+        let (ds, out, push, region) = (t.depth_stencil, self.out, self.push, f.region);
+        passes.push(
+            pass.image(ds, AccessKind::DepthStencilReadOnly)
+                .image(out, AccessKind::ColorAttachmentLoadWrite)
+                .work(work)
+                .record(move |pc: &PassContext| {
+                    fullscreen_stencil_draw(
+                        pc,
+                        &self.pipeline,
+                        self.set,
+                        &[out],
+                        ds,
+                        region,
+                        STENCIL_SKIN,
+                        |c, cmd| self.pipeline.push(c, cmd, &push),
+                    )
+                }),
+        );
+        passes
+    }
+
+    fn output(&self) -> ImageId {
+        self.out
+    }
+
+    /// Poisson reads the complete diffuse chain, never a seed: its region only
+    /// has to hold the skin pixels it shades.
+    fn reach_px(&self, _depth: f32, _scale: &ReachScale) -> Option<f32> {
+        Some(0.0)
+    }
+
+    fn bind(&mut self, b: &MethodBind) -> Result<()> {
+        let t = b.targets;
+        let normals = t.normals.expect("poisson has the normal target");
+        let [color, depth, normal] = [
+            b.res.levels(t.diffuse),
+            b.res.levels(t.linear_depth),
+            b.res.levels(normals),
+        ];
+        self.mip_sets = (1..self.levels as usize)
+            .map(|l| {
+                b.pool.write_set(
+                    b.ctx,
+                    &self.mip_pipeline,
+                    0,
+                    &[
+                        ("srcColor", Bind::Texture(b.res.view(color[l - 1]))),
+                        ("srcDepth", Bind::Texture(b.res.view(depth[l - 1]))),
+                        ("srcNormal", Bind::Texture(b.res.view(normal[l - 1]))),
+                    ],
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        self.set = b.pool.write_set(
+            b.ctx,
+            &self.pipeline,
+            0,
+            &[
+                (
+                    "colorChain",
+                    Bind::Texture(b.res.image(t.diffuse).chain_view),
+                ),
+                (
+                    "depthChain",
+                    Bind::Texture(b.res.image(t.linear_depth).chain_view),
+                ),
+                (
+                    "normalChain",
+                    Bind::Texture(b.res.image(normals).chain_view),
+                ),
+                ("mipClamp", Bind::Sampler(b.samplers.mip_clamp)),
+                (
+                    "disk",
+                    Bind::Uniform {
+                        buffer: self.disk_buffer.raw,
+                        size: (MAX_TAPS * 16) as u64,
+                    },
+                ),
+            ],
+        )?;
+        Ok(())
+    }
+
+    fn intermediates(&self) -> Vec<ImageId> {
+        vec![self.out]
+    }
+
+    fn details(&self) -> serde_json::Value {
+        serde_json::json!({ "params": self.params, "levels": self.levels })
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.mip_pipeline.destroy(ctx);
+        self.pipeline.destroy(ctx);
+        self.disk_buffer.destroy(ctx);
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}

@@ -1,0 +1,403 @@
+//! Screen-space sum of Gaussians (`ssg`, thesis ch. 4, "SS Full"): for each
+//! Gaussian after the first of Table 4.2's fit, a horizontal pass RT1 -> RT2 and a
+//! vertical pass RT2 -> RT1 and RTF (MRT; RTF = the diffuse target, blended with
+//! the constant w'_i of eq. 4.8-4.9), kernels scaled by the stretch factors of
+//! eq. 4.1-4.4, and depth-based Gaussian skipping (4.2.1): each Gaussian's
+//! triangle is drawn at the projected depth beyond which it spans under a
+//! pixel, with depth test GREATER and early tests forced, so far pixels run no
+//! shader. RT1 and RT2 are seeded with a copy of the diffuse target.
+
+use std::any::Any;
+
+use anyhow::{bail, Result};
+use ash::vk;
+
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
+use super::screen::{
+    color_write, declare_intermediate, fetch, fetch_at_most, masked_work, seed_copy, source_set,
+};
+use super::{
+    skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
+    OptKind, OptSpec, Opts, SssMethod, STENCIL_SKIN,
+};
+use crate::graph::draw::fullscreen_stencil_draw;
+use crate::graph::work::{Fetch, Filter, PassRole};
+use crate::graph::{ImageId, Pass, PassContext};
+use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::pipeline::{Blend, GraphicsDesc, Pipeline};
+
+/// Taps per 1D Gaussian (Listing 4.1).
+const TAPS: u32 = 7;
+
+const OPTIONS: &[OptSpec] = &[
+    OptSpec {
+        key: "fit",
+        kind: OptKind::Value,
+        default: "6",
+        help: "the Gaussian fit of thesis Table 4.2: 6 or 4",
+    },
+    OptSpec {
+        key: "lod",
+        kind: OptKind::NoFlag,
+        default: "true",
+        help: "draw every Gaussian everywhere (no depth-based level of detail)",
+    },
+    OptSpec {
+        key: "mask",
+        kind: OptKind::Value,
+        default: "stencil",
+        help: "keep non-skin pixels out with the stencil test or a shader branch: stencil | branch",
+    },
+];
+
+pub static ENTRY: MethodEntry = MethodEntry {
+    name: "ssg",
+    aliases: &[],
+    summary: "screen-space sum of Gaussians (thesis ch. 4) with depth-based Gaussian LOD",
+    options: OPTIONS,
+    eval: &[
+        EvalSetting {
+            label: "6 Gaussians, LOD",
+            options: &[("fit", "6")],
+        },
+        EvalSetting {
+            label: "4 Gaussians, LOD",
+            options: &[("fit", "4")],
+        },
+        EvalSetting {
+            label: "6 Gaussians, no LOD",
+            options: &[("fit", "6"), ("lod", "false")],
+        },
+        EvalSetting {
+            label: "6 Gaussians, branch mask",
+            options: &[("mask", "branch")],
+        },
+    ],
+    ground_truth: false,
+    needs: |_, _| Needs::PLAIN,
+    check: |o| Config::parse(o).map(|_| ()),
+    build: |s| Ok(Box::new(Ssg::new(s)?)),
+};
+
+/// How non-skin pixels are kept out of the SSS passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MaskMode {
+    /// Hardware stencil test on the skin bit (masked pixels run no shader).
+    Stencil,
+    /// A dynamic branch on the mask in the shader (every pixel of the quad runs it).
+    Branch,
+}
+
+impl std::str::FromStr for MaskMode {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "stencil" => Ok(MaskMode::Stencil),
+            "branch" => Ok(MaskMode::Branch),
+            other => bail!("unknown mask mode '{other}' (valid: stencil, branch)"),
+        }
+    }
+}
+
+/// The method's options, parsed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    pub fit: GaussianFit,
+    pub lod: bool,
+    pub mask: MaskMode,
+}
+
+impl Config {
+    pub fn parse(o: &Opts) -> Result<Self> {
+        Ok(Config {
+            fit: o.parse("fit")?,
+            lod: o.flag("lod")?,
+            mask: o.parse("mask")?,
+        })
+    }
+}
+
+/// Push constants of screen_common.glsl (std430 layout, 96 bytes), shared with
+/// ss-jittered.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ScreenPush {
+    pub dir: [f32; 2],
+    pub texel: [f32; 2],
+    pub alpha: f32,
+    pub beta: f32,
+    pub gamma: f32,
+    pub std_mm: f32,
+    pub quad_depth: f32,
+    pub mask_branch: i32,
+    pub pad: [f32; 2],
+    pub center: [f32; 4],
+    pub mid: [f32; 4],
+    pub wide: [f32; 4],
+}
+
+pub struct Ssg {
+    horizontal: Pipeline,
+    vertical: Pipeline,
+    set_rt1: vk::DescriptorSet,
+    set_rt2: vk::DescriptorSet,
+    rt1: ImageId,
+    rt2: ImageId,
+    diffuse: ImageId,
+    pub config: Config,
+    pub gaussians: Vec<SsgGaussian>,
+    pub stretch: Stretch,
+    /// Depth-buffer value of each Gaussian's full-screen triangle (1 = no LOD).
+    pub quad_depths: Vec<f32>,
+    /// The LOD distance of each Gaussian in scene units (eq. 4.6 with 0.5).
+    pub lod_distances: Vec<f32>,
+}
+
+impl Ssg {
+    fn new(s: &mut MethodSetup) -> Result<Self> {
+        let config = Config::parse(&s.options)?;
+        if !s.ctx.facts.independent_blend {
+            bail!(
+                "device '{}' lacks independentBlend, which ssg's MRT pass needs",
+                s.ctx.facts.name
+            );
+        }
+        let diffuse = s.targets.diffuse;
+        let rt1 = declare_intermediate(s.res, diffuse, "sss intermediate");
+        let rt2 = declare_intermediate(s.res, diffuse, "sss intermediate 2");
+        let format = s.res.format(diffuse);
+        let ds_format = s.depth_stencil_format;
+        let desc = |name: &str, frag: &'static str, colors: usize| {
+            let mut d = GraphicsDesc::fullscreen(name, frag, format);
+            d.vert = "fullscreen_depth.vert";
+            d.color_formats = vec![format; colors];
+            d.depth_format = Some(ds_format);
+            d.stencil_format = Some(ds_format);
+            // Gaussian LOD: shade only where the surface is nearer than the triangle.
+            d.depth_test = true;
+            d.depth_write = false;
+            d.depth_compare = vk::CompareOp::GREATER;
+            d.stencil = (config.mask == MaskMode::Stencil).then(skin_stencil_test);
+            if colors == 2 {
+                d.blend = Blend::ConstantMix(1);
+            }
+            d
+        };
+        let mut horizontal =
+            Pipeline::graphics(s.ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?;
+        let vertical =
+            match Pipeline::graphics(s.ctx, &desc("ssg vertical", "ssg_vertical.frag", 2)) {
+                Ok(p) => p,
+                Err(e) => {
+                    horizontal.destroy(s.ctx);
+                    return Err(e);
+                }
+            };
+        let stretch = Stretch::for_view(
+            s.view.extent.height,
+            s.view.camera.fovy_rad,
+            s.view.mm_per_unit,
+        );
+        let gaussians = ssg_gaussians(config.fit);
+        let lod_distances: Vec<f32> = gaussians
+            .iter()
+            .map(|g| lod_depth(g.incremental_std_mm, stretch.alpha))
+            .collect();
+        let quad_depths = lod_distances
+            .iter()
+            .map(|&d| {
+                if config.lod {
+                    s.view.ndc_depth(d).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        Ok(Ssg {
+            horizontal,
+            vertical,
+            set_rt1: vk::DescriptorSet::null(),
+            set_rt2: vk::DescriptorSet::null(),
+            rt1,
+            rt2,
+            diffuse,
+            config,
+            gaussians,
+            stretch,
+            quad_depths,
+            lod_distances,
+        })
+    }
+
+    /// What one blur pass fetches: centre colour and depth and the two depth
+    /// texels of the gradient by texel fetch, 7 bilinear colour taps. With the
+    /// branch mask, non-skin fragments stop after the centre colour.
+    fn fetches(&self, f: &FrameView<'_, '_>, src: ImageId) -> Vec<Fetch> {
+        let (res, depth) = (f.res, f.targets.linear_depth);
+        let branch = self.config.mask == MaskMode::Branch;
+        let after_mask = |texture: &str, image, filter, count| {
+            if branch {
+                fetch_at_most(res, image, texture, filter, count)
+            } else {
+                fetch(res, image, texture, filter, count)
+            }
+        };
+        vec![
+            fetch(res, src, "colorTex", Filter::Point, 1.0),
+            after_mask("depthTex", depth, Filter::Point, 3.0),
+            after_mask("colorTex", src, Filter::Bilinear, TAPS as f64),
+        ]
+    }
+}
+
+impl SssMethod for Ssg {
+    fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
+        let t = f.targets;
+        let (rt1, rt2, diffuse) = (self.rt1, self.rt2, self.diffuse);
+        let mut passes = vec![seed_copy(
+            "ssg seed copy",
+            f,
+            diffuse,
+            f.region,
+            &[rt1, rt2],
+        )];
+        let extent = f.extent;
+        let stencil = self.config.mask == MaskMode::Stencil;
+        let region = f.region;
+        for (g, &quad_depth) in self.gaussians.iter().zip(&self.quad_depths) {
+            let base = ScreenPush {
+                texel: [1.0 / extent.width as f32, 1.0 / extent.height as f32],
+                alpha: self.stretch.alpha,
+                beta: self.stretch.beta,
+                gamma: self.stretch.gamma,
+                std_mm: g.incremental_std_mm,
+                quad_depth,
+                mask_branch: !stencil as i32,
+                ..Default::default()
+            };
+            let h = ScreenPush {
+                dir: [1.0, 0.0],
+                ..base
+            };
+            let v = ScreenPush {
+                dir: [0.0, 1.0],
+                ..base
+            };
+            let blend = [g.blend[0], g.blend[1], g.blend[2], 1.0];
+            let ds = t.depth_stencil;
+            let h_work = masked_work(
+                f,
+                "ssg_horizontal.frag",
+                &[TAPS],
+                self.fetches(f, rt1),
+                vec![color_write(f.res, rt2, false)],
+                stencil,
+                true,
+            );
+            passes.push(
+                Pass::new(format!("ssg g{} horizontal", g.index), PassRole::Sss)
+                    .image(rt1, AccessKind::FragmentSampledRead)
+                    .image(t.linear_depth, AccessKind::FragmentSampledRead)
+                    .image(ds, AccessKind::DepthStencilReadOnly)
+                    .image(rt2, AccessKind::ColorAttachmentLoadWrite)
+                    .work(h_work)
+                    .record(move |pc: &PassContext| {
+                        fullscreen_stencil_draw(
+                            pc,
+                            &self.horizontal,
+                            self.set_rt1,
+                            &[rt2],
+                            ds,
+                            region,
+                            STENCIL_SKIN,
+                            |c, cmd| self.horizontal.push(c, cmd, &h),
+                        )
+                    }),
+            );
+            let v_work = masked_work(
+                f,
+                "ssg_vertical.frag",
+                &[TAPS],
+                self.fetches(f, rt2),
+                vec![
+                    color_write(f.res, rt1, false),
+                    color_write(f.res, diffuse, true),
+                ],
+                stencil,
+                true,
+            );
+            passes.push(
+                Pass::new(format!("ssg g{} vertical", g.index), PassRole::Sss)
+                    .image(rt2, AccessKind::FragmentSampledRead)
+                    .image(t.linear_depth, AccessKind::FragmentSampledRead)
+                    .image(ds, AccessKind::DepthStencilReadOnly)
+                    .image(rt1, AccessKind::ColorAttachmentLoadWrite)
+                    .image(diffuse, AccessKind::ColorAttachmentLoadWrite)
+                    .work(v_work)
+                    .record(move |pc: &PassContext| {
+                        fullscreen_stencil_draw(
+                            pc,
+                            &self.vertical,
+                            self.set_rt2,
+                            &[rt1, diffuse],
+                            ds,
+                            region,
+                            STENCIL_SKIN,
+                            |c, cmd| {
+                                self.vertical.push(c, cmd, &v);
+                                unsafe { c.device.cmd_set_blend_constants(cmd, &blend) };
+                            },
+                        )
+                    }),
+            );
+        }
+        passes
+    }
+
+    fn output(&self) -> ImageId {
+        self.diffuse
+    }
+
+    /// 3 steps of std/3 stretched (eq. 4.1-4.4; the depth-gradient term only
+    /// narrows it) for the widest Gaussian.
+    fn reach_px(&self, depth: f32, scale: &ReachScale) -> Option<f32> {
+        let widest = self
+            .gaussians
+            .iter()
+            .map(|g| g.incremental_std_mm)
+            .fold(0.0, f32::max);
+        Some(self.stretch.alpha * scale.max_strength / depth * widest + BILINEAR_MARGIN_PX)
+    }
+
+    fn bind(&mut self, b: &MethodBind) -> Result<()> {
+        self.set_rt1 = source_set(b, &self.horizontal, self.rt1)?;
+        self.set_rt2 = source_set(b, &self.vertical, self.rt2)?;
+        Ok(())
+    }
+
+    fn intermediates(&self) -> Vec<ImageId> {
+        vec![self.rt1, self.rt2]
+    }
+
+    fn details(&self) -> serde_json::Value {
+        serde_json::json!({
+            "fit": self.config.fit,
+            "lod": self.config.lod,
+            "mask": self.config.mask,
+            "stretch": { "alpha": self.stretch.alpha, "beta": self.stretch.beta, "gamma": self.stretch.gamma },
+            "lod_distances_units": self.lod_distances,
+        })
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.horizontal.destroy(ctx);
+        self.vertical.destroy(ctx);
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}

@@ -1,0 +1,713 @@
+//! The frame around the SSS method: shadow map (key light, orthographic, so its
+//! depth is linear) -> geometry pass into the targets (Lambert + transmittance,
+//! Kelemen/Szirmay-Kalos specular, linear depth, the skin stencil bit) -> the
+//! method's passes -> composite (diffuse after SSS + specular) -> Hable tone map.
+
+use anyhow::Result;
+use ash::vk;
+use glam::Mat4;
+
+use super::scene_gpu::GpuObject;
+use super::settings::RenderSettings;
+use super::targets::{LDR_FORMAT, SHADOW_FORMAT};
+use crate::graph::draw::{begin_rendering, fullscreen_draw, DepthTarget, Load};
+use crate::graph::work::{
+    ColorWrite, DepthStencilUse, Fetch, Filter, Format, PassRole, ShaderWork, Work,
+};
+use crate::graph::{work_format, ImageId, Pass, PassContext, Resources};
+use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
+use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
+use crate::scene::camera::Camera;
+use crate::scene::framing::Framing;
+use crate::scene::light::LightFrame;
+use crate::scene::Scene;
+use crate::skin::beckmann::beckmann_lut;
+use crate::skin::transmittance::shrink_units;
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::memory::{Buffer, Image};
+use crate::vk::pipeline::{
+    Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput,
+};
+use crate::vk::shader_stats::alu_estimate;
+use crate::vk::upload;
+
+/// Side of the Beckmann look-up texture (seed 004's specular): 256 x 256 R16F.
+const BECKMANN_SIZE: u32 = 256;
+/// Receiver bias of the shadow test along the light, in millimetres: half a
+/// millimetre keeps skin from shadowing itself at the shadow map's resolution.
+const SHADOW_BIAS_MM: f32 = 0.5;
+/// Slope-scaled depth bias of the shadow pass (in units of the depth slope):
+/// the usual 1.5 against acne on curved skin at grazing light.
+const SHADOW_SLOPE_BIAS: f32 = 1.5;
+/// Linear white point of Hable's filmic curve (his Uncharted 2 value).
+const WHITE_POINT: f32 = 11.2;
+const COMPOSITE_SHADER: &str = "composite.frag";
+const TONEMAP_SHADER: &str = "tonemap.frag";
+/// Loop trip counts of the 3x3 percentage-closer filter in lighting.glsl.
+const PCF_TRIPS: [u32; 2] = [3, 3];
+
+/// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: [[f32; 4]; 4],
+    pub view: [[f32; 4]; 4],
+    pub light_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub light_dir: [f32; 4],
+    pub light_color: [f32; 4],
+    pub ambient: [f32; 4],
+    pub params: [f32; 4],
+    pub shadow_params: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadowPush {
+    model: [[f32; 4]; 4],
+    light_view_proj: [[f32; 4]; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TonemapPush {
+    exposure: f32,
+    white_point: f32,
+}
+
+/// The frame's pipelines, uniforms, scene objects and placement.
+pub struct Frame {
+    pub settings: RenderSettings,
+    pub extent: vk::Extent2D,
+    pub mm_per_unit: f32,
+    pub targets: FrameTargets,
+    pub camera: Camera,
+    pub light_frame: LightFrame,
+    pub instances: Vec<Mat4>,
+    /// Model matrix of the non-skin objects (the backdrop).
+    backdrop: Mat4,
+    pub samplers: Samplers,
+    pub pool: DescriptorPool,
+    shadow_pipeline: Pipeline,
+    geometry_pipeline: Pipeline,
+    composite_pipeline: Pipeline,
+    tonemap_pipeline: Pipeline,
+    frame_set: vk::DescriptorSet,
+    composite_set: vk::DescriptorSet,
+    tonemap_set: vk::DescriptorSet,
+    frame_ubo: Buffer,
+    beckmann: Image,
+    pub objects: Vec<GpuObject>,
+    /// Where the SSS passes work (see `method::region`); change it with
+    /// `set_region`, which keeps the scissors the passes read in step.
+    pub region_px: Vec<PixelRect>,
+    sss_region: Vec<vk::Rect2D>,
+    screen_rect: Vec<vk::Rect2D>,
+}
+
+/// The rectangles of a pixel region as scissors.
+pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
+    region
+        .iter()
+        .map(|r| vk::Rect2D {
+            offset: vk::Offset2D {
+                x: r.x0 as i32,
+                y: r.y0 as i32,
+            },
+            extent: vk::Extent2D {
+                width: r.width(),
+                height: r.height(),
+            },
+        })
+        .collect()
+}
+
+impl Frame {
+    /// Pipelines, uniforms and scene objects (no descriptor set that needs a
+    /// frame image yet: `bind` writes those once the images exist).
+    pub fn new(
+        ctx: &Context,
+        scene: &Scene,
+        settings: &RenderSettings,
+        targets: FrameTargets,
+        framing: Framing,
+        res: &Resources,
+        transmittance: bool,
+    ) -> Result<Self> {
+        let extent = vk::Extent2D {
+            width: settings.width,
+            height: settings.height,
+        };
+        let samplers = Samplers::new(ctx)?;
+        let pool = DescriptorPool::new(ctx, 256)?;
+        let ds_format = res.format(targets.depth_stencil);
+        let shadow_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "shadow".into(),
+                vert: "shadow.vert",
+                frag: None,
+                color_formats: vec![],
+                depth_format: Some(SHADOW_FORMAT),
+                stencil_format: None,
+                vertex_input: VertexInput::MeshPositionOnly,
+                // No culling: thin parts (ears) must cast from both faces.
+                cull: vk::CullModeFlags::NONE,
+                depth_test: true,
+                depth_write: true,
+                depth_compare: vk::CompareOp::LESS,
+                stencil: None,
+                depth_bias: Some((0.0, SHADOW_SLOPE_BIAS)),
+                blend: Blend::None,
+            },
+        )?;
+        let color_formats: Vec<vk::Format> =
+            [targets.diffuse, targets.specular, targets.linear_depth]
+                .into_iter()
+                .chain(targets.normals)
+                .map(|t| res.format(t))
+                .collect();
+        let geometry_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "geometry".into(),
+                vert: "geometry.vert",
+                frag: Some(geometry_shader(&targets)),
+                color_formats,
+                depth_format: Some(ds_format),
+                stencil_format: Some(ds_format),
+                vertex_input: VertexInput::Mesh,
+                cull: vk::CullModeFlags::BACK,
+                depth_test: true,
+                depth_write: true,
+                depth_compare: vk::CompareOp::LESS,
+                // Every drawn pixel gets the object's skin bit (reference per draw).
+                stencil: Some(vk::StencilOpState {
+                    fail_op: vk::StencilOp::KEEP,
+                    pass_op: vk::StencilOp::REPLACE,
+                    depth_fail_op: vk::StencilOp::KEEP,
+                    compare_op: vk::CompareOp::ALWAYS,
+                    compare_mask: 0xff,
+                    write_mask: STENCIL_SKIN,
+                    reference: 0,
+                }),
+                depth_bias: None,
+                blend: Blend::None,
+            },
+        )?;
+        let composite_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
+        )?;
+        let tonemap_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc::fullscreen("tonemap", TONEMAP_SHADER, LDR_FORMAT),
+        )?;
+        let lut: Vec<u16> = beckmann_lut(BECKMANN_SIZE as usize)
+            .iter()
+            .map(|&v| half::f16::from_f32(v).to_bits())
+            .collect();
+        let beckmann = upload::texture(
+            ctx,
+            "beckmann",
+            vk::Extent2D {
+                width: BECKMANN_SIZE,
+                height: BECKMANN_SIZE,
+            },
+            vk::Format::R16_SFLOAT,
+            bytemuck::cast_slice(&lut),
+        )?;
+
+        let aspect = settings.width as f32 / settings.height as f32;
+        let camera = framing.camera;
+        let light_frame = framing.light;
+        let light_dir = settings.light.direction_to_light(scene.forward);
+        let light = settings.light;
+        let mm = scene.mm_per_unit;
+        let bias = SHADOW_BIAS_MM / mm / light_frame.depth_range_units;
+        let uniforms = FrameUniforms {
+            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
+            view: camera.view().to_cols_array_2d(),
+            light_view_proj: light_frame.view_proj.to_cols_array_2d(),
+            camera_pos: camera.eye.extend(1.0).to_array(),
+            light_dir: light_dir.extend(0.0).to_array(),
+            light_color: [
+                light.color[0] * light.intensity,
+                light.color[1] * light.intensity,
+                light.color[2] * light.intensity,
+                0.0,
+            ],
+            ambient: [settings.ambient; 4],
+            params: [
+                mm,
+                light_frame.depth_range_units,
+                shrink_units(mm),
+                (settings.transmittance && transmittance) as u32 as f32,
+            ],
+            shadow_params: [
+                1.0 / settings.shadow_size as f32,
+                bias,
+                settings.transmittance_profile.exponent_scale(),
+                0.0,
+            ],
+        };
+        let frame_ubo = Buffer::with_data(
+            ctx,
+            "frame uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let mut objects = Vec::new();
+        if let Some(b) = &scene.backdrop {
+            objects.push(GpuObject::new(
+                ctx,
+                "backdrop",
+                b,
+                &pool,
+                &geometry_pipeline,
+                &samplers,
+            )?);
+        }
+        objects.push(GpuObject::new(
+            ctx,
+            "head",
+            &scene.head,
+            &pool,
+            &geometry_pipeline,
+            &samplers,
+        )?);
+        let full = PixelRect::full(extent.width, extent.height);
+        Ok(Frame {
+            settings: settings.clone(),
+            extent,
+            mm_per_unit: mm,
+            targets,
+            camera,
+            light_frame,
+            instances: framing.instances,
+            backdrop: framing.backdrop,
+            samplers,
+            pool,
+            shadow_pipeline,
+            geometry_pipeline,
+            composite_pipeline,
+            tonemap_pipeline,
+            frame_set: vk::DescriptorSet::null(),
+            composite_set: vk::DescriptorSet::null(),
+            tonemap_set: vk::DescriptorSet::null(),
+            frame_ubo,
+            beckmann,
+            objects,
+            region_px: vec![full],
+            sss_region: scissors(&[full]),
+            screen_rect: scissors(&[full]),
+        })
+    }
+
+    /// The view the method is built for.
+    pub fn view_info(&self) -> ViewInfo {
+        ViewInfo {
+            extent: self.extent,
+            camera: self.camera,
+            mm_per_unit: self.mm_per_unit,
+        }
+    }
+
+    /// Where `method` has work in `scene` (the whole screen without a region).
+    pub fn region_for(&self, scene: &Scene, method: &dyn SssMethod) -> Vec<PixelRect> {
+        let full = PixelRect::full(self.extent.width, self.extent.height);
+        let s = &self.settings;
+        let view = self.view_info();
+        let probe = crate::method::region::ReachScale {
+            height_px: self.extent.height,
+            tan_half_fovy: view.tan_half_fovy(),
+            mm_per_unit: self.mm_per_unit,
+            max_strength: 1.0,
+        };
+        if s.sss_region == RegionMode::Screen || method.reach_px(1.0, &probe).is_none() {
+            return vec![full];
+        }
+        let rv = RegionView {
+            view: self.camera.view(),
+            proj: self.camera.proj(view.aspect()),
+            near: self.camera.near,
+            width: self.extent.width,
+            height: self.extent.height,
+        };
+        scene_region(
+            scene,
+            &self.instances,
+            &rv,
+            view.tan_half_fovy(),
+            s.sss_region_tile,
+            |d, scale| method.reach_px(d, scale),
+        )
+    }
+
+    pub fn set_region(&mut self, px: Vec<PixelRect>) {
+        self.sss_region = scissors(&px);
+        self.region_px = px;
+    }
+
+    /// The bindings of `lighting.glsl`'s set 0 (frame).
+    pub fn frame_binds(&self, res: &Resources) -> Vec<(&'static str, Bind)> {
+        vec![
+            (
+                "frame",
+                Bind::Uniform {
+                    buffer: self.frame_ubo.raw,
+                    size: std::mem::size_of::<FrameUniforms>() as u64,
+                },
+            ),
+            ("shadowMap", Bind::Texture(res.view(self.targets.shadow))),
+            ("shadowCompare", Bind::Sampler(self.samplers.shadow_compare)),
+            ("nearestClamp", Bind::Sampler(self.samplers.nearest_clamp)),
+            ("beckmannTex", Bind::Texture(self.beckmann.view)),
+            ("linearClamp", Bind::Sampler(self.samplers.linear_clamp)),
+        ]
+    }
+
+    /// The descriptor sets that read frame images (after they exist); the
+    /// composite reads whatever image the method names as its output.
+    pub fn bind(&mut self, ctx: &Context, res: &Resources, sss_output: ImageId) -> Result<()> {
+        let t = self.targets;
+        self.frame_set =
+            self.pool
+                .write_set(ctx, &self.geometry_pipeline, 0, &self.frame_binds(res))?;
+        self.composite_set = self.pool.write_set(
+            ctx,
+            &self.composite_pipeline,
+            0,
+            &[
+                ("diffuseTex", Bind::Texture(res.view(sss_output))),
+                ("specularTex", Bind::Texture(res.view(t.specular))),
+            ],
+        )?;
+        self.tonemap_set = self.pool.write_set(
+            ctx,
+            &self.tonemap_pipeline,
+            0,
+            &[("hdrTex", Bind::Texture(res.view(t.hdr)))],
+        )?;
+        Ok(())
+    }
+
+    pub fn view<'a, 'r>(&'a self, res: &'r Resources) -> FrameView<'a, 'r> {
+        FrameView {
+            targets: &self.targets,
+            res,
+            extent: self.extent,
+            region: &self.sss_region,
+            screen: &self.screen_rect,
+        }
+    }
+
+    /// The frame's passes in order, the method's in the middle.
+    pub fn passes<'a>(&'a self, method: &'a dyn SssMethod, res: &Resources) -> Vec<Pass<'a>> {
+        let mut passes = vec![self.shadow_pass(res), self.geometry_pass(res)];
+        passes.extend(method.passes(&self.view(res)));
+        passes.push(self.composite_pass(res, method.output()));
+        passes.push(self.tonemap_pass(res));
+        passes
+    }
+
+    /// Triangles the skin objects submit per frame (every character), and all objects.
+    fn triangles(&self, skin_only: bool) -> u64 {
+        self.objects
+            .iter()
+            .filter(|o| o.skin || !skin_only)
+            .map(|o| {
+                let copies = if o.skin { self.instances.len() } else { 1 };
+                o.index_count as u64 / 3 * copies as u64
+            })
+            .sum()
+    }
+
+    fn shadow_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+        let shadow = self.targets.shadow;
+        let e = res.extent(shadow);
+        Pass::new("shadow map", PassRole::Shadow)
+            .image(shadow, AccessKind::DepthStencilWrite)
+            .work(Work::Raster {
+                shader: None,
+                color: vec![],
+                depth_stencil: Some(DepthStencilUse {
+                    format: Format::D32Float,
+                    depth_test: true,
+                    depth_write: true,
+                    stencil_test: false,
+                    stencil_write: false,
+                }),
+                width: e.width,
+                height: e.height,
+                triangles: self.triangles(true),
+                msaa: 1,
+            })
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                begin_rendering(
+                    pc,
+                    &[],
+                    Some(DepthTarget {
+                        image: shadow,
+                        clear_depth: Some(1.0),
+                        stencil: false,
+                    }),
+                );
+                self.shadow_pipeline.bind(ctx, cmd, &[]);
+                // Heads only: the backdrop receives shadows but casts none worth a texel.
+                for obj in self.objects.iter().filter(|o| o.skin) {
+                    for m in &self.instances {
+                        let push = ShadowPush {
+                            model: m.to_cols_array_2d(),
+                            light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
+                        };
+                        self.shadow_pipeline.push(ctx, cmd, &push);
+                        obj.bind_and_draw(ctx, cmd);
+                    }
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            })
+    }
+
+    fn geometry_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+        let t = self.targets;
+        let colors: Vec<ImageId> = [t.diffuse, t.specular, t.linear_depth]
+            .into_iter()
+            .chain(t.normals)
+            .collect();
+        let shader = geometry_shader(&t);
+        let rgba8 = |texture: &str, exact| Fetch {
+            texture: texture.into(),
+            format: Format::Rgba8Unorm,
+            filter: Filter::Bilinear,
+            count: 1.0,
+            exact,
+        };
+        let shadow_format = work_format(res.format(t.shadow)).expect("shadow format");
+        // Per fragment: the 3x3 PCF, the three material maps (the normal map
+        // only where the tangent frame is valid), the Beckmann lobe where
+        // N.L > 0, and one shadow-map texel for transmittance on skin.
+        let fetches = vec![
+            Fetch {
+                texture: "shadowMap".into(),
+                format: shadow_format,
+                filter: Filter::DepthCompare,
+                count: 9.0,
+                exact: true,
+            },
+            rgba8("normalTex", false),
+            rgba8("albedoTex", true),
+            Fetch {
+                texture: "shadowMap".into(),
+                format: shadow_format,
+                filter: Filter::Point,
+                count: 1.0,
+                exact: false,
+            },
+            rgba8("specTex", true),
+            Fetch {
+                texture: "beckmannTex".into(),
+                format: Format::R16Float,
+                filter: Filter::Bilinear,
+                count: 1.0,
+                exact: false,
+            },
+        ];
+        let work = Work::Raster {
+            shader: Some(ShaderWork {
+                shader: shader.into(),
+                fetches,
+                alu: alu_estimate(shader, &PCF_TRIPS),
+                ..Default::default()
+            }),
+            color: colors
+                .iter()
+                .map(|&c| ColorWrite {
+                    format: work_format(res.format(c)).expect("colour formats"),
+                    blend: false,
+                })
+                .collect(),
+            depth_stencil: Some(DepthStencilUse {
+                format: work_format(res.format(t.depth_stencil)).expect("depth formats"),
+                depth_test: true,
+                depth_write: true,
+                stencil_test: false,
+                stencil_write: true,
+            }),
+            width: self.extent.width,
+            height: self.extent.height,
+            triangles: self.triangles(false),
+            msaa: 1,
+        };
+        let mut pass = Pass::new("geometry", PassRole::Geometry)
+            .image(t.shadow, AccessKind::FragmentSampledRead)
+            .work(work);
+        // Declared in the order the dumps number them: the three targets, depth
+        // and stencil, then the normals a method asked for.
+        for &c in &colors[..3] {
+            pass = pass.image(c, AccessKind::ColorAttachmentWrite);
+        }
+        pass = pass.image(t.depth_stencil, AccessKind::DepthStencilWrite);
+        for &c in &colors[3..] {
+            pass = pass.image(c, AccessKind::ColorAttachmentWrite);
+        }
+        let far = self.camera.far;
+        pass.record(move |pc: &PassContext| {
+            let (ctx, cmd) = (pc.ctx, pc.cmd);
+            // Linear depth clears to the far plane: no surface reads as "in front".
+            let clears = [[0.0f32; 4], [0.0; 4], [far, 0.0, 0.0, 0.0], [0.0; 4]];
+            let targets: Vec<(ImageId, Load)> = colors
+                .iter()
+                .zip(clears)
+                .map(|(&c, v)| (c, Load::Clear(v)))
+                .collect();
+            begin_rendering(
+                pc,
+                &targets,
+                Some(DepthTarget {
+                    image: t.depth_stencil,
+                    clear_depth: Some(1.0),
+                    stencil: true,
+                }),
+            );
+            let p = &self.geometry_pipeline;
+            p.bind(ctx, cmd, &[self.frame_set]);
+            for obj in &self.objects {
+                p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
+                unsafe {
+                    ctx.device.cmd_set_stencil_reference(
+                        cmd,
+                        vk::StencilFaceFlags::FRONT_AND_BACK,
+                        if obj.skin { STENCIL_SKIN } else { 0 },
+                    );
+                }
+                let backdrop = [self.backdrop];
+                let models: &[Mat4] = if obj.skin { &self.instances } else { &backdrop };
+                for m in models {
+                    p.push(ctx, cmd, &m.to_cols_array_2d());
+                    obj.bind_and_draw(ctx, cmd);
+                }
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        })
+    }
+
+    fn fullscreen_pass<'a>(
+        &'a self,
+        res: &Resources,
+        name: &str,
+        (pipeline, shader): (&'a Pipeline, &'static str),
+        set: vk::DescriptorSet,
+        reads: &[(ImageId, &str)],
+        target: ImageId,
+        push: Option<TonemapPush>,
+    ) -> Pass<'a> {
+        let work = Work::Raster {
+            shader: Some(ShaderWork {
+                shader: shader.into(),
+                fetches: reads
+                    .iter()
+                    .map(|&(id, texture)| Fetch {
+                        texture: texture.into(),
+                        format: work_format(res.format(id)).expect("frame formats"),
+                        filter: Filter::Point,
+                        count: 1.0,
+                        exact: true,
+                    })
+                    .collect(),
+                alu: alu_estimate(shader, &[]),
+                ..Default::default()
+            }),
+            color: vec![ColorWrite {
+                format: work_format(res.format(target)).expect("frame formats"),
+                blend: false,
+            }],
+            depth_stencil: None,
+            width: self.extent.width,
+            height: self.extent.height,
+            triangles: 1,
+            msaa: 1,
+        };
+        let mut pass = Pass::new(name, PassRole::Post).work(work);
+        for &(r, _) in reads {
+            pass = pass.image(r, AccessKind::FragmentSampledRead);
+        }
+        pass.image(target, AccessKind::ColorAttachmentWrite)
+            .record(move |pc: &PassContext| {
+                fullscreen_draw(pc, pipeline, set, &[target], |c, cmd| {
+                    if let Some(p) = &push {
+                        pipeline.push(c, cmd, p);
+                    }
+                })
+            })
+    }
+
+    fn composite_pass<'a>(&'a self, res: &Resources, sss_output: ImageId) -> Pass<'a> {
+        let t = self.targets;
+        self.fullscreen_pass(
+            res,
+            "composite",
+            (&self.composite_pipeline, COMPOSITE_SHADER),
+            self.composite_set,
+            &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
+            t.hdr,
+            None,
+        )
+    }
+
+    fn tonemap_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+        let t = self.targets;
+        self.fullscreen_pass(
+            res,
+            "tonemap",
+            (&self.tonemap_pipeline, TONEMAP_SHADER),
+            self.tonemap_set,
+            &[(t.hdr, "hdrTex")],
+            t.ldr,
+            Some(TonemapPush {
+                exposure: self.settings.exposure,
+                white_point: WHITE_POINT,
+            }),
+        )
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for o in &mut self.objects {
+            o.destroy(ctx);
+        }
+        self.beckmann.destroy(ctx);
+        self.frame_ubo.destroy(ctx);
+        for p in [
+            &mut self.shadow_pipeline,
+            &mut self.geometry_pipeline,
+            &mut self.composite_pipeline,
+            &mut self.tonemap_pipeline,
+        ] {
+            p.destroy(ctx);
+        }
+        self.pool.destroy(ctx);
+        self.samplers.destroy(ctx);
+    }
+}
+
+/// The geometry pass's fragment shader: with the normal MRT when a method needs it.
+fn geometry_shader(t: &FrameTargets) -> &'static str {
+    if t.normals.is_some() {
+        "geometry_normals.frag"
+    } else {
+        "geometry.frag"
+    }
+}
+
+/// The skin object's material bindings (set 1 of lighting.glsl), for methods
+/// that shade surfaces; none in a scene without skin.
+pub fn skin_material_binds(frame: &Frame) -> Vec<(&'static str, Bind)> {
+    frame
+        .objects
+        .iter()
+        .find(|o| o.skin)
+        .map(|o| o.material_binds(&frame.samplers))
+        .unwrap_or_default()
+}

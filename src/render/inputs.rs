@@ -1,0 +1,229 @@
+//! Writes into the frame's images outside the frame, as passes of the graph:
+//! synthetic SSS inputs (tests compare the GPU passes with CPU references on
+//! them) and fills of the intermediates (zeroed at set-up outside the SSS
+//! region; poisoned by tests so a tap that reads outside shows). Their accesses
+//! are declared here once: the renderer creates the images with the usages they
+//! need, and the passes use the same kinds.
+
+use anyhow::{bail, Result};
+use ash::vk;
+
+use super::Renderer;
+use crate::graph::work::{PassRole, Work};
+use crate::graph::{ImageId, Pass, PassContext};
+use crate::method::{FrameTargets, STENCIL_SKIN};
+use crate::vk::barrier::AccessKind;
+use crate::vk::memory::Buffer;
+
+/// How the uploads write the targets (whole contents).
+const UPLOAD_ACCESS: AccessKind = AccessKind::TransferWrite;
+/// How fills write the intermediates (whole contents, by a clear).
+pub const FILL_ACCESS: AccessKind = AccessKind::ClearWrite;
+
+/// The images `upload_sss_inputs` and `upload_normals` write.
+pub fn upload_accesses(t: &FrameTargets) -> Vec<(ImageId, AccessKind)> {
+    [t.diffuse, t.linear_depth, t.depth_stencil]
+        .into_iter()
+        .chain(t.normals)
+        .map(|i| (i, UPLOAD_ACCESS))
+        .collect()
+}
+
+/// A setup pass copying `buffer` into `image`: one region per (aspect, offset).
+fn upload_pass<'a>(
+    name: &str,
+    image: ImageId,
+    buffer: vk::Buffer,
+    aspects: Vec<(vk::ImageAspectFlags, u64)>,
+    extent: vk::Extent2D,
+    bytes: u64,
+) -> Pass<'a> {
+    Pass::new(name, PassRole::Setup)
+        .image(image, UPLOAD_ACCESS)
+        .work(Work::Copy {
+            texels: extent.width as u64 * extent.height as u64,
+            bytes_per_texel: (bytes / (extent.width as u64 * extent.height as u64).max(1)) as u32,
+        })
+        .record(move |pc: &PassContext| {
+            let regions: Vec<vk::BufferImageCopy> = aspects
+                .iter()
+                .map(|&(aspect, offset)| {
+                    vk::BufferImageCopy::default()
+                        .buffer_offset(offset)
+                        .image_subresource(
+                            vk::ImageSubresourceLayers::default()
+                                .aspect_mask(aspect)
+                                .layer_count(1),
+                        )
+                        .image_extent(vk::Extent3D {
+                            width: extent.width,
+                            height: extent.height,
+                            depth: 1,
+                        })
+                })
+                .collect();
+            unsafe {
+                pc.ctx.device.cmd_copy_buffer_to_image(
+                    pc.cmd,
+                    buffer,
+                    pc.image(image).raw,
+                    pc.layout(image),
+                    &regions,
+                )
+            };
+        })
+}
+
+impl Renderer<'_> {
+    /// Fills every intermediate of the method with `value` in every channel.
+    pub(super) fn fill_intermediates(&mut self, value: f32) -> Result<()> {
+        let ids = self.method.intermediates();
+        let passes: Vec<Pass> = ids
+            .into_iter()
+            .map(|id| {
+                let e = self.resources.extent(id);
+                Pass::new(format!("fill {}", self.resources.name(id)), PassRole::Setup)
+                    .image(id, FILL_ACCESS)
+                    .work(Work::Clear {
+                        texels: e.width as u64 * e.height as u64,
+                        bytes_per_texel: 8,
+                    })
+                    .record(move |pc: &PassContext| {
+                        let range = vk::ImageSubresourceRange::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .level_count(1)
+                            .layer_count(1);
+                        unsafe {
+                            pc.ctx.device.cmd_clear_color_image(
+                                pc.cmd,
+                                pc.image(id).raw,
+                                pc.layout(id),
+                                &vk::ClearColorValue {
+                                    float32: [value; 4],
+                                },
+                                &[range],
+                            )
+                        };
+                    })
+            })
+            .collect();
+        self.submit_untimed(&passes, "while filling the intermediates")
+    }
+
+    /// Fills the SSS intermediates with `value` (tests): texels the seed copies
+    /// skip keep it, so a tap that reads one shows in the output.
+    pub fn poison_intermediates(&mut self, value: f32) -> Result<()> {
+        self.fill_intermediates(value)
+    }
+
+    /// Uploads synthetic inputs into the SSS targets (tests): diffuse RGBA as f16,
+    /// linear depth (the depth buffer gets the matching projected depth), and the
+    /// stencil skin bit. The skin is then wherever the upload says, so the SSS
+    /// region becomes the whole screen.
+    pub fn upload_sss_inputs(
+        &mut self,
+        diffuse_f16: &[u16],
+        depth: &[f32],
+        skin: &[bool],
+    ) -> Result<()> {
+        let t = self.frame.targets;
+        let ds_format = self.resources.format(t.depth_stencil);
+        if ds_format != vk::Format::D32_SFLOAT_S8_UINT {
+            bail!("depth/stencil uploads need D32_SFLOAT_S8_UINT, the device gave {ds_format:?}");
+        }
+        let extent = self.frame.extent;
+        let ndc: Vec<f32> = depth
+            .iter()
+            .map(|&d| self.ndc_depth(d).clamp(0.0, 1.0))
+            .collect();
+        let mut ds_bytes: Vec<u8> = bytemuck::cast_slice(&ndc).to_vec();
+        let stencil_offset = ds_bytes.len() as u64;
+        ds_bytes.extend(skin.iter().map(|&s| if s { STENCIL_SKIN as u8 } else { 0 }));
+        let color = vk::ImageAspectFlags::COLOR;
+        let uploads: [(ImageId, &[u8], Vec<(vk::ImageAspectFlags, u64)>); 3] = [
+            (
+                t.diffuse,
+                bytemuck::cast_slice(diffuse_f16),
+                vec![(color, 0)],
+            ),
+            (
+                t.linear_depth,
+                bytemuck::cast_slice(depth),
+                vec![(color, 0)],
+            ),
+            (
+                t.depth_stencil,
+                &ds_bytes,
+                vec![
+                    (vk::ImageAspectFlags::DEPTH, 0),
+                    (vk::ImageAspectFlags::STENCIL, stencil_offset),
+                ],
+            ),
+        ];
+        self.upload(uploads.into_iter().collect(), extent)?;
+        let full = crate::method::region::PixelRect::full(extent.width, extent.height);
+        self.frame.set_region(vec![full]);
+        Ok(())
+    }
+
+    /// Uploads synthetic view-space normals (RGBA f16) into level 0 of the normal
+    /// target (tests of methods that read normals).
+    pub fn upload_normals(&mut self, normals_f16: &[u16]) -> Result<()> {
+        let Some(id) = self.frame.targets.normals else {
+            bail!("this method has no normal target");
+        };
+        let extent = self.frame.extent;
+        self.upload(
+            vec![(
+                id,
+                bytemuck::cast_slice(normals_f16),
+                vec![(vk::ImageAspectFlags::COLOR, 0)],
+            )],
+            extent,
+        )
+    }
+
+    fn upload(
+        &mut self,
+        uploads: Vec<(ImageId, &[u8], Vec<(vk::ImageAspectFlags, u64)>)>,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
+        let mut staging = Vec::new();
+        for (id, bytes, _) in &uploads {
+            match Buffer::with_data(
+                self.ctx,
+                &format!("{} upload", self.resources.name(*id)),
+                bytes,
+                vk::BufferUsageFlags::TRANSFER_SRC,
+            ) {
+                Ok(b) => staging.push(b),
+                Err(e) => {
+                    for mut b in staging {
+                        b.destroy(self.ctx);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let passes: Vec<Pass> = uploads
+            .into_iter()
+            .zip(&staging)
+            .map(|((id, bytes, aspects), b)| {
+                upload_pass(
+                    &format!("upload {}", self.resources.name(id)),
+                    id,
+                    b.raw,
+                    aspects,
+                    extent,
+                    bytes.len() as u64,
+                )
+            })
+            .collect();
+        let result = self.submit_untimed(&passes, "while uploading test inputs");
+        drop(passes);
+        for mut b in staging {
+            b.destroy(self.ctx);
+        }
+        result
+    }
+}

@@ -1,0 +1,217 @@
+//! Where the camera, the characters and the key light's shadow frustum go for a
+//! scene, a layout and a shot. Pure CPU code.
+
+use glam::{Mat4, Vec3};
+
+use super::camera::Camera;
+use super::layout::{crowd, grid_bounds, head_grid, Layout};
+use super::light::{shadow_frame, LightFrame};
+use super::mesh::Aabb;
+use super::Scene;
+
+/// What a shot needs to know beyond the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shot {
+    pub layout: Layout,
+    pub heads: u32,
+    /// Camera distance from the (first) head's centre, in head heights.
+    pub distance_heads: f32,
+    pub fovy_deg: f32,
+    pub aspect: f32,
+    /// Unit vector toward the key light.
+    pub light_dir: Vec3,
+}
+
+/// The placed shot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Framing {
+    pub camera: Camera,
+    /// Model matrix of every character.
+    pub instances: Vec<Mat4>,
+    /// Bounds of every character (what the shadow map covers).
+    pub bounds: Aabb,
+    pub light: LightFrame,
+    /// Model matrix of the backdrop: the identity, or, behind a crowd, the
+    /// backdrop pushed back past the last row and scaled about the eye so it
+    /// keeps its place on screen.
+    pub backdrop: Mat4,
+}
+
+/// Frames `scene` for `shot`.
+///
+/// One head, and the crowd: the camera looks at the (first) head's centre from
+/// `distance_heads` head heights along the face's forward; a crowd stands behind
+/// that head, and the far plane reaches its last row. Grid: the camera pulls
+/// back until the whole grid fills the old framing.
+pub fn frame(scene: &Scene, shot: &Shot) -> Framing {
+    let head_height = scene.head_height_units();
+    let center = scene.head_center();
+    let local = scene.head_bounds;
+    let heads = shot.heads.max(1);
+    let (instances, mut camera) = match shot.layout {
+        Layout::Grid => {
+            let instances = head_grid(heads, &local);
+            let gb = grid_bounds(heads, &local);
+            let grid_h = gb.size().y.max(gb.size().x / shot.aspect);
+            let (fit, target) = if heads > 1 {
+                ((grid_h / head_height).max(1.0), gb.center())
+            } else {
+                (1.0, center)
+            };
+            let camera = Camera::framing(
+                target,
+                scene.forward,
+                head_height,
+                shot.distance_heads * fit,
+                shot.fovy_deg,
+            );
+            (instances, camera)
+        }
+        Layout::Crowd => {
+            let mut camera = Camera::framing(
+                center,
+                scene.forward,
+                head_height,
+                shot.distance_heads,
+                shot.fovy_deg,
+            );
+            let half_width = (0.5 * shot.fovy_deg.to_radians()).tan() * shot.aspect;
+            let eye_distance = shot.distance_heads * head_height;
+            let instances = crowd(heads, head_height, scene.forward, eye_distance, half_width);
+            if heads > 1 {
+                // The last row must lie inside the far plane.
+                let view = camera.view();
+                let deepest = instances
+                    .iter()
+                    .flat_map(|m| corners(&local.transformed(m)))
+                    .map(|p| -view.transform_point3(p).z)
+                    .fold(0.0f32, f32::max);
+                camera.far = camera.far.max(deepest + head_height);
+            }
+            (instances, camera)
+        }
+    };
+    let bounds = instances
+        .iter()
+        .map(|m| local.transformed(m))
+        .reduce(|a, b| a.union(&b))
+        .unwrap_or(local);
+    let light = shadow_frame(shot.light_dir, bounds.center(), bounds.bounding_radius());
+    let backdrop = match &scene.backdrop {
+        Some(b) if instances.len() > 1 => behind(&camera, &b.mesh.bounds(), &bounds, head_height),
+        _ => Mat4::IDENTITY,
+    };
+    if backdrop != Mat4::IDENTITY {
+        // The far plane must reach the moved backdrop too.
+        let view = camera.view();
+        let moved = scene
+            .backdrop
+            .as_ref()
+            .map(|b| b.mesh.bounds().transformed(&backdrop))
+            .expect("moved only when there is one");
+        let deepest = corners(&moved)
+            .iter()
+            .map(|p| -view.transform_point3(*p).z)
+            .fold(0.0f32, f32::max);
+        camera.far = camera.far.max(deepest + head_height);
+    }
+    Framing {
+        camera,
+        instances,
+        bounds,
+        light,
+        backdrop,
+    }
+}
+
+/// A backdrop `bd` that `characters` would stand in: pushed back along the view
+/// to `head_height` behind the deepest character, scaled about the eye by the
+/// same ratio so it covers the same part of the screen. Identity when it is
+/// already behind them.
+fn behind(camera: &Camera, bd: &Aabb, characters: &Aabb, head_height: f32) -> Mat4 {
+    let view = camera.view();
+    let depth = |b: &Aabb, far: bool| {
+        corners(b)
+            .iter()
+            .map(|p| -view.transform_point3(*p).z)
+            .fold(if far { f32::MIN } else { f32::MAX }, |a, d| {
+                if far {
+                    a.max(d)
+                } else {
+                    a.min(d)
+                }
+            })
+    };
+    let (front, deepest) = (depth(bd, false), depth(characters, true));
+    if front <= 0.0 || front >= deepest + head_height {
+        return Mat4::IDENTITY;
+    }
+    let k = (deepest + head_height) / front;
+    Mat4::from_translation(camera.eye)
+        * Mat4::from_scale(glam::Vec3::splat(k))
+        * Mat4::from_translation(-camera.eye)
+}
+
+fn corners(b: &Aabb) -> [Vec3; 8] {
+    let (lo, hi) = (b.min, b.max);
+    [0, 1, 2, 3, 4, 5, 6, 7].map(|i| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::camera::project;
+    use crate::scene::default_scene;
+
+    fn shot(layout: Layout, heads: u32) -> Shot {
+        Shot {
+            layout,
+            heads,
+            distance_heads: 5.67,
+            fovy_deg: 20.0,
+            aspect: 16.0 / 9.0,
+            light_dir: Vec3::new(0.5, 0.5, 0.7).normalize(),
+        }
+    }
+
+    // One head frames the same in both layouts; a crowd keeps the camera and
+    // fits every character between the near and far planes.
+    #[test]
+    fn crowd_keeps_the_camera_and_the_depth_range_covers_it() {
+        let s = default_scene();
+        let one = frame(&s, &shot(Layout::Crowd, 1));
+        assert_eq!(one, frame(&s, &shot(Layout::Grid, 1)));
+        let many = frame(&s, &shot(Layout::Crowd, 16));
+        assert_eq!(many.camera.eye, one.camera.eye);
+        assert_eq!(many.instances.len(), 16);
+        let vp = many.camera.view_proj(16.0 / 9.0);
+        for m in &many.instances {
+            let c = s.head_bounds.transformed(m).center();
+            let ndc = project(&vp, c);
+            assert!((0.0..1.0).contains(&ndc.z), "{c} -> {ndc}");
+        }
+        // The backdrop moved behind the last row, and stays on screen.
+        let bd = s.backdrop.as_ref().unwrap().mesh.bounds();
+        let moved = bd.transformed(&many.backdrop);
+        let deepest = many
+            .instances
+            .iter()
+            .map(|m| s.head_bounds.transformed(m).min.z)
+            .fold(f32::MAX, f32::min);
+        assert!(moved.max.z < deepest, "{moved:?} vs {deepest}");
+        assert!(project(&vp, moved.center()).z < 1.0);
+        assert_eq!(one.backdrop, Mat4::IDENTITY);
+        // The grid pulls the camera back instead.
+        let grid = frame(&s, &shot(Layout::Grid, 16));
+        assert!(
+            grid.camera.eye.distance(grid.camera.target)
+                > one.camera.eye.distance(one.camera.target)
+        );
+    }
+}

@@ -1,0 +1,234 @@
+//! What a SPIR-V module does per invocation, read off its instructions: the
+//! arithmetic instructions executed (function calls expanded, loop bodies times
+//! their trip counts, both sides of a branch taken: an upper bound) and its
+//! static image instructions. Pass declarations take their ALU estimate from
+//! here, so the estimate follows the shader it describes.
+//!
+//! Pure: parses the binary itself (SPIR-V 1.0, structured control flow as
+//! glslang emits it: a loop's blocks lie between its header and its merge block).
+
+use std::collections::HashMap;
+
+use anyhow::{bail, Context as _, Result};
+
+use super::shader::{spirv, words};
+
+const OP_EXT_INST: u16 = 12;
+const OP_FUNCTION: u16 = 54;
+const OP_FUNCTION_END: u16 = 56;
+const OP_FUNCTION_CALL: u16 = 57;
+const OP_ENTRY_POINT: u16 = 15;
+const OP_ATOMIC_IADD: u16 = 234;
+const OP_LOOP_MERGE: u16 = 246;
+const OP_LABEL: u16 = 248;
+
+/// Whether `op` is an arithmetic instruction (conversions, arithmetic,
+/// relational and logical, bit operations, extended instructions such as
+/// GLSL.std.450's exp or clamp). Vector instructions count once each.
+fn is_alu(op: u16) -> bool {
+    matches!(op,
+        OP_EXT_INST
+        | 109..=124   // conversions (OpConvertFToU .. OpBitcast)
+        | 126..=152   // OpSNegate .. OpSMulExtended (incl. Dot, matrix products)
+        | 154..=191   // OpAny .. OpFUnordGreaterThanEqual (incl. OpSelect)
+        | 194..=205) // shifts and bit operations
+}
+
+/// Whether `op` reads a texel: sampling, fetch, gather, storage-image read.
+fn is_image_read(op: u16) -> bool {
+    (87..=98).contains(&op)
+}
+
+struct Block {
+    label: u32,
+    alu: u32,
+    /// Merge block of the loop this block heads, if it heads one.
+    loop_merge: Option<u32>,
+    calls: Vec<u32>,
+}
+
+struct Function {
+    blocks: Vec<Block>,
+}
+
+/// A parsed module: its functions and the entry point.
+pub struct ShaderStats {
+    functions: HashMap<u32, Function>,
+    entry: u32,
+    /// Static count of instructions that read texels (every site once).
+    pub image_reads: u32,
+    /// Static count of OpAtomicIAdd (the fetch-counting build adds one per site).
+    pub atomic_adds: u32,
+}
+
+impl ShaderStats {
+    pub fn parse(code: &[u32]) -> Result<Self> {
+        if code.len() < 5 || code[0] != 0x0723_0203 {
+            bail!("not a SPIR-V module");
+        }
+        let mut functions = HashMap::new();
+        let mut entry = None;
+        let (mut image_reads, mut atomic_adds) = (0, 0);
+        let mut current: Option<(u32, Function)> = None;
+        let mut i = 5;
+        while i < code.len() {
+            let count = (code[i] >> 16) as usize;
+            let op = (code[i] & 0xffff) as u16;
+            if count == 0 || i + count > code.len() {
+                bail!("malformed SPIR-V instruction at word {i}");
+            }
+            let args = &code[i + 1..i + count];
+            match op {
+                OP_ENTRY_POINT if entry.is_none() => entry = Some(args[1]),
+                OP_FUNCTION => current = Some((args[1], Function { blocks: Vec::new() })),
+                OP_FUNCTION_END => {
+                    if let Some((id, f)) = current.take() {
+                        functions.insert(id, f);
+                    }
+                }
+                OP_LABEL => {
+                    if let Some((_, f)) = current.as_mut() {
+                        f.blocks.push(Block {
+                            label: args[0],
+                            alu: 0,
+                            loop_merge: None,
+                            calls: Vec::new(),
+                        });
+                    }
+                }
+                _ => {
+                    if is_image_read(op) {
+                        image_reads += 1;
+                    }
+                    if op == OP_ATOMIC_IADD {
+                        atomic_adds += 1;
+                    }
+                    if let Some(b) = current.as_mut().and_then(|(_, f)| f.blocks.last_mut()) {
+                        match op {
+                            OP_LOOP_MERGE => b.loop_merge = Some(args[0]),
+                            OP_FUNCTION_CALL => b.calls.push(args[2]),
+                            o if is_alu(o) => b.alu += 1,
+                            _ => {}
+                        }
+                    }
+                }
+            }
+            i += count;
+        }
+        Ok(ShaderStats {
+            functions,
+            entry: entry.context("the module has no entry point")?,
+            image_reads,
+            atomic_adds,
+        })
+    }
+
+    /// Arithmetic instructions one invocation executes, with the loops' trip
+    /// counts given in the order their headers are reached (calls expanded
+    /// where they are made). Every loop must get a trip count.
+    pub fn alu(&self, trips: &[u32]) -> Result<f64> {
+        let mut next = 0usize;
+        let total = self.eval(self.entry, trips, &mut next, 0)?;
+        if next != trips.len() {
+            bail!(
+                "the shader has {next} loop(s) but {} trip count(s) were given",
+                trips.len()
+            );
+        }
+        Ok(total)
+    }
+
+    fn eval(&self, id: u32, trips: &[u32], next: &mut usize, depth: u32) -> Result<f64> {
+        if depth > 64 {
+            bail!("call depth over 64 (recursion is not valid SPIR-V for shaders)");
+        }
+        let f = self
+            .functions
+            .get(&id)
+            .with_context(|| format!("call of an unknown function %{id}"))?;
+        // (merge label, multiplier) of the loops the traversal is inside.
+        let mut loops: Vec<(u32, f64)> = Vec::new();
+        let mut total = 0.0;
+        for b in &f.blocks {
+            while loops.last().is_some_and(|(m, _)| *m == b.label) {
+                loops.pop();
+            }
+            let outer = loops.last().map_or(1.0, |l| l.1);
+            let mult = match b.loop_merge {
+                Some(merge) => {
+                    let t = *trips.get(*next).with_context(|| {
+                        format!(
+                            "loop {} has no trip count (only {} given)",
+                            *next + 1,
+                            trips.len()
+                        )
+                    })?;
+                    *next += 1;
+                    let m = outer * t as f64;
+                    loops.push((merge, m));
+                    m
+                }
+                None => outer,
+            };
+            total += mult * b.alu as f64;
+            for &c in &b.calls {
+                total += mult * self.eval(c, trips, next, depth + 1)?;
+            }
+        }
+        Ok(total)
+    }
+}
+
+/// The statistics of the embedded shader `name`.
+pub fn stats(name: &str) -> Result<ShaderStats> {
+    ShaderStats::parse(&words(spirv(name)?)?).with_context(|| format!("shader {name}"))
+}
+
+/// The ALU estimate of the embedded shader `name` (see [`ShaderStats::alu`]).
+/// Declarations call this at set-up; a mismatch between a shader's loops and
+/// the trip counts its pass declares is a programmer error.
+pub fn alu_estimate(name: &str, trips: &[u32]) -> f64 {
+    stats(name)
+        .and_then(|s| s.alu(trips))
+        .unwrap_or_else(|e| panic!("ALU estimate of {name}: {e:#}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // A loop's body scales with its trip count: the difference between two trip
+    // counts is the body's size times their difference.
+    #[test]
+    fn loops_scale_with_their_trip_counts() {
+        let s = stats("sss_blur.frag").unwrap();
+        let a = s.alu(&[8]).unwrap();
+        let b = s.alu(&[16]).unwrap();
+        let body = (b - a) / 8.0;
+        assert!(body >= 5.0, "loop body of {body} ALU instructions");
+        assert!((s.alu(&[32]).unwrap() - (a + 24.0 * body)).abs() < 1e-9);
+        assert!(s.alu(&[]).is_err());
+        assert!(s.alu(&[8, 8]).is_err());
+    }
+
+    // Nested loops multiply: the geometry pass's 3x3 PCF.
+    #[test]
+    fn nested_loops_multiply() {
+        let s = stats("geometry.frag").unwrap();
+        let base = s.alu(&[3, 3]).unwrap();
+        let wider = s.alu(&[3, 6]).unwrap();
+        let wider2 = s.alu(&[6, 3]).unwrap();
+        // Doubling the inner trips adds 3 x 3 inner bodies; doubling the outer
+        // adds 3 x (outer body + 3 inner bodies): more.
+        assert!(wider > base && wider2 > wider, "{base} {wider} {wider2}");
+    }
+
+    #[test]
+    fn straight_shaders_need_no_trips_and_count_their_reads() {
+        let s = stats("composite.frag").unwrap();
+        assert!(s.alu(&[]).unwrap() >= 1.0);
+        assert_eq!(s.image_reads, 2);
+        assert_eq!(stats("tonemap.frag").unwrap().image_reads, 1);
+        assert!(ShaderStats::parse(&[1, 2, 3]).is_err());
+    }
+}
