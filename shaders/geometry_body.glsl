@@ -16,6 +16,7 @@ layout(location = 3) out vec4 outNormal;
 #endif
 
 void main() {
+    COUNT_INVOCATION();
     vec3 Nv = normalize(vNormal);
     vec3 N = shadingNormal(Nv, vTangent, vUv);
     vec3 albedo = albedoAt(vUv);
@@ -31,13 +32,13 @@ void main() {
         // Listing 5.1: shrink along the vertex normal, read the light-side depth,
         // distance in millimetres, back irradiance from the reversed vertex normal.
         vec3 c = shadowCoord(vWorldPos - frame.params.z * Nv);
-        float d1 = texture(sampler2D(shadowMap, nearestClamp), c.xy).r;
+        float d1 = COUNTED(SITE(0, 1, FK_POINT), texture(sampler2D(shadowMap, nearestClamp), c.xy)).r;
         float sMm = abs(c.z - d1) * frame.params.y * frame.params.x;
         float E = max(0.3 + dot(-Nv, L), 0.0);
         diffuse += transmittanceProfile(sMm) * light * albedo * E;
     }
 
-    float specMask = texture(sampler2D(specTex, materialSampler), vUv).r;
+    float specMask = COUNTED(SITE(1, 2, FK_BILINEAR), texture(sampler2D(specTex, materialSampler), vUv)).r;
     float spec = kelemenSzirmayKalos(N, L, V, material.params.x, material.params.y) * specMask;
 
     outDiffuse = vec4(diffuse, skin ? material.params.z : 0.0);

@@ -17,9 +17,10 @@ float jitterAngle(uvec2 p) {
 }
 
 void main() {
+    COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 colorM = texelFetch(colorTex, p, 0);
-    float depth = texelFetch(depthTex, p, 0).r;
+    vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, p, 0));
+    float depth = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, p, 0)).r;
     vec2 s = vec2(stretch(p, ivec2(1, 0), depth, colorM.a), stretch(p, ivec2(0, 1), depth, colorM.a));
     vec2 mmToUv = s / 3.0 * pc.texel;
     vec2 uv = (vec2(p) + 0.5) * pc.texel;
@@ -28,10 +29,10 @@ void main() {
     vec3 acc = pc.center.rgb * colorM.rgb;
     for (int k = 0; k < 6; k++) {
         float a = theta + float(k) * (PI / 3.0);
-        vec3 c = texture(sampler2D(colorTex, linearClamp), uv + vec2(cos(a), sin(a)) * pc.wide.y * mmToUv).rgb;
+        vec3 c = COUNTED(SITE(0, 0, FK_BILINEAR), texture(sampler2D(colorTex, linearClamp), uv + vec2(cos(a), sin(a)) * pc.wide.y * mmToUv)).rgb;
         acc += (pc.mid.rgb / 6.0) * c;
         float b = a + PI / 6.0;
-        vec3 cw = texture(sampler2D(colorTex, linearClamp), uv + vec2(cos(b), sin(b)) * pc.wide.z * mmToUv).rgb;
+        vec3 cw = COUNTED(SITE(0, 0, FK_BILINEAR), texture(sampler2D(colorTex, linearClamp), uv + vec2(cos(b), sin(b)) * pc.wide.z * mmToUv)).rgb;
         acc.r += (pc.wide.x / 6.0) * cw.r;
     }
     outColor = vec4(acc, colorM.a);

@@ -5,6 +5,7 @@
 // Every fetch names LOD 0 (the textures have one level), so the code does not
 // depend on derivatives (the reference runs it over surface samples, not pixels).
 #include "frame_uniforms.glsl"
+#include "fetch_count.glsl"
 layout(set = 0, binding = 1) uniform texture2D shadowMap;
 layout(set = 0, binding = 2) uniform samplerShadow shadowCompare;  // LESS_OR_EQUAL, bilinear: 2x2 PCF
 layout(set = 0, binding = 3) uniform sampler nearestClamp;
@@ -49,7 +50,7 @@ float shadowPcf(vec3 worldPos, vec3 n) {
     for (int y = -1; y <= 1; y++)
         for (int x = -1; x <= 1; x++) {
             vec2 uv = c.xy + vec2(x, y) * texel;
-            sum += textureLod(sampler2DShadow(shadowMap, shadowCompare), vec3(uv, ref), 0.0);
+            sum += COUNTED(SITE(0, 1, FK_COMPARE), textureLod(sampler2DShadow(shadowMap, shadowCompare), vec3(uv, ref), 0.0));
         }
     return sum / 9.0;
 }
@@ -67,7 +68,7 @@ float kelemenSzirmayKalos(vec3 N, vec3 L, vec3 V, float m, float rhoS) {
     vec3 h = L + V;
     vec3 H = normalize(h);
     float nDotH = dot(N, H);
-    float PH = pow(2.0 * textureLod(sampler2D(beckmannTex, linearClamp), vec2(nDotH, m), 0.0).r, 10.0);
+    float PH = pow(2.0 * COUNTED(SITE(0, 4, FK_BILINEAR), textureLod(sampler2D(beckmannTex, linearClamp), vec2(nDotH, m), 0.0)).r, 10.0);
     float F = fresnelSchlick(dot(H, V), 0.028);
     float frSpec = max(PH * F / dot(h, h), 0.0);
     return nDotL * rhoS * frSpec;
@@ -80,12 +81,12 @@ vec3 shadingNormal(vec3 Nv, vec4 tangent, vec2 uv) {
     if (dot(T, T) <= 1e-12) return Nv;
     T = normalize(T);
     vec3 B = cross(Nv, T) * tangent.w;
-    vec3 tn = textureLod(sampler2D(normalTex, materialSampler), uv, 0.0).xyz * 2.0 - 1.0;
+    vec3 tn = COUNTED(SITE(1, 1, FK_BILINEAR), textureLod(sampler2D(normalTex, materialSampler), uv, 0.0)).xyz * 2.0 - 1.0;
     return normalize(mat3(T, B, Nv) * tn);
 }
 
 vec3 albedoAt(vec2 uv) {
-    return textureLod(sampler2D(albedoTex, materialSampler), uv, 0.0).rgb * material.baseColor.rgb;
+    return COUNTED(SITE(1, 0, FK_BILINEAR), textureLod(sampler2D(albedoTex, materialSampler), uv, 0.0)).rgb * material.baseColor.rgb;
 }
 
 // Diffuse radiance before scattering: albedo x (key light x N.L x shadow + ambient).

@@ -1,5 +1,7 @@
 #version 450
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_GOOGLE_include_directive : require
+#include "fetch_count.glsl"
 // Poisson-disk screen-space SSS (Agni's Philosophy, seed 003): 32 disk samples
 // weighted by distance to the centre (per channel), depth difference and normal
 // difference, fetched from a mip level chosen by the radius; fewer samples when
@@ -24,10 +26,11 @@ layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 void main() {
+    COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 colorM = texelFetch(colorChain, p, 0);
-    float d = texelFetch(depthChain, p, 0).r;
-    vec3 n = texelFetch(normalChain, p, 0).xyz;
+    vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorChain, p, 0));
+    float d = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthChain, p, 0)).r;
+    vec3 n = COUNTED(SITE(0, 2, FK_POINT), texelFetch(normalChain, p, 0)).xyz;
     vec2 uv = (vec2(p) + 0.5) / pc.size;
     float rPx = pc.radiusMm / (pc.mmPerUnit * 2.0 * d * pc.tanHalfFovy) * pc.size.y * colorM.a;
     int count = rPx >= 16.0 ? 32 : (rPx >= 8.0 ? 16 : 8);
@@ -37,9 +40,9 @@ void main() {
     for (int i = 0; i < count; i++) {
         vec2 q = disk.points[i].xy;
         vec2 uvS = uv + vec2(q.x * rPx / pc.size.x, q.y * rPx / pc.size.y);
-        vec4 c = textureLod(sampler2D(colorChain, mipClamp), uvS, lod);
-        float ds = textureLod(sampler2D(depthChain, mipClamp), uvS, lod).r;
-        vec3 ns = textureLod(sampler2D(normalChain, mipClamp), uvS, lod).xyz;
+        vec4 c = COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorChain, mipClamp), uvS, lod));
+        float ds = COUNTED(SITE(0, 1, FK_BILINEAR), textureLod(sampler2D(depthChain, mipClamp), uvS, lod)).r;
+        vec3 ns = COUNTED(SITE(0, 2, FK_BILINEAR), textureLod(sampler2D(normalChain, mipClamp), uvS, lod)).xyz;
         float dD = (ds - d) * pc.mmPerUnit;
         float wc = c.a * exp(-pc.depthSensitivity * dD * dD) * exp(-pc.normalSensitivity * (1.0 - clamp(dot(ns, n), 0.0, 1.0)));
         vec3 w = wc * exp(-pc.falloff.rgb * (q.x * q.x + q.y * q.y));

@@ -1,5 +1,7 @@
 #version 450
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_GOOGLE_include_directive : require
+#include "fetch_count.glsl"
 // Ground truth, step 2: for every skin pixel, the radiant exitance
 // M(x_o) = sum_j L_d(x_j) R(|x_j - x_o|) dA_j over all surface samples within the
 // cut-off (true 3D distances, visible or not), R the six-Gaussian profile. The three
@@ -42,15 +44,16 @@ vec3 wideProfile(float r2) {
 }
 
 void main() {
+    COUNT_INVOCATION();
     ivec2 size = textureSize(diffuseTex, 0);
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= size.x || p.y >= size.y) return;
-    vec4 d0 = texelFetch(diffuseTex, p, 0);
+    vec4 d0 = COUNTED(SITE(0, 0, FK_POINT), texelFetch(diffuseTex, p, 0));
     if (d0.a <= 0.0) {
         if (pc.dy == -1 && pc.dz == -1 && pc.first == 0u) imageStore(outImage, p, d0);
         return;
     }
-    float z = texelFetch(depthTex, p, 0).r;
+    float z = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, p, 0)).r;
     vec2 ndc = (vec2(p) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 viewPos = vec3(ndc.x * params.view.x * params.view.y * z, -ndc.y * params.view.x * z, -z);
     vec3 xo = (params.invView * vec4(viewPos, 1.0)).xyz;
@@ -74,7 +77,7 @@ void main() {
             vec3 dv = (pa.xyz - xo) * mm;
             float r2 = dot(dv, dv);
             if (r2 > cutoff2) continue;
-            vec3 radiance = texelFetch(radianceTex, ivec2(k % params.gridDims.w, k / params.gridDims.w), 0).rgb;
+            vec3 radiance = COUNTED(SITE(0, 4, FK_POINT), texelFetch(radianceTex, ivec2(k % params.gridDims.w, k / params.gridDims.w), 0)).rgb;
             acc += pa.w * radiance * wideProfile(r2);
         }
     }

@@ -19,6 +19,7 @@ layout(push_constant) uniform Push { uint count; uint width; uint firstRow; } pc
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outRadiance;
 void main() {
+    COUNT_INVOCATION();
     uint i = (uint(gl_FragCoord.y) - pc.firstRow) * pc.width + uint(gl_FragCoord.x);
     if (i >= pc.count) {
         outRadiance = vec4(0.0);

@@ -1,3 +1,4 @@
+#include "fetch_count.glsl"
 // Shared by the chapter-4 screen-space passes (ssg, ss-jittered): sources,
 // push constants and the stretch factors of thesis eq. 4.1-4.4.
 layout(set = 0, binding = 0) uniform texture2D colorTex;  // RGBA16F, alpha = SSS strength
@@ -25,8 +26,8 @@ layout(push_constant) uniform Push {
 // reproduce them).
 float depthGradient(ivec2 p, ivec2 axis) {
     ivec2 hi = textureSize(depthTex, 0) - 1;
-    float a = texelFetch(depthTex, clamp(p + axis, ivec2(0), hi), 0).r;
-    float b = texelFetch(depthTex, clamp(p - axis, ivec2(0), hi), 0).r;
+    float a = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, clamp(p + axis, ivec2(0), hi), 0)).r;
+    float b = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, clamp(p - axis, ivec2(0), hi), 0)).r;
     return 0.5 * (a - b);
 }
 

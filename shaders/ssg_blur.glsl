@@ -2,11 +2,12 @@
 // one standard deviation, scaled per pixel by the stretch factors.
 layout(early_fragment_tests) in;
 vec4 ssgBlur() {
+    COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 colorM = texelFetch(colorTex, p, 0);
+    vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, p, 0));
     // The thesis' alternative to the stencil test: a dynamic branch on the mask.
     if (pc.maskBranch != 0 && colorM.a <= 0.0) discard;
-    float depth = texelFetch(depthTex, p, 0).r;
+    float depth = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, p, 0)).r;
     ivec2 axis = pc.dir.x > 0.5 ? ivec2(1, 0) : ivec2(0, 1);
     float stepPx = stretch(p, axis, depth, colorM.a) * pc.stdMm / 3.0;
     vec2 uv = (vec2(p) + 0.5) * pc.texel;
@@ -14,7 +15,7 @@ vec4 ssgBlur() {
     const float w[7] = float[](0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006);
     vec3 acc = vec3(0.0);
     for (int k = -3; k <= 3; k++) {
-        acc += w[k + 3] * texture(sampler2D(colorTex, linearClamp), uv + float(k) * stepUv).rgb;
+        acc += w[k + 3] * COUNTED(SITE(0, 0, FK_BILINEAR), texture(sampler2D(colorTex, linearClamp), uv + float(k) * stepUv)).rgb;
     }
     return vec4(acc, colorM.a);
 }

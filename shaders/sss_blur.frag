@@ -1,5 +1,7 @@
 #version 450
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_GOOGLE_include_directive : require
+#include "fetch_count.glsl"
 // Separable SSS, one direction per pass (thesis ch. 6 and its HLSL listing).
 // Stencil-tested on the skin bit: early tests are forced so masked pixels never
 // run this shader.
@@ -25,9 +27,10 @@ layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 void main() {
+    COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 colorM = texelFetch(colorTex, p, 0);
-    float depthM = texelFetch(depthTex, p, 0).r;
+    vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, p, 0));
+    float depthM = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, p, 0)).r;
     vec2 uv = (vec2(p) + 0.5) / vec2(textureSize(sampler2D(colorTex, linearClamp), 0));
 
     // Screen height in scene units at this depth; one millimetre in uv, the same
@@ -41,11 +44,11 @@ void main() {
     for (int i = 1; i < pc.nSamples; i++) {
         vec4 k = kernel.samples[i];
         vec2 o = uv + k.w * stepUv;
-        vec3 c = texture(sampler2D(colorTex, linearClamp), o).rgb;
+        vec3 c = COUNTED(SITE(0, 0, FK_BILINEAR), texture(sampler2D(colorTex, linearClamp), o)).rgb;
         if (pc.followSurface != 0) {
             // Follow the surface: a sample across a depth step larger than the
             // kernel is replaced by the centre colour.
-            float d = texture(sampler2D(depthTex, linearClamp), o).r;
+            float d = COUNTED(SITE(0, 1, FK_BILINEAR), texture(sampler2D(depthTex, linearClamp), o)).r;
             float s = clamp(abs(depthM - d) * pc.mmPerUnit / pc.followTolMm, 0.0, 1.0);
             c = c + (colorM.rgb - c) * s;
         }

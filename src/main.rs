@@ -319,6 +319,7 @@ impl Common {
                 .map(|d| d.parse::<DeviceChoice>().unwrap_or_default())
                 .unwrap_or_default(),
             validate: self.validate,
+            ..Default::default()
         })
     }
 }
@@ -449,6 +450,7 @@ fn main_result() -> Result<()> {
             let ctx = Context::new(&ContextDesc {
                 device: DeviceChoice::Auto,
                 validate,
+                ..Default::default()
             })?;
             for (i, name, kind) in ctx.devices()? {
                 println!("{i}: {name} ({kind})");

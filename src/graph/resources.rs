@@ -271,7 +271,8 @@ impl Resources {
                     AccessKind::ComputeStorageWrite
                     | AccessKind::ComputeStorageRead
                     | AccessKind::ComputeStorageReadWrite
-                    | AccessKind::FragmentStorageRead => ImageUseKind::Storage,
+                    | AccessKind::FragmentStorageRead
+                    | AccessKind::FragmentStorageReadWrite => ImageUseKind::Storage,
                     AccessKind::TransferRead => ImageUseKind::CopySource,
                     AccessKind::TransferWrite
                     | AccessKind::TransferWritePartial

@@ -350,17 +350,22 @@ impl Reference {
         let lit = "reference_irradiance.frag";
         let shader = ShaderWork {
             shader: lit.into(),
+            // The texels past the last sample of a chunk's last row return
+            // before shading: every count is a bound.
             fetches: vec![
-                fetch(
-                    f.res,
-                    f.targets.shadow,
-                    "shadowMap",
-                    Filter::DepthCompare,
-                    9.0,
-                ),
+                Fetch {
+                    exact: false,
+                    ..fetch(
+                        f.res,
+                        f.targets.shadow,
+                        "shadowMap",
+                        Filter::DepthCompare,
+                        9.0,
+                    )
+                },
                 // Material textures are not frame images: RGBA8 bilinear.
-                material_fetch("normalTex", false),
-                material_fetch("albedoTex", true),
+                material_fetch("normalTex"),
+                material_fetch("albedoTex"),
             ],
             alu: alu_estimate(lit, &[3, 3]),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
@@ -400,10 +405,7 @@ impl Reference {
             for c in &self.chunks {
                 begin_rendering(pc, &[(c.radiance, Load::Discard)], None);
                 let p = &self.irradiance;
-                unsafe {
-                    ctx.device
-                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, p.raw);
-                }
+                p.bind(ctx, cmd, &[]);
                 p.bind_sets(ctx, cmd, 1, &[self.material_set]);
                 for &(set, first, n) in &c.draws {
                     let first_row = first / RADIANCE_WIDTH;
@@ -428,14 +430,14 @@ impl Reference {
     }
 }
 
-/// A fetch of the skin material's RGBA8 textures (bilinear, level 0).
-fn material_fetch(texture: &str, exact: bool) -> Fetch {
+/// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
+fn material_fetch(texture: &str) -> Fetch {
     Fetch {
         texture: texture.into(),
         format: Format::Rgba8Unorm,
         filter: Filter::Bilinear,
         count: 1.0,
-        exact,
+        exact: false,
     }
 }
 

@@ -3,6 +3,7 @@
 //! the passes, create them and write the descriptor sets), then recorded,
 //! submitted and measured frame by frame.
 
+pub mod counting;
 pub mod frame;
 pub mod inputs;
 pub mod readback;

@@ -98,7 +98,10 @@ pub fn frame(scene: &Scene, shot: &Shot) -> Framing {
         .unwrap_or(local);
     let light = shadow_frame(shot.light_dir, bounds.center(), bounds.bounding_radius());
     let backdrop = match &scene.backdrop {
-        Some(b) if instances.len() > 1 => behind(&camera, &b.mesh.bounds(), &bounds, head_height),
+        // A grid stands in the head's own plane: the backdrop stays where it is.
+        Some(b) if shot.layout == Layout::Crowd && instances.len() > 1 => {
+            behind(&camera, &b.mesh.bounds(), &bounds, head_height)
+        }
         _ => Mat4::IDENTITY,
     };
     if backdrop != Mat4::IDENTITY {

@@ -47,6 +47,8 @@ pub enum AccessKind {
     ComputeStorageReadWrite,
     /// Read as a storage buffer by a fragment shader.
     FragmentStorageRead,
+    /// Read and written (atomics) as a storage buffer by a fragment shader.
+    FragmentStorageReadWrite,
     /// Source of a copy.
     TransferRead,
     /// Destination of a copy or clear (whole contents produced).
@@ -134,6 +136,11 @@ impl AccessKind {
             AccessKind::FragmentStorageRead => {
                 (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ, L::GENERAL)
             }
+            AccessKind::FragmentStorageReadWrite => (
+                S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::GENERAL,
+            ),
             AccessKind::TransferRead => (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
             AccessKind::TransferWrite | AccessKind::TransferWritePartial => {
                 (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL)
@@ -168,6 +175,7 @@ impl AccessKind {
                 | AccessKind::DepthStencilWrite
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::ComputeStorageReadWrite
+                | AccessKind::FragmentStorageReadWrite
                 | AccessKind::TransferWrite
                 | AccessKind::TransferWritePartial
                 | AccessKind::ClearWrite
@@ -205,7 +213,8 @@ impl AccessKind {
             AccessKind::ComputeStorageWrite
             | AccessKind::ComputeStorageRead
             | AccessKind::ComputeStorageReadWrite
-            | AccessKind::FragmentStorageRead => U::STORAGE,
+            | AccessKind::FragmentStorageRead
+            | AccessKind::FragmentStorageReadWrite => U::STORAGE,
             AccessKind::TransferRead => U::TRANSFER_SRC,
             AccessKind::TransferWrite
             | AccessKind::TransferWritePartial
@@ -373,7 +382,8 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 20] = [
+    const ALL: [AccessKind; 21] = [
+        AccessKind::FragmentStorageReadWrite,
         AccessKind::ClearWrite,
         AccessKind::ComputeStorageReadWrite,
         AccessKind::FragmentStorageRead,
@@ -681,6 +691,7 @@ mod tests {
                     | AccessKind::ComputeStorageRead
                     | AccessKind::ComputeStorageReadWrite
                     | AccessKind::FragmentStorageRead
+                    | AccessKind::FragmentStorageReadWrite
             ) {
                 assert_ne!(i.layout, L::GENERAL, "{k:?}");
             }

@@ -35,6 +35,9 @@ pub struct ContextDesc {
     pub device: DeviceChoice,
     /// Enables VK_LAYER_KHRONOS_validation with synchronization validation.
     pub validate: bool,
+    /// Builds every pipeline from the fetch-counting build of its shaders
+    /// (tests of the passes' declared work; see shaders/fetch_count.glsl).
+    pub count_fetches: bool,
 }
 
 /// Facts about the chosen device that the renderer and the report need.
@@ -78,6 +81,8 @@ pub struct Context {
     // Boxed so the pointer handed to the messenger stays valid.
     _messages_box: Box<MessageLog>,
     pub allocator: Option<Mutex<Allocator>>,
+    /// The counters of the fetch-counting build (host-visible), when enabled.
+    pub fetch_counts: Option<super::memory::Buffer>,
     pub command_pool: vk::CommandPool,
     pub validation: bool,
 }
@@ -105,6 +110,10 @@ unsafe extern "system" fn debug_callback(
     }
     vk::FALSE
 }
+
+/// Counters of the fetch-counting build: slot 0 counts invocations, slot
+/// 1 + (set * 16 + binding) * 4 + kind counts fetches (shaders/fetch_count.glsl).
+pub const FETCH_COUNTERS: u64 = 1 + 4 * 16 * 4;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -190,15 +199,31 @@ impl Context {
             None
         };
 
-        let result = Self::with_instance(
+        let mut ctx = Self::with_instance(
             entry,
             instance,
             desc,
             debug_instance,
             messages,
             messages_box,
-        );
-        result
+        )?;
+        if desc.count_fetches {
+            if !ctx.facts.fragment_stores_and_atomics {
+                bail!(
+                    "device '{}' cannot write storage buffers from fragment shaders: no fetch counting",
+                    ctx.facts.name
+                );
+            }
+            ctx.fetch_counts = Some(super::memory::Buffer::new(
+                &ctx,
+                "fetch counters",
+                FETCH_COUNTERS * 4,
+                // Zeroed by vkCmdFillBuffer before each counted pass.
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                gpu_allocator::MemoryLocation::GpuToCpu,
+            )?);
+        }
+        Ok(ctx)
     }
 
     fn with_instance(
@@ -357,6 +382,7 @@ impl Context {
             messages,
             _messages_box: messages_box,
             allocator: Some(Mutex::new(allocator)),
+            fetch_counts: None,
             command_pool,
             validation: desc.validate,
         };
@@ -536,6 +562,11 @@ impl Drop for Context {
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
+        }
+        if let Some(mut b) = self.fetch_counts.take() {
+            b.destroy(self);
+        }
+        unsafe {
             // The allocator must go before the device.
             self.allocator.take();
             self.device.destroy_device(None);

@@ -77,6 +77,65 @@ pub struct Pipeline {
     pub has_stencil: bool,
     /// Whether it blends with a constant (the constant is dynamic state).
     pub has_blend_constants: bool,
+    /// The fetch-counting build's counter set (set 3) and its pool.
+    count_set: Option<(vk::DescriptorPool, vk::DescriptorSet)>,
+}
+
+/// Set number of the fetch counters in the counting build (fetch_count.glsl).
+const COUNT_SET: u32 = 3;
+
+/// The shader to build a pipeline from: its fetch-counting build when the
+/// context counts fetches and the shader has one.
+fn variant(ctx: &Context, name: &str) -> String {
+    let counted = format!("{name}#count");
+    if ctx.fetch_counts.is_some() && super::shader::spirv(&counted).is_ok() {
+        counted
+    } else {
+        name.to_string()
+    }
+}
+
+/// Allocates and writes the counter set of a counting pipeline (none otherwise).
+fn count_set(
+    ctx: &Context,
+    reflection: &Reflection,
+    set_layouts: &[vk::DescriptorSetLayout],
+) -> Result<Option<(vk::DescriptorPool, vk::DescriptorSet)>> {
+    let (Some(buffer), Some(b)) = (&ctx.fetch_counts, reflection.find(COUNT_SET, "FetchCounts"))
+    else {
+        return Ok(None);
+    };
+    let sizes = [vk::DescriptorPoolSize {
+        ty: b.descriptor_type,
+        descriptor_count: 1,
+    }];
+    let pool = unsafe {
+        ctx.device.create_descriptor_pool(
+            &vk::DescriptorPoolCreateInfo::default()
+                .max_sets(1)
+                .pool_sizes(&sizes),
+            None,
+        )
+    }?;
+    let set = unsafe {
+        ctx.device.allocate_descriptor_sets(
+            &vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(pool)
+                .set_layouts(&set_layouts[COUNT_SET as usize..=COUNT_SET as usize]),
+        )
+    }?[0];
+    let info = [vk::DescriptorBufferInfo {
+        buffer: buffer.raw,
+        offset: 0,
+        range: vk::WHOLE_SIZE,
+    }];
+    let write = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(b.binding)
+        .descriptor_type(b.descriptor_type)
+        .buffer_info(&info);
+    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+    Ok(Some((pool, set)))
 }
 
 fn make_layout(
@@ -108,15 +167,16 @@ fn make_layout(
 
 impl Pipeline {
     pub fn graphics(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
+        let frag = d.frag.map(|f| variant(ctx, f));
         let mut stages_names = vec![d.vert];
-        if let Some(f) = d.frag {
+        if let Some(f) = &frag {
             stages_names.push(f);
         }
         let reflection =
             reflect(&stages_names).with_context(|| format!("pipeline '{}'", d.name))?;
         let (layout, set_layouts) = make_layout(ctx, &d.name, &reflection)?;
         let vs = create_module(ctx, d.vert)?;
-        let fs = d.frag.map(|f| create_module(ctx, f)).transpose()?;
+        let fs = frag.as_deref().map(|f| create_module(ctx, f)).transpose()?;
         let entry = c"main";
         let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
@@ -242,6 +302,7 @@ impl Pipeline {
         Ok(Pipeline {
             raw,
             layout,
+            count_set: count_set(ctx, &reflection, &set_layouts)?,
             set_layouts,
             reflection,
             bind_point: vk::PipelineBindPoint::GRAPHICS,
@@ -253,9 +314,10 @@ impl Pipeline {
 
     /// A compute pipeline from one shader, its layout reflected.
     pub fn compute(ctx: &Context, name: &str, shader: &'static str) -> Result<Self> {
-        let reflection = reflect(&[shader]).with_context(|| format!("pipeline '{name}'"))?;
+        let shader = variant(ctx, shader);
+        let reflection = reflect(&[&shader]).with_context(|| format!("pipeline '{name}'"))?;
         let (layout, set_layouts) = make_layout(ctx, name, &reflection)?;
-        let module = create_module(ctx, shader)?;
+        let module = create_module(ctx, &shader)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
@@ -273,6 +335,7 @@ impl Pipeline {
         Ok(Pipeline {
             raw,
             layout,
+            count_set: count_set(ctx, &reflection, &set_layouts)?,
             set_layouts,
             reflection,
             bind_point: vk::PipelineBindPoint::COMPUTE,
@@ -286,6 +349,9 @@ impl Pipeline {
         unsafe {
             ctx.device.destroy_pipeline(self.raw, None);
             ctx.device.destroy_pipeline_layout(self.layout, None);
+            if let Some((pool, _)) = self.count_set.take() {
+                ctx.device.destroy_descriptor_pool(pool, None);
+            }
             for l in self.set_layouts.drain(..) {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
@@ -298,6 +364,9 @@ impl Pipeline {
             ctx.device.cmd_bind_pipeline(cmd, self.bind_point, self.raw);
         }
         self.bind_sets(ctx, cmd, 0, sets);
+        if let Some((_, set)) = self.count_set {
+            self.bind_sets(ctx, cmd, COUNT_SET, &[set]);
+        }
     }
 
     /// Binds `sets` from set number `first` on.

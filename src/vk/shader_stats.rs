@@ -34,9 +34,10 @@ fn is_alu(op: u16) -> bool {
         | 194..=205) // shifts and bit operations
 }
 
-/// Whether `op` reads a texel: sampling, fetch, gather, storage-image read.
+/// Whether `op` is a texture fetch: sampling, texel fetch or gather (not a
+/// storage-image read: storage traffic is declared apart).
 fn is_image_read(op: u16) -> bool {
-    (87..=98).contains(&op)
+    (87..=97).contains(&op)
 }
 
 struct Block {
@@ -55,7 +56,7 @@ struct Function {
 pub struct ShaderStats {
     functions: HashMap<u32, Function>,
     entry: u32,
-    /// Static count of instructions that read texels (every site once).
+    /// Static count of texture fetch instructions (every site once).
     pub image_reads: u32,
     /// Static count of OpAtomicIAdd (the fetch-counting build adds one per site).
     pub atomic_adds: u32,
@@ -221,6 +222,40 @@ mod tests {
         // Doubling the inner trips adds 3 x 3 inner bodies; doubling the outer
         // adds 3 x (outer body + 3 inner bodies): more.
         assert!(wider > base && wider2 > wider, "{base} {wider} {wider2}");
+    }
+
+    // Every fetch of every shader is counted in its fetch-counting build: one
+    // atomic per fetch site, plus the invocation counter. A fetch written
+    // without COUNTED(...) would escape the declared-work test; this catches it.
+    #[test]
+    fn every_fetch_site_is_counted_in_the_counting_build() {
+        let mut checked = 0;
+        for (name, _) in super::super::shader::SHADERS {
+            let Some(base) = name.strip_suffix("#count") else {
+                continue;
+            };
+            let normal = stats(base).unwrap();
+            let counted = stats(name).unwrap();
+            assert_eq!(normal.atomic_adds, 0, "{base}");
+            let expected = if normal.image_reads > 0 {
+                normal.image_reads + 1
+            } else {
+                0
+            };
+            assert_eq!(
+                counted.atomic_adds, expected,
+                "{base}: {} fetch sites, {} counters",
+                normal.image_reads, counted.atomic_adds
+            );
+            assert_eq!(counted.image_reads, normal.image_reads, "{base}");
+            checked += 1;
+        }
+        // Every fragment and compute shader has a counting build.
+        let shaders = super::super::shader::SHADERS
+            .iter()
+            .filter(|(n, _)| !n.contains('#') && !n.ends_with(".vert"))
+            .count();
+        assert_eq!(checked, shaders);
     }
 
     #[test]

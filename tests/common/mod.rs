@@ -9,7 +9,7 @@ use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 /// The test device: lavapipe unless DERMIS_TEST_DEVICE names another.
 pub fn ctx() -> Context {
     let name = std::env::var("DERMIS_TEST_DEVICE").unwrap_or_else(|_| "llvmpipe".into());
-    Context::new(&ContextDesc { device: DeviceChoice::Name(name), validate: true })
+    Context::new(&ContextDesc { device: DeviceChoice::Name(name), validate: true, count_fetches: false })
         .expect("creating a validated Vulkan context on lavapipe (install mesa-vulkan-drivers and vulkan-validationlayers)")
 }
 
@@ -42,4 +42,16 @@ pub fn lps_path() -> Option<PathBuf> {
 /// A registered method by CLI name.
 pub fn m(name: &str) -> &'static dermis::method::MethodEntry {
     dermis::method::lookup(name).expect("a registered method")
+}
+
+/// The test device with every pipeline built from the fetch-counting build of
+/// its shaders (see `dermis::render::counting`).
+pub fn counting_ctx() -> Context {
+    let name = std::env::var("DERMIS_TEST_DEVICE").unwrap_or_else(|_| "llvmpipe".into());
+    Context::new(&ContextDesc {
+        device: DeviceChoice::Name(name),
+        validate: true,
+        count_fetches: true,
+    })
+    .expect("creating a validated, fetch-counting Vulkan context on lavapipe")
 }

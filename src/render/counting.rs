@@ -1,0 +1,92 @@
+//! Counting what the passes' shaders really fetch (tests): with a context that
+//! builds every pipeline from the fetch-counting build of its shaders, each
+//! pass of a frame runs on its own between a zeroing of the counters and a
+//! read-back, so the counts are per pass.
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+
+use super::Renderer;
+use crate::graph::work::{PassRole, Work};
+use crate::graph::{Pass, PassContext};
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::FETCH_COUNTERS;
+
+/// One pass's counts.
+#[derive(Clone, Debug)]
+pub struct PassCounts {
+    pub name: String,
+    /// Shader invocations that reached main (helper invocations excluded).
+    pub invocations: u64,
+    /// Fetches by site: 1 + (set * 16 + binding) * 4 + kind (fetch_count.glsl).
+    pub fetches: Vec<(u32, u64)>,
+}
+
+/// The counter site of a fetch of binding (`set`, `binding`) of `kind` (the
+/// index of `graph::work::Filter`'s variant).
+pub fn site(set: u32, binding: u32, kind: u32) -> u32 {
+    1 + (set * 16 + binding) * 4 + kind
+}
+
+impl Renderer<'_> {
+    /// Runs one frame pass by pass and returns every pass's counts. Needs a
+    /// context made with `count_fetches`.
+    pub fn count_fetches(&mut self) -> Result<Vec<PassCounts>> {
+        let ctx = self.ctx;
+        let counter = ctx
+            .fetch_counts
+            .as_ref()
+            .context("counting fetches needs a context made with count_fetches")?;
+        let (raw, bytes) = (counter.raw, FETCH_COUNTERS * 4);
+        let id = self.resources.add_buffer("fetch counters", raw);
+        let mut out = Vec::new();
+        let n = self.passes().len();
+        for i in 0..n {
+            let mut passes = self.frame.passes(self.method.as_ref(), &self.resources);
+            let mut pass = passes.swap_remove(i);
+            drop(passes);
+            let counted = match pass.work {
+                Some(Work::Compute { .. }) => AccessKind::ComputeStorageReadWrite,
+                _ => AccessKind::FragmentStorageReadWrite,
+            };
+            let name = pass.name.clone();
+            pass.buffers.push((id, counted));
+            let zero = Pass::new("zero fetch counters", PassRole::Setup)
+                // vkCmdFillBuffer runs in the copy stage (what synchronization validation sees).
+                .buffer(id, AccessKind::TransferWrite)
+                .record(move |pc: &PassContext| unsafe {
+                    pc.ctx
+                        .device
+                        .cmd_fill_buffer(pc.cmd, raw, 0, vk::WHOLE_SIZE, 0)
+                });
+            let host = Pass::new("fetch counters to host", PassRole::Setup)
+                .buffer(id, AccessKind::HostRead);
+            super::submit_passes(
+                ctx,
+                &self.submit,
+                &mut self.resources,
+                &[zero, pass, host],
+                false,
+                "while counting fetches",
+            )?;
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&counter.read()?[..bytes as usize]);
+            if words.len() != FETCH_COUNTERS as usize {
+                bail!("fetch counters read back {} words", words.len());
+            }
+            out.push(PassCounts {
+                name,
+                invocations: words[0] as u64,
+                fetches: words
+                    .iter()
+                    .enumerate()
+                    .skip(1)
+                    .filter(|(_, &c)| c > 0)
+                    .map(|(s, &c)| (s as u32, c as u64))
+                    .collect(),
+            });
+        }
+        self.resources
+            .truncate_buffers(self.resources.buffer_count() - 1);
+        Ok(out)
+    }
+}

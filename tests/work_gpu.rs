@@ -1,0 +1,120 @@
+//! Every pass's declared work against the shader it describes: each method's
+//! frame runs with the fetch-counting build of its shaders (lavapipe,
+//! validation on), pass by pass, and the fetches each shader really made are
+//! held to what its pass declares: exact counts exactly, upper bounds as bounds,
+//! and no fetch that is not declared.
+
+mod common;
+
+use std::collections::BTreeMap;
+
+use dermis::graph::work::{Filter, Work};
+use dermis::method::METHODS;
+use dermis::render::counting::site;
+use dermis::render::{RenderSettings, Renderer};
+use dermis::scene::default_scene;
+use dermis::vk::shader::reflect;
+
+fn kind(f: Filter) -> u32 {
+    match f {
+        Filter::Point => 0,
+        Filter::Bilinear => 1,
+        Filter::DepthCompare => 2,
+        Filter::Trilinear => 3,
+    }
+}
+
+#[test]
+fn declared_fetches_are_what_the_shaders_fetch() {
+    let ctx = common::counting_ctx();
+    let scene = default_scene();
+    let mut checked = 0;
+    for m in METHODS {
+        let mut settings: Vec<(String, RenderSettings)> = m
+            .eval
+            .iter()
+            .map(|e| {
+                (
+                    format!("{} {}", m.name, e.label),
+                    RenderSettings::default().with(m, e.options),
+                )
+            })
+            .collect();
+        if m.ground_truth {
+            settings.push((
+                m.name.to_string(),
+                RenderSettings::default().with(m, &[("density", "2")]),
+            ));
+        }
+        for (label, s) in settings {
+            let s = RenderSettings {
+                width: 96,
+                height: 64,
+                shadow_size: 128,
+                distance_heads: 1.5,
+                ..s
+            };
+            let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+            let counts = r.count_fetches().unwrap();
+            let passes = r.passes();
+            assert_eq!(counts.len(), passes.len());
+            for (c, p) in counts.iter().zip(&passes) {
+                let at = format!("{label}: pass '{}'", p.name);
+                let shader = match &p.work {
+                    Some(Work::Raster {
+                        shader: Some(sh), ..
+                    }) => sh,
+                    Some(Work::Compute { shader, .. }) => shader,
+                    _ => {
+                        assert_eq!(c.invocations, 0, "{at}: runs no shader");
+                        assert!(c.fetches.is_empty(), "{at}: {:?}", c.fetches);
+                        continue;
+                    }
+                };
+                let refl = reflect(&[&shader.shader]).unwrap();
+                // Declared fetches per counter site: (exact sum, bound sum, all exact).
+                let mut declared: BTreeMap<u32, (f64, bool)> = BTreeMap::new();
+                for f in &shader.fetches {
+                    let b = refl
+                        .bindings
+                        .iter()
+                        .find(|b| b.name == f.texture)
+                        .unwrap_or_else(|| {
+                            panic!(
+                                "{at}: {} declares '{}', which it has no binding for",
+                                shader.shader, f.texture
+                            )
+                        });
+                    let e = declared
+                        .entry(site(b.set, b.binding, kind(f.filter)))
+                        .or_insert((0.0, true));
+                    e.0 += f.count;
+                    e.1 &= f.exact;
+                }
+                let n = c.invocations as f64;
+                let counted: BTreeMap<u32, u64> = c.fetches.iter().copied().collect();
+                for (s, &got) in &counted {
+                    assert!(
+                        declared.contains_key(s),
+                        "{at}: site {s} fetched {got} times but is not declared ({:?})",
+                        shader.fetches
+                    );
+                }
+                for (s, &(per, exact)) in &declared {
+                    let got = counted.get(s).copied().unwrap_or(0) as f64;
+                    if exact {
+                        assert_eq!(got, per * n, "{at}: site {s}: {got} fetches for {n} invocations, {per} declared each");
+                    } else {
+                        assert!(
+                            got <= per * n,
+                            "{at}: site {s}: {got} fetches exceed the bound {per} x {n}"
+                        );
+                    }
+                }
+                checked += 1;
+            }
+        }
+    }
+    println!("{checked} pass declarations checked against their shaders");
+    assert!(checked > 40, "{checked}");
+}

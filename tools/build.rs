@@ -1,0 +1,76 @@
+//! Compiles every GLSL shader in `shaders/` to SPIR-V with glslangValidator and
+//! generates the table `shaders.rs` that embeds them: each fragment and compute
+//! shader twice, as itself and as its fetch-counting build (`NAME#count`,
+//! compiled with -DDERMIS_COUNT_FETCHES; see shaders/fetch_count.glsl). The target is SPIR-V 1.0
+//! (vulkan1.0 environment): the vendored spirv-reflect misses storage buffers in
+//! the StorageBuffer storage class (SPIR-V 1.3+) and cannot parse the SPIR-V 1.4+
+//! entry-point interfaces; SPIR-V 1.0 spells SSBOs as Uniform + BufferBlock. A missing compiler stops
+//! the build with the name of the Debian package that provides it.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Suffix of a shader's fetch-counting build in the table.
+const COUNT_SUFFIX: &str = "#count";
+
+fn main() {
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let dir = Path::new("shaders");
+    // Headers (*.glsl) are compiled only through the shaders that include them.
+    println!("cargo:rerun-if-changed=shaders");
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("shaders/ directory is missing")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("vert" | "frag" | "comp")
+            )
+        })
+        .collect();
+    entries.sort();
+    let compiler = std::env::var("GLSLANG_VALIDATOR").unwrap_or_else(|_| "glslangValidator".into());
+    let mut table = String::from("/// (file name, SPIR-V bytes) of every shader in shaders/, built by build.rs.\npub static SHADERS: &[(&str, &[u8])] = &[\n");
+    for src in &entries {
+        println!("cargo:rerun-if-changed={}", src.display());
+        let name = src.file_name().unwrap().to_string_lossy().to_string();
+        let counted = !name.ends_with(".vert");
+        let variants: &[(&str, &[&str])] = if counted {
+            &[("", &[]), (COUNT_SUFFIX, &["-DDERMIS_COUNT_FETCHES"])]
+        } else {
+            &[("", &[])]
+        };
+        for (suffix, defines) in variants {
+            let spv = out.join(format!("{name}{}.spv", suffix.replace('#', "_")));
+            let status = Command::new(&compiler)
+                .args(["-V", "--target-env", "vulkan1.0", "-Ishaders"])
+                .args(defines.iter())
+                .arg("-o")
+                .arg(&spv)
+                .arg(src)
+                .output();
+            match status {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => panic!(
+                    "glslangValidator not found: install the Debian package glslang-tools (apt-get install glslang-tools), or set GLSLANG_VALIDATOR"
+                ),
+                Err(e) => panic!("running glslangValidator on {name}: {e}"),
+                Ok(o) if !o.status.success() => panic!(
+                    "glslangValidator failed on shaders/{name}{suffix}:\n{}{}",
+                    String::from_utf8_lossy(&o.stdout),
+                    String::from_utf8_lossy(&o.stderr)
+                ),
+                Ok(_) => {}
+            }
+            writeln!(
+                table,
+                "    ({:?}, include_bytes!({:?})),",
+                format!("{name}{suffix}"),
+                spv.display().to_string()
+            )
+            .unwrap();
+        }
+    }
+    table.push_str("];\n");
+    std::fs::write(out.join("shaders.rs"), table).expect("writing shaders.rs");
+}
