@@ -97,6 +97,55 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
+impl Texture {
+    /// Shrinks the texture to fit within `max_dim` on both sides, keeping its aspect
+    /// ratio, and returns whether it had to. A device cannot create an image larger than
+    /// its maxImageDimension2D; a smaller, blurrier skin texture is better than no frame.
+    ///
+    /// Box filter: each output texel averages the source texels of its footprint. The
+    /// footprints tile the source exactly (integer boundaries `x * W / w`), so every
+    /// source texel counts once. Bytes are averaged as stored (sRGB albedo averages a
+    /// little dark; at the 2x-4x reductions this is for, it does not show).
+    pub fn downscale_to_fit(&mut self, max_dim: u32) -> bool {
+        let max_dim = max_dim.max(1) as u64;
+        let (sw, sh) = (self.width as u64, self.height as u64);
+        if sw <= max_dim && sh <= max_dim {
+            return false;
+        }
+        let (dw, dh) = if sw >= sh {
+            (max_dim, (sh * max_dim / sw).clamp(1, max_dim))
+        } else {
+            ((sw * max_dim / sh).clamp(1, max_dim), max_dim)
+        };
+        let mut out = Vec::with_capacity((dw * dh * 4) as usize);
+        for y in 0..dh {
+            let (y0, y1) = (y * sh / dh, ((y + 1) * sh / dh).max(y * sh / dh + 1));
+            for x in 0..dw {
+                let (x0, x1) = (x * sw / dw, ((x + 1) * sw / dw).max(x * sw / dw + 1));
+                let mut sum = [0u64; 4];
+                for sy in y0..y1 {
+                    let row = (sy * sw * 4) as usize;
+                    let texels = self
+                        .rgba8
+                        .get(row + (x0 * 4) as usize..row + (x1 * 4) as usize)
+                        .unwrap_or(&[]);
+                    for px in texels.chunks_exact(4) {
+                        for c in 0..4 {
+                            sum[c] += px[c] as u64;
+                        }
+                    }
+                }
+                let n = (x1 - x0) * (y1 - y0);
+                out.extend(sum.map(|s| ((s + n / 2) / n) as u8));
+            }
+        }
+        self.width = dw as u32;
+        self.height = dh as u32;
+        self.rgba8 = out;
+        true
+    }
+}
+
 /// Shading parameters of one object. `skin` selects the subsurface path; the rest of the
 /// numbers follow d'Eon & Luebke's skin model (Beckmann roughness, Kelemen/Szirmay-Kalos
 /// specular scale).
@@ -239,6 +288,31 @@ impl Mesh {
                 .unwrap_or(Vec3::Y);
             v.normal = n.into();
         }
+    }
+
+    /// Flat normals, as glTF requires for a primitive without NORMAL: every triangle gets
+    /// its own three vertices carrying its face normal (shared vertices would average
+    /// across the edge and smooth what the file says is faceted). Degenerate triangles
+    /// cover no pixels; they get +Y rather than a NaN.
+    pub fn make_flat_normals(&mut self) {
+        let mut vertices = Vec::with_capacity(self.indices.len());
+        for tri in self.indices.chunks_exact(3) {
+            let Some(v) = tri
+                .iter()
+                .map(|&i| self.vertices.get(i as usize).copied())
+                .collect::<Option<Vec<Vertex>>>()
+            else {
+                continue;
+            };
+            let p = |k: usize| Vec3::from(v[k].position);
+            let n = (p(1) - p(0)).cross(p(2) - p(0)).normalize_or(Vec3::Y);
+            vertices.extend(v.into_iter().map(|mut v| {
+                v.normal = n.into();
+                v
+            }));
+        }
+        self.indices = (0..vertices.len() as u32).collect();
+        self.vertices = vertices;
     }
 
     /// Applies a model transform: positions by `m`, normals by its inverse transpose,
@@ -413,6 +487,93 @@ mod tests {
         let moved = b.transformed(&Mat4::from_translation(Vec3::X * 2.0));
         assert!(!b.overlaps(&moved));
         assert_eq!(Mesh::default().bounds().size(), Vec3::ZERO);
+    }
+
+    #[test]
+    fn flat_normals_unweld_and_follow_each_face() {
+        // Two triangles folded along the shared edge 0-2: one in z = 0, one in x = 1.
+        let mut m = Mesh {
+            vertices: vec![
+                vtx([0.0, 0.0, 0.0], [0.0; 2]),
+                vtx([1.0, 0.0, 0.0], [0.0; 2]),
+                vtx([1.0, 1.0, 0.0], [0.0; 2]),
+                vtx([1.0, 0.0, -1.0], [0.0; 2]),
+            ],
+            indices: vec![0, 1, 2, 1, 3, 2],
+        };
+        m.make_flat_normals();
+        assert_eq!(m.vertices.len(), 6);
+        assert_eq!(m.indices, vec![0, 1, 2, 3, 4, 5]);
+        for v in &m.vertices[..3] {
+            assert_eq!(v.normal, [0.0, 0.0, 1.0]);
+        }
+        for v in &m.vertices[3..] {
+            assert_eq!(v.normal, [1.0, 0.0, 0.0]);
+        }
+        assert_eq!(m.vertices[4].position, [1.0, 0.0, -1.0]);
+        // Degenerate triangles get a unit normal, not NaN.
+        let mut d = Mesh {
+            vertices: vec![vtx([1.0; 3], [0.0; 2]); 3],
+            indices: vec![0, 1, 2],
+        };
+        d.make_flat_normals();
+        assert!(d.vertices.iter().all(|v| v.normal == [0.0, 1.0, 0.0]));
+        d.validate().unwrap();
+    }
+
+    fn texture(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
+        let mut rgba8 = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                rgba8.extend(f(x, y));
+            }
+        }
+        Texture {
+            width: w,
+            height: h,
+            rgba8,
+        }
+    }
+
+    #[test]
+    fn downscale_to_fit_box_filters_and_keeps_aspect() {
+        let mut small = texture(4, 2, |_, _| [1, 2, 3, 4]);
+        let before = small.clone();
+        assert!(!small.downscale_to_fit(4));
+        assert_eq!(small, before);
+
+        // 2x2 checker blocks of 0 and 200 average to 100 in every output texel.
+        let mut t = texture(8, 4, |x, y| {
+            let v = if (x + y) % 2 == 0 { 0 } else { 200 };
+            [v, v, v, 255]
+        });
+        assert!(t.downscale_to_fit(4));
+        assert_eq!((t.width, t.height), (4, 2));
+        assert_eq!(t.rgba8.len(), 4 * 2 * 4);
+        assert!(t.rgba8.chunks_exact(4).all(|p| p == [100, 100, 100, 255]));
+
+        // A left half black and right half white stays split in the middle.
+        let mut t = texture(10, 20, |x, _| if x < 5 { [0; 4] } else { [255; 4] });
+        assert!(t.downscale_to_fit(8));
+        assert_eq!((t.width, t.height), (4, 8));
+        for row in t.rgba8.chunks_exact(16) {
+            assert_eq!(&row[..4], &[0; 4]);
+            assert_eq!(&row[12..], &[255; 4]);
+        }
+
+        // Non-integer ratios: constant channels stay constant and the size fits.
+        let mut t = texture(1000, 3, |x, y| [(x % 256) as u8, (y * 100) as u8, 7, 255]);
+        assert!(t.downscale_to_fit(333));
+        assert_eq!((t.width, t.height), (333, 1));
+        assert!(t.rgba8.chunks_exact(4).all(|p| p[1] == 100 && p[2] == 7));
+
+        // Extreme aspect ratios never reach zero texels; max 0 is taken as 1.
+        let mut t = texture(4096, 1, |_, _| [9; 4]);
+        assert!(t.downscale_to_fit(16));
+        assert_eq!((t.width, t.height), (16, 1));
+        let mut t = texture(3, 5, |_, _| [9; 4]);
+        assert!(t.downscale_to_fit(0));
+        assert_eq!((t.width, t.height, t.rgba8.clone()), (1, 1, vec![9; 4]));
     }
 
     #[test]

@@ -4,12 +4,15 @@
 
 pub mod camera;
 pub mod framing;
+pub mod gltf_accessor;
 pub mod gltf_load;
+pub mod gltf_source;
 pub mod head_measure;
 pub mod layout;
 pub mod light;
 pub mod mesh;
 pub mod procedural;
+pub mod robust_bounds;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
@@ -98,9 +101,17 @@ pub fn load_gltf_scene(
     let mm_per_unit = match mm_per_unit {
         Some(mm) => mm,
         None if height.is_finite() && height > 0.0 => head_measure::HEAD_HEIGHT_MM / height,
+        // Say what was measured: an overflowing extent is not "no height".
+        None if !height.is_finite() => bail!(
+            "cannot derive mm_per_unit: the head in {} is too large to measure in f32 (from y = {} to {})",
+            path.display(),
+            head_part.min.y,
+            head_part.max.y
+        ),
         None => bail!(
-            "cannot derive mm_per_unit: the head in {} has no height",
-            path.display()
+            "cannot derive mm_per_unit: the head in {} has no height above its chin (chin and crown both at y = {})",
+            path.display(),
+            head_part.min.y
         ),
     };
     let name = path
@@ -150,6 +161,18 @@ mod tests {
         }
         let s = load_gltf_scene(&p, &Default::default(), Some(2.5)).unwrap();
         assert_eq!(s.mm_per_unit, 2.5);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn head_far_from_the_origin_keeps_its_height() {
+        // At 1e8 f32 steps are 8 units: transforming in f32 flattened the 1-unit
+        // triangle and the scene was refused as having no height.
+        let dir = temp_dir("far");
+        let p = tiny_gltf(&dir, true, true, [1e8, -1e8, 1e8]);
+        let s = load_gltf_scene(&p, &Default::default(), None).unwrap();
+        assert_eq!(s.head_bounds.size(), Vec3::new(1.0, 1.0, 0.0));
+        assert!((s.head_height_units() - 1.0).abs() < 1e-6);
         let _ = std::fs::remove_dir_all(dir);
     }
 

@@ -1,0 +1,1207 @@
+//! glTF fuzzer: a fixed-seed mutation run over the Lee Perry-Smith head and over
+//! generated files (accessor storage and layout, node graphs with cycles and deep
+//! chains, primitive modes, buffer and image URIs, GLB containers, non-finite values).
+//! Every case must end in a loaded scene or one clean error line: a panic, a hang or a
+//! multi-line error fails the test. A few loaded cases are then rendered on lavapipe
+//! at 64x36 with validation on, and must give finite output.
+//!
+//! Quick run (the default: 3000 random cases plus the fixed ones, up to 40 loaded cases
+//! per category rendered; well under a minute in the debug profile):
+//!     cargo test --test gltf_fuzz -- --nocapture
+//! Long run (the number of random cases, and another seed):
+//!     DERMIS_FUZZ_ITERS=50000 DERMIS_FUZZ_SEED=7 cargo test --release --test gltf_fuzz -- --nocapture
+//! DERMIS_FUZZ_RENDER=0 skips the rendering part (no Vulkan needed).
+
+mod common;
+
+use dermis::render::RenderSettings;
+use dermis::run::{run, RunOptions};
+use dermis::scene::gltf_load::{load_head_with_warnings, TextureOverrides};
+use dermis::scene::load_gltf_scene;
+use dermis::scene::mesh::Object;
+use serde_json::{json, Value};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// A case taking longer than this is a hang.
+const CASE_TIMEOUT: Duration = Duration::from_secs(60);
+/// A clean error is one line of at most this many characters.
+const MAX_ERROR_LEN: usize = 600;
+/// Loaded cases rendered per category.
+const RENDER_PER_CATEGORY: usize = 40;
+
+// ---- Deterministic PRNG (SplitMix64: tiny, good enough to pick mutations) -------------
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64 <= p
+    }
+    fn pick<T: Clone>(&mut self, v: &[T]) -> T {
+        v[self.below(v.len())].clone()
+    }
+}
+
+// ---- Generated models -----------------------------------------------------------------
+
+/// A glTF document and its one buffer, before it is written in some container.
+#[derive(Clone)]
+struct Model {
+    json: Value,
+    buffer: Vec<u8>,
+}
+
+fn f32_bytes(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|f| f.to_le_bytes()).collect()
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// A small PNG for the embedded texture.
+fn png(rng: &mut Rng) -> Vec<u8> {
+    let (w, h) = (1 + rng.below(6) as u32, 1 + rng.below(6) as u32);
+    let img = image::RgbaImage::from_fn(w, h, |x, y| {
+        image::Rgba([(x * 40) as u8, (y * 40) as u8, 150, 255])
+    });
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .expect("encode PNG");
+    out.into_inner()
+}
+
+/// A valid model: a bumpy n x n grid facing +Z with normals, texture coordinates,
+/// u16 indices and an embedded PNG albedo. Views: 0 positions, 1 normals, 2 UVs,
+/// 3 indices, 4 image. Accessors: 0 POSITION, 1 NORMAL, 2 TEXCOORD_0, 3 indices.
+fn base_model(rng: &mut Rng) -> Model {
+    let n = 2 + rng.below(7);
+    let (mut pos, mut nrm, mut uv, mut idx) = (vec![], vec![], vec![], vec![]);
+    for j in 0..n {
+        for i in 0..n {
+            let (u, v) = (i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32);
+            pos.extend([u - 0.5, v - 0.5, 0.1 * (u * 3.0).sin() * (v * 3.0).cos()]);
+            nrm.extend([0.0, 0.0, 1.0]);
+            uv.extend([u, 1.0 - v]);
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = (j * n + i) as u16;
+            let (b, c, d) = (a + 1, a + n as u16 + 1, a + n as u16);
+            idx.extend([a, b, c, a, c, d]);
+        }
+    }
+    let mut buffer = Vec::new();
+    let mut views = Vec::new();
+    let mut push = |bytes: Vec<u8>, buffer: &mut Vec<u8>| {
+        while buffer.len() % 4 != 0 {
+            buffer.push(0);
+        }
+        views.push(json!({"buffer": 0, "byteOffset": buffer.len(), "byteLength": bytes.len()}));
+        buffer.extend(bytes);
+    };
+    push(f32_bytes(&pos), &mut buffer);
+    push(f32_bytes(&nrm), &mut buffer);
+    push(f32_bytes(&uv), &mut buffer);
+    push(
+        idx.iter().flat_map(|i| i.to_le_bytes()).collect(),
+        &mut buffer,
+    );
+    push(png(rng), &mut buffer);
+    let count = n * n;
+    let json = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "name": "grid"}],
+        "meshes": [{"name": "grid", "primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+            "indices": 3,
+            "material": 0
+        }]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 4, "mimeType": "image/png"}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3",
+             "min": [-0.5, -0.5, -0.1], "max": [0.5, 0.5, 0.1]},
+            {"bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": idx.len(), "type": "SCALAR"}
+        ],
+        "bufferViews": views,
+        "buffers": [{"byteLength": buffer.len()}]
+    });
+    Model { json, buffer }
+}
+
+/// Appends bytes to the buffer as a new view; returns the view index.
+fn add_view(m: &mut Model, bytes: &[u8], stride: Option<usize>) -> usize {
+    while m.buffer.len() % 4 != 0 {
+        m.buffer.push(0);
+    }
+    let mut v = json!({"buffer": 0, "byteOffset": m.buffer.len(), "byteLength": bytes.len()});
+    if let Some(s) = stride {
+        v["byteStride"] = json!(s);
+    }
+    m.buffer.extend(bytes);
+    m.json["buffers"][0]["byteLength"] = json!(m.buffer.len());
+    let views = m.json["bufferViews"].as_array_mut().expect("views");
+    views.push(v);
+    views.len() - 1
+}
+
+fn add_accessor(m: &mut Model, acc: Value) -> usize {
+    let accs = m.json["accessors"].as_array_mut().expect("accessors");
+    accs.push(acc);
+    accs.len() - 1
+}
+
+fn vertex_count(m: &Model) -> usize {
+    m.json["accessors"][0]["count"].as_u64().unwrap_or(0) as usize
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Container {
+    DataUri,
+    BinFile,
+    Glb,
+}
+
+fn glb_bytes(json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).expect("json");
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let mut v = b"glTF".to_vec();
+    v.extend(2u32.to_le_bytes());
+    v.extend(0u32.to_le_bytes());
+    v.extend((j.len() as u32).to_le_bytes());
+    v.extend(b"JSON");
+    v.extend(&j);
+    if let Some(bin) = bin {
+        let mut b = bin.to_vec();
+        while b.len() % 4 != 0 {
+            b.push(0);
+        }
+        v.extend((b.len() as u32).to_le_bytes());
+        v.extend(b"BIN\0");
+        v.extend(b);
+    }
+    let n = v.len() as u32;
+    v[8..12].copy_from_slice(&n.to_le_bytes());
+    v
+}
+
+/// Writes the model; buffer 0 gets its URI from the container unless the case set one.
+fn write(m: &Model, c: Container, dir: &Path, name: &str) -> PathBuf {
+    let mut json = m.json.clone();
+    // A generic JSON mutation may have broken the buffer's shape: then write as is.
+    if let Some(b) = json
+        .pointer_mut("/buffers/0")
+        .and_then(Value::as_object_mut)
+    {
+        match c {
+            Container::DataUri if !b.contains_key("uri") => {
+                b.insert(
+                    "uri".into(),
+                    json!(format!(
+                        "data:application/octet-stream;base64,{}",
+                        base64(&m.buffer)
+                    )),
+                );
+            }
+            Container::BinFile if !b.contains_key("uri") => {
+                std::fs::write(dir.join(format!("{name}.bin")), &m.buffer).expect("write bin");
+                b.insert("uri".into(), json!(format!("{name}.bin")));
+            }
+            _ => {}
+        }
+    }
+    if c == Container::Glb {
+        let path = dir.join(format!("{name}.glb"));
+        std::fs::write(&path, glb_bytes(&json, Some(&m.buffer))).expect("write glb");
+        path
+    } else {
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_vec(&json).expect("json")).expect("write gltf");
+        path
+    }
+}
+
+// ---- Mutations --------------------------------------------------------------------------
+
+const COMPONENT_TYPES: &[u64] = &[5120, 5121, 5122, 5123, 5125, 5126, 5124, 9999];
+const TYPES: &[&str] = &["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT4", "BOGUS"];
+
+fn interesting_count(rng: &mut Rng, real: u64) -> Value {
+    json!(rng.pick(&[
+        0,
+        1,
+        real.saturating_sub(1),
+        real,
+        real + 1,
+        real * 2,
+        1 << 31,
+        1 << 40,
+        u64::MAX >> 11
+    ]))
+}
+
+fn interesting_offset(rng: &mut Rng, real: u64) -> Value {
+    json!(rng.pick(&[0, 1, 2, 3, 4, 8, real, real + 4, 1 << 32, 1 << 50]))
+}
+
+/// Accessor storage and layout: component type, normalized, type, count, offsets,
+/// strides, buffer lengths, sparse storage, index values.
+fn mutate_accessors(m: &mut Model, rng: &mut Rng) -> String {
+    let mut what = Vec::new();
+    for _ in 0..1 + rng.below(3) {
+        let a = rng.below(4);
+        match rng.below(11) {
+            0 => {
+                let ct = rng.pick(COMPONENT_TYPES);
+                m.json["accessors"][a]["componentType"] = json!(ct);
+                what.push(format!("acc{a}.componentType={ct}"));
+            }
+            1 => {
+                m.json["accessors"][a]["normalized"] = json!(true);
+                let ct = rng.pick(COMPONENT_TYPES);
+                m.json["accessors"][a]["componentType"] = json!(ct);
+                what.push(format!("acc{a}.normalized ct={ct}"));
+            }
+            2 => {
+                let t = rng.pick(TYPES);
+                m.json["accessors"][a]["type"] = json!(t);
+                what.push(format!("acc{a}.type={t}"));
+            }
+            3 => {
+                let real = m.json["accessors"][a]["count"].as_u64().unwrap_or(1);
+                let c = interesting_count(rng, real);
+                what.push(format!("acc{a}.count={c}"));
+                m.json["accessors"][a]["count"] = c;
+            }
+            4 => {
+                let o = interesting_offset(rng, 4);
+                what.push(format!("acc{a}.byteOffset={o}"));
+                m.json["accessors"][a]["byteOffset"] = o;
+            }
+            5 => {
+                let v = rng.below(5);
+                let s = rng.pick(&[0u64, 1, 2, 3, 4, 6, 8, 12, 16, 252, 256, 1 << 33]);
+                m.json["bufferViews"][v]["byteStride"] = json!(s);
+                what.push(format!("view{v}.byteStride={s}"));
+            }
+            6 => {
+                let v = rng.below(5);
+                let real = m.json["bufferViews"][v]["byteLength"].as_u64().unwrap_or(0);
+                let key = rng.pick(&["byteLength", "byteOffset"]);
+                let val = interesting_offset(rng, real);
+                what.push(format!("view{v}.{key}={val}"));
+                m.json["bufferViews"][v][key] = val;
+            }
+            7 => {
+                let real = m.buffer.len() as u64;
+                let l = rng.pick(&[0, real - 1, real + 1, 1 << 40, u64::MAX >> 11]);
+                m.json["buffers"][0]["byteLength"] = json!(l);
+                what.push(format!("buffer.byteLength={l}"));
+            }
+            8 => {
+                // Sparse storage: random substitutions, sometimes out of order or range.
+                let count = m.json["accessors"][a]["count"].as_u64().unwrap_or(1);
+                let n = 1 + rng.below(4);
+                let mut ids: Vec<u32> = (0..n)
+                    .map(|_| rng.below(count as usize + 2) as u32)
+                    .collect();
+                if rng.chance(0.7) {
+                    ids.sort();
+                    ids.dedup();
+                }
+                let ibytes: Vec<u8> = ids.iter().flat_map(|i| i.to_le_bytes()).collect();
+                let iv = add_view(m, &ibytes, None);
+                let vals: Vec<f32> = (0..ids.len() * 4).map(|k| k as f32 * 0.01).collect();
+                let vv = add_view(m, &f32_bytes(&vals), None);
+                let sc = if rng.chance(0.9) {
+                    ids.len()
+                } else {
+                    ids.len() + 3
+                };
+                m.json["accessors"][a]["sparse"] = json!({
+                    "count": sc,
+                    "indices": {"bufferView": iv, "componentType": 5125},
+                    "values": {"bufferView": vv}
+                });
+                if rng.chance(0.3) {
+                    m.json["accessors"][a]
+                        .as_object_mut()
+                        .expect("accessor")
+                        .remove("bufferView");
+                }
+                what.push(format!("acc{a}.sparse {ids:?} count {sc}"));
+            }
+            9 => {
+                // Index values: one random index replaced (out of range, restart value).
+                let n = vertex_count(m) as u16;
+                let at = rng.below(6);
+                let val = rng.pick(&[n, n.wrapping_add(1), 0xffff, 0]);
+                let off =
+                    m.json["bufferViews"][3]["byteOffset"].as_u64().unwrap_or(0) as usize + at * 2;
+                if off + 2 <= m.buffer.len() {
+                    m.buffer[off..off + 2].copy_from_slice(&val.to_le_bytes());
+                }
+                what.push(format!("index[{at}]={val}"));
+            }
+            _ => {
+                // Attributes removed, pointed elsewhere, or added.
+                let attrs = &mut m.json["meshes"][0]["primitives"][0]["attributes"];
+                match rng.below(5) {
+                    0 => {
+                        attrs.as_object_mut().expect("attrs").remove("NORMAL");
+                        what.push("no NORMAL".into());
+                    }
+                    1 => {
+                        attrs.as_object_mut().expect("attrs").remove("TEXCOORD_0");
+                        what.push("no TEXCOORD_0".into());
+                    }
+                    2 => {
+                        let t = rng.below(5);
+                        attrs["TANGENT"] = json!(t);
+                        what.push(format!("TANGENT=acc{t}"));
+                    }
+                    3 => {
+                        let k = rng.pick(&["POSITION", "NORMAL", "TEXCOORD_0"]);
+                        let t = rng.below(5);
+                        attrs[k] = json!(t);
+                        what.push(format!("{k}=acc{t}"));
+                    }
+                    _ => {
+                        attrs["_CUSTOM"] = json!(0);
+                        attrs["TEXCOORD_x"] = json!(0);
+                        what.push("odd attribute names".into());
+                    }
+                }
+            }
+        }
+    }
+    what.join(", ")
+}
+
+/// Quantized and small-integer storage written for real (not just relabelled), so the
+/// allowed combinations load.
+fn quantized(m: &mut Model, rng: &mut Rng) -> String {
+    let n = vertex_count(m);
+    let uvs: Vec<[f32; 2]> = (0..n)
+        .map(|i| [(i % 7) as f32 / 6.0, (i % 5) as f32 / 4.0])
+        .collect();
+    let (ct, normalized, bytes): (u64, bool, Vec<u8>) = match rng.below(5) {
+        0 => (
+            5121,
+            true,
+            uvs.iter()
+                .flat_map(|u| [(u[0] * 255.0) as u8, (u[1] * 255.0) as u8, 0, 0])
+                .collect(),
+        ),
+        1 => (
+            5123,
+            true,
+            uvs.iter()
+                .flat_map(|u| {
+                    [
+                        ((u[0] * 65535.0) as u16).to_le_bytes(),
+                        ((u[1] * 65535.0) as u16).to_le_bytes(),
+                    ]
+                })
+                .flatten()
+                .collect(),
+        ),
+        2 => (
+            5120,
+            true,
+            uvs.iter()
+                .flat_map(|u| [(u[0] * 127.0) as i8 as u8, (u[1] * 127.0) as i8 as u8, 0, 0])
+                .collect(),
+        ),
+        3 => (
+            5122,
+            rng.chance(0.5),
+            uvs.iter()
+                .flat_map(|u| {
+                    [
+                        ((u[0] * 32767.0) as i16).to_le_bytes(),
+                        ((u[1] * 32767.0) as i16).to_le_bytes(),
+                    ]
+                })
+                .flatten()
+                .collect(),
+        ),
+        _ => (
+            5120,
+            false,
+            uvs.iter()
+                .flat_map(|u| [u[0] as i8 as u8, u[1] as i8 as u8, 0, 0])
+                .collect(),
+        ),
+    };
+    let stride = if matches!(ct, 5121 | 5120) {
+        Some(4)
+    } else {
+        None
+    };
+    let v = add_view(m, &bytes, stride);
+    let a = add_accessor(
+        m,
+        json!({"bufferView": v, "componentType": ct, "normalized": normalized, "count": n, "type": "VEC2"}),
+    );
+    m.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(a);
+    let mut what = format!("TEXCOORD_0 ct={ct} normalized={normalized}");
+    if rng.chance(0.3) {
+        m.json["extensionsUsed"] = json!(["KHR_mesh_quantization"]);
+        m.json["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
+        what.push_str(" +KHR_mesh_quantization");
+    }
+    if rng.chance(0.3) {
+        // u8 indices.
+        let idx: Vec<u8> = (0..6)
+            .map(|k| [0u8, 1, 2, 0, 2, 3][k].min(n as u8 - 1))
+            .collect();
+        let v = add_view(m, &idx, None);
+        let a = add_accessor(
+            m,
+            json!({"bufferView": v, "componentType": 5121, "count": 6, "type": "SCALAR"}),
+        );
+        m.json["meshes"][0]["primitives"][0]["indices"] = json!(a);
+        what.push_str(" u8 indices");
+    }
+    what
+}
+
+/// Node graphs: random children (self, cycles, two parents, out of range), scene roots,
+/// deep chains, odd transforms.
+fn mutate_nodes(m: &mut Model, rng: &mut Rng) -> String {
+    if rng.chance(0.15) {
+        let depth = 1000 + rng.below(19_000);
+        let nodes: Vec<Value> = (0..depth)
+            .map(|i| {
+                if i + 1 < depth {
+                    json!({"children": [i + 1], "translation": [0.0, 1e-4, 0.0]})
+                } else {
+                    json!({"mesh": 0})
+                }
+            })
+            .collect();
+        m.json["nodes"] = json!(nodes);
+        let mut what = format!("chain of {depth}");
+        if rng.chance(0.5) {
+            let at = rng.below(depth);
+            let to = rng.below(at + 1);
+            m.json["nodes"][at]["children"] = json!([to]);
+            what.push_str(&format!(", node {at} -> {to}"));
+        }
+        return what;
+    }
+    let n = 1 + rng.below(6);
+    let mut nodes = Vec::new();
+    for _ in 0..n {
+        let mut node = json!({});
+        if rng.chance(0.6) {
+            node["mesh"] = json!(0);
+        }
+        if rng.chance(0.6) {
+            let k = rng.below(3);
+            let children: Vec<usize> = (0..k).map(|_| rng.below(n + 1)).collect();
+            node["children"] = json!(children);
+        }
+        match rng.below(8) {
+            0 => {
+                node["matrix"] = json!([
+                    1,
+                    0,
+                    0,
+                    0,
+                    0,
+                    1,
+                    0,
+                    0,
+                    0,
+                    0,
+                    1,
+                    0,
+                    rng.pick(&[0.0, 1e8, 1e39, -1e39]),
+                    0,
+                    0,
+                    1
+                ])
+            }
+            1 => {
+                node["rotation"] = json!(rng.pick(&[
+                    [0.0, 0.0, 0.0, 0.0],
+                    [0.0, 0.0, 0.0, 2.0],
+                    [1e39, 0.0, 0.0, 1.0]
+                ]))
+            }
+            2 => {
+                node["scale"] = json!(rng.pick(&[
+                    [0.0, 0.0, 0.0],
+                    [-1.0, 1.0, 1.0],
+                    [1e30, 1e30, 1e30],
+                    [1e39, 1.0, 1.0]
+                ]))
+            }
+            3 => {
+                node["translation"] =
+                    json!(rng.pick(&[[1e7, 0.0, 0.0], [1e8, -1e8, 1e8], [3e38, 0.0, 0.0]]))
+            }
+            _ => {}
+        }
+        nodes.push(node);
+    }
+    let roots: Vec<usize> = (0..1 + rng.below(3)).map(|_| rng.below(n + 1)).collect();
+    let what = format!(
+        "{n} nodes {} roots {roots:?}",
+        serde_json::to_string(&nodes).unwrap_or_default()
+    );
+    m.json["nodes"] = json!(nodes);
+    match rng.below(6) {
+        0 => {
+            m.json.as_object_mut().expect("root").remove("scene");
+            m.json.as_object_mut().expect("root").remove("scenes");
+        }
+        _ => m.json["scenes"] = json!([{"nodes": roots}]),
+    }
+    what
+}
+
+/// Primitive modes with index lists of random lengths.
+fn mutate_mode(m: &mut Model, rng: &mut Rng) -> String {
+    let mode = rng.below(8);
+    let n = vertex_count(m);
+    let k = rng.pick(&[0, 1, 2, 3, 4, 5, 6, 7, 12, 13]);
+    let idx: Vec<u16> = (0..k).map(|_| rng.below(n) as u16).collect();
+    let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
+    let prim = &mut m.json["meshes"][0]["primitives"][0];
+    prim["mode"] = json!(mode);
+    if k == 0 {
+        prim.as_object_mut().expect("prim").remove("indices");
+    } else {
+        let v = add_view(m, &bytes, None);
+        let a = add_accessor(
+            m,
+            json!({"bufferView": v, "componentType": 5123, "count": k, "type": "SCALAR"}),
+        );
+        m.json["meshes"][0]["primitives"][0]["indices"] = json!(a);
+    }
+    format!("mode {mode} with {k} indices")
+}
+
+/// Buffer and image URIs: devices, missing files, directories, data: URIs good and bad,
+/// other schemes, percent-encoding, declared lengths.
+fn mutate_uri(m: &mut Model, rng: &mut Rng, dir: &Path, name: &str) -> String {
+    let good = format!("data:application/octet-stream;base64,{}", base64(&m.buffer));
+    let ext = format!("{name}-ext.bin");
+    std::fs::write(dir.join(&ext), &m.buffer).expect("write");
+    let abs = dir.join(&ext).display().to_string();
+    let subdir = format!("{name}-dir");
+    let _ = std::fs::create_dir_all(dir.join(&subdir));
+    let uris = [
+        "/dev/zero".to_string(),
+        "/dev/null".into(),
+        "/dev/urandom".into(),
+        "missing.bin".into(),
+        subdir,
+        ".".into(),
+        good.clone(),
+        format!("{}!!", &good[..good.len() / 2]),
+        good[..good.len() * 2 / 3].to_string(),
+        "data:text/plain,hello".into(),
+        "data:application/octet-stream;base64".into(),
+        "http://example.com/b.bin".into(),
+        "file:///dev/zero".into(),
+        "%zz.bin".into(),
+        "%FF%FE.bin".into(),
+        ext.replace('-', "%2D"),
+        abs,
+        format!(
+            "../{}/{ext}",
+            dir.file_name().and_then(|f| f.to_str()).unwrap_or("x")
+        ),
+    ];
+    let uri = rng.pick(&uris);
+    let target = rng.below(3);
+    let real = m.buffer.len() as u64;
+    let shown = if uri.len() > 40 {
+        format!("{}...", &uri[..40])
+    } else {
+        uri.clone()
+    };
+    if target < 2 {
+        m.json["buffers"][0]["uri"] = json!(uri);
+        let l = rng.pick(&[real, real, real + 1, 1 << 40, u64::MAX >> 11]);
+        m.json["buffers"][0]["byteLength"] = json!(l);
+        format!("buffer uri {shown} byteLength {l}")
+    } else {
+        m.json["images"][0] = json!({"uri": uri});
+        format!("image uri {shown}")
+    }
+}
+
+/// Non-finite or absurd numbers: NaN/inf in positions, normals, UVs; 1e31 outliers.
+fn mutate_values(m: &mut Model, rng: &mut Rng) -> String {
+    let n = vertex_count(m);
+    let view = rng.below(3);
+    let comps = [3, 3, 2][view];
+    let at = rng.below(n * comps);
+    let val = rng.pick(&[
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1e31,
+        -1e31,
+        f32::MAX,
+        1e-45,
+    ]);
+    let off = m.json["bufferViews"][view]["byteOffset"]
+        .as_u64()
+        .unwrap_or(0) as usize
+        + at * 4;
+    m.buffer[off..off + 4].copy_from_slice(&val.to_le_bytes());
+    format!("view {view} component {at} = {val}")
+}
+
+/// A GLB with a damaged container.
+fn corrupt_glb(m: &Model, rng: &mut Rng) -> (Vec<u8>, String) {
+    let mut b = glb_bytes(&m.json, Some(&m.buffer));
+    let json_len = u32::from_le_bytes([b[12], b[13], b[14], b[15]]) as usize;
+    let bin_at = 20 + json_len;
+    let what = match rng.below(8) {
+        0 => {
+            let v = rng.pick(&[0u32, 1, 3, u32::MAX]);
+            b[4..8].copy_from_slice(&v.to_le_bytes());
+            format!("version {v}")
+        }
+        1 => {
+            let v = rng.pick(&[0u32, 12, b.len() as u32 - 1, b.len() as u32 + 1, u32::MAX]);
+            b[8..12].copy_from_slice(&v.to_le_bytes());
+            format!("length {v}")
+        }
+        2 => {
+            let v = rng.pick(&[0u32, 1, json_len as u32 + 8, u32::MAX]);
+            b[12..16].copy_from_slice(&v.to_le_bytes());
+            format!("JSON chunk length {v}")
+        }
+        3 => {
+            b[16..20].copy_from_slice(b"BIN\0");
+            "first chunk is BIN".into()
+        }
+        4 => {
+            let v = rng.pick(&[0u32, 1, (m.buffer.len() / 2) as u32, u32::MAX]);
+            b[bin_at..bin_at + 4].copy_from_slice(&v.to_le_bytes());
+            format!("BIN chunk length {v}")
+        }
+        5 => {
+            b[bin_at + 4..bin_at + 8].copy_from_slice(b"XYZW");
+            "BIN chunk type unknown".into()
+        }
+        6 => {
+            let cut = rng.below(b.len());
+            b.truncate(cut);
+            let n = b.len() as u32;
+            if n >= 12 && rng.chance(0.5) {
+                b[8..12].copy_from_slice(&n.to_le_bytes());
+            }
+            format!("cut at {cut}")
+        }
+        _ => {
+            let k = 1 + rng.below(4);
+            for _ in 0..k {
+                let at = rng.below(b.len().min(64));
+                b[at] ^= 1 << rng.below(8);
+            }
+            format!("{k} bit flips in the first 64 bytes")
+        }
+    };
+    (b, what)
+}
+
+/// Every JSON pointer in a document (for generic mutations).
+fn pointers(v: &Value, at: String, out: &mut Vec<String>) {
+    out.push(at.clone());
+    match v {
+        Value::Object(o) => {
+            for (k, c) in o {
+                pointers(
+                    c,
+                    format!("{at}/{}", k.replace('~', "~0").replace('/', "~1")),
+                    out,
+                );
+            }
+        }
+        Value::Array(a) => {
+            for (i, c) in a.iter().enumerate().take(64) {
+                pointers(c, format!("{at}/{i}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A generic JSON mutation: a random element replaced by an interesting value or
+/// removed.
+fn mutate_json(json: &mut Value, rng: &mut Rng) -> String {
+    let mut ptrs = Vec::new();
+    pointers(json, String::new(), &mut ptrs);
+    let p = rng.pick(&ptrs[1..]);
+    let values = [
+        json!(0),
+        json!(-1),
+        json!(1),
+        json!(2),
+        json!(3),
+        json!(4294967295u64),
+        json!(1u64 << 53),
+        json!(1e39),
+        json!(-1e39),
+        json!(0.5),
+        json!("x"),
+        json!(null),
+        json!([]),
+        json!({}),
+        json!([0, 0, 0]),
+    ];
+    if rng.chance(0.2) {
+        let (parent, key) = p.rsplit_once('/').unwrap_or(("", ""));
+        if let Some(Value::Object(o)) = json.pointer_mut(parent) {
+            o.remove(key);
+            return format!("removed {p}");
+        }
+    }
+    let v = rng.pick(&values);
+    if let Some(slot) = json.pointer_mut(&p) {
+        *slot = v.clone();
+    }
+    format!("{p} = {v}")
+}
+
+// ---- Running cases ------------------------------------------------------------------------
+
+enum Outcome {
+    Loaded(Box<Object>),
+    Error(String),
+    Panic(String),
+    Hang,
+}
+
+/// Loads a file on its own thread (default 2 MiB stack, so recursion shows) under
+/// catch_unwind, giving up after CASE_TIMEOUT.
+fn load(path: &Path) -> Outcome {
+    let p = path.to_path_buf();
+    let (tx, rx) = mpsc::channel();
+    let spawned = std::thread::Builder::new()
+        .name("fuzz-load".into())
+        .spawn(move || {
+            let r = std::panic::catch_unwind(|| {
+                load_head_with_warnings(&p, &TextureOverrides::default())
+            });
+            let _ = tx.send(match r {
+                Ok(Ok((obj, _warnings))) => Outcome::Loaded(Box::new(obj)),
+                Ok(Err(e)) => Outcome::Error(format!("{e:#}")),
+                Err(p) => Outcome::Panic(
+                    p.downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_default(),
+                ),
+            });
+        });
+    if spawned.is_err() {
+        return Outcome::Panic("could not spawn the loader thread".into());
+    }
+    rx.recv_timeout(CASE_TIMEOUT).unwrap_or(Outcome::Hang)
+}
+
+/// A loaded object must be something the renderer can take.
+fn check_loaded(obj: &Object) -> Result<(), String> {
+    obj.mesh
+        .validate()
+        .map_err(|e| format!("loaded an invalid mesh: {e:#}"))?;
+    for (i, v) in obj.mesh.vertices.iter().enumerate() {
+        let all = v
+            .position
+            .iter()
+            .chain(&v.normal)
+            .chain(&v.uv)
+            .chain(&v.tangent);
+        if !all.clone().all(|c| c.is_finite()) {
+            return Err(format!("loaded vertex {i} is not finite: {v:?}"));
+        }
+    }
+    Ok(())
+}
+
+#[derive(Default)]
+struct Tally {
+    tried: usize,
+    loaded: usize,
+    errors: usize,
+    samples: Vec<String>,
+}
+
+struct Fuzz {
+    tally: BTreeMap<&'static str, Tally>,
+    failures: Vec<String>,
+    /// Loaded cases kept for rendering: (category, path).
+    renderable: Vec<(&'static str, PathBuf)>,
+}
+
+impl Fuzz {
+    fn case(&mut self, category: &'static str, path: &Path, what: &str) {
+        let t = self.tally.entry(category).or_default();
+        t.tried += 1;
+        match load(path) {
+            Outcome::Loaded(obj) => {
+                t.loaded += 1;
+                if let Err(e) = check_loaded(&obj) {
+                    self.failures.push(format!("[{category}] {what}: {e}"));
+                }
+                if self
+                    .renderable
+                    .iter()
+                    .filter(|(c, _)| *c == category)
+                    .count()
+                    < RENDER_PER_CATEGORY
+                {
+                    self.renderable.push((category, path.to_path_buf()));
+                }
+            }
+            Outcome::Error(e) => {
+                t.errors += 1;
+                if e.contains('\n') || e.is_empty() || e.len() > MAX_ERROR_LEN {
+                    self.failures.push(format!(
+                        "[{category}] {what}: not one clean line ({} chars): {e:?}",
+                        e.len()
+                    ));
+                }
+                if t.samples.len() < 3
+                    && !t
+                        .samples
+                        .iter()
+                        .any(|s| s[..20.min(s.len())] == e[..20.min(e.len())])
+                {
+                    t.samples.push(e);
+                }
+            }
+            Outcome::Panic(p) => self
+                .failures
+                .push(format!("[{category}] {what}: PANIC {p}")),
+            Outcome::Hang => self.failures.push(format!(
+                "[{category}] {what}: no result within {CASE_TIMEOUT:?}"
+            )),
+        }
+    }
+}
+
+/// The one place the renderer is called, so a renamed API is adapted here only.
+/// Returns the diffuse light and the 8-bit frame.
+fn render_small(
+    ctx: &dermis::vk::context::Context,
+    scene: &dermis::scene::Scene,
+) -> anyhow::Result<(Vec<[f32; 4]>, Vec<u8>)> {
+    let settings = RenderSettings {
+        width: 64,
+        height: 36,
+        shadow_size: 256,
+        ..Default::default()
+    };
+    let opts = RunOptions {
+        warmup: 0,
+        measured: 1,
+        capture: true,
+        dump: false,
+        ceilings: false,
+        command: "fuzz".into(),
+        progress: false,
+    };
+    let out = run(ctx, scene, &settings, &opts)?;
+    let cap = out.capture.ok_or_else(|| anyhow::anyhow!("no capture"))?;
+    ctx.check_validation("after the fuzz render")?;
+    Ok((cap.diffuse, cap.ldr))
+}
+
+fn temp_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dermis-gltf-fuzz-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn env_usize(key: &str, default: usize) -> usize {
+    std::env::var(key)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+#[test]
+fn gltf_fuzz() {
+    let start = Instant::now();
+    let iters = env_usize("DERMIS_FUZZ_ITERS", 3000);
+    let seed = env_usize("DERMIS_FUZZ_SEED", 1) as u64;
+    let mut rng = Rng(seed);
+    let dir = temp_dir();
+    let mut fz = Fuzz {
+        tally: BTreeMap::new(),
+        failures: Vec::new(),
+        renderable: Vec::new(),
+    };
+
+    // Fixed cases first: the clean base in every container, then the random run.
+    for (k, c) in [Container::DataUri, Container::BinFile, Container::Glb]
+        .into_iter()
+        .enumerate()
+    {
+        let m = base_model(&mut rng);
+        let p = write(&m, c, &dir, &format!("base{k}"));
+        fz.case("base", &p, "clean base model");
+    }
+    // A FIFO as a buffer: opening it would block forever.
+    let fifo = dir.join("fifo.bin");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let mut m = base_model(&mut rng);
+        m.json["buffers"][0]["uri"] = json!("fifo.bin");
+        let p = write(&m, Container::DataUri, &dir, "fifo");
+        fz.case("uri", &p, "FIFO buffer");
+    }
+
+    // The head: byte flips and JSON mutations of the real file, in its own directory
+    // (no textures beside it, so the cases stay fast).
+    let lps = common::lps_path();
+    let lps_dir = dir.join("lps");
+    std::fs::create_dir_all(&lps_dir).expect("lps dir");
+    let lps_bytes = lps
+        .as_ref()
+        .map(|p| std::fs::read(p).expect("read LeePerrySmith.glb"));
+    let lps_parts = lps_bytes.as_ref().map(|b| {
+        let jl = u32::from_le_bytes([b[12], b[13], b[14], b[15]]) as usize;
+        let json: Value = serde_json::from_slice(&b[20..20 + jl]).expect("LPS JSON");
+        let bin = b[20 + jl + 8..].to_vec();
+        (json, bin)
+    });
+    if let Some(b) = &lps_bytes {
+        let p = lps_dir.join("clean.glb");
+        std::fs::write(&p, b).expect("write");
+        fz.case("lps", &p, "clean head");
+    } else {
+        eprintln!("LeePerrySmith.glb not found: the head part of the fuzz is skipped");
+    }
+
+    for i in 0..iters {
+        let category: &'static str = match i % 9 {
+            0 => "accessor",
+            1 => "quantized",
+            2 => "nodes",
+            3 => "modes",
+            4 => "uri",
+            5 => "glb",
+            6 => "values",
+            7 => "json",
+            _ => "lps",
+        };
+        let name = format!("{category}{i}");
+        let mut m = base_model(&mut rng);
+        let container = rng.pick(&[Container::DataUri, Container::BinFile, Container::Glb]);
+        let (path, what) = match category {
+            "accessor" => {
+                let w = mutate_accessors(&mut m, &mut rng);
+                (write(&m, container, &dir, &name), w)
+            }
+            "quantized" => {
+                let w = quantized(&mut m, &mut rng);
+                (write(&m, container, &dir, &name), w)
+            }
+            "nodes" => {
+                let w = mutate_nodes(&mut m, &mut rng);
+                (write(&m, container, &dir, &name), w)
+            }
+            "modes" => {
+                let w = mutate_mode(&mut m, &mut rng);
+                (write(&m, container, &dir, &name), w)
+            }
+            "uri" => {
+                let w = mutate_uri(&mut m, &mut rng, &dir, &name);
+                let c = if container == Container::Glb {
+                    Container::DataUri
+                } else {
+                    container
+                };
+                (write(&m, c, &dir, &name), w)
+            }
+            "glb" => {
+                let (bytes, w) = corrupt_glb(&m, &mut rng);
+                let p = dir.join(format!("{name}.glb"));
+                std::fs::write(&p, bytes).expect("write");
+                (p, w)
+            }
+            "values" => {
+                let w = mutate_values(&mut m, &mut rng);
+                (write(&m, container, &dir, &name), w)
+            }
+            "json" => {
+                let k = 1 + rng.below(3);
+                let w: Vec<String> = (0..k).map(|_| mutate_json(&mut m.json, &mut rng)).collect();
+                (write(&m, container, &dir, &name), w.join("; "))
+            }
+            _ => {
+                let (Some(bytes), Some((json, bin))) = (&lps_bytes, &lps_parts) else {
+                    continue;
+                };
+                let p = lps_dir.join(format!("{name}.glb"));
+                if rng.chance(0.5) {
+                    let mut b = bytes.clone();
+                    let k = 1 + rng.below(8);
+                    for _ in 0..k {
+                        let at = rng.below(b.len());
+                        b[at] ^= 1 << rng.below(8);
+                    }
+                    std::fs::write(&p, b).expect("write");
+                    (p, format!("{k} bit flips"))
+                } else {
+                    let mut j = json.clone();
+                    let k = 1 + rng.below(3);
+                    let w: Vec<String> = (0..k).map(|_| mutate_json(&mut j, &mut rng)).collect();
+                    std::fs::write(&p, glb_bytes(&j, Some(bin))).expect("write");
+                    (p, w.join("; "))
+                }
+            }
+        };
+        fz.case(category, &path, &what);
+    }
+    let load_time = start.elapsed();
+
+    // Figures.
+    let (mut tried, mut loaded, mut errors) = (0, 0, 0);
+    eprintln!("glTF fuzz, seed {seed}, {iters} random cases:");
+    eprintln!(
+        "  {:<10} {:>6} {:>7} {:>7}",
+        "category", "tried", "loaded", "errors"
+    );
+    for (c, t) in &fz.tally {
+        eprintln!("  {c:<10} {:>6} {:>7} {:>7}", t.tried, t.loaded, t.errors);
+        tried += t.tried;
+        loaded += t.loaded;
+        errors += t.errors;
+    }
+    eprintln!(
+        "  {:<10} {tried:>6} {loaded:>7} {errors:>7}   (loading took {load_time:.1?})",
+        "all"
+    );
+    for (c, t) in &fz.tally {
+        for s in &t.samples {
+            eprintln!("  e.g. [{c}] {s}");
+        }
+    }
+
+    // Render one loaded case per category through the real renderer.
+    if std::env::var("DERMIS_FUZZ_RENDER").as_deref() != Ok("0") && fz.failures.is_empty() {
+        let ctx = common::ctx();
+        let t0 = Instant::now();
+        let (mut rendered, mut with_skin, mut unframed) = (0, 0, 0);
+        for (category, path) in &fz.renderable {
+            let scene = match load_gltf_scene(path, &TextureOverrides::default(), None) {
+                Ok(s) => s,
+                Err(e) => {
+                    let e = format!("{e:#}");
+                    if e.contains('\n') {
+                        fz.failures
+                            .push(format!("[{category}] scene: not one line: {e:?}"));
+                    }
+                    if unframed < 3 {
+                        eprintln!("  [{category}] not rendered: {e}");
+                    }
+                    unframed += 1;
+                    continue;
+                }
+            };
+            match render_small(&ctx, &scene) {
+                Ok((diffuse, ldr)) => {
+                    rendered += 1;
+                    // Alpha of the diffuse light is the SSS strength: > 0 where skin
+                    // was drawn. The clean head must show it (the generated grids are
+                    // no heads: the framing may look at them edge-on).
+                    let skin = diffuse.iter().filter(|p| p[3] > 0.0).count();
+                    if skin > 0 {
+                        with_skin += 1;
+                    } else if path.ends_with("lps/clean.glb") {
+                        fz.failures.push(format!(
+                            "[{category}] {}: no skin in the frame",
+                            path.display()
+                        ));
+                    }
+                    if diffuse.iter().flatten().any(|v| !v.is_finite()) {
+                        fz.failures.push(format!(
+                            "[{category}] {}: non-finite diffuse light",
+                            path.display()
+                        ));
+                    }
+                    if ldr.len() != 64 * 36 * 4 {
+                        fz.failures.push(format!(
+                            "[{category}] {}: frame has {} bytes",
+                            path.display(),
+                            ldr.len()
+                        ));
+                    }
+                }
+                Err(e) => fz.failures.push(format!(
+                    "[{category}] {}: render failed: {e:#}",
+                    path.display()
+                )),
+            }
+        }
+        eprintln!(
+            "  rendered {rendered} loaded cases at 64x36 ({with_skin} show skin) in {:.1?}; {unframed} loaded but not framed (mm_per_unit)",
+            t0.elapsed()
+        );
+    }
+    eprintln!("  total {:.1?}", start.elapsed());
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        fz.failures.is_empty(),
+        "{} failures:\n{}",
+        fz.failures.len(),
+        fz.failures.join("\n")
+    );
+    assert!(
+        loaded > 0 && errors > 0,
+        "the run should both load and refuse files"
+    );
+}
