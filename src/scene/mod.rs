@@ -3,6 +3,7 @@
 //! independent of Vulkan so it can be tested without a GPU.
 
 pub mod camera;
+pub mod face;
 pub mod gltf_load;
 pub mod head_measure;
 pub mod instancing;
