@@ -13,7 +13,10 @@ use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::gltf_load::TextureOverrides;
-use dermis::scene::{default_scene, load_gltf_scene, Scene};
+use dermis::scene::{builtin, load_gltf_scene, Scene};
+
+/// `--scene builtin:NAME` names a built-in scene instead of a file.
+const BUILTIN: &str = "builtin:";
 use dermis::skin::kernel::{Preset, SeparableKernel};
 use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 
@@ -130,7 +133,7 @@ struct Common {
     /// Enable the Khronos validation layer with synchronization validation; any message fails the run.
     #[arg(long)]
     validate: bool,
-    /// glTF/GLB scene (default: the embedded procedural head).
+    /// glTF/GLB scene, or builtin:face | builtin:egg (default: the embedded procedural face).
     #[arg(long)]
     scene: Option<PathBuf>,
     #[arg(long)]
@@ -287,18 +290,13 @@ impl Common {
     }
 
     fn scene(&self) -> Result<Scene> {
-        match &self.scene {
-            None => {
-                let mut s = default_scene();
-                if let Some(mm) = self.mm_per_unit {
-                    if !mm.is_finite() || mm <= 0.0 {
-                        bail!("mm_per_unit must be a positive number, got {mm}");
-                    }
-                    s.mm_per_unit = mm;
-                }
-                Ok(s)
-            }
-            Some(p) => load_gltf_scene(
+        let builtin_name = self
+            .scene
+            .as_ref()
+            .and_then(|p| p.to_str())
+            .and_then(|p| p.strip_prefix(BUILTIN));
+        match (&self.scene, builtin_name) {
+            (Some(p), None) => load_gltf_scene(
                 p,
                 &TextureOverrides {
                     albedo: self.albedo.clone(),
@@ -308,6 +306,16 @@ impl Common {
                 },
                 self.mm_per_unit,
             ),
+            (_, name) => {
+                let mut s = builtin(name.unwrap_or("face"))?;
+                if let Some(mm) = self.mm_per_unit {
+                    if !mm.is_finite() || mm <= 0.0 {
+                        bail!("mm_per_unit must be a positive number, got {mm}");
+                    }
+                    s.mm_per_unit = mm;
+                }
+                Ok(s)
+            }
         }
     }
 

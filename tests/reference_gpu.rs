@@ -8,7 +8,7 @@ use dermis::eval::metrics::relative_rmse;
 use dermis::method::reference::Reference;
 use dermis::reference::cpu::{gather_f64, GatherView};
 use dermis::render::{RenderSettings, Renderer};
-use dermis::scene::default_scene;
+use dermis::scene::egg_scene;
 
 fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
     RenderSettings {
@@ -32,7 +32,7 @@ struct Run {
 
 fn render(s: &RenderSettings) -> Run {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let mut r = Renderer::new(&ctx, &scene, s).unwrap();
     let cap = r.capture(true).unwrap();
     let find = |pass: &str, image: &str| {

@@ -13,7 +13,7 @@ use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::layout::Layout;
 use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
-use dermis::scene::{default_scene, load_gltf_scene, Scene};
+use dermis::scene::{egg_scene, load_gltf_scene, Scene};
 
 /// What one frame gave: diffuse after SSS, the tone-mapped frame, per-pass
 /// (name, samples passed, fragment invocations), and the region's pixels.
@@ -157,14 +157,14 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
 }
 
 #[test]
-fn the_region_changes_no_pixel_on_the_default_scene() {
+fn the_region_changes_no_pixel_on_the_egg_scene() {
     let base = RenderSettings {
         width: 192,
         height: 108,
         shadow_size: 256,
         ..RenderSettings::default()
     };
-    region_changes_nothing(&default_scene(), base.clone(), true);
+    region_changes_nothing(&egg_scene(), base.clone(), true);
     // Close and wide: taps reach far past the silhouette, where only the
     // margin keeps them on seeded texels (a region 0.3x too narrow fails here).
     let mut wide = RenderSettings {
@@ -174,7 +174,7 @@ fn the_region_changes_no_pixel_on_the_default_scene() {
         ..base
     };
     wide.options.set("sss-width-mm", "20");
-    region_changes_nothing(&default_scene(), wide, true);
+    region_changes_nothing(&egg_scene(), wide, true);
 }
 
 #[test]
@@ -212,7 +212,7 @@ fn the_region_changes_no_pixel_on_many_heads_and_cut_heads() {
 
 #[test]
 fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
-    let scene = default_scene();
+    let scene = egg_scene();
     let s = RenderSettings {
         width: 96,
         height: 64,
@@ -237,7 +237,7 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
         distance_heads: 3.0,
         ..RenderSettings::default()
     };
-    let r = Renderer::new(&ctx, &default_scene(), &s).expect("renderer");
+    let r = Renderer::new(&ctx, &egg_scene(), &s).expect("renderer");
     let region = &r.frame.region_px;
     // A 2x2 grid of heads centred on the screen: the centre lies between them.
     assert!(region.iter().all(|t| !t.contains(480, 270)), "{region:?}");
@@ -250,7 +250,7 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
 /// box has no depth, so its footprint hugs its silhouette and only the reach
 /// margin keeps the taps that leave it on seeded texels.
 fn card_scene() -> Scene {
-    let mut scene = default_scene();
+    let mut scene = egg_scene();
     let v = |x: f32, y: f32| Vertex {
         position: [x, y, 0.0],
         normal: [0.0, 0.0, 1.0],

@@ -9,7 +9,7 @@ use dermis::method::lookup;
 use dermis::method::poisson::Poisson;
 use dermis::method::ssg::{MaskMode, Ssg};
 use dermis::render::{RenderSettings, Renderer};
-use dermis::scene::default_scene;
+use dermis::scene::egg_scene;
 use dermis::skin::jittered::hable_kernel;
 use dermis::skin::screen_ref::{jittered, ScreenInput};
 use dermis::skin::ssg::{GaussianFit, Stretch};
@@ -96,7 +96,7 @@ fn samples(s: &[PassSample], name: &str) -> u64 {
 #[test]
 fn ssg_matches_cpu_reference_with_and_without_lod() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let (diffuse, depth, skin) = synthetic();
     for (fit, lod) in [
         (GaussianFit::Six, true),
@@ -189,7 +189,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
 #[test]
 fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let (diffuse, depth, skin) = synthetic();
     let mut images = Vec::new();
     for mask in [MaskMode::Stencil, MaskMode::Branch] {
@@ -244,7 +244,7 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
 #[test]
 fn jittered_matches_cpu_reference() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let (diffuse, depth, skin) = synthetic();
     let s = settings("ss-jittered");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
@@ -287,7 +287,7 @@ fn jittered_matches_cpu_reference() {
 #[test]
 fn gaussian_lod_by_counts_on_a_dolly() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let mut zero_at: Vec<Option<f32>> = vec![None; 5];
     for distance in [2.0f32, 3.0, 4.5, 7.0, 11.0, 17.0, 26.0] {
         for lod in [true, false] {
@@ -361,7 +361,7 @@ fn poisson_matches_cpu_reference() {
     use dermis::skin::poisson::PoissonParams;
     use dermis::skin::screen_ref::poisson_with_rounding;
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let (diffuse, depth, skin) = synthetic();
     // A smooth view-space normal field with a crease (normal weights matter there).
     let normals: Vec<[f32; 4]> = (0..W * H)

@@ -5,7 +5,7 @@ mod common;
 
 use dermis::method::separable::Separable;
 use dermis::render::{RenderSettings, Renderer};
-use dermis::scene::default_scene;
+use dermis::scene::egg_scene;
 use dermis::skin::separable_ref::{separable_sss, SssInput, SssView};
 use dermis::skin::texel::round_f16;
 
@@ -59,7 +59,7 @@ fn renderer_settings() -> RenderSettings {
 #[test]
 fn gpu_matches_cpu_reference() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let settings = renderer_settings();
     let (diffuse, depth, skin) = synthetic();
     for follow in [true, false] {
@@ -182,7 +182,7 @@ fn check_invocations(
 #[test]
 fn no_skin_means_no_sss_work() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let mut r = Renderer::new(&ctx, &scene, &renderer_settings()).unwrap();
     let (diffuse, depth, _) = synthetic();
     let skin = vec![false; W * H];

@@ -8,7 +8,7 @@ mod common;
 use dermis::method::{MethodEntry, MethodOptions};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::mesh::{Aabb, Material, Mesh, Object, Vertex};
-use dermis::scene::{default_scene, Scene};
+use dermis::scene::{egg_scene, Scene};
 use dermis::vk::context::Context;
 use glam::Vec3;
 
@@ -54,7 +54,7 @@ fn before_after(
 #[test]
 fn extremes_stay_finite_and_non_negative() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     type Tweak = fn(&mut RenderSettings);
     let cases: [(&str, Tweak); 6] = [
         ("sub-pixel head", |s| s.distance_heads = 400.0),
@@ -86,7 +86,7 @@ fn extremes_stay_finite_and_non_negative() {
 #[test]
 fn non_skin_pixels_are_untouched_by_every_method() {
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     for method in methods() {
         let (before, after) = before_after(
             &ctx,
@@ -257,7 +257,7 @@ fn halo_across_a_depth_discontinuity() {
 fn thin_parts_need_transmittance() {
     use dermis::eval::metrics::relative_rmse;
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let backlit = |method: &'static MethodEntry, transmittance: bool| {
         let mut s = RenderSettings {
             width: 160,
@@ -349,7 +349,7 @@ fn thin_parts_need_transmittance() {
 fn distance_sweep_does_not_pop() {
     use dermis::eval::metrics::relative_rmse;
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let methods = [
         common::m("separable"),
         common::m("ssg"),
@@ -392,7 +392,7 @@ fn distance_sweep_does_not_pop() {
 #[test]
 fn slow_orbit_does_not_flicker() {
     let ctx = common::ctx();
-    let base = default_scene();
+    let base = egg_scene();
     let frames: Vec<Scene> = (0..5)
         .map(|k| {
             let mut s = base.clone();
@@ -457,7 +457,7 @@ fn slow_orbit_does_not_flicker() {
 fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {
     use dermis::eval::metrics::relative_rmse;
     let ctx = common::ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let side = |method: &'static MethodEntry, samples: usize| {
         let mut s = RenderSettings {
             width: 128,

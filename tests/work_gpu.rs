@@ -12,7 +12,7 @@ use dermis::graph::work::{Filter, Work};
 use dermis::method::METHODS;
 use dermis::render::counting::site;
 use dermis::render::{RenderSettings, Renderer};
-use dermis::scene::default_scene;
+use dermis::scene::egg_scene;
 use dermis::vk::shader::reflect;
 
 fn kind(f: Filter) -> u32 {
@@ -27,7 +27,7 @@ fn kind(f: Filter) -> u32 {
 #[test]
 fn declared_fetches_are_what_the_shaders_fetch() {
     let ctx = common::counting_ctx();
-    let scene = default_scene();
+    let scene = egg_scene();
     let mut checked = 0;
     for m in METHODS {
         let mut settings: Vec<(String, RenderSettings)> = m
