@@ -1,7 +1,7 @@
 //! The command line: bad input gives one clear error line and a non-zero exit,
 //! never a panic or a validation error; good input writes what it promises.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn dermis() -> Command {
@@ -72,7 +72,7 @@ fn fails_with_env(args: &[&str], phrase: &str, env: &[(&str, &str)]) {
 }
 
 /// A minimal glTF (one triangle) with some attributes left out.
-fn tiny_gltf(dir: &PathBuf, name: &str, normals: bool, uvs: bool) -> PathBuf {
+fn tiny_gltf(dir: &Path, name: &str, normals: bool, uvs: bool) -> PathBuf {
     let mut bin: Vec<u8> = Vec::new();
     for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
         for c in v {

@@ -154,6 +154,41 @@ fn many_heads_render_more_skin() {
     );
 }
 
+// The crowd the multi-character benchmarks use: the camera stays where one
+// head's shot puts it and the characters stand behind, so every character added
+// adds skin on screen (the old grid pulled the camera back instead: 25 heads had
+// fewer skin pixels than one). Skin pixels are the separable passes' samples
+// passed, which the stencil limits to skin exactly.
+#[test]
+fn a_crowd_of_1_4_16_64_heads_adds_skin_with_every_step() {
+    let scene = default_scene();
+    let ctx = common::ctx();
+    let mut skin = Vec::new();
+    for heads in [1, 4, 16, 64] {
+        let s = RenderSettings {
+            width: 320,
+            height: 180,
+            shadow_size: 512,
+            heads,
+            ..RenderSettings::default()
+        };
+        let out = run(&ctx, &scene, &s, &opts(false)).expect("render");
+        let n = out
+            .report
+            .passes
+            .iter()
+            .find(|p| p.name == "sss horizontal")
+            .expect("the separable pass")
+            .samples_passed;
+        println!("{heads} heads: {n} skin pixels");
+        skin.push(n);
+    }
+    for w in skin.windows(2) {
+        assert!(w[1] > w[0], "skin pixels {skin:?}");
+    }
+    assert!(skin[3] > 2 * skin[0], "{skin:?}");
+}
+
 #[test]
 fn a_scene_without_skin_runs_no_sss_fragments() {
     let mut scene = default_scene();

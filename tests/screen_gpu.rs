@@ -147,7 +147,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
                 .sum::<f32>()
                 / (W * H * 3) as f32;
             println!("ssg fit={fit:?} lod={lod} rounding={mode:?}: worst {ulps:.2} half ulps ({rel:.2e} relative), mean {mean:.3}");
-            if best.map_or(true, |(_, m, _)| mean < m) {
+            if best.is_none_or(|(_, m, _)| mean < m) {
                 best = Some((ulps, mean, mode));
             }
         }

@@ -50,7 +50,7 @@ fn before_after(
     (before, cap.diffuse)
 }
 
-/// 5. Extremes: every output finite and non-negative, no validation message.
+/// Case 5: Extremes: every output finite and non-negative, no validation message.
 #[test]
 fn extremes_stay_finite_and_non_negative() {
     let ctx = common::ctx();
@@ -82,7 +82,7 @@ fn extremes_stay_finite_and_non_negative() {
     }
 }
 
-/// 7. Background bleeding: non-skin pixels leave every method bit for bit.
+/// Case 7: Background bleeding: non-skin pixels leave every method bit for bit.
 #[test]
 fn non_skin_pixels_are_untouched_by_every_method() {
     let ctx = common::ctx();
@@ -170,7 +170,7 @@ fn halo_scene() -> Scene {
     }
 }
 
-/// 2. Halo: light leaking from the lit ball onto the unlit wall around it.
+/// Case 2: Halo: light leaking from the lit ball onto the unlit wall around it.
 #[test]
 fn halo_across_a_depth_discontinuity() {
     let ctx = common::ctx();
@@ -249,7 +249,7 @@ fn halo_across_a_depth_discontinuity() {
     );
 }
 
-/// 3. Thin parts: the procedural head lit from behind, so the ear flaps glow.
+/// Case 3: Thin parts: the procedural head lit from behind, so the ear flaps glow.
 /// Screen space cannot see light arriving from the back; transmittance
 /// (thesis ch. 5) adds it in the geometry pass. Errors are relative RMSE of the
 /// diffuse after SSS against the reference over skin pixels.
@@ -340,7 +340,7 @@ fn thin_parts_need_transmittance() {
     }
 }
 
-/// 1. Distance sweep: a dolly from 2 to 9 head heights in steps of 15%. Each
+/// Case 1: Distance sweep: a dolly from 2 to 9 head heights in steps of 15%. Each
 /// method's error against the reference, minus the unscattered frame's error at
 /// the same step (what all methods share: the pixel footprint of a small frame),
 /// must not jump between steps. Gaussian LOD and the stretch factors switch with
@@ -387,7 +387,7 @@ fn distance_sweep_does_not_pop() {
     }
 }
 
-/// 4. Temporal flicker: a slow orbit (1 degree per frame, light following the
+/// Case 4: Temporal flicker: a slow orbit (1 degree per frame, light following the
 /// camera); the method's frame-to-frame change minus the reference's.
 #[test]
 fn slow_orbit_does_not_flicker() {
@@ -451,7 +451,7 @@ fn slow_orbit_does_not_flicker() {
     }
 }
 
-/// 6. Banding: a hard shadow edge across the skin (key light from the side, the
+/// Case 6: Banding: a hard shadow edge across the skin (key light from the side, the
 /// nose's shadow); error in the penumbra band for 9, 17 and 33 separable samples.
 #[test]
 fn banding_at_a_hard_shadow_edge_shrinks_with_samples() {

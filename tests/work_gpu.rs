@@ -118,3 +118,81 @@ fn declared_fetches_are_what_the_shaders_fetch() {
     println!("{checked} pass declarations checked against their shaders");
     assert!(checked > 40, "{checked}");
 }
+
+fn rust_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// Labels name passes; behaviour keys on roles and declared work. So no code
+/// outside tests compares a string with a pass's label: collected here from
+/// every method's frame as recorded (up to the first digit, so "ssg g2
+/// horizontal" stands for every Gaussian's pass).
+#[test]
+fn no_code_compares_a_pass_label() {
+    let ctx = common::ctx();
+    let scene = egg_scene();
+    let mut labels = std::collections::BTreeSet::new();
+    for m in METHODS {
+        let s = RenderSettings {
+            width: 64,
+            height: 40,
+            shadow_size: 64,
+            ..RenderSettings::default()
+        }
+        .with(m, &[("density", "1")]);
+        let r = Renderer::new(&ctx, &scene, &s).unwrap();
+        for p in r.passes() {
+            let label: String = p.name.chars().take_while(|c| !c.is_ascii_digit()).collect();
+            labels.insert(label.trim_end().to_string());
+        }
+    }
+    labels.extend([
+        "readback".to_string(),
+        "upload".to_string(),
+        "fill".to_string(),
+    ]);
+    assert!(
+        labels.contains("sss horizontal") && labels.contains("ssg g"),
+        "{labels:?}"
+    );
+    let mut files = Vec::new();
+    rust_files(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
+        &mut files,
+    );
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        // Unit tests may name passes: they test labels.
+        let text = text.split("#[cfg(test)]").next().unwrap_or_default();
+        for label in &labels {
+            for op in [
+                "== \"",
+                "!= \"",
+                "starts_with(\"",
+                "ends_with(\"",
+                "contains(\"",
+                "strip_prefix(\"",
+            ] {
+                let needle = format!("{op}{label}");
+                assert!(
+                    !text.contains(&needle),
+                    "{} compares with the pass label '{label}' ({needle})",
+                    f.display()
+                );
+            }
+            assert!(
+                !text.contains(&format!("\"{label}\" =>"))
+                    && !text.contains(&format!("\"{label}\" |")),
+                "{} matches on the pass label '{label}'",
+                f.display()
+            );
+        }
+    }
+}

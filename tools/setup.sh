@@ -19,3 +19,8 @@ if ! command -v cargo >/dev/null 2>&1; then
   echo "setup: cargo not found; install a Rust toolchain (stable, 1.85 or newer) with rustup" >&2
   exit 1
 fi
+# The test command lints with clippy: rustup's default profile ships it.
+if ! cargo clippy --version >/dev/null 2>&1; then
+  echo "setup: clippy not found; adding it (rustup component add clippy)"
+  rustup component add clippy
+fi

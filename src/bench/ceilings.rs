@@ -227,13 +227,25 @@ fn probe_all(
     profiler.destroy(ctx);
     let samples = samples?;
     ctx.check_validation("during the ceiling probes")?;
+    let with_src: Vec<(&str, bool)> = probes.iter().map(|(n, p)| (*n, p.src.is_some())).collect();
+    Ok(ceilings_from(&samples, &with_src, reps, n))
+}
+
+/// The ceilings from the probes' timings: probe `i` of round `r` (round 0 is
+/// the warm-up) is sample `r * probes + i`.
+fn ceilings_from(
+    samples: &[crate::vk::profiler::PassTiming],
+    probes: &[(&str, bool)],
+    reps: usize,
+    n: u64,
+) -> (Ceilings, Vec<ProbeResult>) {
     let mut results = Vec::new();
-    for (pi, (name, probe)) in probes.iter().enumerate() {
+    for (pi, (name, fetches)) in probes.iter().enumerate() {
         let times: Vec<f64> = (1..=reps)
             .map(|r| samples[r * probes.len() + pi].gpu_ms)
             .collect();
         let stats = Stats::of(&times).expect("reps >= 1");
-        let taps = if probe.src.is_some() { PROBE_TAPS } else { 1 };
+        let taps = if *fetches { PROBE_TAPS } else { 1 };
         let ops = n as f64 * taps as f64;
         results.push(ProbeResult {
             name: name.to_string(),
@@ -244,7 +256,7 @@ fn probe_all(
         });
     }
     let r = |i: usize| results[i].rate_g_per_s;
-    Ok((
+    (
         Ceilings {
             bilinear_rgba16f_gtaps: r(0),
             point_rgba16f_gtaps: r(1),
@@ -255,7 +267,7 @@ fn probe_all(
             blend_rgba16f_gpix: r(6),
         },
         results,
-    ))
+    )
 }
 
 /// The probes' pipelines, pool and samplers, destroyed whatever happens.

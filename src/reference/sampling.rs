@@ -80,7 +80,8 @@ pub fn sample_surface(
             let p = v.map(|x| m.transform_point3(Vec3::from(x.position)));
             let area_units = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
             let area_mm2 = area_units * mm_per_unit * mm_per_unit;
-            if !(area_mm2 > 0.0) {
+            // Degenerate (or non-finite) triangles stand for no surface.
+            if area_mm2.is_nan() || area_mm2 <= 0.0 {
                 continue;
             }
             let n = ((area_mm2 * density).round() as usize).max(1);
@@ -216,8 +217,8 @@ mod tests {
                 m[c] += x.pos_area[3] as f64 * p[c];
             }
         }
-        for c in 0..3 {
-            assert!((m[c] - 1.0).abs() < 2e-3, "channel {c}: {}", m[c]);
+        for (c, mc) in m.iter().enumerate() {
+            assert!((mc - 1.0).abs() < 2e-3, "channel {c}: {mc}");
         }
     }
 

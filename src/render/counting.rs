@@ -37,7 +37,7 @@ impl Renderer<'_> {
             .fetch_counts
             .as_ref()
             .context("counting fetches needs a context made with count_fetches")?;
-        let (raw, bytes) = (counter.raw, FETCH_COUNTERS * 4);
+        let raw = counter.raw;
         let id = self.resources.add_buffer("fetch counters", raw);
         let mut out = Vec::new();
         let n = self.passes().len();
@@ -69,7 +69,7 @@ impl Renderer<'_> {
                 false,
                 "while counting fetches",
             )?;
-            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&counter.read()?[..bytes as usize]);
+            let words = counter.read()?;
             if words.len() != FETCH_COUNTERS as usize {
                 bail!("fetch counters read back {} words", words.len());
             }

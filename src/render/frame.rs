@@ -32,6 +32,9 @@ use crate::vk::pipeline::{
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
 
+/// Descriptor sets the frame's pool holds: the frame's and the objects' few,
+/// and every method's (the reference's sets grow with its sample chunks).
+const DESCRIPTOR_SETS: u32 = 256;
 /// Side of the Beckmann look-up texture (seed 004's specular): 256 x 256 R16F.
 const BECKMANN_SIZE: u32 = 256;
 /// Receiver bias of the shadow test along the light, in millimetres: half a
@@ -74,6 +77,17 @@ struct ShadowPush {
 struct TonemapPush {
     exposure: f32,
     white_point: f32,
+}
+
+/// A full-screen post pass: what it reads (image, shader variable), what it writes.
+struct PostPass<'a, 'r> {
+    name: &'r str,
+    pipeline: &'a Pipeline,
+    shader: &'static str,
+    set: vk::DescriptorSet,
+    reads: &'r [(ImageId, &'r str)],
+    target: ImageId,
+    push: Option<TonemapPush>,
 }
 
 /// The frame's pipelines, uniforms, scene objects and placement.
@@ -126,6 +140,9 @@ pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
 impl Frame {
     /// Pipelines, uniforms and scene objects (no descriptor set that needs a
     /// frame image yet: `bind` writes those once the images exist).
+    /// Pipelines, uniforms and scene objects (no descriptor set that needs a
+    /// frame image yet: `bind` writes those once the images exist). On an
+    /// error, whatever was made is destroyed.
     pub fn new(
         ctx: &Context,
         scene: &Scene,
@@ -139,10 +156,97 @@ impl Frame {
             width: settings.width,
             height: settings.height,
         };
-        let samplers = Samplers::new(ctx)?;
-        let pool = DescriptorPool::new(ctx, 256)?;
+        let full = PixelRect::full(extent.width, extent.height);
+        let mut f = Frame {
+            settings: settings.clone(),
+            extent,
+            mm_per_unit: scene.mm_per_unit,
+            targets,
+            camera: framing.camera,
+            light_frame: framing.light,
+            instances: framing.instances,
+            backdrop: framing.backdrop,
+            samplers: Samplers::default(),
+            pool: DescriptorPool::default(),
+            shadow_pipeline: Pipeline::default(),
+            geometry_pipeline: Pipeline::default(),
+            composite_pipeline: Pipeline::default(),
+            tonemap_pipeline: Pipeline::default(),
+            frame_set: vk::DescriptorSet::null(),
+            composite_set: vk::DescriptorSet::null(),
+            tonemap_set: vk::DescriptorSet::null(),
+            frame_ubo: Buffer::default(),
+            beckmann: Image::default(),
+            objects: Vec::new(),
+            region_px: vec![full],
+            sss_region: scissors(&[full]),
+            screen_rect: scissors(&[full]),
+        };
+        match f.build(ctx, scene, res, transmittance) {
+            Ok(()) => Ok(f),
+            Err(e) => {
+                f.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Fills in the frame's objects, each step on its own so a failure leaves
+    /// only complete objects for `destroy`.
+    fn build(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        res: &Resources,
+        transmittance: bool,
+    ) -> Result<()> {
+        self.samplers = Samplers::new(ctx)?;
+        self.pool = DescriptorPool::new(ctx, DESCRIPTOR_SETS)?;
+        self.create_pipelines(ctx, res)?;
+        let lut: Vec<u16> = beckmann_lut(BECKMANN_SIZE as usize)
+            .iter()
+            .map(|&v| half::f16::from_f32(v).to_bits())
+            .collect();
+        self.beckmann = upload::texture(
+            ctx,
+            "beckmann",
+            vk::Extent2D {
+                width: BECKMANN_SIZE,
+                height: BECKMANN_SIZE,
+            },
+            vk::Format::R16_SFLOAT,
+            bytemuck::cast_slice(&lut),
+        )?;
+        let uniforms = self.uniforms(scene, transmittance);
+        self.frame_ubo = Buffer::with_data(
+            ctx,
+            "frame uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let objects = scene
+            .backdrop
+            .iter()
+            .map(|b| ("backdrop", b))
+            .chain(std::iter::once(("head", &scene.head)));
+        for (name, o) in objects {
+            let g = GpuObject::new(
+                ctx,
+                name,
+                o,
+                &self.pool,
+                &self.geometry_pipeline,
+                &self.samplers,
+            )?;
+            self.objects.push(g);
+        }
+        Ok(())
+    }
+
+    fn create_pipelines(&mut self, ctx: &Context, res: &Resources) -> Result<()> {
+        let targets = self.targets;
         let ds_format = res.format(targets.depth_stencil);
-        let shadow_pipeline = Pipeline::graphics(
+        self.shadow_pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
                 name: "shadow".into(),
@@ -168,7 +272,7 @@ impl Frame {
                 .chain(targets.normals)
                 .map(|t| res.format(t))
                 .collect();
-        let geometry_pipeline = Pipeline::graphics(
+        self.geometry_pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
                 name: "geometry".into(),
@@ -196,37 +300,27 @@ impl Frame {
                 blend: Blend::None,
             },
         )?;
-        let composite_pipeline = Pipeline::graphics(
+        self.composite_pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
         )?;
-        let tonemap_pipeline = Pipeline::graphics(
+        self.tonemap_pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc::fullscreen("tonemap", TONEMAP_SHADER, LDR_FORMAT),
         )?;
-        let lut: Vec<u16> = beckmann_lut(BECKMANN_SIZE as usize)
-            .iter()
-            .map(|&v| half::f16::from_f32(v).to_bits())
-            .collect();
-        let beckmann = upload::texture(
-            ctx,
-            "beckmann",
-            vk::Extent2D {
-                width: BECKMANN_SIZE,
-                height: BECKMANN_SIZE,
-            },
-            vk::Format::R16_SFLOAT,
-            bytemuck::cast_slice(&lut),
-        )?;
+        Ok(())
+    }
 
+    /// The frame's uniforms: camera, key light, shadow and transmittance parameters.
+    fn uniforms(&self, scene: &Scene, transmittance: bool) -> FrameUniforms {
+        let settings = &self.settings;
         let aspect = settings.width as f32 / settings.height as f32;
-        let camera = framing.camera;
-        let light_frame = framing.light;
+        let (camera, light_frame) = (self.camera, self.light_frame);
         let light_dir = settings.light.direction_to_light(scene.forward);
         let light = settings.light;
         let mm = scene.mm_per_unit;
         let bias = SHADOW_BIAS_MM / mm / light_frame.depth_range_units;
-        let uniforms = FrameUniforms {
+        FrameUniforms {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             view: camera.view().to_cols_array_2d(),
             light_view_proj: light_frame.view_proj.to_cols_array_2d(),
@@ -251,58 +345,7 @@ impl Frame {
                 settings.transmittance_profile.exponent_scale(),
                 0.0,
             ],
-        };
-        let frame_ubo = Buffer::with_data(
-            ctx,
-            "frame uniforms",
-            bytemuck::bytes_of(&uniforms),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
-        let mut objects = Vec::new();
-        if let Some(b) = &scene.backdrop {
-            objects.push(GpuObject::new(
-                ctx,
-                "backdrop",
-                b,
-                &pool,
-                &geometry_pipeline,
-                &samplers,
-            )?);
         }
-        objects.push(GpuObject::new(
-            ctx,
-            "head",
-            &scene.head,
-            &pool,
-            &geometry_pipeline,
-            &samplers,
-        )?);
-        let full = PixelRect::full(extent.width, extent.height);
-        Ok(Frame {
-            settings: settings.clone(),
-            extent,
-            mm_per_unit: mm,
-            targets,
-            camera,
-            light_frame,
-            instances: framing.instances,
-            backdrop: framing.backdrop,
-            samplers,
-            pool,
-            shadow_pipeline,
-            geometry_pipeline,
-            composite_pipeline,
-            tonemap_pipeline,
-            frame_set: vk::DescriptorSet::null(),
-            composite_set: vk::DescriptorSet::null(),
-            tonemap_set: vk::DescriptorSet::null(),
-            frame_ubo,
-            beckmann,
-            objects,
-            region_px: vec![full],
-            sss_region: scissors(&[full]),
-            screen_rect: scissors(&[full]),
-        })
     }
 
     /// The view the method is built for.
@@ -594,16 +637,16 @@ impl Frame {
         })
     }
 
-    fn fullscreen_pass<'a>(
-        &'a self,
-        res: &Resources,
-        name: &str,
-        (pipeline, shader): (&'a Pipeline, &'static str),
-        set: vk::DescriptorSet,
-        reads: &[(ImageId, &str)],
-        target: ImageId,
-        push: Option<TonemapPush>,
-    ) -> Pass<'a> {
+    fn fullscreen_pass<'a>(&'a self, res: &Resources, p: PostPass<'a, '_>) -> Pass<'a> {
+        let PostPass {
+            name,
+            pipeline,
+            shader,
+            set,
+            reads,
+            target,
+            push,
+        } = p;
         let work = Work::Raster {
             shader: Some(ShaderWork {
                 shader: shader.into(),
@@ -648,12 +691,15 @@ impl Frame {
         let t = self.targets;
         self.fullscreen_pass(
             res,
-            "composite",
-            (&self.composite_pipeline, COMPOSITE_SHADER),
-            self.composite_set,
-            &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
-            t.hdr,
-            None,
+            PostPass {
+                name: "composite",
+                pipeline: &self.composite_pipeline,
+                shader: COMPOSITE_SHADER,
+                set: self.composite_set,
+                reads: &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
+                target: t.hdr,
+                push: None,
+            },
         )
     }
 
@@ -661,15 +707,18 @@ impl Frame {
         let t = self.targets;
         self.fullscreen_pass(
             res,
-            "tonemap",
-            (&self.tonemap_pipeline, TONEMAP_SHADER),
-            self.tonemap_set,
-            &[(t.hdr, "hdrTex")],
-            t.ldr,
-            Some(TonemapPush {
-                exposure: self.settings.exposure,
-                white_point: WHITE_POINT,
-            }),
+            PostPass {
+                name: "tonemap",
+                pipeline: &self.tonemap_pipeline,
+                shader: TONEMAP_SHADER,
+                set: self.tonemap_set,
+                reads: &[(t.hdr, "hdrTex")],
+                target: t.ldr,
+                push: Some(TonemapPush {
+                    exposure: self.settings.exposure,
+                    white_point: WHITE_POINT,
+                }),
+            },
         )
     }
 

@@ -29,6 +29,9 @@ pub fn upload_accesses(t: &FrameTargets) -> Vec<(ImageId, AccessKind)> {
         .collect()
 }
 
+/// One upload: the image, its bytes, and (aspect, offset in the bytes) per region.
+type Upload<'a> = (ImageId, &'a [u8], Vec<(vk::ImageAspectFlags, u64)>);
+
 /// A setup pass copying `buffer` into `image`: one region per (aspect, offset).
 fn upload_pass<'a>(
     name: &str,
@@ -140,7 +143,7 @@ impl Renderer<'_> {
         let stencil_offset = ds_bytes.len() as u64;
         ds_bytes.extend(skin.iter().map(|&s| if s { STENCIL_SKIN as u8 } else { 0 }));
         let color = vk::ImageAspectFlags::COLOR;
-        let uploads: [(ImageId, &[u8], Vec<(vk::ImageAspectFlags, u64)>); 3] = [
+        let uploads: [Upload; 3] = [
             (
                 t.diffuse,
                 bytemuck::cast_slice(diffuse_f16),
@@ -183,11 +186,7 @@ impl Renderer<'_> {
         )
     }
 
-    fn upload(
-        &mut self,
-        uploads: Vec<(ImageId, &[u8], Vec<(vk::ImageAspectFlags, u64)>)>,
-        extent: vk::Extent2D,
-    ) -> Result<()> {
+    fn upload(&mut self, uploads: Vec<Upload>, extent: vk::Extent2D) -> Result<()> {
         let mut staging = Vec::new();
         for (id, bytes, _) in &uploads {
             match Buffer::with_data(

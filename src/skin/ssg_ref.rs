@@ -267,14 +267,14 @@ mod tests {
             &no_lod(GaussianFit::Six),
         );
         let mut changed = 0;
-        for i in 0..s.w * s.h {
+        for (i, o) in out.iter().enumerate() {
             if s.skin[i] {
-                changed += usize::from(out[i] != s.diffuse[i]);
-                assert_eq!(out[i][3], s.diffuse[i][3]);
-                assert_eq!(out[i], round_f16(out[i]));
+                changed += usize::from(*o != s.diffuse[i]);
+                assert_eq!(o[3], s.diffuse[i][3]);
+                assert_eq!(*o, round_f16(*o));
             } else {
                 assert_eq!(
-                    out[i].map(f32::to_bits),
+                    o.map(f32::to_bits),
                     s.diffuse[i].map(f32::to_bits),
                     "pixel {i}"
                 );
@@ -302,12 +302,12 @@ mod tests {
         let quads = [0.0, 0.0, q_mid];
         let out = ssg(&s.input(), GaussianFit::Four, Stretch::THESIS, &quads);
         let mut shaded_count = 0;
-        for p in 0..s.w * s.h {
+        for (p, o) in out.iter().enumerate() {
             if shaded(&s.input(), p, q_mid) {
                 shaded_count += 1;
-                assert_ne!(out[p][0], s.diffuse[p][0], "pixel {p} not shaded");
+                assert_ne!(o[0], s.diffuse[p][0], "pixel {p} not shaded");
             } else {
-                assert_eq!(out[p], s.diffuse[p], "pixel {p} shaded");
+                assert_eq!(*o, s.diffuse[p], "pixel {p} shaded");
             }
         }
         assert!(shaded_count > 0);

@@ -82,7 +82,7 @@ pub struct Context {
     _messages_box: Box<MessageLog>,
     pub allocator: Option<Mutex<Allocator>>,
     /// The counters of the fetch-counting build (host-visible), when enabled.
-    pub fetch_counts: Option<super::memory::Buffer>,
+    pub fetch_counts: Option<FetchCounters>,
     pub command_pool: vk::CommandPool,
     pub validation: bool,
 }
@@ -114,6 +114,63 @@ unsafe extern "system" fn debug_callback(
 /// Counters of the fetch-counting build: slot 0 counts invocations, slot
 /// 1 + (set * 16 + binding) * 4 + kind counts fetches (shaders/fetch_count.glsl).
 pub const FETCH_COUNTERS: u64 = 1 + 4 * 16 * 4;
+
+/// The host-visible counters of the fetch-counting build (kept here, not as a
+/// `memory::Buffer`, because pipelines reach them through the context).
+pub struct FetchCounters {
+    pub raw: vk::Buffer,
+    allocation: gpu_allocator::vulkan::Allocation,
+}
+
+impl FetchCounters {
+    fn new(ctx: &Context) -> Result<Self> {
+        let raw = unsafe {
+            ctx.device.create_buffer(
+                &vk::BufferCreateInfo::default()
+                    .size(FETCH_COUNTERS * 4)
+                    // Zeroed by vkCmdFillBuffer before each counted pass.
+                    .usage(
+                        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                    ),
+                None,
+            )
+        }?;
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx
+            .allocator()
+            .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                name: "fetch counters",
+                requirements,
+                location: gpu_allocator::MemoryLocation::GpuToCpu,
+                linear: true,
+                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+            });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(e).context("allocating the fetch counters");
+            }
+        };
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }?;
+        ctx.name(raw, "fetch counters");
+        Ok(FetchCounters { raw, allocation })
+    }
+
+    /// The counters (after the fence of the submission that wrote them).
+    pub fn read(&self) -> Result<Vec<u32>> {
+        let bytes = self
+            .allocation
+            .mapped_slice()
+            .context("the fetch counters are not host visible")?;
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[..(FETCH_COUNTERS * 4) as usize],
+        ))
+    }
+}
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -214,18 +271,14 @@ impl Context {
                     ctx.facts.name
                 );
             }
-            ctx.fetch_counts = Some(super::memory::Buffer::new(
-                &ctx,
-                "fetch counters",
-                FETCH_COUNTERS * 4,
-                // Zeroed by vkCmdFillBuffer before each counted pass.
-                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                gpu_allocator::MemoryLocation::GpuToCpu,
-            )?);
+            ctx.fetch_counts = Some(FetchCounters::new(&ctx)?);
         }
         Ok(ctx)
     }
 
+    // Long because device creation is one sequence of queries and creation
+    // steps whose early exits must each destroy the instance; split up, that
+    // cleanup would have to travel with every piece.
     fn with_instance(
         entry: ash::Entry,
         instance: ash::Instance,
@@ -563,8 +616,11 @@ impl Drop for Context {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
         }
-        if let Some(mut b) = self.fetch_counts.take() {
-            b.destroy(self);
+        if let Some(c) = self.fetch_counts.take() {
+            unsafe { self.device.destroy_buffer(c.raw, None) };
+            if let Some(a) = self.allocator.as_ref() {
+                let _ = a.lock().map(|mut a| a.free(c.allocation));
+            }
         }
         unsafe {
             // The allocator must go before the device.

@@ -9,6 +9,9 @@ use gpu_allocator::MemoryLocation;
 
 use super::context::Context;
 
+/// `Default` is the null object: destroying it does nothing (set-up fills
+/// fields one by one and destroys whatever it made when a step fails).
+#[derive(Default)]
 pub struct Image {
     pub raw: vk::Image,
     /// View of mip level 0 (attachments, texel fetches).
@@ -219,6 +222,9 @@ impl Image {
     }
 }
 
+/// `Default` is the null object: destroying it does nothing (set-up fills
+/// fields one by one and destroys whatever it made when a step fails).
+#[derive(Default)]
 pub struct Buffer {
     pub raw: vk::Buffer,
     pub size: u64,

@@ -66,6 +66,9 @@ impl GraphicsDesc {
     }
 }
 
+/// `Default` is the null object: destroying it does nothing (set-up fills
+/// fields one by one and destroys whatever it made when a step fails).
+#[derive(Default)]
 pub struct Pipeline {
     pub raw: vk::Pipeline,
     pub layout: vk::PipelineLayout,
@@ -435,6 +438,9 @@ pub enum Bind {
 }
 
 /// A descriptor pool sized for the whole renderer (everything is allocated once).
+/// `Default` is the null object: destroying it does nothing (set-up fills
+/// fields one by one and destroys whatever it made when a step fails).
+#[derive(Default)]
 pub struct DescriptorPool {
     pub raw: vk::DescriptorPool,
 }
@@ -610,6 +616,9 @@ impl DescriptorPool {
 }
 
 /// Samplers used across the renderer.
+/// `Default` is the null object: destroying it does nothing (set-up fills
+/// fields one by one and destroys whatever it made when a step fails).
+#[derive(Default)]
 pub struct Samplers {
     pub linear_clamp: vk::Sampler,
     pub nearest_clamp: vk::Sampler,
