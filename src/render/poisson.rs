@@ -29,14 +29,15 @@ pub fn levels_for(extent: vk::Extent2D) -> u32 {
     full.min(MAX_LEVELS)
 }
 
-/// Push constants of poisson.frag (std430, 48 bytes).
+/// Push constants of poisson.frag (std430, 80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct PoissonPush {
     pub size: [f32; 2],
     pub tan_half_fovy: f32,
     pub mm_per_unit: f32,
-    pub falloff: [f32; 4],
+    /// One row per tap count (8, 16, 32): rgb falloff, w unused.
+    pub falloff: [[f32; 4]; 3],
     pub radius_mm: f32,
     pub depth_sensitivity: f32,
     pub normal_sensitivity: f32,
@@ -188,7 +189,7 @@ impl PoissonSss {
             size: [t.extent.width as f32, t.extent.height as f32],
             tan_half_fovy: (0.5 * fovy_rad).tan(),
             mm_per_unit,
-            falloff: [p.falloff[0], p.falloff[1], p.falloff[2], 0.0],
+            falloff: p.falloff.map(|f| [f[0], f[1], f[2], 0.0]),
             radius_mm: p.radius_mm,
             depth_sensitivity: p.depth_sensitivity,
             normal_sensitivity: p.normal_sensitivity,
