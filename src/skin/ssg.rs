@@ -234,7 +234,9 @@ pub const LISTING_4_1_WEIGHTS: [f32; 7] = [0.006, 0.061, 0.242, 0.382, 0.242, 0.
 
 /// Eq. 4.6 with the thesis' 0.5 factor instead of 2: the view depth (scene
 /// units) beyond which Gaussian `i` is skipped. The thesis found 0.5 turns
-/// narrow Gaussians off sooner without visible popping.
+/// narrow Gaussians off sooner without visible popping. With alpha at the
+/// view's true scale ([`Stretch::for_view`]) that is where the step's 3
+/// sigma span less than 2 pixels (sigma less than 2/3 pixel).
 pub fn lod_depth(incremental_std_mm: f32, alpha: f32) -> f32 {
     0.5 * incremental_std_mm * alpha
 }
