@@ -16,7 +16,7 @@ layout(push_constant) uniform Push {
     vec2 size;          // level-0 size in pixels
     float tanHalfFovy;
     float mmPerUnit;
-    vec4 falloff;       // rgb: k in exp(-k |q|^2)
+    vec4 falloff[3];    // rgb: k in exp(-k |q|^2), for 8, 16 and 32 samples
     float radiusMm;
     float depthSensitivity;   // per mm^2
     float normalSensitivity;
@@ -34,6 +34,7 @@ void main() {
     vec2 uv = (vec2(p) + 0.5) / pc.size;
     float rPx = pc.radiusMm / (pc.mmPerUnit * 2.0 * d * pc.tanHalfFovy) * pc.size.y * colorM.a;
     int count = rPx >= 16.0 ? 32 : (rPx >= 8.0 ? 16 : 8);
+    vec3 falloff = pc.falloff[count == 32 ? 2 : (count == 16 ? 1 : 0)].rgb;
     float lod = clamp(floor(log2(max(rPx, 1.0) / 16.0)), 0.0, float(pc.maxLevel));
     vec3 acc = colorM.rgb;
     vec3 total = vec3(1.0);
@@ -45,7 +46,7 @@ void main() {
         vec3 ns = COUNTED(SITE(0, 2, FK_BILINEAR), textureLod(sampler2D(normalChain, mipClamp), uvS, lod)).xyz;
         float dD = (ds - d) * pc.mmPerUnit;
         float wc = c.a * exp(-pc.depthSensitivity * dD * dD) * exp(-pc.normalSensitivity * (1.0 - clamp(dot(ns, n), 0.0, 1.0)));
-        vec3 w = wc * exp(-pc.falloff.rgb * (q.x * q.x + q.y * q.y));
+        vec3 w = wc * exp(-falloff * (q.x * q.x + q.y * q.y));
         acc += c.rgb * w;
         total += w;
     }

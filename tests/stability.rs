@@ -228,7 +228,8 @@ fn halo_across_a_depth_discontinuity() {
     assert_eq!(none, 0.0);
     assert_eq!(reference, 0.0, "the reference leaks across the gap");
     // Measured on lavapipe at 96x64: separable 0.061 with follow-surface, 0.60
-    // without; ssg 2.41; ss-jittered 3.60; poisson 0.042 (its mip levels average
+    // without; ssg 0.47 and ss-jittered 2.87 at their true scale (2.41 and 3.60
+    // when their stretch was 18% too wide); poisson 0.013 (its mip levels average
     // ball and wall depths at the silhouette, so some samples pass the depth weight).
     // Follow-surface is what stops the separable blur crossing the step (10x measured).
     assert!(
@@ -242,9 +243,11 @@ fn halo_across_a_depth_discontinuity() {
     // Poisson's depth weight keeps most of it out too.
     assert!(poisson < 0.2 * sep_no_follow, "poisson leaks {poisson}");
     // The chapter-4 methods have no depth test on their taps: the halo the thesis
-    // reports (section 4.5) is there, several times the unguarded separable one.
+    // reports (section 4.5) is there, several times what follow-surface leaves
+    // (ssg's blurs are narrow at this size: its first Gaussians span under a
+    // pixel; ss-jittered's wide ring reaches past the unguarded separable blur).
     assert!(
-        ssg > sep_no_follow && jittered > sep_no_follow,
+        ssg > 4.0 * sep_follow && jittered > sep_no_follow,
         "ssg {ssg}, ss-jittered {jittered}"
     );
 }

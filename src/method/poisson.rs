@@ -62,14 +62,15 @@ pub fn levels_for(extent: vk::Extent2D) -> u32 {
     full.min(MAX_LEVELS)
 }
 
-/// Push constants of poisson.frag (std430, 48 bytes).
+/// Push constants of poisson.frag (std430, 80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct PoissonPush {
     size: [f32; 2],
     tan_half_fovy: f32,
     mm_per_unit: f32,
-    falloff: [f32; 4],
+    /// One row per tap count (8, 16, 32): rgb falloff, w unused.
+    falloff: [[f32; 4]; 3],
     radius_mm: f32,
     depth_sensitivity: f32,
     normal_sensitivity: f32,
@@ -134,7 +135,7 @@ impl Poisson {
             size: [s.view.extent.width as f32, s.view.extent.height as f32],
             tan_half_fovy: s.view.tan_half_fovy(),
             mm_per_unit: s.view.mm_per_unit,
-            falloff: [p.falloff[0], p.falloff[1], p.falloff[2], 0.0],
+            falloff: p.falloff.map(|f| [f[0], f[1], f[2], 0.0]),
             radius_mm: p.radius_mm,
             depth_sensitivity: p.depth_sensitivity,
             normal_sensitivity: p.normal_sensitivity,

@@ -36,7 +36,7 @@ const OPTIONS: &[OptSpec] = &[
         key: "preset",
         kind: OptKind::Value,
         default: "table6.1",
-        help: "kernel preset: table6.1 | demo",
+        help: "kernel preset: table6.1 | demo (the sources' artists' presets) | physical (the profile's per-channel marginal)",
     },
     OptSpec {
         key: "sss-width-mm",

@@ -8,6 +8,7 @@
 //! screen-space SSS passes.
 
 pub mod beckmann;
+pub mod card;
 pub mod jittered;
 pub mod kernel;
 pub mod poisson;

@@ -73,6 +73,12 @@ pub fn red_profile_line_integral(a_mm: f64, b_mm: f64) -> f64 {
 
 /// Line integral of one 2D-normalised Gaussian over `[a, b]`.
 fn gaussian_line_integral(variance: f64, a: f64, b: f64) -> f64 {
+    gaussian_marginal_integral(variance, a, b) / (2.0 * PI * variance).sqrt()
+}
+
+/// `Phi(b/sigma) - Phi(a/sigma)` with `sigma = sqrt(variance)`: the mass of
+/// the 1D Gaussian (the 2D Gaussian's marginal) on `[a, b]`.
+fn gaussian_marginal_integral(variance: f64, a: f64, b: f64) -> f64 {
     let s = (2.0 * variance).sqrt();
     let (za, zb) = (a / s, b / s);
     // Subtract tails rather than erf values when the interval lies on one
@@ -85,7 +91,71 @@ fn gaussian_line_integral(variance: f64, a: f64, b: f64) -> f64 {
     } else {
         erf(zb) - erf(za)
     };
-    0.5 * diff / (2.0 * PI * variance).sqrt()
+    0.5 * diff
+}
+
+/// The six-Gaussian profile `R_c(r)` of every channel (r in mm, per mm^2).
+pub fn profile_rgb(r_mm: f64) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (&v, w) in SIX_GAUSSIAN_VARIANCES_MM2
+        .iter()
+        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+    {
+        let g = gaussian_2d(f64::from(v), r_mm);
+        for c in 0..3 {
+            out[c] += f64::from(w[c]) * g;
+        }
+    }
+    out
+}
+
+/// Exact `integral_a^b m_c(x) dx` of the profile's marginal (mm) for channel
+/// `c`: `m_c(x) = integral R_c(sqrt(x^2 + y^2)) dy = sum_i w_ic N(x; 0, v_i)`,
+/// the 2D profile projected onto a line (each 2D Gaussian's marginal is the
+/// 1D Gaussian of the same variance). Integrates to 1 over the whole line,
+/// unlike [`red_profile_line_integral`] (a slice through the centre, which
+/// weighs Gaussian i by `w_i / sqrt(2 pi v_i)`). Negative when `b < a`.
+pub fn marginal_integral(c: usize, a_mm: f64, b_mm: f64) -> f64 {
+    SIX_GAUSSIAN_VARIANCES_MM2
+        .iter()
+        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+        .map(|(&v, w)| f64::from(w[c]) * gaussian_marginal_integral(f64::from(v), a_mm, b_mm))
+        .sum()
+}
+
+/// Exact `integral_a^b x m_c(x) dx` (the marginal's first moment over
+/// `[a, b]`): per Gaussian `sigma (phi(a/sigma) - phi(b/sigma))`, i.e.
+/// `sqrt(v / 2 pi) (exp(-a^2/2v) - exp(-b^2/2v))`.
+pub fn marginal_first_moment(c: usize, a_mm: f64, b_mm: f64) -> f64 {
+    SIX_GAUSSIAN_VARIANCES_MM2
+        .iter()
+        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+        .map(|(&v, w)| {
+            let v = f64::from(v);
+            let e = |x: f64| (-x * x / (2.0 * v)).exp();
+            f64::from(w[c]) * (v / (2.0 * PI)).sqrt() * (e(a_mm) - e(b_mm))
+        })
+        .sum()
+}
+
+/// Per-channel variance of the profile along one axis, `sum_i w_ic v_i`
+/// (mm^2): the variance of its marginal.
+pub fn profile_variance_mm2() -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (&v, w) in SIX_GAUSSIAN_VARIANCES_MM2
+        .iter()
+        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+    {
+        for c in 0..3 {
+            out[c] += f64::from(w[c]) * f64::from(v);
+        }
+    }
+    out
+}
+
+/// Standard normal distribution function `Phi(x) = erfc(-x / sqrt 2) / 2`.
+pub fn normal_cdf(x: f64) -> f64 {
+    0.5 * erfc(-x / std::f64::consts::SQRT_2)
 }
 
 /// Below this |x| the power series is used; above it the continued fraction.

@@ -131,9 +131,14 @@ pub fn ssg_gaussians(fit: GaussianFit) -> Vec<SsgGaussian> {
 
 /// Parameters of the stretch factors, eq. 4.1-4.2:
 /// `s = alpha / (d + beta * min(|grad d|, gamma))`.
+///
+/// Units: Listing 4.1 steps its 7 taps by `s * sigma / 3` pixels, so on a
+/// flat surface `alpha / (3 d)` is the number of pixels one millimetre of
+/// sigma spans at view depth `d` (scene units).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Stretch {
-    /// Global SSS level; scales with the projected size of a millimetre.
+    /// Global SSS level: three times the pixels per millimetre at unit
+    /// view depth.
     pub alpha: f32,
     /// How strongly depth gradients (grazing surfaces, silhouettes) shrink
     /// the kernel.
@@ -143,38 +148,57 @@ pub struct Stretch {
 }
 
 impl Stretch {
-    /// The thesis' values, chosen for a head 1 unit tall, a 20 degree
-    /// vertical field of view and a 720 pixel high viewport.
+    /// The thesis' values, chosen empirically for a head 1 unit tall, a
+    /// 20 degree vertical field of view and a 720 pixel high viewport.
+    ///
+    /// Its alpha is not that view's true scale: with a 230 mm head,
+    /// `alpha / 3 = 10.5` px per mm at depth 1 against a true
+    /// `720 / (2 tan(10 deg) 230) = 8.88`, so it blurs 18% wider than the
+    /// profile. [`Stretch::for_view`] derives alpha from the view instead
+    /// and keeps only beta and gamma from here.
     pub const THESIS: Stretch = Stretch {
         alpha: 31.5,
         beta: 800.0,
         gamma: 0.001,
     };
 
-    /// [`Stretch::THESIS`] scaled to another view.
+    /// The stretch for a view, at the scene's true scale.
     ///
-    /// The thesis' head is 1 unit = [`DEMO_UNIT_MM`] (230 mm); with
-    /// `k = 230 / mm_per_unit` (scene units per thesis unit inverted):
-    /// * `alpha = 31.5 * (height_px/720) * (tan(10 deg)/tan(fovy/2)) * k`:
-    ///   `alpha / d` is pixels per mm (times 3, see Listing 4.1), which grows
-    ///   with the viewport height, shrinks with a wider field of view, and
-    ///   in scene units grows with `k` because `d` is measured in them;
-    /// * `beta = 800 * (height_px/720)`: `beta * |grad d|` is compared with
-    ///   `d`; the per-pixel gradient shrinks as pixels get smaller, so
-    ///   `beta` grows with the height to keep the product in scene units;
-    /// * `gamma = 0.001 * k * (720/height_px)`: a gradient cap in scene
-    ///   units per pixel, so it scales with the unit and the pixel size.
+    /// With the focal length in pixels `f = height_px / (2 tan(fovy/2))`, a
+    /// length `l` (scene units) at view depth `d` spans `l f / d` pixels, so
+    /// one millimetre spans `f / (mm_per_unit d)`:
+    /// * `alpha = 3 f / mm_per_unit`, so that `alpha / (3 d)` is exactly the
+    ///   pixels per mm at depth `d` (the 3 of Listing 4.1) and a Gaussian of
+    ///   sigma mm spans sigma mm of the surface on screen;
+    /// * `beta = 800 f / f_T`, with `f_T = 720 / (2 tan(10 deg))` the
+    ///   thesis' focal length: the per-pixel depth gradient of a surface of
+    ///   slope `m` is `m d / f`, so `beta |grad d| / d = 800 m / f_T` is the
+    ///   same function of the slope as in the thesis, on any view;
+    /// * `gamma = 0.001 k f_T / f`, `k = 230 / mm_per_unit`: the gradient cap
+    ///   (scene units per pixel), kept at the thesis' slope for the same
+    ///   depth in millimetres (its unit is 230 mm, [`DEMO_UNIT_MM`]).
     ///
-    /// `for_view(720, 20 deg, 230) == THESIS` exactly.
+    /// At 720 px and 20 degrees beta and gamma are the thesis' (scaled by
+    /// `k` for gamma) and alpha is `31.5 / 1.183` for a 230 mm unit.
     pub fn for_view(height_px: u32, fovy_rad: f32, mm_per_unit: f32) -> Stretch {
         let k = DEMO_UNIT_MM / mm_per_unit;
+        let tan_half = (0.5 * fovy_rad).tan();
+        let focal_px = height_px as f32 / (2.0 * tan_half);
+        // f / f_T, as (height/720) (tan 10 / tan(fovy/2)): exactly
+        // height/720 at 20 degrees.
         let h = height_px as f32 / 720.0;
-        let fov = 10f32.to_radians().tan() / (0.5 * fovy_rad).tan();
+        let focal_ratio = h * (10f32.to_radians().tan() / tan_half);
         Stretch {
-            alpha: Self::THESIS.alpha * h * fov * k,
-            beta: Self::THESIS.beta * h,
-            gamma: Self::THESIS.gamma * k * (720.0 / height_px as f32),
+            alpha: 3.0 * focal_px / mm_per_unit,
+            beta: Self::THESIS.beta * focal_ratio,
+            gamma: Self::THESIS.gamma * k / focal_ratio,
         }
+    }
+
+    /// Pixels per millimetre at view depth `d` on a flat surface (no
+    /// gradient, strength 1): `alpha / (3 d)`.
+    pub fn px_per_mm(&self, depth: f32) -> f32 {
+        self.alpha / (3.0 * depth)
     }
 
     /// Stretch factors `[s_x, s_y]` of eq. 4.1-4.2 at pixel `(x, y)`,
@@ -210,7 +234,9 @@ pub const LISTING_4_1_WEIGHTS: [f32; 7] = [0.006, 0.061, 0.242, 0.382, 0.242, 0.
 
 /// Eq. 4.6 with the thesis' 0.5 factor instead of 2: the view depth (scene
 /// units) beyond which Gaussian `i` is skipped. The thesis found 0.5 turns
-/// narrow Gaussians off sooner without visible popping.
+/// narrow Gaussians off sooner without visible popping. With alpha at the
+/// view's true scale ([`Stretch::for_view`]) that is where the step's 3
+/// sigma span less than 2 pixels (sigma less than 2/3 pixel).
 pub fn lod_depth(incremental_std_mm: f32, alpha: f32) -> f32 {
     0.5 * incremental_std_mm * alpha
 }
@@ -311,11 +337,34 @@ mod tests {
     }
 
     #[test]
-    fn for_view_reproduces_the_thesis_setup() {
-        assert_eq!(
-            Stretch::for_view(720, 20f32.to_radians(), DEMO_UNIT_MM),
-            Stretch::THESIS
-        );
+    fn for_view_at_the_thesis_setup() {
+        let s = Stretch::for_view(720, 20f32.to_radians(), DEMO_UNIT_MM);
+        // beta and gamma are the thesis' exactly.
+        assert_eq!(s.beta, Stretch::THESIS.beta);
+        assert_eq!(s.gamma, Stretch::THESIS.gamma);
+        // True scale: 720 / (2 tan 10 deg 230 mm) = 8.876 px per mm at
+        // depth 1; the thesis' 31.5 / 3 = 10.5 is 18.3% wider.
+        assert!((s.px_per_mm(1.0) - 8.876).abs() < 1e-3, "{}", s.alpha);
+        let ratio = Stretch::THESIS.alpha / s.alpha;
+        assert!((ratio - 1.183).abs() < 1e-3, "{ratio}");
+    }
+
+    #[test]
+    fn alpha_is_the_projected_millimetre() {
+        // One mm at depth d, projected: height / (2 d tan(fovy/2) mm_per_unit)
+        // pixels (render::region::px_per_mm), for several views.
+        for (h, fov_deg, mm, d) in [
+            (720u32, 20f32, 230f32, 1.0f32),
+            (1080, 35.0, 10.0, 37.0),
+            (2160, 60.0, 48.3, 4.5),
+        ] {
+            let s = Stretch::for_view(h, fov_deg.to_radians(), mm);
+            let want = h as f32 / (2.0 * d * (0.5 * fov_deg.to_radians()).tan() * mm);
+            assert!((s.px_per_mm(d) - want).abs() < 1e-5 * want, "{h} {fov_deg}");
+            let flat = vec![d; 9];
+            let [sx, sy] = s.factors(&flat, 3, 3, 1, 1);
+            assert!((sx / 3.0 - want).abs() < 1e-5 * want && sx == sy);
+        }
     }
 
     #[test]
@@ -331,10 +380,35 @@ mod tests {
         assert!((mm.alpha - 230.0 * a.alpha).abs() < 1e-2);
         assert!((mm.gamma - 230.0 * a.gamma).abs() < 1e-6);
         assert_eq!(mm.beta, a.beta);
-        // A wider field of view makes everything smaller on screen.
+        // A wider field of view makes everything smaller on screen: alpha
+        // and beta shrink with the focal length, the gradient cap grows.
         let wide = Stretch::for_view(720, 60f32.to_radians(), 230.0);
-        let want = a.alpha * 10f32.to_radians().tan() / 30f32.to_radians().tan();
-        assert!((wide.alpha - want).abs() < 1e-4);
+        let f = 10f32.to_radians().tan() / 30f32.to_radians().tan();
+        assert!((wide.alpha - a.alpha * f).abs() < 1e-4);
+        assert!((wide.beta - a.beta * f).abs() < 1e-3);
+        assert!((wide.gamma - a.gamma / f).abs() < 1e-8);
+    }
+
+    #[test]
+    fn depth_gradient_term_depends_on_the_slope_only() {
+        // A plane of slope m seen at depth d: per-pixel gradient m d / f.
+        // The shrink d / (d + beta |g|) must be the same on every view.
+        let m = 0.4f32;
+        let shrink = |h: u32, fov_deg: f32, mm: f32, d_mm: f32| {
+            let s = Stretch::for_view(h, fov_deg.to_radians(), mm);
+            let d = d_mm / mm;
+            let f = h as f32 / (2.0 * (0.5 * fov_deg.to_radians()).tan());
+            let g = m * d / f;
+            d / (d + s.beta * g.min(s.gamma))
+        };
+        let base = shrink(720, 20.0, 230.0, 600.0);
+        for (h, fov, mm) in [(1080, 20.0, 10.0), (720, 45.0, 48.3), (2160, 70.0, 1.0)] {
+            let other = shrink(h, fov, mm, 600.0);
+            assert!(
+                (other - base).abs() < 1e-5,
+                "{h} {fov} {mm}: {other} vs {base}"
+            );
+        }
     }
 
     #[test]
