@@ -7,6 +7,7 @@
 //! math: profiles, kernels, CPU references), `render` (the frame), `bench`
 //! (ceilings and floors), `report` (statistics, tables, JSON).
 pub mod bench;
+pub mod budget;
 pub mod eval;
 pub mod graph;
 pub mod reference;
