@@ -11,6 +11,7 @@
 //! around a method) -> `report`, `bench`, `run` (runs, statistics, floors) ->
 //! `eval` (ground-truth comparisons, charts). `main.rs` parses arguments only.
 pub mod bench;
+pub mod budget;
 pub mod eval;
 pub mod graph;
 pub mod method;

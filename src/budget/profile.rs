@@ -1,0 +1,701 @@
+//! Hardware budget profiles: what a target GPU can do, read from `profiles/*.toml`.
+//!
+//! Every number is a [`Quantity`]: a plain number (its source is a comment in the
+//! file), a parameter `{ value, min, max }` for a number no public source
+//! confirms (HARDWARE.md's "(?)"), or the word `"unknown"`, in which case the
+//! model names each pass it could not price for want of it. Parsing is strict:
+//! a missing, misspelt or negative field is a one-line error naming the file,
+//! the line, the table and the field.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::graph::work::Format;
+
+/// A number of a profile.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawQuantity", into = "RawQuantity")]
+pub enum Quantity {
+    /// A published number (the file names its source).
+    Known(f64),
+    /// A number with no confirmed source: modelled with `value`, plausible
+    /// within `[min, max]`.
+    Param { value: f64, min: f64, max: f64 },
+    /// Not known: the passes that need it are reported unpriced.
+    Unknown,
+}
+
+impl Quantity {
+    /// The number the model uses, if there is one.
+    pub fn value(self) -> Option<f64> {
+        match self {
+            Quantity::Known(v) | Quantity::Param { value: v, .. } => Some(v),
+            Quantity::Unknown => None,
+        }
+    }
+
+    pub fn is_param(self) -> bool {
+        matches!(self, Quantity::Param { .. })
+    }
+}
+
+/// How a quantity is spelt in TOML: `8.0`, `{ value = 16.0, min = 5.6, max = 22.4 }`
+/// or `"unknown"`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+enum RawQuantity {
+    Number(f64),
+    Param(RawParam),
+    Word(String),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParam {
+    value: f64,
+    min: f64,
+    max: f64,
+}
+
+impl TryFrom<RawQuantity> for Quantity {
+    type Error = String;
+    fn try_from(r: RawQuantity) -> Result<Self, String> {
+        match r {
+            RawQuantity::Number(v) => Ok(Quantity::Known(v)),
+            RawQuantity::Param(p) => Ok(Quantity::Param {
+                value: p.value,
+                min: p.min,
+                max: p.max,
+            }),
+            RawQuantity::Word(w) if w == "unknown" => Ok(Quantity::Unknown),
+            RawQuantity::Word(w) => Err(format!(
+                "'{w}' is not a quantity (a number, {{ value, min, max }} or \"unknown\")"
+            )),
+        }
+    }
+}
+
+impl From<Quantity> for RawQuantity {
+    fn from(q: Quantity) -> Self {
+        match q {
+            Quantity::Known(v) => RawQuantity::Number(v),
+            Quantity::Param { value, min, max } => RawQuantity::Param(RawParam { value, min, max }),
+            Quantity::Unknown => RawQuantity::Word("unknown".into()),
+        }
+    }
+}
+
+/// Render-target and texture formats a profile can name: the renderer's
+/// [`Format`]s plus the console formats a port would substitute (7e3 float,
+/// the Xenos fixed-point 16-bit formats, two-channel formats).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TargetFormat {
+    Rgba8Unorm,
+    Rgba8Srgb,
+    Rgb10a2Unorm,
+    /// Xenos 2_10_10_10_FLOAT: 7e3 floats in [0, 32), 2-bit alpha.
+    Rgb10a2Float,
+    R11g11b10Float,
+    Rg16Unorm,
+    /// Xenos 16_16_16_16: fixed point in [-32, 32].
+    Rgba16Fixed,
+    R16Float,
+    Rg16Float,
+    Rgba16Float,
+    R32Float,
+    Rg32Float,
+    Rgba32Float,
+    D24UnormS8Uint,
+    /// Xenos D24FS8: 20e4 float depth.
+    D24FloatS8Uint,
+    D32Float,
+    D32FloatS8Uint,
+}
+
+/// What kind of values a format holds (for choosing a substitute).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormatClass {
+    Unorm,
+    /// Floating point or HDR fixed point (range beyond [0, 1]).
+    Hdr,
+    Depth,
+}
+
+impl TargetFormat {
+    pub fn from_work(f: Format) -> TargetFormat {
+        match f {
+            Format::Rgba8Unorm => TargetFormat::Rgba8Unorm,
+            Format::Rgba8Srgb => TargetFormat::Rgba8Srgb,
+            Format::R16Float => TargetFormat::R16Float,
+            Format::Rgba16Float => TargetFormat::Rgba16Float,
+            Format::R32Float => TargetFormat::R32Float,
+            Format::Rgba32Float => TargetFormat::Rgba32Float,
+            Format::D32Float => TargetFormat::D32Float,
+            Format::D24UnormS8Uint => TargetFormat::D24UnormS8Uint,
+            Format::D32FloatS8Uint => TargetFormat::D32FloatS8Uint,
+        }
+    }
+
+    /// Bytes per texel as stored (matches [`Format::bytes_per_texel`]).
+    pub fn bytes(self) -> u32 {
+        use TargetFormat::*;
+        match self {
+            R16Float => 2,
+            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rgb10a2Float | R11g11b10Float | Rg16Unorm
+            | Rg16Float | R32Float | D24UnormS8Uint | D24FloatS8Uint | D32Float => 4,
+            D32FloatS8Uint => 5,
+            Rgba16Fixed | Rgba16Float | Rg32Float => 8,
+            Rgba32Float => 16,
+        }
+    }
+
+    pub fn channels(self) -> u32 {
+        use TargetFormat::*;
+        match self {
+            R16Float | R32Float | D24UnormS8Uint | D24FloatS8Uint | D32Float | D32FloatS8Uint => 1,
+            Rg16Unorm | Rg16Float | Rg32Float => 2,
+            R11g11b10Float => 3,
+            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rgb10a2Float | Rgba16Fixed | Rgba16Float
+            | Rgba32Float => 4,
+        }
+    }
+
+    /// Bits of the widest colour channel (depth: depth bits).
+    pub fn channel_bits(self) -> u32 {
+        use TargetFormat::*;
+        match self {
+            Rgba8Unorm | Rgba8Srgb => 8,
+            Rgb10a2Unorm | Rgb10a2Float => 10,
+            R11g11b10Float => 11,
+            Rg16Unorm | Rgba16Fixed | R16Float | Rg16Float | Rgba16Float => 16,
+            D24UnormS8Uint | D24FloatS8Uint => 24,
+            R32Float | Rg32Float | Rgba32Float | D32Float | D32FloatS8Uint => 32,
+        }
+    }
+
+    pub fn class(self) -> FormatClass {
+        use TargetFormat::*;
+        match self {
+            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rg16Unorm => FormatClass::Unorm,
+            D24UnormS8Uint | D24FloatS8Uint | D32Float | D32FloatS8Uint => FormatClass::Depth,
+            _ => FormatClass::Hdr,
+        }
+    }
+
+    /// How far `self` is from `wanted` as a substitute (smaller is nearer):
+    /// another class or fewer channels cost most (the data would not fit),
+    /// then lost precision, then extra bytes.
+    pub fn distance_from(self, wanted: TargetFormat) -> f64 {
+        let mut d = 0.0;
+        if self.class() != wanted.class() {
+            d += 1000.0;
+        }
+        if self.channels() < wanted.channels() {
+            d += 100.0 * f64::from(wanted.channels() - self.channels());
+        }
+        if self.channel_bits() < wanted.channel_bits() {
+            d += 10.0 * f64::from(wanted.channel_bits() - self.channel_bits()) / 8.0;
+        }
+        if self.is_float() != wanted.is_float() {
+            d += 1.0;
+        }
+        d + (f64::from(self.bytes()) - f64::from(wanted.bytes())).abs() / 4.0
+    }
+
+    /// Floating-point channels.
+    pub fn is_float(self) -> bool {
+        use TargetFormat::*;
+        matches!(
+            self,
+            Rgb10a2Float
+                | R11g11b10Float
+                | R16Float
+                | Rg16Float
+                | Rgba16Float
+                | R32Float
+                | Rg32Float
+                | Rgba32Float
+                | D24FloatS8Uint
+                | D32Float
+                | D32FloatS8Uint
+        )
+    }
+}
+
+/// Identity and kind of a target.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Meta {
+    /// Short name (the file's stem).
+    pub name: String,
+    pub description: String,
+    pub kind: ProfileKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProfileKind {
+    Console,
+    Handheld,
+    Desktop,
+    Laptop,
+    Datacenter,
+}
+
+/// The frame a port aims at.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Target {
+    pub width_px: u32,
+    pub height_px: u32,
+    /// The whole frame's GPU time (33.3 ms at 30 fps).
+    pub frame_ms: f64,
+}
+
+/// The frame's time split by pass role, as fractions of `frame_ms` (design
+/// defaults a port edits, not measurements; they need not sum to 1: the rest
+/// is left to what dermis does not render, e.g. UI, particles).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetShares {
+    pub shadow_share: f64,
+    pub geometry_share: f64,
+    /// The default skin-SSS budget.
+    pub sss_share: f64,
+    pub post_share: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Alu {
+    /// Peak FP32 rate of the pixel/unified shaders, counting a multiply-add
+    /// as two operations.
+    pub gflops: Quantity,
+    /// Peak rate reachable by compute dispatches (`"unknown"` where the GPU
+    /// has no compute path).
+    pub compute_gflops: Quantity,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Texture {
+    /// Bilinear fetches of 32-bit texels per second from fragment shaders.
+    pub bilinear_gtexels: Quantity,
+    /// Cost of one point (nearest) fetch in bilinear-fetch units.
+    pub point_cost: Quantity,
+    /// Cost of one trilinear fetch in bilinear-fetch units.
+    pub trilinear_cost: Quantity,
+    /// Cost of one depth-compare (2x2 PCF) fetch in bilinear-fetch units.
+    pub depth_compare_cost: Quantity,
+    /// Cost multiplier for 64-bit texels (RGBA16F) over 32-bit ones.
+    pub texel_64bpp_cost: Quantity,
+    /// Cost multiplier for 128-bit texels (RGBA32F).
+    pub texel_128bpp_cost: Quantity,
+    /// Bilinear fetches per second from compute dispatches.
+    pub compute_bilinear_gtexels: Quantity,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Raster {
+    /// Triangles set up per second.
+    pub triangles_gtris: Quantity,
+    /// Depth/stencil-only samples per second (Z-only passes, early rejection).
+    pub z_only_gsamples: Quantity,
+    /// Colour samples written per second with MSAA on.
+    pub msaa_gsamples: Quantity,
+    /// Most colour targets one pass may write.
+    pub max_color_targets: u32,
+    /// Most samples per pixel.
+    pub max_msaa: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Memory {
+    /// Bandwidth of the memory that holds textures and (without eDRAM)
+    /// render targets.
+    pub bandwidth_gbps: Quantity,
+    /// Whether the CPU shares it (its traffic is not modelled).
+    pub shared_with_cpu: bool,
+    /// A second pool the GPU can reach (PS3: XDR through FlexIO); not used
+    /// for render targets by the model.
+    pub second_pool_gbps: Quantity,
+}
+
+/// Embedded frame-buffer memory (Xbox 360): render targets live there while
+/// drawn and reach textures only through a resolve.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Edram {
+    pub size_mib: f64,
+    /// Tiles available to one screen tile's colour and depth.
+    pub tiles: u32,
+    pub tile_width_samples: u32,
+    pub tile_height_samples: u32,
+    /// Bytes of one tile at 32 bpp (a 64 bpp format takes twice the tiles).
+    pub tile_bytes: u32,
+    /// eDRAM-internal bandwidth (blending, clears, MSAA).
+    pub internal_gbps: Quantity,
+    /// GPU-to-eDRAM link.
+    pub link_gbps: Quantity,
+    /// Rate of a resolve (eDRAM to main memory); no public number: a
+    /// parameter whose upper bound is main-memory bandwidth.
+    pub resolve_gbps: Quantity,
+    /// Geometry cost multiplier of a predicated-tiled pass.
+    pub tiled_geometry_factor: Quantity,
+}
+
+/// What the profile can do with one format as a render target.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FormatCaps {
+    pub format: TargetFormat,
+    /// Can be a render target.
+    pub render: bool,
+    /// Can be blended into.
+    pub blend: bool,
+    /// Pixels written per second (depth formats: samples per second).
+    pub fill_gpix: Quantity,
+    /// Pixels blended per second (`"unknown"` where `blend` is false).
+    pub blend_gpix: Quantity,
+}
+
+/// A hardware budget profile.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Profile {
+    pub profile: Meta,
+    pub target: Target,
+    pub budget: BudgetShares,
+    pub alu: Alu,
+    pub texture: Texture,
+    pub raster: Raster,
+    pub memory: Memory,
+    #[serde(default)]
+    pub edram: Option<Edram>,
+    pub formats: Vec<FormatCaps>,
+}
+
+/// The folder `profiles/` beside Cargo.toml, or `$DERMIS_PROFILES` when set.
+pub fn profiles_dir() -> PathBuf {
+    match std::env::var_os("DERMIS_PROFILES") {
+        Some(p) => PathBuf::from(p),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles"),
+    }
+}
+
+/// Names of the profiles in [`profiles_dir`], sorted.
+pub fn list_profiles() -> Result<Vec<String>> {
+    let dir = profiles_dir();
+    let mut names = Vec::new();
+    for e in std::fs::read_dir(&dir).with_context(|| format!("listing {}", dir.display()))? {
+        let p = e?.path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            if let Some(s) = p.file_stem().and_then(|s| s.to_str()) {
+                names.push(s.to_string());
+            }
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
+impl Profile {
+    /// A profile by name (`xbox360` -> `profiles/xbox360.toml`) or by path
+    /// (anything with a `/` or ending in `.toml`).
+    pub fn load(name_or_path: &str) -> Result<Profile> {
+        let path = if name_or_path.contains('/') || name_or_path.ends_with(".toml") {
+            PathBuf::from(name_or_path)
+        } else {
+            profiles_dir().join(format!("{name_or_path}.toml"))
+        };
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            let known = list_profiles().map(|v| v.join(", ")).unwrap_or_default();
+            anyhow!(
+                "{}: cannot read profile ({e}); profiles: {known}",
+                path.display()
+            )
+        })?;
+        Profile::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses and checks a profile; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Profile> {
+        let p: Profile = toml::from_str(text).map_err(|e| anyhow!(one_line(file, text, &e)))?;
+        p.check().map_err(|e| anyhow!("{file}: {e}"))?;
+        Ok(p)
+    }
+
+    /// What the profile says about `f` as a render target.
+    pub fn caps(&self, f: TargetFormat) -> Option<&FormatCaps> {
+        self.formats.iter().find(|c| c.format == f)
+    }
+
+    /// The budget in ms of a share of the frame.
+    pub fn share_ms(&self, share: f64) -> f64 {
+        share * self.target.frame_ms
+    }
+
+    /// Range and consistency checks serde cannot express; errors name the field.
+    fn check(&self) -> Result<()> {
+        let pos = |path: &str, v: f64| -> Result<()> {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("field `{path}` must be a positive number, got {v}");
+            }
+            Ok(())
+        };
+        let q = |path: &str, q: Quantity| -> Result<()> {
+            match q {
+                Quantity::Known(v) => pos(path, v),
+                Quantity::Param { value, min, max } => {
+                    pos(path, value)?;
+                    pos(&format!("{path}.min"), min)?;
+                    if !(min <= value && value <= max) {
+                        bail!("field `{path}`: value {value} is outside [min {min}, max {max}]");
+                    }
+                    Ok(())
+                }
+                Quantity::Unknown => Ok(()),
+            }
+        };
+        if self.target.width_px == 0 || self.target.height_px == 0 {
+            bail!("field `target.width_px`/`target.height_px` must be positive");
+        }
+        pos("target.frame_ms", self.target.frame_ms)?;
+        let b = &self.budget;
+        let shares = [
+            ("budget.shadow_share", b.shadow_share),
+            ("budget.geometry_share", b.geometry_share),
+            ("budget.sss_share", b.sss_share),
+            ("budget.post_share", b.post_share),
+        ];
+        for (n, s) in shares {
+            if !(0.0..=1.0).contains(&s) {
+                bail!("field `{n}` must be a fraction in [0, 1], got {s}");
+            }
+        }
+        let sum: f64 = shares.iter().map(|s| s.1).sum();
+        if sum > 1.0 + 1e-9 {
+            bail!("fields `budget.*_share` add up to {sum}, more than the frame");
+        }
+        q("alu.gflops", self.alu.gflops)?;
+        q("alu.compute_gflops", self.alu.compute_gflops)?;
+        let t = &self.texture;
+        q("texture.bilinear_gtexels", t.bilinear_gtexels)?;
+        q("texture.point_cost", t.point_cost)?;
+        q("texture.trilinear_cost", t.trilinear_cost)?;
+        q("texture.depth_compare_cost", t.depth_compare_cost)?;
+        q("texture.texel_64bpp_cost", t.texel_64bpp_cost)?;
+        q("texture.texel_128bpp_cost", t.texel_128bpp_cost)?;
+        q(
+            "texture.compute_bilinear_gtexels",
+            t.compute_bilinear_gtexels,
+        )?;
+        let r = &self.raster;
+        q("raster.triangles_gtris", r.triangles_gtris)?;
+        q("raster.z_only_gsamples", r.z_only_gsamples)?;
+        q("raster.msaa_gsamples", r.msaa_gsamples)?;
+        if r.max_color_targets == 0 || r.max_msaa == 0 {
+            bail!("field `raster.max_color_targets`/`raster.max_msaa` must be at least 1");
+        }
+        q("memory.bandwidth_gbps", self.memory.bandwidth_gbps)?;
+        q("memory.second_pool_gbps", self.memory.second_pool_gbps)?;
+        if let Some(e) = &self.edram {
+            pos("edram.size_mib", e.size_mib)?;
+            for (n, v) in [
+                ("edram.tiles", e.tiles),
+                ("edram.tile_width_samples", e.tile_width_samples),
+                ("edram.tile_height_samples", e.tile_height_samples),
+                ("edram.tile_bytes", e.tile_bytes),
+            ] {
+                if v == 0 {
+                    bail!("field `{n}` must be positive");
+                }
+            }
+            q("edram.internal_gbps", e.internal_gbps)?;
+            q("edram.link_gbps", e.link_gbps)?;
+            q("edram.resolve_gbps", e.resolve_gbps)?;
+            q("edram.tiled_geometry_factor", e.tiled_geometry_factor)?;
+        }
+        for (i, f) in self.formats.iter().enumerate() {
+            let n = format!("formats[{i}] ({})", kebab(f.format));
+            q(&format!("{n}.fill_gpix"), f.fill_gpix)?;
+            q(&format!("{n}.blend_gpix"), f.blend_gpix)?;
+            if self.formats[..i].iter().any(|g| g.format == f.format) {
+                bail!("field `{n}.format` is listed twice");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A format's TOML spelling.
+pub fn kebab(f: TargetFormat) -> String {
+    serde_json::to_value(f)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{f:?}"))
+}
+
+/// A TOML error as one line: `file:line: in [table]: message`.
+fn one_line(file: &str, text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+    let Some(span) = e.span() else {
+        return format!("{file}: {msg}");
+    };
+    let start = span.start.min(text.len());
+    let line = text[..start].matches('\n').count() + 1;
+    // The innermost table header at or above the error's line names where the
+    // field sits (a missing field's span is its table's header).
+    let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+    let table = text[..line_end]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['))
+        .map(|l| format!(" in {l}"))
+        .unwrap_or_default();
+    format!("{file}:{line}:{table}: {msg}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_profile_parses() {
+        let names = list_profiles().unwrap();
+        for want in [
+            "xbox360",
+            "ps3",
+            "switch-docked",
+            "switch-handheld",
+            "steam-deck",
+            "geforce-8800-gtx",
+            "geforce-8600m-gs",
+            "geforce-9800-gtx-plus",
+            "geforce-gtx-470",
+            "geforce-gtx-580",
+            "geforce-gt-130m",
+            "geforce-gtx-970m",
+            "nvidia-h100",
+            "nvidia-h200",
+        ] {
+            assert!(
+                names.iter().any(|n| n == want),
+                "profiles/{want}.toml missing"
+            );
+        }
+        for n in &names {
+            let p = Profile::load(n).unwrap_or_else(|e| panic!("{e:#}"));
+            assert_eq!(&p.profile.name, n, "profile name must match its file stem");
+        }
+    }
+
+    #[test]
+    fn load_by_path_too() {
+        let path = profiles_dir().join("xbox360.toml");
+        let p = Profile::load(path.to_str().unwrap()).unwrap();
+        assert_eq!(p.target.width_px, 1280);
+        assert!(p.edram.is_some());
+        assert!(Profile::load("no-such-gpu").is_err());
+    }
+
+    fn xbox_text() -> String {
+        std::fs::read_to_string(profiles_dir().join("xbox360.toml")).unwrap()
+    }
+
+    fn err_of(text: &str) -> String {
+        let e = Profile::parse(text, "profiles/test.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains('\n'), "error must be one line: {e}");
+        assert!(
+            e.starts_with("profiles/test.toml"),
+            "error must name the file: {e}"
+        );
+        e
+    }
+
+    #[test]
+    fn missing_field_is_one_line_naming_it() {
+        let t = xbox_text().replace("frame_ms = 33.3", "");
+        let e = err_of(&t);
+        assert!(e.contains("frame_ms") && e.contains("[target]"), "{e}");
+    }
+
+    #[test]
+    fn misspelt_field_is_one_line_naming_it() {
+        let t = xbox_text().replace("frame_ms = 33.3", "frame_msec = 33.3");
+        let e = err_of(&t);
+        assert!(e.contains("frame_msec"), "{e}");
+    }
+
+    #[test]
+    fn negative_field_is_one_line_naming_it() {
+        let t = xbox_text().replace("bandwidth_gbps = 22.4", "bandwidth_gbps = -22.4");
+        let e = err_of(&t);
+        assert!(e.contains("memory.bandwidth_gbps"), "{e}");
+        let t = xbox_text().replace("width_px = 1280", "width_px = -1280");
+        let e = err_of(&t);
+        assert!(e.contains("-1280") && e.contains("[target]"), "{e}");
+    }
+
+    #[test]
+    fn quantities_parse_all_three_ways() {
+        let p = Profile::load("xbox360").unwrap();
+        let e = p.edram.unwrap();
+        assert!(e.resolve_gbps.is_param());
+        assert_eq!(p.texture.compute_bilinear_gtexels, Quantity::Unknown);
+        assert_eq!(p.texture.bilinear_gtexels, Quantity::Known(8.0));
+        let t = xbox_text().replace("max_msaa = 4", "max_msaa = \"four\"");
+        err_of(&t);
+        let t = xbox_text().replacen("z_only_gsamples = 32.0", "z_only_gsamples = \"maybe\"", 1);
+        let e = err_of(&t);
+        assert!(e.contains("[raster]"), "{e}");
+    }
+
+    #[test]
+    fn param_outside_its_bounds_is_an_error() {
+        let t = xbox_text();
+        let start = t.find("resolve_gbps =").unwrap();
+        let end = start + t[start..].find('\n').unwrap();
+        let t = format!(
+            "{}resolve_gbps = {{ value = 40.0, min = 5.6, max = 22.4 }}{}",
+            &t[..start],
+            &t[end..]
+        );
+        let e = err_of(&t);
+        assert!(e.contains("edram.resolve_gbps"), "{e}");
+    }
+
+    #[test]
+    fn substitutes_keep_class_and_channels() {
+        use TargetFormat::*;
+        // RGBA16F wanted: another 4-channel HDR format is nearer than RG32F.
+        assert!(Rgba16Fixed.distance_from(Rgba16Float) < Rg32Float.distance_from(Rgba16Float));
+        assert!(Rgb10a2Float.distance_from(Rgba16Float) < Rgba8Unorm.distance_from(Rgba16Float));
+        // R16F wanted: RG16F (one more channel, same bits) beats R32F? Both fit;
+        // RG16F wastes 2 bytes, R32F 2 bytes and widens: equal bytes, so the
+        // tie goes to either; both beat an 8-bit format.
+        assert!(Rg16Float.distance_from(R16Float) < Rgba8Unorm.distance_from(R16Float));
+        assert_eq!(TargetFormat::from_work(Format::Rgba16Float).bytes(), 8);
+        for f in [
+            Format::Rgba8Unorm,
+            Format::Rgba8Srgb,
+            Format::R16Float,
+            Format::Rgba16Float,
+            Format::R32Float,
+            Format::Rgba32Float,
+            Format::D32Float,
+            Format::D24UnormS8Uint,
+            Format::D32FloatS8Uint,
+        ] {
+            assert_eq!(TargetFormat::from_work(f).bytes(), f.bytes_per_texel());
+        }
+    }
+}
