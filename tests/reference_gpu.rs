@@ -6,7 +6,7 @@ mod common;
 
 use dermis::eval::metrics::relative_rmse;
 use dermis::method::reference::Reference;
-use dermis::reference::cpu::{gather_f64, GatherView};
+use dermis::reference::cpu::{gather_f64, GatherView, SurfaceImages};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 
@@ -28,6 +28,8 @@ struct Run {
     radiance: Vec<[f32; 4]>,
     samples: Vec<dermis::reference::sampling::SurfaceSample>,
     view: GatherView,
+    /// The supersampled surface: factor, radiance, position, normal.
+    surface: (u32, Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<[f32; 4]>),
 }
 
 fn render(s: &RenderSettings) -> Run {
@@ -43,7 +45,9 @@ fn render(s: &RenderSettings) -> Run {
             .rgba
             .clone()
     };
-    let samples = r.method_as::<Reference>().unwrap().surface.clone();
+    let m = r.method_as::<Reference>().unwrap();
+    let samples = m.surface.clone();
+    let ss = m.supersampling();
     let aspect = s.width as f32 / s.height as f32;
     Run {
         output: find("reference gather 9/9", "reference"),
@@ -53,6 +57,12 @@ fn render(s: &RenderSettings) -> Run {
             .map(|p| p[0])
             .collect(),
         radiance: find("reference irradiance", "reference radiance"),
+        surface: (
+            ss,
+            find("reference surface", "reference surface radiance"),
+            find("reference surface", "reference surface position"),
+            find("reference surface", "reference surface normal"),
+        ),
         samples,
         view: GatherView {
             width: s.width as usize,
@@ -69,25 +79,39 @@ fn render(s: &RenderSettings) -> Run {
 fn gpu_gather_matches_f64_cpu_gather() {
     // Tiny: 48x32 pixels, 0.5 samples per mm^2 (~60k samples).
     let run = render(&settings(48, 32, 0.5));
+    let (s, radiance, position, normal) = &run.surface;
     let cpu = gather_f64(
         &run.view,
         &run.diffuse,
         &run.depth,
+        &SurfaceImages {
+            s: *s,
+            radiance,
+            position,
+            normal,
+        },
         &run.samples,
         &run.radiance,
     );
-    let mut worst = 0.0f64;
+    let mut worst = (0.0f64, 0usize);
     let mut skin = 0;
-    for (g, c) in run.output.iter().zip(&cpu) {
+    let mut off = 0;
+    for (k, (g, c)) in run.output.iter().zip(&cpu).enumerate() {
         for i in 0..3 {
             let rel = (g[i] as f64 - c[i]).abs() / c[i].abs().max(1e-3);
-            worst = worst.max(rel);
+            off += (rel > 1e-4) as usize;
+            if rel > worst.0 {
+                worst = (rel, k);
+            }
         }
         skin += (c[3] > 0.0) as usize;
     }
+    let (worst, at) = worst;
     println!(
-        "{skin} skin pixels, {} samples: worst relative difference {worst:.2e}",
-        run.samples.len()
+        "{skin} skin pixels, {} samples: worst relative difference {worst:.2e} at pixel {at} (gpu {:?}, cpu {:?}), {off} channels over 1e-4",
+        run.samples.len(),
+        run.output[at],
+        cpu[at]
     );
     assert!(skin > 100, "the tiny view holds skin");
     // f32 accumulation of a few hundred positive terms: ~1e-6; the bound is 1e-4.

@@ -12,10 +12,11 @@ use crate::vk::memory::Image;
 /// A tracked image subresource: one mip level of a declared image (level 0 for
 /// single-level images). Levels are tracked apart because passes read one level
 /// and write the next.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// (`Default` is a placeholder for a field that set-up fills in.)
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct ImageId(pub usize);
 /// A tracked buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct BufferId(pub usize);
 
 /// What an image is, before it exists. Its usage is not part of it: it follows

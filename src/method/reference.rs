@@ -1,8 +1,11 @@
 //! The ground truth as a method of the frame (`--method reference`): the diffuse
 //! radiant exitance M(x_o) = integral E(x_i) R(|x_i - x_o|) dA over the actual skin
-//! surface, by brute force on the GPU. Two steps: the diffuse radiance of every
-//! surface sample, lit by the geometry pass's own shading code (a fragment pass
-//! over images with one texel per sample, so the shadow test is the same
+//! surface, through tissue only (`crate::reference::tissue`), by brute force on
+//! the GPU. The narrow Gaussians (sigma <= 0.43 mm) are summed over the visible
+//! surface rendered at s x the frame's resolution (`crate::reference::narrow`);
+//! the wide ones over area-weighted samples of the whole skin surface: their
+//! diffuse radiance, lit by the geometry pass's own shading code (a fragment
+//! pass over images with one texel per sample, so the shadow test is the same
 //! hardware compare), then compute passes that sum, for every skin pixel, all
 //! samples within the cut-off, found with a uniform grid. The geometry pass runs
 //! with transmittance off for this method: light through thin parts arrives
@@ -25,19 +28,28 @@ use super::screen::fetch;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::draw::{begin_rendering, Load};
-use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
+use crate::graph::draw::{begin_rendering, DepthTarget, Load};
+use crate::graph::work::{
+    ColorWrite, DepthStencilUse, Fetch, Filter, Format, PassRole, ShaderWork, Work,
+};
 use crate::graph::{BufferId, ImageDesc, ImageId, Pass, PassContext};
+use crate::reference::narrow::{radius, supersampling};
 use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface, Grid, SurfaceSample};
+use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::memory::Buffer;
-use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload::device_buffer;
 
 const IRRADIANCE_SHADER: &str = "reference_irradiance.frag";
+const SURFACE_SHADER: &str = "reference_surface.frag";
+const NARROW_SHADER: &str = "reference_narrow.comp";
 const GATHER_SHADER: &str = "reference_gather.comp";
+/// The surface pass's targets: radiance, position + area, normal.
+const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const SURFACE_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 /// Width of the radiance images: sample i of a chunk is texel (i % width, i / width).
 pub const RADIANCE_WIDTH: u32 = 2048;
 /// Workgroup side of the gather (reference_gather.comp's local size).
@@ -84,6 +96,25 @@ struct GatherParams {
     grid_origin: [f32; 4],
     grid_dims: [u32; 4],
     view: [f32; 4],
+    /// x: tissue tolerance, y: subsamples per pixel per axis.
+    tissue: [f32; 4],
+}
+
+/// std140 layout of `NarrowParams` (reference_narrow.comp).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct NarrowParams {
+    inv_view: [[f32; 4]; 4],
+    view: [f32; 4],
+    surface: [u32; 4],
+}
+
+/// Push constants of the surface pass (geometry.vert's model, then the frag's scale).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct SurfacePush {
+    model: [[f32; 4]; 4],
+    mm_per_subsample_per_depth: f32,
 }
 
 /// Push constants of the gather: the slab, and the chunk's range of samples.
@@ -168,39 +199,99 @@ fn max_slab_candidates(grid: &Grid) -> u32 {
 }
 
 /// One chunk: its samples' buffers and radiance image, and its sets.
+#[derive(Default)]
 struct Chunk {
     first: u32,
     count: u32,
     samples: Buffer,
     positions: Buffer,
-    buffer_ids: [BufferId; 2],
+    normals: Buffer,
+    /// Graph ids of the samples, positions and normals buffers.
+    buffer_ids: Vec<BufferId>,
     radiance: ImageId,
     /// (set, first sample of the draw within the chunk, samples) per draw.
     draws: Vec<(vk::DescriptorSet, u32, u32)>,
     gather_set: vk::DescriptorSet,
 }
 
+impl Chunk {
+    fn destroy(&mut self, ctx: &Context) {
+        self.samples.destroy(ctx);
+        self.positions.destroy(ctx);
+        self.normals.destroy(ctx);
+    }
+}
+
+/// The supersampled visible surface (the narrow part's input).
+#[derive(Default)]
+struct Surface {
+    s: u32,
+    radiance: ImageId,
+    position: ImageId,
+    normal: ImageId,
+    depth: ImageId,
+    /// The skin mesh, uploaded (the frame's copies are the renderer's).
+    vertices: Buffer,
+    indices: Buffer,
+    index_count: u32,
+    /// The largest narrow window radius (subsamples) any skin pixel uses.
+    max_radius: u32,
+    mm_per_subsample_per_depth: f32,
+}
+
+#[derive(Default)]
 pub struct Reference {
     irradiance: Pipeline,
+    surface_pipeline: Pipeline,
+    narrow: Pipeline,
     gather: Pipeline,
     material_set: vk::DescriptorSet,
+    frame_set: vk::DescriptorSet,
+    surf_material: vk::DescriptorSet,
+    narrow_set: vk::DescriptorSet,
     chunks: Vec<Chunk>,
     draw_samples: u32,
     cells: Buffer,
     cells_id: BufferId,
     params: Buffer,
+    narrow_params: Buffer,
     out: ImageId,
     max_candidates: u32,
+    surf: Surface,
+    instances: Vec<glam::Mat4>,
     pub sample_count: u32,
-    pub grid: Grid,
+    pub grid: Option<Grid>,
     /// The samples in grid order (for CPU checks).
     pub surface: Vec<SurfaceSample>,
     pub density: f32,
 }
 
 impl Reference {
+    /// Subsamples per pixel per axis of the narrow part's surface.
+    pub fn supersampling(&self) -> u32 {
+        self.surf.s
+    }
+
     fn new(s: &mut MethodSetup) -> Result<Self> {
-        let density = density(&s.options)?;
+        let mut r = Reference {
+            density: density(&s.options)?,
+            instances: s.instances.to_vec(),
+            ..Default::default()
+        };
+        match r.build(s) {
+            Ok(()) => Ok(r),
+            Err(e) => {
+                r.destroy(s.ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Samples, grid, buffers, pipelines and images, step by step (on an error,
+    /// `destroy` frees whatever exists).
+    // Long because the set-up is one sequence of checks and creations over
+    // shared state (the samples, the grid, the device limits).
+    fn build(&mut self, s: &mut MethodSetup) -> Result<()> {
         let mm = s.view.mm_per_unit;
         let skin = [&s.scene.head]
             .into_iter()
@@ -209,7 +300,7 @@ impl Reference {
         let Some(skin) = skin else {
             bail!("the reference found no skin surface to sample");
         };
-        let mut surface = sample_surface(&skin.mesh, s.instances, mm, density);
+        let mut surface = sample_surface(&skin.mesh, s.instances, mm, self.density);
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
         }
@@ -223,12 +314,13 @@ impl Reference {
                 max_image_dimension: f.max_image_dimension_2d,
             },
         )?;
-        // Samples (64 B), positions (16 B) and radiance (16 B) per sample.
-        let need = count as u64 * 96;
+        // Samples (64 B), positions (16 B), normals (16 B) and radiance (16 B) per sample.
+        let need = count as u64 * 112;
         if need > f.device_local_bytes / 2 {
             bail!(
-                "{count} reference samples ({:.1} GB at {density} per mm^2) are more than half of this device's memory ({:.1} GB); lower --density or the number of heads",
+                "{count} reference samples ({:.1} GB at {} per mm^2) are more than half of this device's memory ({:.1} GB); lower --density or the number of heads",
                 need as f64 / 1e9,
+                self.density,
                 f.device_local_bytes as f64 / 1e9
             );
         }
@@ -236,41 +328,72 @@ impl Reference {
         if cells_bytes > f.max_storage_buffer_range as u64 {
             bail!("the reference grid has {} cells, more than this device's storage-buffer range holds", grid.cell_start.len());
         }
-        let irradiance = Pipeline::graphics(
+        self.plan_surface(s, skin)?;
+        self.irradiance = Pipeline::graphics(
             s.ctx,
-            &GraphicsDesc::fullscreen(
-                "reference irradiance",
-                IRRADIANCE_SHADER,
-                vk::Format::R32G32B32A32_SFLOAT,
-            ),
+            &GraphicsDesc::fullscreen("reference irradiance", IRRADIANCE_SHADER, SURFACE_FORMAT),
         )?;
-        let gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
-        let cam = &s.view.camera;
+        self.surface_pipeline = Pipeline::graphics(
+            s.ctx,
+            &GraphicsDesc {
+                name: "reference surface".into(),
+                vert: "geometry.vert",
+                frag: Some(SURFACE_SHADER),
+                color_formats: vec![SURFACE_FORMAT; 3],
+                depth_format: Some(SURFACE_DEPTH),
+                stencil_format: None,
+                vertex_input: VertexInput::Mesh,
+                cull: vk::CullModeFlags::BACK,
+                depth_test: true,
+                depth_write: true,
+                depth_compare: vk::CompareOp::LESS,
+                stencil: None,
+                depth_bias: None,
+                blend: crate::vk::pipeline::Blend::None,
+            },
+        )?;
+        self.narrow = Pipeline::compute(s.ctx, "reference narrow", NARROW_SHADER)?;
+        self.gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
+        let inv_view = s.view.camera.view().inverse().to_cols_array_2d();
+        let view = [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()];
         let p = GatherParams {
-            inv_view: cam.view().inverse().to_cols_array_2d(),
+            inv_view,
             grid_origin: grid.origin.extend(grid.cell).to_array(),
             grid_dims: [grid.dims[0], grid.dims[1], grid.dims[2], RADIANCE_WIDTH],
-            view: [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()],
+            view,
+            tissue: [TISSUE_TOLERANCE, self.surf.s as f32, 0.0, 0.0],
         };
-        let params = Buffer::with_data(
+        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
+        self.params = Buffer::with_data(
             s.ctx,
             "reference gather params",
             bytemuck::bytes_of(&p),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            uniform,
+        )?;
+        let np = NarrowParams {
+            inv_view,
+            view: [view[0], view[1], mm, TISSUE_TOLERANCE],
+            surface: [self.surf.s, crate::reference::narrow::MAX_RADIUS, 0, 0],
+        };
+        self.narrow_params = Buffer::with_data(
+            s.ctx,
+            "reference narrow params",
+            bytemuck::bytes_of(&np),
+            uniform,
         )?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let cells = device_buffer(
+        self.cells = device_buffer(
             s.ctx,
             "reference grid cells",
             bytemuck::cast_slice(&grid.cell_start),
             storage,
             AccessKind::ComputeStorageRead,
         )?;
-        let cells_id = s.res.add_buffer("reference grid cells", cells.raw);
+        let cells_id = s.res.add_buffer("reference grid cells", self.cells.raw);
         s.res
             .set_buffer_uploaded(cells_id, AccessKind::ComputeStorageRead);
+        self.cells_id = cells_id;
         let one = plan.chunks.len() == 1;
-        let mut chunks = Vec::with_capacity(plan.chunks.len());
         for (k, &(first, n)) in plan.chunks.iter().enumerate() {
             let name = |what: &str| {
                 if one {
@@ -280,30 +403,49 @@ impl Reference {
                 }
             };
             let range = &surface[first as usize..(first + n) as usize];
-            let samples = device_buffer(
-                s.ctx,
-                &name("samples"),
-                bytemuck::cast_slice(range),
-                storage,
-                AccessKind::FragmentStorageRead,
-            )?;
+            let mut c = Chunk {
+                first,
+                count: n,
+                ..Default::default()
+            };
             let pos: Vec<[f32; 4]> = range.iter().map(|s| s.pos_area).collect();
-            let positions = device_buffer(
-                s.ctx,
-                &name("positions"),
-                bytemuck::cast_slice(&pos),
-                storage,
-                AccessKind::ComputeStorageRead,
-            )?;
-            let buffer_ids = [
-                s.res.add_buffer(&name("samples"), samples.raw),
-                s.res.add_buffer(&name("positions"), positions.raw),
+            let nrm: Vec<[f32; 4]> = range.iter().map(|s| s.normal).collect();
+            let uploads: [(&str, &[u8], AccessKind); 3] = [
+                (
+                    "samples",
+                    bytemuck::cast_slice(range),
+                    AccessKind::FragmentStorageRead,
+                ),
+                (
+                    "positions",
+                    bytemuck::cast_slice(&pos),
+                    AccessKind::ComputeStorageRead,
+                ),
+                (
+                    "normals",
+                    bytemuck::cast_slice(&nrm),
+                    AccessKind::ComputeStorageRead,
+                ),
             ];
-            s.res
-                .set_buffer_uploaded(buffer_ids[0], AccessKind::FragmentStorageRead);
-            s.res
-                .set_buffer_uploaded(buffer_ids[1], AccessKind::ComputeStorageRead);
-            let radiance = s.res.declare(ImageDesc::new(
+            for (i, (what, bytes, first_use)) in uploads.into_iter().enumerate() {
+                let b = device_buffer(s.ctx, &name(what), bytes, storage, first_use);
+                let b = match b {
+                    Ok(b) => b,
+                    Err(e) => {
+                        c.destroy(s.ctx);
+                        return Err(e);
+                    }
+                };
+                let id = s.res.add_buffer(&name(what), b.raw);
+                s.res.set_buffer_uploaded(id, first_use);
+                c.buffer_ids.push(id);
+                match i {
+                    0 => c.samples = b,
+                    1 => c.positions = b,
+                    _ => c.normals = b,
+                }
+            }
+            c.radiance = s.res.declare(ImageDesc::new(
                 &name("radiance"),
                 vk::Extent2D {
                     width: RADIANCE_WIDTH,
@@ -311,38 +453,83 @@ impl Reference {
                 },
                 vk::Format::R32G32B32A32_SFLOAT,
             ));
-            chunks.push(Chunk {
-                first,
-                count: n,
-                samples,
-                positions,
-                buffer_ids,
-                radiance,
-                draws: Vec::new(),
-                gather_set: vk::DescriptorSet::null(),
-            });
+            self.chunks.push(c);
         }
-        let out = s.res.declare(ImageDesc::new(
+        self.out = s.res.declare(ImageDesc::new(
             "reference",
             s.view.extent,
             vk::Format::R32G32B32A32_SFLOAT,
         ));
-        Ok(Reference {
-            irradiance,
-            gather,
-            material_set: vk::DescriptorSet::null(),
-            chunks,
-            draw_samples: plan.draw_samples,
-            max_candidates: max_slab_candidates(&grid),
-            cells,
-            cells_id,
-            params,
-            out,
-            sample_count: count,
-            grid,
-            surface,
-            density,
-        })
+        self.draw_samples = plan.draw_samples;
+        self.max_candidates = max_slab_candidates(&grid);
+        self.sample_count = count;
+        self.grid = Some(grid);
+        self.surface = surface;
+        Ok(())
+    }
+
+    /// The supersampled surface: its factor from the nearest skin's scale on
+    /// screen, its images, and the skin mesh uploaded for its pass.
+    fn plan_surface(
+        &mut self,
+        s: &mut MethodSetup,
+        skin: &crate::scene::mesh::Object,
+    ) -> Result<()> {
+        let mm = s.view.mm_per_unit;
+        let eye = s.view.camera.eye;
+        let bounds = skin.mesh.bounds();
+        let nearest = s
+            .instances
+            .iter()
+            .map(|m| {
+                let b = bounds.transformed(m);
+                (eye.clamp(b.min, b.max) - eye).length()
+            })
+            .fold(f32::INFINITY, f32::min)
+            .max(s.view.camera.near);
+        let px_per_mm = s.view.extent.height as f32 / (2.0 * nearest * s.view.tan_half_fovy() * mm);
+        let ss = supersampling(px_per_mm);
+        let extent = vk::Extent2D {
+            width: s.view.extent.width * ss,
+            height: s.view.extent.height * ss,
+        };
+        if extent.width.max(extent.height) > s.ctx.facts.max_image_dimension_2d {
+            bail!(
+                "the reference's {ss}x supersampled surface ({}x{}) exceeds this device's largest image",
+                extent.width,
+                extent.height
+            );
+        }
+        let desc = |what: &str, format| {
+            ImageDesc::new(&format!("reference surface {what}"), extent, format)
+        };
+        self.surf = Surface {
+            s: ss,
+            radiance: s.res.declare(desc("radiance", SURFACE_FORMAT)),
+            position: s.res.declare(desc("position", SURFACE_FORMAT)),
+            normal: s.res.declare(desc("normal", SURFACE_FORMAT)),
+            depth: s.res.declare(desc("depth", SURFACE_DEPTH)),
+            max_radius: radius(px_per_mm, ss),
+            mm_per_subsample_per_depth: 2.0 * s.view.tan_half_fovy() * mm / extent.height as f32,
+            ..Default::default()
+        };
+        let mesh = &skin.mesh;
+        self.surf.vertices = device_buffer(
+            s.ctx,
+            "reference surface vertices",
+            bytemuck::cast_slice(&mesh.vertices),
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            AccessKind::VertexInputRead,
+        )?;
+        self.surf.indices = device_buffer(
+            s.ctx,
+            "reference surface indices",
+            bytemuck::cast_slice(&mesh.indices),
+            vk::BufferUsageFlags::INDEX_BUFFER,
+            AccessKind::VertexInputRead,
+        )?;
+        self.surf.index_count = mesh.indices.len() as u32;
+        Ok(())
     }
 
     /// The radiance pass: every chunk's samples lit, one draw per range.
@@ -430,6 +617,147 @@ impl Reference {
     }
 }
 
+impl Reference {
+    /// The visible skin at s x the frame's resolution: radiance, position and
+    /// area, normal (the narrow part's input).
+    fn surface_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let sf = &self.surf;
+        let e = f.res.extent(sf.radiance);
+        let shadow = fetch(
+            f.res,
+            f.targets.shadow,
+            "shadowMap",
+            Filter::DepthCompare,
+            9.0,
+        );
+        let albedo = Fetch {
+            exact: true,
+            ..material_fetch("albedoTex")
+        };
+        let work = Work::Raster {
+            shader: Some(ShaderWork {
+                shader: SURFACE_SHADER.into(),
+                fetches: vec![shadow, material_fetch("normalTex"), albedo],
+                alu: alu_estimate(SURFACE_SHADER, &[3, 3]),
+                ..Default::default()
+            }),
+            color: vec![
+                ColorWrite {
+                    format: Format::Rgba32Float,
+                    blend: false
+                };
+                3
+            ],
+            depth_stencil: Some(DepthStencilUse {
+                format: Format::D32Float,
+                depth_test: true,
+                depth_write: true,
+                stencil_test: false,
+                stencil_write: false,
+            }),
+            width: e.width,
+            height: e.height,
+            triangles: sf.index_count as u64 / 3 * self.instances.len() as u64,
+            msaa: 1,
+        };
+        let targets = [sf.radiance, sf.position, sf.normal];
+        let depth = sf.depth;
+        let mut pass = Pass::new("reference surface", PassRole::Sss)
+            .image(f.targets.shadow, AccessKind::FragmentSampledRead)
+            .work(work);
+        for &t in &targets {
+            pass = pass.image(t, AccessKind::ColorAttachmentWrite);
+        }
+        pass = pass.image(depth, AccessKind::DepthStencilWrite);
+        pass.record(move |pc: &PassContext| {
+            let (ctx, cmd) = (pc.ctx, pc.cmd);
+            let colors: Vec<(ImageId, Load)> = targets
+                .iter()
+                .map(|&t| (t, Load::Clear([0.0; 4])))
+                .collect();
+            begin_rendering(
+                pc,
+                &colors,
+                Some(DepthTarget {
+                    image: depth,
+                    clear_depth: Some(1.0),
+                    stencil: false,
+                }),
+            );
+            let p = &self.surface_pipeline;
+            p.bind(ctx, cmd, &[self.frame_set, self.surf_material]);
+            unsafe {
+                ctx.device
+                    .cmd_bind_vertex_buffers(cmd, 0, &[self.surf.vertices.raw], &[0]);
+                ctx.device.cmd_bind_index_buffer(
+                    cmd,
+                    self.surf.indices.raw,
+                    0,
+                    vk::IndexType::UINT32,
+                );
+            }
+            for m in &self.instances {
+                p.push(
+                    ctx,
+                    cmd,
+                    &SurfacePush {
+                        model: m.to_cols_array_2d(),
+                        mm_per_subsample_per_depth: self.surf.mm_per_subsample_per_depth,
+                    },
+                );
+                unsafe {
+                    ctx.device
+                        .cmd_draw_indexed(cmd, self.surf.index_count, 1, 0, 0, 0)
+                };
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        })
+    }
+
+    /// The narrow part, written into the output for every pixel.
+    fn narrow_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let t = f.targets;
+        let sf = &self.surf;
+        let extent = f.extent;
+        let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
+        let side = (2 * sf.max_radius + 1) as f64;
+        let window = side * side;
+        let bound = |image, texture: &str, count| Fetch {
+            exact: false,
+            ..fetch(f.res, image, texture, Filter::Point, count)
+        };
+        let work = Work::Compute {
+            shader: ShaderWork {
+                shader: NARROW_SHADER.into(),
+                fetches: vec![
+                    fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
+                    bound(t.linear_depth, "depthTex", 1.0),
+                    bound(sf.normal, "surfNormal", 1.0 + window),
+                    bound(sf.position, "surfPosition", window),
+                    bound(sf.radiance, "surfRadiance", window + 1.0),
+                ],
+                alu: alu_estimate(NARROW_SHADER, &[side as u32, side as u32, 3, 3]),
+                storage_write_bytes: 16.0,
+                ..Default::default()
+            },
+            invocations: (groups.0 * groups.1 * GROUP * GROUP) as u64,
+        };
+        let set = self.narrow_set;
+        Pass::new("reference narrow", PassRole::Sss)
+            .image(t.diffuse, AccessKind::ComputeSampledRead)
+            .image(t.linear_depth, AccessKind::ComputeSampledRead)
+            .image(sf.radiance, AccessKind::ComputeSampledRead)
+            .image(sf.position, AccessKind::ComputeSampledRead)
+            .image(sf.normal, AccessKind::ComputeSampledRead)
+            .image(self.out, AccessKind::ComputeStorageWrite)
+            .work(work)
+            .record(move |pc: &PassContext| {
+                self.narrow.bind(pc.ctx, pc.cmd, &[set]);
+                unsafe { pc.ctx.device.cmd_dispatch(pc.cmd, groups.0, groups.1, 1) };
+            })
+    }
+}
+
 /// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
 fn material_fetch(texture: &str) -> Fetch {
     Fetch {
@@ -444,7 +772,11 @@ fn material_fetch(texture: &str) -> Fetch {
 impl SssMethod for Reference {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
         let t = f.targets;
-        let mut passes = vec![self.irradiance_pass(f)];
+        let mut passes = vec![
+            self.irradiance_pass(f),
+            self.surface_pass(f),
+            self.narrow_pass(f),
+        ];
         let extent = f.extent;
         let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
         let invocations = (groups.0 * groups.1 * GROUP * GROUP) as u64;
@@ -452,12 +784,8 @@ impl SssMethod for Reference {
         let out = self.out;
         for (ci, c) in self.chunks.iter().enumerate() {
             for k in 0..SLABS {
-                // The very first dispatch writes the output; the rest add to it.
-                let out_access = if ci == 0 && k == 0 {
-                    AccessKind::ComputeStorageWrite
-                } else {
-                    AccessKind::ComputeStorageReadWrite
-                };
+                // Every slab adds to the narrow part.
+                let out_access = AccessKind::ComputeStorageReadWrite;
                 let name = if one {
                     format!("reference gather {}/9", k + 1)
                 } else {
@@ -480,11 +808,16 @@ impl SssMethod for Reference {
                             },
                             Fetch {
                                 exact: false,
+                                ..fetch(f.res, self.surf.normal, "surfNormal", Filter::Point, 1.0)
+                            },
+                            Fetch {
+                                exact: false,
                                 ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
                             },
                         ],
                         alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3)]),
-                        storage_read_bytes: 16.0 * (1.0 + candidates) + 8.0,
+                        // Positions and normals of the candidates, cell ranges, the output.
+                        storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
                         storage_write_bytes: 16.0,
                     },
                     invocations,
@@ -501,8 +834,10 @@ impl SssMethod for Reference {
                         .image(t.diffuse, AccessKind::ComputeSampledRead)
                         .image(t.linear_depth, AccessKind::ComputeSampledRead)
                         .image(c.radiance, AccessKind::ComputeSampledRead)
+                        .image(self.surf.normal, AccessKind::ComputeSampledRead)
                         .image(out, out_access)
                         .buffer(c.buffer_ids[1], AccessKind::ComputeStorageRead)
+                        .buffer(c.buffer_ids[2], AccessKind::ComputeStorageRead)
                         .buffer(self.cells_id, AccessKind::ComputeStorageRead)
                         .work(work)
                         .record(move |pc: &PassContext| {
@@ -531,6 +866,40 @@ impl SssMethod for Reference {
             .pool
             .write_set(b.ctx, &self.irradiance, 1, &b.skin_material_binds)?;
         let t = b.targets;
+        self.frame_set = b
+            .pool
+            .write_set(b.ctx, &self.surface_pipeline, 0, &b.frame_binds)?;
+        let surface_material =
+            b.pool
+                .write_set(b.ctx, &self.surface_pipeline, 1, &b.skin_material_binds)?;
+        self.surf_material = surface_material;
+        let sz = |n: usize| n as u64;
+        self.narrow_set = b.pool.write_set(
+            b.ctx,
+            &self.narrow,
+            0,
+            &[
+                ("diffuseTex", Bind::Texture(b.res.view(t.diffuse))),
+                ("depthTex", Bind::Texture(b.res.view(t.linear_depth))),
+                ("outImage", Bind::Texture(b.res.view(self.out))),
+                (
+                    "surfRadiance",
+                    Bind::Texture(b.res.view(self.surf.radiance)),
+                ),
+                (
+                    "surfPosition",
+                    Bind::Texture(b.res.view(self.surf.position)),
+                ),
+                ("surfNormal", Bind::Texture(b.res.view(self.surf.normal))),
+                (
+                    "params",
+                    Bind::Uniform {
+                        buffer: self.narrow_params.raw,
+                        size: sz(std::mem::size_of::<NarrowParams>()),
+                    },
+                ),
+            ],
+        )?;
         for c in &mut self.chunks {
             c.draws.clear();
             let mut first = 0;
@@ -569,6 +938,14 @@ impl SssMethod for Reference {
                     ),
                     ("radianceTex", Bind::Texture(b.res.view(c.radiance))),
                     (
+                        "Normals",
+                        Bind::Uniform {
+                            buffer: c.normals.raw,
+                            size: c.normals.size,
+                        },
+                    ),
+                    ("surfNormal", Bind::Texture(b.res.view(self.surf.normal))),
+                    (
                         "Cells",
                         Bind::Uniform {
                             buffer: self.cells.raw,
@@ -593,19 +970,34 @@ impl SssMethod for Reference {
             "density_per_mm2": self.density,
             "samples": self.sample_count,
             "chunks": self.chunks.len(),
-            "grid_dims": self.grid.dims,
+            "grid_dims": self.grid.as_ref().map(|g| g.dims),
+            "supersampling": self.surf.s,
+            "narrow_window_radius": self.surf.max_radius,
+            "tissue_tolerance": TISSUE_TOLERANCE,
         })
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        self.irradiance.destroy(ctx);
-        self.gather.destroy(ctx);
-        for c in &mut self.chunks {
-            c.samples.destroy(ctx);
-            c.positions.destroy(ctx);
+        for p in [
+            &mut self.irradiance,
+            &mut self.surface_pipeline,
+            &mut self.narrow,
+            &mut self.gather,
+        ] {
+            p.destroy(ctx);
         }
-        self.cells.destroy(ctx);
-        self.params.destroy(ctx);
+        for c in &mut self.chunks {
+            c.destroy(ctx);
+        }
+        for b in [
+            &mut self.cells,
+            &mut self.params,
+            &mut self.narrow_params,
+            &mut self.surf.vertices,
+            &mut self.surf.indices,
+        ] {
+            b.destroy(ctx);
+        }
     }
 
     fn as_any(&self) -> &dyn Any {

@@ -1,10 +1,14 @@
-//! The gather of the ground truth in f64 on the CPU, by brute force over every
-//! sample (no grid): an independent check of the GPU gather (grid, cut-off,
-//! profile, position reconstruction) on a tiny scene.
+//! The ground truth in f64 on the CPU, by brute force over every sample (no
+//! grid): an independent check of the GPU passes (the narrow part's windowed sum
+//! over the supersampled surface, the wide part's grid, cut-off, profile,
+//! position reconstruction, the tissue test) on a tiny scene.
 
 use glam::{DMat4, DVec3, Mat4};
 
-use super::sampling::{cutoff_mm, narrow_weight, wide_profile, SurfaceSample};
+use super::narrow::radius;
+use super::sampling::{cutoff_mm, wide_profile, SurfaceSample, NARROW_GAUSSIANS};
+use super::tissue::through_tissue;
+use crate::skin::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 
 /// What the gather needs of the view.
 #[derive(Clone, Copy, Debug)]
@@ -17,18 +21,33 @@ pub struct GatherView {
     pub mm_per_unit: f32,
 }
 
-/// M(x_o) for every pixel: skin pixels (alpha > 0) gather, others keep `diffuse`.
+/// The supersampled visible skin surface (what reference_surface.frag writes).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceImages<'a> {
+    /// Subsamples per pixel per axis.
+    pub s: u32,
+    /// Diffuse radiance (rgb).
+    pub radiance: &'a [[f32; 4]],
+    /// World position (xyz) and area in mm^2 (w; 0 where no skin).
+    pub position: &'a [[f32; 4]],
+    /// Unit normal (xyz).
+    pub normal: &'a [[f32; 4]],
+}
+
+/// M(x_o) for every pixel: skin pixels (alpha > 0) take the narrow part from
+/// `surface` and gather the wide part from `samples`, both through tissue only;
+/// others keep `diffuse`.
 pub fn gather_f64(
     view: &GatherView,
     diffuse: &[[f32; 4]],
     linear_depth: &[f32],
+    surface: &SurfaceImages,
     samples: &[SurfaceSample],
     radiance: &[[f32; 4]],
 ) -> Vec<[f64; 4]> {
     let inv = DMat4::from_cols_array(&view.inv_view.to_cols_array().map(|v| v as f64));
     let mm = view.mm_per_unit as f64;
     let cutoff2 = (cutoff_mm() as f64).powi(2);
-    let narrow = narrow_weight();
     let pts: Vec<DVec3> = samples
         .iter()
         .map(|s| {
@@ -39,6 +58,7 @@ pub fn gather_f64(
             )
         })
         .collect();
+    let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
@@ -52,19 +72,80 @@ pub fn gather_f64(
             let t = view.tan_half_fovy as f64;
             let vp = DVec3::new(ndc_x * t * view.aspect as f64 * z, -ndc_y * t * z, -z);
             let xo = inv.transform_point3(vp);
-            let mut acc = [
-                narrow[0] * d0[0] as f64,
-                narrow[1] * d0[1] as f64,
-                narrow[2] * d0[2] as f64,
+            let xo32 = xo.as_vec3().to_array();
+            // The normal of the subsample under the pixel's centre.
+            let (cx, cy) = ((x * s + s / 2), (y * s + s / 2));
+            let c = cy * sw + cx;
+            let no = [
+                surface.normal[c][0],
+                surface.normal[c][1],
+                surface.normal[c][2],
             ];
+            // Narrow part: windowed, weight-normalised sums per Gaussian.
+            let px_per_mm = view.height as f32
+                / (2.0 * linear_depth[i] * view.tan_half_fovy * view.mm_per_unit);
+            let r = radius(px_per_mm, surface.s) as i64;
+            let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
+            let mut norm = [0.0f64; NARROW_GAUSSIANS];
+            let sh = view.height * s;
+            for qy in (cy as i64 - r)..=(cy as i64 + r) {
+                for qx in (cx as i64 - r)..=(cx as i64 + r) {
+                    if qx < 0 || qy < 0 || qx >= sw as i64 || qy >= sh as i64 {
+                        continue;
+                    }
+                    let q = qy as usize * sw + qx as usize;
+                    let p = surface.position[q];
+                    let nq = [
+                        surface.normal[q][0],
+                        surface.normal[q][1],
+                        surface.normal[q][2],
+                    ];
+                    if p[3] <= 0.0
+                        || !through_tissue(xo32, no, [p[0], p[1], p[2]], nq, view.mm_per_unit)
+                    {
+                        continue;
+                    }
+                    let r2 = ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - xo) * mm)
+                        .length_squared();
+                    for g in 0..NARROW_GAUSSIANS {
+                        let e = (-r2 / (2.0 * SIX_GAUSSIAN_VARIANCES_MM2[g] as f64)).exp()
+                            * p[3] as f64;
+                        norm[g] += e;
+                        for ch in 0..3 {
+                            sum[g][ch] += e * surface.radiance[q][ch] as f64;
+                        }
+                    }
+                }
+            }
+            let mut acc = [0.0f64; 3];
+            for g in 0..NARROW_GAUSSIANS {
+                for ch in 0..3 {
+                    let m = if norm[g] > 0.0 {
+                        sum[g][ch] / norm[g]
+                    } else {
+                        surface.radiance[c][ch] as f64
+                    };
+                    acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[g][ch] as f64 * m;
+                }
+            }
+            // Wide part: every sample within the cut-off, through tissue.
             for (j, p) in pts.iter().enumerate() {
                 let r2 = ((*p - xo) * mm).length_squared();
-                if r2 > cutoff2 {
+                let n = samples[j].normal;
+                if r2 > cutoff2
+                    || !through_tissue(
+                        xo32,
+                        no,
+                        p.as_vec3().to_array(),
+                        [n[0], n[1], n[2]],
+                        view.mm_per_unit,
+                    )
+                {
                     continue;
                 }
                 let prof = wide_profile(r2);
-                for c in 0..3 {
-                    acc[c] += samples[j].pos_area[3] as f64 * radiance[j][c] as f64 * prof[c];
+                for ch in 0..3 {
+                    acc[ch] += samples[j].pos_area[3] as f64 * radiance[j][ch] as f64 * prof[ch];
                 }
             }
             [acc[0], acc[1], acc[2], d0[3] as f64]
