@@ -2,15 +2,18 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_GOOGLE_include_directive : require
 #include "fetch_count.glsl"
-// Ground truth, the wide part: for every skin pixel, adds to the narrow part
-// (reference_narrow.comp) M(x_o) = sum_j L_d(x_j) R(|x_j - x_o|) dA_j over all
-// surface samples within the cut-off that light reaches through tissue (true 3D
-// distances, visible or not; src/reference/tissue.rs), R the profile's Gaussians
-// 4-6. Keep in step with NARROW_GAUSSIANS in src/reference/sampling.rs.
+// Ground truth, the wide part: for every skin pixel and each of the profile's
+// Gaussians 4-6, accumulates sum_j L_d(x_j) G_i(|x_j - x_o|) dA_j (rgb) and
+// sum_j G_i(|x_j - x_o|) dA_j (alpha) over all surface samples within the cut-off
+// that light reaches through tissue (true 3D distances, visible or not;
+// src/reference/tissue.rs). reference_resolve.comp divides one by the other
+// (each Gaussian conserves the light it gathers; src/reference/narrow.rs says
+// why) and adds them to the narrow part. Keep in step with NARROW_GAUSSIANS in
+// src/reference/sampling.rs.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;  // L_d(x_o) (no transmittance), alpha = strength
 layout(set = 0, binding = 1) uniform texture2D depthTex;    // linear view depth
-layout(set = 0, binding = 2, rgba32f) uniform image2D outImage;
+layout(set = 0, binding = 2, rgba32f) uniform image2D accum4;
 // Positions (scene units) and areas (mm^2) of the samples, in grid order.
 layout(std430, set = 0, binding = 3) readonly buffer Positions { vec4 positions[]; };
 layout(set = 0, binding = 4) uniform texture2D radianceTex;  // sample i at (i % width, i / width)
@@ -25,6 +28,8 @@ layout(set = 0, binding = 6) uniform GatherParams {
 // Normals of the samples, in grid order (this chunk's).
 layout(std430, set = 0, binding = 7) readonly buffer Normals { vec4 normals[]; };
 layout(set = 0, binding = 8) uniform texture2D surfNormal;  // the supersampled surface's normals
+layout(set = 0, binding = 9, rgba32f) uniform image2D accum5;
+layout(set = 0, binding = 10, rgba32f) uniform image2D accum6;
 // One row of 3 cells of the 3x3x3 neighbourhood per dispatch (dy, dz in -1..1),
 // summed into the output: splitting keeps each invocation's loop count a ninth of
 // the whole (llvmpipe cuts shader loops after 65535 iterations). One chunk of the
@@ -32,17 +37,9 @@ layout(set = 0, binding = 8) uniform texture2D surfNormal;  // the supersampled 
 // radianceTex hold that chunk only (binding ranges and image sizes are limited).
 layout(push_constant) uniform Push { int dy; int dz; uint first; uint count; } pc;
 
-// Six-Gaussian skin profile (thesis Table 4.2), variances in mm^2.
-const vec3 W4 = vec3(0.113, 0.007, 0.007);
-const vec3 W5 = vec3(0.358, 0.004, 0.0);
-const vec3 W6 = vec3(0.078, 0.0, 0.0);
+// Variances (mm^2) of the six-Gaussian profile's Gaussians 4-6 (thesis Table 4.2).
+const float V[3] = float[](0.567, 1.99, 7.41);
 const float TWO_PI = 6.28318530718;
-
-vec3 wideProfile(float r2) {
-    return W4 * (exp(-r2 / (2.0 * 0.567)) / (TWO_PI * 0.567)) +
-           W5 * (exp(-r2 / (2.0 * 1.99)) / (TWO_PI * 1.99)) +
-           W6 * (exp(-r2 / (2.0 * 7.41)) / (TWO_PI * 7.41));
-}
 
 bool throughTissue(vec3 xo, vec3 no, vec3 xi, vec3 ni) {
     vec3 d = xi - xo;
@@ -70,7 +67,7 @@ void main() {
     ivec3 dims = ivec3(params.gridDims.xyz);
     int s = int(params.tissue.y);
     vec3 no = COUNTED(SITE(0, 8, FK_POINT), texelFetch(surfNormal, p * s + s / 2, 0)).xyz;
-    vec3 acc = imageLoad(outImage, p).rgb;
+    vec4 acc[3] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
     int dz = pc.dz;
     int dy = pc.dy;
     for (int dx = -1; dx <= 1; dx++) {
@@ -85,8 +82,13 @@ void main() {
             float r2 = dot(dv, dv);
             if (r2 > cutoff2 || !throughTissue(xo, no, pa.xyz, normals[k].xyz)) continue;
             vec3 radiance = COUNTED(SITE(0, 4, FK_POINT), texelFetch(radianceTex, ivec2(k % params.gridDims.w, k / params.gridDims.w), 0)).rgb;
-            acc += pa.w * radiance * wideProfile(r2);
+            for (int g = 0; g < 3; g++) {
+                float e = pa.w * exp(-r2 / (2.0 * V[g])) / (TWO_PI * V[g]);
+                acc[g] += vec4(e * radiance, e);
+            }
         }
     }
-    imageStore(outImage, p, vec4(acc, d0.a));
+    imageStore(accum4, p, acc[0]);
+    imageStore(accum5, p, acc[1]);
+    imageStore(accum6, p, acc[2]);
 }

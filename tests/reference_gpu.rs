@@ -50,7 +50,7 @@ fn render(s: &RenderSettings) -> Run {
     let ss = m.supersampling();
     let aspect = s.width as f32 / s.height as f32;
     Run {
-        output: find("reference gather 9/9", "reference"),
+        output: find("reference resolve", "reference"),
         diffuse: find("geometry", "diffuse"),
         depth: find("geometry", "linear depth")
             .iter()

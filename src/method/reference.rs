@@ -47,6 +47,7 @@ const IRRADIANCE_SHADER: &str = "reference_irradiance.frag";
 const SURFACE_SHADER: &str = "reference_surface.frag";
 const NARROW_SHADER: &str = "reference_narrow.comp";
 const GATHER_SHADER: &str = "reference_gather.comp";
+const RESOLVE_SHADER: &str = "reference_resolve.comp";
 /// The surface pass's targets: radiance, position + area, normal.
 const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const SURFACE_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
@@ -245,6 +246,10 @@ pub struct Reference {
     surface_pipeline: Pipeline,
     narrow: Pipeline,
     gather: Pipeline,
+    resolve: Pipeline,
+    resolve_set: vk::DescriptorSet,
+    /// Per wide Gaussian: accumulated radiance (rgb) and weight (a).
+    accum: [ImageId; 3],
     material_set: vk::DescriptorSet,
     frame_set: vk::DescriptorSet,
     surf_material: vk::DescriptorSet,
@@ -354,6 +359,7 @@ impl Reference {
         )?;
         self.narrow = Pipeline::compute(s.ctx, "reference narrow", NARROW_SHADER)?;
         self.gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
+        self.resolve = Pipeline::compute(s.ctx, "reference resolve", RESOLVE_SHADER)?;
         let inv_view = s.view.camera.view().inverse().to_cols_array_2d();
         let view = [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()];
         let p = GatherParams {
@@ -460,6 +466,13 @@ impl Reference {
             s.view.extent,
             vk::Format::R32G32B32A32_SFLOAT,
         ));
+        self.accum = [4, 5, 6].map(|g| {
+            s.res.declare(ImageDesc::new(
+                &format!("reference gaussian {g}"),
+                s.view.extent,
+                vk::Format::R32G32B32A32_SFLOAT,
+            ))
+        });
         self.draw_samples = plan.draw_samples;
         self.max_candidates = max_slab_candidates(&grid);
         self.sample_count = count;
@@ -714,6 +727,65 @@ impl Reference {
         })
     }
 
+    /// Zeroes the wide Gaussians' accumulators before the gather adds to them.
+    fn clear_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let accum = self.accum;
+        let e = f.extent;
+        let mut pass = Pass::new("reference clear", PassRole::Sss).work(Work::Clear {
+            texels: 3 * e.width as u64 * e.height as u64,
+            bytes_per_texel: 16,
+        });
+        for a in accum {
+            pass = pass.image(a, AccessKind::ClearWrite);
+        }
+        pass.record(move |pc: &PassContext| {
+            let range = vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(1)
+                .layer_count(1);
+            for a in accum {
+                unsafe {
+                    pc.ctx.device.cmd_clear_color_image(
+                        pc.cmd,
+                        pc.image(a).raw,
+                        pc.layout(a),
+                        &vk::ClearColorValue::default(),
+                        &[range],
+                    )
+                };
+            }
+        })
+    }
+
+    /// The wide Gaussians, each over its weight, added to the narrow part.
+    fn resolve_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let t = f.targets;
+        let extent = f.extent;
+        let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
+        let work = Work::Compute {
+            shader: ShaderWork {
+                shader: RESOLVE_SHADER.into(),
+                fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
+                alu: alu_estimate(RESOLVE_SHADER, &[3]),
+                storage_read_bytes: 64.0,
+                storage_write_bytes: 16.0,
+            },
+            invocations: (groups.0 * groups.1 * GROUP * GROUP) as u64,
+        };
+        let set = self.resolve_set;
+        let mut pass = Pass::new("reference resolve", PassRole::Sss)
+            .image(t.diffuse, AccessKind::ComputeSampledRead)
+            .image(self.out, AccessKind::ComputeStorageReadWrite)
+            .work(work);
+        for a in self.accum {
+            pass = pass.image(a, AccessKind::ComputeStorageRead);
+        }
+        pass.record(move |pc: &PassContext| {
+            self.resolve.bind(pc.ctx, pc.cmd, &[set]);
+            unsafe { pc.ctx.device.cmd_dispatch(pc.cmd, groups.0, groups.1, 1) };
+        })
+    }
+
     /// The narrow part, written into the output for every pixel.
     fn narrow_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let t = f.targets;
@@ -776,12 +848,12 @@ impl SssMethod for Reference {
             self.irradiance_pass(f),
             self.surface_pass(f),
             self.narrow_pass(f),
+            self.clear_pass(f),
         ];
         let extent = f.extent;
         let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
         let invocations = (groups.0 * groups.1 * GROUP * GROUP) as u64;
         let one = self.chunks.len() == 1;
-        let out = self.out;
         for (ci, c) in self.chunks.iter().enumerate() {
             for k in 0..SLABS {
                 // Every slab adds to the narrow part.
@@ -815,10 +887,10 @@ impl SssMethod for Reference {
                                 ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
                             },
                         ],
-                        alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3)]),
+                        alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3), 3]),
                         // Positions and normals of the candidates, cell ranges, the output.
                         storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
-                        storage_write_bytes: 16.0,
+                        storage_write_bytes: 48.0,
                     },
                     invocations,
                 };
@@ -835,7 +907,9 @@ impl SssMethod for Reference {
                         .image(t.linear_depth, AccessKind::ComputeSampledRead)
                         .image(c.radiance, AccessKind::ComputeSampledRead)
                         .image(self.surf.normal, AccessKind::ComputeSampledRead)
-                        .image(out, out_access)
+                        .image(self.accum[0], out_access)
+                        .image(self.accum[1], out_access)
+                        .image(self.accum[2], out_access)
                         .buffer(c.buffer_ids[1], AccessKind::ComputeStorageRead)
                         .buffer(c.buffer_ids[2], AccessKind::ComputeStorageRead)
                         .buffer(self.cells_id, AccessKind::ComputeStorageRead)
@@ -848,6 +922,7 @@ impl SssMethod for Reference {
                 );
             }
         }
+        passes.push(self.resolve_pass(f));
         passes
     }
 
@@ -900,6 +975,18 @@ impl SssMethod for Reference {
                 ),
             ],
         )?;
+        self.resolve_set = b.pool.write_set(
+            b.ctx,
+            &self.resolve,
+            0,
+            &[
+                ("diffuseTex", Bind::Texture(b.res.view(t.diffuse))),
+                ("outImage", Bind::Texture(b.res.view(self.out))),
+                ("accum4", Bind::Texture(b.res.view(self.accum[0]))),
+                ("accum5", Bind::Texture(b.res.view(self.accum[1]))),
+                ("accum6", Bind::Texture(b.res.view(self.accum[2]))),
+            ],
+        )?;
         for c in &mut self.chunks {
             c.draws.clear();
             let mut first = 0;
@@ -928,7 +1015,9 @@ impl SssMethod for Reference {
                 &[
                     ("diffuseTex", Bind::Texture(b.res.view(t.diffuse))),
                     ("depthTex", Bind::Texture(b.res.view(t.linear_depth))),
-                    ("outImage", Bind::Texture(b.res.view(self.out))),
+                    ("accum4", Bind::Texture(b.res.view(self.accum[0]))),
+                    ("accum5", Bind::Texture(b.res.view(self.accum[1]))),
+                    ("accum6", Bind::Texture(b.res.view(self.accum[2]))),
                     (
                         "Positions",
                         Bind::Uniform {
@@ -983,6 +1072,7 @@ impl SssMethod for Reference {
             &mut self.surface_pipeline,
             &mut self.narrow,
             &mut self.gather,
+            &mut self.resolve,
         ] {
             p.destroy(ctx);
         }

@@ -6,7 +6,7 @@
 use glam::{DMat4, DVec3, Mat4};
 
 use super::narrow::radius;
-use super::sampling::{cutoff_mm, wide_profile, SurfaceSample, NARROW_GAUSSIANS};
+use super::sampling::{cutoff_mm, SurfaceSample, NARROW_GAUSSIANS};
 use super::tissue::through_tissue;
 use crate::skin::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 
@@ -128,7 +128,9 @@ pub fn gather_f64(
                     acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[g][ch] as f64 * m;
                 }
             }
-            // Wide part: every sample within the cut-off, through tissue.
+            // Wide part: every sample within the cut-off, through tissue, each
+            // Gaussian over its own weight.
+            let mut wide = [[0.0f64; 4]; 6 - NARROW_GAUSSIANS];
             for (j, p) in pts.iter().enumerate() {
                 let r2 = ((*p - xo) * mm).length_squared();
                 let n = samples[j].normal;
@@ -143,9 +145,22 @@ pub fn gather_f64(
                 {
                     continue;
                 }
-                let prof = wide_profile(r2);
-                for ch in 0..3 {
-                    acc[ch] += samples[j].pos_area[3] as f64 * radiance[j][ch] as f64 * prof[ch];
+                for (g, w) in wide.iter_mut().enumerate() {
+                    let v = SIX_GAUSSIAN_VARIANCES_MM2[NARROW_GAUSSIANS + g] as f64;
+                    let e = samples[j].pos_area[3] as f64 * (-r2 / (2.0 * v)).exp()
+                        / (2.0 * std::f64::consts::PI * v);
+                    for ch in 0..3 {
+                        w[ch] += e * radiance[j][ch] as f64;
+                    }
+                    w[3] += e;
+                }
+            }
+            for (g, w) in wide.iter().enumerate() {
+                if w[3] > 0.0 {
+                    for ch in 0..3 {
+                        acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[NARROW_GAUSSIANS + g][ch] as f64 * w[ch]
+                            / w[3];
+                    }
                 }
             }
             [acc[0], acc[1], acc[2], d0[3] as f64]

@@ -1,0 +1,290 @@
+//! The accuracy instrument checked against what no code of ours produced
+//! (lavapipe, validation on):
+//! - a flat skin card with an albedo step, lit evenly: every method's and the
+//!   ground truth's edge response against the profile's closed form (the energy
+//!   moved across the edge, E (a_L - a_R) sum_i w_i sigma_i / sqrt(2 pi), sampled
+//!   at the pixel centres as any image is);
+//! - uniform light (white skin, ambient only): the ground truth must return its
+//!   input (what light goes in comes out), thin parts apart.
+
+mod common;
+
+use dermis::method::reference::Reference;
+use dermis::render::{RenderSettings, Renderer};
+use dermis::scene::mesh::{Material, Mesh, Object, Texture, Vertex};
+use dermis::scene::{default_scene, Scene};
+use dermis::skin::card::{Card, Row};
+use glam::Vec3;
+
+/// The card: 200 x 120 mm in the z = 0 plane facing +Z, 1 unit = 1 mm, its
+/// left half of albedo 1 and right half 0.25 (sRGB 137) times a skin tint. The
+/// halves are two quads whose texture coordinates sit on the centres of the two
+/// texels of a 2 x 1 texture: each half is one albedo, and the step is sharp
+/// (a texture's bilinear ramp across the step would smear it).
+fn card_scene() -> Scene {
+    let mut scene = default_scene();
+    let (w, h) = (200.0f32, 120.0f32);
+    let v = |x: f32, y: f32, u: f32| Vertex {
+        position: [x * w, y * h, 0.0],
+        normal: [0.0, 0.0, 1.0],
+        uv: [u, 0.5],
+        tangent: [1.0, 0.0, 0.0, 1.0],
+    };
+    let mesh = Mesh {
+        vertices: vec![
+            v(-0.5, -0.5, 0.25),
+            v(0.0, -0.5, 0.25),
+            v(0.0, 0.5, 0.25),
+            v(-0.5, 0.5, 0.25),
+            v(0.0, -0.5, 0.75),
+            v(0.5, -0.5, 0.75),
+            v(0.5, 0.5, 0.75),
+            v(0.0, 0.5, 0.75),
+        ],
+        indices: vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7],
+    };
+    let mut material = Material::skin([0.8, 0.6, 0.5]);
+    material.base_color = Some(Texture {
+        width: 2,
+        height: 1,
+        rgba8: vec![255, 255, 255, 255, 137, 137, 137, 255],
+    });
+    material.specular_intensity = 0.0;
+    scene.head_bounds = mesh.bounds();
+    scene.head = Object { mesh, material };
+    scene.backdrop = None;
+    scene.mm_per_unit = 1.0;
+    scene.forward = Vec3::Z;
+    scene.name = "card".into();
+    scene
+}
+
+/// Settings that put `px_per_mm` pixels on a millimetre of the card, lit from
+/// the camera's side (even irradiance, no back light, no ambient).
+fn card_settings(scene: &Scene, px_per_mm: f32) -> RenderSettings {
+    let (width, height) = (256u32, 128u32);
+    let fovy: f32 = 20.0;
+    let d = height as f32 / (2.0 * (0.5 * fovy.to_radians()).tan() * px_per_mm);
+    let mut s = RenderSettings {
+        width,
+        height,
+        shadow_size: 512,
+        fovy_deg: fovy,
+        distance_heads: d / scene.head_height_units(),
+        ambient: 0.0,
+        ..RenderSettings::default()
+    };
+    s.light.azimuth_deg = 0.0;
+    s.light.elevation_deg = 0.0;
+    s
+}
+
+/// Energy moved per channel over the closed form's, both sampled at the pixel
+/// centres, averaged over the rows. Left and right levels (E a) are read off
+/// the unscattered image far from the edge.
+fn energy_ratio(out: &[[f32; 4]], diffuse: &[[f32; 4]], w: usize, mm_per_px: f64) -> [f64; 3] {
+    let rows = out.len() / w;
+    let mut ratio = [0.0; 3];
+    for c in 0..3 {
+        let left = diffuse[rows / 2 * w + 2][c] as f64;
+        let right = diffuse[rows / 2 * w + w - 3][c] as f64;
+        let card = Card {
+            albedo_left: [left; 3],
+            albedo_right: [right; 3],
+            irradiance: 1.0,
+        };
+        let exact: Vec<f64> = (0..w)
+            .map(|x| card.exitance((x as f64 + 0.5 - (w / 2) as f64) * mm_per_px)[c])
+            .collect();
+        let exact = Row {
+            values: &exact,
+            edge_px: w / 2,
+            mm_per_px,
+        }
+        .energy_moved(right);
+        for y in 0..rows {
+            let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
+            let moved = Row {
+                values: &row,
+                edge_px: w / 2,
+                mm_per_px,
+            }
+            .energy_moved(right);
+            ratio[c] += moved / exact / rows as f64;
+        }
+    }
+    ratio
+}
+
+fn render_card(
+    ctx: &dermis::vk::context::Context,
+    scene: &Scene,
+    s: &RenderSettings,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, f64) {
+    let mut r = Renderer::new(ctx, scene, s).unwrap();
+    let cap = r.capture(false).unwrap();
+    let diffuse = r.read_back(r.frame.targets.diffuse).unwrap();
+    let depth = r.read_back(r.frame.targets.linear_depth).unwrap();
+    let z = depth[depth.len() / 2][0] as f64;
+    let mm_per_px =
+        2.0 * z * (0.5 * s.fovy_deg.to_radians() as f64).tan() * scene.mm_per_unit as f64
+            / s.height as f64;
+    (cap.diffuse, diffuse, mm_per_px)
+}
+
+// The card at the eval's close-up scale (8.5 px/mm, the thesis' 720p zoom
+// shot). The ground truth must move the profile's energy within a few percent
+// in every channel; each method is held to what its design moves (see
+// src/skin/card.rs and docs/accuracy.md for the per-method derivations).
+#[test]
+fn edge_response_of_every_method_against_the_closed_form() {
+    let ctx = common::ctx();
+    let scene = card_scene();
+    let base = card_settings(&scene, 8.5);
+    let mut report = Vec::new();
+    let mut run = |label: &str, s: RenderSettings| {
+        let (out, diffuse, mm_per_px) = render_card(&ctx, &scene, &s);
+        // Geometry pass diffuse of a method is overwritten by SSS: the unscattered
+        // levels come from `none`'s frame instead.
+        let (none, _, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
+        let _ = diffuse;
+        let r = energy_ratio(&out, &none, s.width as usize, mm_per_px);
+        println!("{label}: energy moved / closed form = {r:.3?} ({:.2} px/mm)", 1.0 / mm_per_px);
+        report.push((label.to_string(), r));
+        r
+    };
+    let reference = run(
+        "reference",
+        base.clone().with(common::m("reference"), &[("density", "16")]),
+    );
+    let physical = run(
+        "separable physical 33",
+        base.clone()
+            .with(common::m("separable"), &[("preset", "physical"), ("samples", "33")]),
+    );
+    let table = run("separable table6.1", base.clone().with(common::m("separable"), &[]));
+    let ssg = run("ssg", base.clone().with(common::m("ssg"), &[("lod", "false")]));
+    let jittered = run("ss-jittered", base.clone().with(common::m("ss-jittered"), &[]));
+    let poisson = run("poisson", base.clone().with(common::m("poisson"), &[]));
+    let none = run("none", base.clone().with(common::m("none"), &[]));
+    for c in 0..3 {
+        // The ground truth: within 3% in every channel.
+        assert!((reference[c] - 1.0).abs() < 0.03, "reference {reference:?}");
+        // The physical preset is the profile's marginal: within 5% (blue moves
+        // 0.05 mm of its contrast, half a pixel's tenth: f16 storage and the
+        // sampler's 8-bit bilinear weights move that by a few percent).
+        assert!((physical[c] - 1.0).abs() < 0.05, "physical {physical:?}");
+        assert_eq!(none[c], 0.0);
+        // Table 6.1 is an artist's preset: far narrower than the profile.
+        assert!(table[c] < 0.2, "table6.1 {table:?}");
+    }
+    // The screen-space sums at their true scale: red (wide Gaussians, where
+    // their designs are exact up to their taps) within 6%; the stretch was 18%
+    // too wide before.
+    assert!((ssg[0] - 1.0).abs() < 0.06, "ssg {ssg:?}");
+    assert!((jittered[0] - 1.0).abs() < 0.06, "ss-jittered {jittered:?}");
+    // ssg leaves Gaussian 1 unblurred and builds the others on it: green and
+    // blue move at most what sqrt(v_i - v_1) allows (0.79 and 0.57).
+    assert!(ssg[1] < 0.85 && ssg[2] < 0.62, "ssg {ssg:?}");
+    // Poisson's disk moves 0.88-1.1 of the closed form in every channel, by orientation.
+    for c in 0..3 {
+        assert!((0.8..1.15).contains(&poisson[c]), "poisson {poisson:?}");
+    }
+}
+
+/// Uniform light: white skin, ambient light only, no key light. Every surface
+/// point is lit alike and the profile loses no light (its weights sum to one),
+/// so the ground truth must return its input at every point, folds and thin
+/// parts included: median within 2%, 99th percentile within 10% over skin
+/// pixels that are not thin parts, thin parts reported apart. (Before the
+/// ground truth gathered through tissue only and let each Gaussian conserve what
+/// it gathers, seams returned up to 1.63 of their input.)
+fn uniform_light(scene: &Scene, s: &RenderSettings, thin: impl Fn(Vec3) -> bool) -> (f64, f64, f64, usize) {
+    let ctx = common::ctx();
+    let mut r = Renderer::new(&ctx, scene, s).unwrap();
+    let cap = r.capture(false).unwrap();
+    let input = r.read_back(r.frame.targets.diffuse).unwrap();
+    let depth = r.read_back(r.frame.targets.linear_depth).unwrap();
+    let inv_view = r.frame.camera.view().inverse();
+    assert!(r.method_as::<Reference>().is_some());
+    let (w, h) = (s.width as usize, s.height as usize);
+    let t = (0.5 * s.fovy_deg.to_radians()).tan();
+    let aspect = w as f32 / h as f32;
+    let mut ratios = Vec::new();
+    let mut thin_ratios = Vec::new();
+    let mut map = vec![0u8; w * h * 4];
+    for (i, (o, d)) in cap.diffuse.iter().zip(&input).enumerate() {
+        if d[3] <= 0.0 || d[0] <= 0.0 {
+            continue;
+        }
+        let z = depth[i][0];
+        let (x, y) = ((i % w) as f32, (i / w) as f32);
+        let ndc = [(x + 0.5) / w as f32 * 2.0 - 1.0, (y + 0.5) / h as f32 * 2.0 - 1.0];
+        let p = inv_view.transform_point3(Vec3::new(ndc[0] * t * aspect * z, -ndc[1] * t * z, -z));
+        let q = (0..3).map(|c| o[c] as f64 / d[c] as f64).fold(0.0f64, |a, b| a.max((b - 1.0).abs()));
+        let v = (q / 0.2 * 255.0).min(255.0) as u8;
+        map[i * 4..i * 4 + 4].copy_from_slice(&[v, if thin(p) { 128 } else { 0 }, 255 - v, 255]);
+        if thin(p) {
+            thin_ratios.push(q);
+        } else {
+            ratios.push(q);
+        }
+    }
+    if let Ok(path) = std::env::var("UNIFORM_MAP") {
+        image::RgbaImage::from_raw(w as u32, h as u32, map)
+            .unwrap()
+            .save(format!("{path}-{}.png", scene.name))
+            .unwrap();
+    }
+    ratios.sort_by(f64::total_cmp);
+    thin_ratios.sort_by(f64::total_cmp);
+    let pct = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p) as usize];
+    let thin_median = if thin_ratios.is_empty() { 0.0 } else { pct(&thin_ratios, 0.5) };
+    (pct(&ratios, 0.5), pct(&ratios, 0.99), thin_median, ratios.len())
+}
+
+fn white_ambient(scene: &mut Scene) -> RenderSettings {
+    scene.head.material.base_color = None;
+    scene.head.material.base_color_factor = [1.0; 3];
+    let mut s = RenderSettings {
+        width: 160,
+        height: 120,
+        shadow_size: 256,
+        ambient: 1.0,
+        ..RenderSettings::default()
+    }
+    .with(common::m("reference"), &[("density", "16")]);
+    s.light.intensity = 0.0;
+    s
+}
+
+#[test]
+fn uniform_light_comes_out_as_it_went_in_on_the_face() {
+    let mut scene = default_scene();
+    let mut s = white_ambient(&mut scene);
+    s.distance_heads = dermis::scene::camera::Camera::close_up_distance_heads(20.0);
+    let ears = dermis::scene::face::ears();
+    let mm = scene.mm_per_unit;
+    let (median, p99, thin, n) = uniform_light(&scene, &s, |p| {
+        ears.iter().any(|e| (p - e.center).length() * mm < 40.0)
+    });
+    println!("face, uniform light: |out/in - 1| median {median:.4}, p99 {p99:.4} over {n} pixels; thin parts (ears) median {thin:.4}");
+    assert!(median < 0.02 && p99 < 0.10, "median {median}, p99 {p99}");
+}
+
+#[test]
+fn uniform_light_comes_out_as_it_went_in_on_the_head_scan() {
+    let Some(path) = common::lps_path() else {
+        return;
+    };
+    let mut scene = dermis::scene::load_gltf_scene(&path, &Default::default(), None).unwrap();
+    let mut s = white_ambient(&mut scene);
+    s.distance_heads = dermis::scene::camera::Camera::close_up_distance_heads(20.0);
+    s.options.set("density", "8");
+    // The scan's ears: beyond 60 mm to either side of the head's centre line.
+    let c = scene.head_center();
+    let mm = scene.mm_per_unit;
+    let (median, p99, thin, n) = uniform_light(&scene, &s, |p| ((p.x - c.x) * mm).abs() > 60.0);
+    println!("head scan, uniform light: |out/in - 1| median {median:.4}, p99 {p99:.4} over {n} pixels; thin parts (ears) median {thin:.4}");
+    assert!(median < 0.02 && p99 < 0.10, "median {median}, p99 {p99}");
+}
