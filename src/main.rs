@@ -68,14 +68,20 @@ enum Command {
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
     },
-    /// Compare two render outputs (DIR with diffuse.exr and frame.png): relative
-    /// RMSE of the linear diffuse over skin pixels (skin from B) and FLIP of the
-    /// tone-mapped frames; writes error images and compare.json into --out.
+    /// Compare two render outputs (DIR with diffuse.exr, depth.exr, frame.png and
+    /// report.json): relative RMSE of the linear diffuse over skin pixels (skin
+    /// from B) and FLIP of the tone-mapped frames, over all skin and per band
+    /// (interior, silhouette, depth steps); with --none also err/none and the
+    /// per-channel gain. Writes error images, bands.png and compare.json into --out.
     Compare {
         /// The image under test.
         a: PathBuf,
         /// The reference.
         b: PathBuf,
+        /// The no-SSS render of the same view (`render --method none`): err/none
+        /// and the gains are relative to it.
+        #[arg(long)]
+        none: Option<PathBuf>,
         /// Where to write the error images (default: A).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -365,15 +371,11 @@ fn main_result() -> Result<()> {
             warn_foreign(&settings);
             render(&common, settings, &out, false, 0, 1)?;
         }
-        Command::Compare { a, b, out } => {
+        Command::Compare { a, b, none, out } => {
             let out = out.unwrap_or_else(|| a.clone());
-            let c = study::compare(&a, &b, &out)?;
-            println!(
-                "relative RMSE (linear diffuse, skin) {:.4e} | FLIP (tone-mapped) {:.4} | error images in {}",
-                c.relative_rmse,
-                c.flip_mean,
-                out.display()
-            );
+            let c = study::compare(&a, &b, none.as_deref(), &out)?;
+            print!("{}", study::comparison_table(&c));
+            println!("error images and compare.json in {}", out.display());
         }
         Command::Eval {
             common,

@@ -249,7 +249,7 @@ pub fn header(r: &Report) -> String {
     )
 }
 
-/// Renders and writes frame.png, diffuse.exr and report.json (with `dump`,
+/// Renders and writes frame.png, diffuse.exr, depth.exr and report.json (with `dump`,
 /// every pass output as EXR under passes/) into `out`.
 pub fn render_to_dir(
     ctx: &Context,
@@ -263,6 +263,7 @@ pub fn render_to_dir(
     let capture = output.capture.as_ref().context("no frame was captured")?;
     write_png(&out.join("frame.png"), capture)?;
     write_diffuse_exr(&out.join("diffuse.exr"), capture)?;
+    write_depth_exr(&out.join("depth.exr"), capture)?;
     if opts.dump {
         let dir = out.join("passes");
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -334,6 +335,22 @@ pub fn write_diffuse_exr(path: &Path, c: &Capture) -> Result<()> {
             width: c.width,
             height: c.height,
             rgba: c.diffuse.clone(),
+        },
+    )
+}
+
+/// Writes the linear view depth (scene units, in R, G and B) as EXR: with
+/// report.json's fovy_deg and mm_per_unit, what `compare` finds the accuracy
+/// bands from.
+pub fn write_depth_exr(path: &Path, c: &Capture) -> Result<()> {
+    write_exr(
+        path,
+        &DumpedImage {
+            pass: "final".into(),
+            image: "linear depth".into(),
+            width: c.width,
+            height: c.height,
+            rgba: c.depth.iter().map(|&d| [d, d, d, 1.0]).collect(),
         },
     )
 }

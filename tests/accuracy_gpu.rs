@@ -149,22 +149,37 @@ fn edge_response_of_every_method_against_the_closed_form() {
         let (none, _, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
         let _ = diffuse;
         let r = energy_ratio(&out, &none, s.width as usize, mm_per_px);
-        println!("{label}: energy moved / closed form = {r:.3?} ({:.2} px/mm)", 1.0 / mm_per_px);
+        println!(
+            "{label}: energy moved / closed form = {r:.3?} ({:.2} px/mm)",
+            1.0 / mm_per_px
+        );
         report.push((label.to_string(), r));
         r
     };
     let reference = run(
         "reference",
-        base.clone().with(common::m("reference"), &[("density", "16")]),
+        base.clone()
+            .with(common::m("reference"), &[("density", "16")]),
     );
     let physical = run(
         "separable physical 33",
-        base.clone()
-            .with(common::m("separable"), &[("preset", "physical"), ("samples", "33")]),
+        base.clone().with(
+            common::m("separable"),
+            &[("preset", "physical"), ("samples", "33")],
+        ),
     );
-    let table = run("separable table6.1", base.clone().with(common::m("separable"), &[]));
-    let ssg = run("ssg", base.clone().with(common::m("ssg"), &[("lod", "false")]));
-    let jittered = run("ss-jittered", base.clone().with(common::m("ss-jittered"), &[]));
+    let table = run(
+        "separable table6.1",
+        base.clone().with(common::m("separable"), &[]),
+    );
+    let ssg = run(
+        "ssg",
+        base.clone().with(common::m("ssg"), &[("lod", "false")]),
+    );
+    let jittered = run(
+        "ss-jittered",
+        base.clone().with(common::m("ss-jittered"), &[]),
+    );
     let poisson = run("poisson", base.clone().with(common::m("poisson"), &[]));
     let none = run("none", base.clone().with(common::m("none"), &[]));
     for c in 0..3 {
@@ -199,7 +214,11 @@ fn edge_response_of_every_method_against_the_closed_form() {
 /// pixels that are not thin parts, thin parts reported apart. (Before the
 /// ground truth gathered through tissue only and let each Gaussian conserve what
 /// it gathers, seams returned up to 1.63 of their input.)
-fn uniform_light(scene: &Scene, s: &RenderSettings, thin: impl Fn(Vec3) -> bool) -> (f64, f64, f64, usize) {
+fn uniform_light(
+    scene: &Scene,
+    s: &RenderSettings,
+    thin: impl Fn(Vec3) -> bool,
+) -> (f64, f64, f64, usize) {
     let ctx = common::ctx();
     let mut r = Renderer::new(&ctx, scene, s).unwrap();
     let cap = r.capture(false).unwrap();
@@ -219,9 +238,14 @@ fn uniform_light(scene: &Scene, s: &RenderSettings, thin: impl Fn(Vec3) -> bool)
         }
         let z = depth[i][0];
         let (x, y) = ((i % w) as f32, (i / w) as f32);
-        let ndc = [(x + 0.5) / w as f32 * 2.0 - 1.0, (y + 0.5) / h as f32 * 2.0 - 1.0];
+        let ndc = [
+            (x + 0.5) / w as f32 * 2.0 - 1.0,
+            (y + 0.5) / h as f32 * 2.0 - 1.0,
+        ];
         let p = inv_view.transform_point3(Vec3::new(ndc[0] * t * aspect * z, -ndc[1] * t * z, -z));
-        let q = (0..3).map(|c| o[c] as f64 / d[c] as f64).fold(0.0f64, |a, b| a.max((b - 1.0).abs()));
+        let q = (0..3)
+            .map(|c| o[c] as f64 / d[c] as f64)
+            .fold(0.0f64, |a, b| a.max((b - 1.0).abs()));
         let v = (q / 0.2 * 255.0).min(255.0) as u8;
         map[i * 4..i * 4 + 4].copy_from_slice(&[v, if thin(p) { 128 } else { 0 }, 255 - v, 255]);
         if thin(p) {
@@ -239,8 +263,17 @@ fn uniform_light(scene: &Scene, s: &RenderSettings, thin: impl Fn(Vec3) -> bool)
     ratios.sort_by(f64::total_cmp);
     thin_ratios.sort_by(f64::total_cmp);
     let pct = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p) as usize];
-    let thin_median = if thin_ratios.is_empty() { 0.0 } else { pct(&thin_ratios, 0.5) };
-    (pct(&ratios, 0.5), pct(&ratios, 0.99), thin_median, ratios.len())
+    let thin_median = if thin_ratios.is_empty() {
+        0.0
+    } else {
+        pct(&thin_ratios, 0.5)
+    };
+    (
+        pct(&ratios, 0.5),
+        pct(&ratios, 0.99),
+        thin_median,
+        ratios.len(),
+    )
 }
 
 fn white_ambient(scene: &mut Scene) -> RenderSettings {

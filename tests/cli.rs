@@ -337,13 +337,44 @@ fn reference_and_compare() {
     let mut args = vec!["reference", "--out", r.to_str().unwrap()];
     args.extend(common);
     run_ok(&args);
-    let out = run_ok(&["compare", a.to_str().unwrap(), r.to_str().unwrap()]);
-    assert!(out.contains("relative RMSE"), "{out}");
+    let n = d.join("none");
+    let mut args = vec![
+        "render",
+        "--method",
+        "none",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--out",
+        n.to_str().unwrap(),
+    ];
+    args.extend(common);
+    run_ok(&args);
+    let out = run_ok(&[
+        "compare",
+        a.to_str().unwrap(),
+        r.to_str().unwrap(),
+        "--none",
+        n.to_str().unwrap(),
+    ]);
+    assert!(
+        out.contains("relative RMSE") && out.contains("interior"),
+        "{out}"
+    );
     let v: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("compare.json")).unwrap()).unwrap();
     let e = v["relative_rmse"].as_f64().unwrap();
     assert!(e > 1e-4 && e < 0.2, "separable vs reference: {e}");
+    // Inside the face scattering beats doing nothing, and moves light the
+    // right way (a positive gain in red).
+    let interior = &v["bands"]["interior"];
+    assert!(interior["pixels"].as_u64().unwrap() > 0, "{v}");
+    let err_none = interior["err_none"].as_f64().unwrap();
+    assert!(err_none > 0.0 && err_none < 1.0, "{v}");
+    assert!(interior["gain"][0].as_f64().unwrap() > 0.0, "{v}");
     assert!(a.join("error_diffuse.png").exists() && a.join("error_flip.png").exists());
+    assert!(a.join("bands.png").exists());
     // The reference against itself is exact.
     run_ok(&[
         "compare",
@@ -356,6 +387,8 @@ fn reference_and_compare() {
         serde_json::from_slice(&std::fs::read(d.join("self").join("compare.json")).unwrap())
             .unwrap();
     assert_eq!(v["relative_rmse"].as_f64().unwrap(), 0.0);
+    // Without --none there is no err/none.
+    assert!(v["bands"]["interior"]["err_none"].is_null(), "{v}");
     // A missing input is one clear error.
     let o = dermis()
         .args(["compare", "/nonexistent/a", r.to_str().unwrap()])
@@ -397,18 +430,23 @@ fn eval_writes_csv_json_and_chart() {
         summary
             .iter()
             .find(|p| p["method"] == m && p["setting"] == s)
-            .unwrap()["error"]
+            .unwrap()["interior"]["err_none"]
             .as_f64()
             .unwrap()
     };
-    // Scattering moves the frame toward the ground truth: separable beats no SSS.
-    assert!(
-        error("separable", "33 samples") < error("none", "-"),
-        "{summary:?}"
-    );
+    // err/none reads as its definition: no SSS scores exactly 1, and
+    // scattering moves the frame toward the ground truth inside the face.
+    assert_eq!(error("none", "-"), 1.0, "{summary:?}");
+    assert!(error("separable", "33 samples") < 1.0, "{summary:?}");
     assert!(!v["pareto_front"].as_array().unwrap().is_empty());
+    // The interior panel and each band that has pixels, side by side.
     let png = image::open(d.join("chart.png")).unwrap();
-    assert_eq!((png.width(), png.height()), (1200, 800));
+    assert!(
+        [1200, 1800].contains(&png.width()) && png.height() == 800,
+        "{}x{}",
+        png.width(),
+        png.height()
+    );
     assert!(std::fs::read_to_string(d.join("chart.svg"))
         .unwrap()
         .contains("<svg"));

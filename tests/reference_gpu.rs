@@ -21,6 +21,9 @@ fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
     .with(common::m("reference"), &[("density", &density.to_string())])
 }
 
+/// The supersampled surface: factor, radiance, position, normal.
+type Supersampled = (u32, Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<[f32; 4]>);
+
 struct Run {
     output: Vec<[f32; 4]>,
     diffuse: Vec<[f32; 4]>,
@@ -28,8 +31,7 @@ struct Run {
     radiance: Vec<[f32; 4]>,
     samples: Vec<dermis::reference::sampling::SurfaceSample>,
     view: GatherView,
-    /// The supersampled surface: factor, radiance, position, normal.
-    surface: (u32, Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<[f32; 4]>),
+    surface: Supersampled,
 }
 
 fn render(s: &RenderSettings) -> Run {

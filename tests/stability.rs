@@ -349,7 +349,10 @@ fn thin_parts_need_transmittance() {
         .iter()
         .map(|r| r.2 / r.1)
         .fold(f64::INFINITY, f64::min);
-    assert!(best < 0.9, "transmittance helped no method on thin parts: {report:?}");
+    assert!(
+        best < 0.9,
+        "transmittance helped no method on thin parts: {report:?}"
+    );
 }
 
 /// Case 1: Distance sweep: a dolly from 2 to 9 head heights in steps of 15%. Each

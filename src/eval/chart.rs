@@ -75,10 +75,90 @@ pub fn cost_error_chart(
     write_png_svg(&plot, png_path, svg_path)
 }
 
+/// One panel of a [`panel_chart`].
+pub struct Panel {
+    pub title: String,
+    pub y_label: String,
+    pub points: Vec<EvalPoint>,
+    /// Whether the Pareto front is drawn (it is computed on one panel only: the
+    /// one the ranking is made on).
+    pub front: bool,
+}
+
+/// Cost/error panels side by side, sharing the x axis range and the method
+/// markers: e.g. the interior's err/none (with the Pareto front) beside the
+/// silhouette's and the depth steps'. Writes `png_path` (600 x 800 per panel)
+/// and `svg_path`.
+pub fn panel_chart(
+    panels: &[Panel],
+    title: &str,
+    x_label: &str,
+    png_path: &Path,
+    svg_path: &Path,
+) -> Result<()> {
+    ensure!(!panels.is_empty(), "panel chart: no panels");
+    let layouts = panels
+        .iter()
+        .map(|p| Layout::new(&p.points).with_context(|| format!("panel '{}'", p.title)))
+        .collect::<Result<Vec<_>>>()?;
+    let x_max = layouts.iter().map(|l| l.x_max).fold(0.0, f64::max);
+    let layouts: Vec<Layout> = layouts.into_iter().map(|l| Layout { x_max, ..l }).collect();
+    let plot = PanelPlot {
+        panels,
+        layouts: &layouts,
+        title,
+        x_label,
+    };
+    write_png_svg(&plot, png_path, svg_path)
+}
+
+struct PanelPlot<'a> {
+    panels: &'a [Panel],
+    layouts: &'a [Layout],
+    title: &'a str,
+    x_label: &'a str,
+}
+
+impl Plot for PanelPlot<'_> {
+    fn size(&self) -> (u32, u32) {
+        (600 * self.panels.len() as u32, SIZE.1)
+    }
+
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        root.fill(&WHITE).map_err(plot_err)?;
+        let inner = root
+            .titled(self.title, ("sans-serif", 30))
+            .map_err(plot_err)?;
+        let areas = inner.split_evenly((1, self.panels.len()));
+        for ((area, panel), layout) in areas.iter().zip(self.panels).zip(self.layouts) {
+            let labels = Labels {
+                title: &panel.title,
+                x: self.x_label,
+                y: &panel.y_label,
+                front: panel.front,
+            };
+            draw(area, &panel.points, layout, &labels)?;
+        }
+        Ok(())
+    }
+}
+
 /// A chart that can draw itself on any plotters backend: the PNG and the SVG
 /// of one chart come from the same code.
 trait Plot {
+    /// Pixel size of both outputs.
+    fn size(&self) -> (u32, u32) {
+        SIZE
+    }
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
+}
+
+/// The texts of one cost/error chart, and whether it shows the Pareto front.
+struct Labels<'a> {
+    title: &'a str,
+    x: &'a str,
+    y: &'a str,
+    front: bool,
 }
 
 struct CostErrorPlot<'a> {
@@ -90,23 +170,31 @@ struct CostErrorPlot<'a> {
 
 impl Plot for CostErrorPlot<'_> {
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
-        draw(root, self.points, self.layout, self.title, self.x_label)
+        root.fill(&WHITE).map_err(plot_err)?;
+        let labels = Labels {
+            title: self.title,
+            x: self.x_label,
+            y: "error",
+            front: true,
+        };
+        draw(root, self.points, self.layout, &labels)
     }
 }
 
 /// Draws `plot` into a `SIZE` PNG and SVG, creating their folders.
 fn write_png_svg(plot: &impl Plot, png_path: &Path, svg_path: &Path) -> Result<()> {
     ensure_font()?;
-    let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+    let size = plot.size();
+    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
     {
-        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         plot.draw_on(&root).context("drawing the PNG chart")?;
         root.present()
             .map_err(plot_err)
             .context("finishing the PNG chart")?;
     }
-    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb)
-        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", SIZE.0, SIZE.1))?;
+    let image = image::RgbImage::from_raw(size.0, size.1, rgb)
+        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", size.0, size.1))?;
     create_parent(png_path)?;
     image
         .save_with_format(png_path, image::ImageFormat::Png)
@@ -114,7 +202,7 @@ fn write_png_svg(plot: &impl Plot, png_path: &Path, svg_path: &Path) -> Result<(
 
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         plot.draw_on(&root).context("drawing the SVG chart")?;
         root.present()
             .map_err(plot_err)
@@ -167,13 +255,11 @@ fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     points: &[EvalPoint],
     layout: &Layout,
-    title: &str,
-    x_label: &str,
+    labels: &Labels,
 ) -> Result<()> {
-    root.fill(&WHITE).map_err(plot_err)?;
     let mut builder = ChartBuilder::on(root);
     builder
-        .caption(title, ("sans-serif", 30))
+        .caption(labels.title, ("sans-serif", 30))
         .margin(24)
         .x_label_area_size(60)
         .y_label_area_size(100);
@@ -183,10 +269,10 @@ fn draw<DB: DrawingBackend>(
         let chart = builder
             .build_cartesian_2d(x, (lo..hi).log_scale())
             .map_err(plot_err)?;
-        draw_in(chart, points, x_label)
+        draw_in(chart, points, labels)
     } else {
         let chart = builder.build_cartesian_2d(x, lo..hi).map_err(plot_err)?;
-        draw_in(chart, points, x_label)
+        draw_in(chart, points, labels)
     }
 }
 
@@ -195,7 +281,7 @@ fn draw<DB: DrawingBackend>(
 fn draw_in<'a, DB, Y>(
     mut chart: ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
     points: &[EvalPoint],
-    x_label: &str,
+    labels: &Labels,
 ) -> Result<()>
 where
     DB: DrawingBackend + 'a,
@@ -203,24 +289,26 @@ where
 {
     chart
         .configure_mesh()
-        .x_desc(x_label)
-        .y_desc("error")
+        .x_desc(labels.x)
+        .y_desc(labels.y)
         .axis_desc_style(("sans-serif", 22))
         .label_style(("sans-serif", 16))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(plot_err)?;
 
-    let front: Vec<(f64, f64)> = pareto_front(points)
-        .into_iter()
-        .map(|i| (points[i].gpu_ms, points[i].error))
-        .collect();
-    let front_style = ShapeStyle::from(&RGBColor(40, 40, 40)).stroke_width(2);
-    chart
-        .draw_series(LineSeries::new(front, front_style))
-        .map_err(plot_err)?
-        .label("Pareto front")
-        .legend(move |(x, y)| PathElement::new([(x - 12, y), (x + 12, y)], front_style));
+    if labels.front {
+        let front: Vec<(f64, f64)> = pareto_front(points)
+            .into_iter()
+            .map(|i| (points[i].gpu_ms, points[i].error))
+            .collect();
+        let front_style = ShapeStyle::from(&RGBColor(40, 40, 40)).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(front, front_style))
+            .map_err(plot_err)?
+            .label("Pareto front")
+            .legend(move |(x, y)| PathElement::new([(x - 12, y), (x + 12, y)], front_style));
+    }
 
     let mut methods: Vec<&str> = Vec::new();
     for p in points {
@@ -588,6 +676,34 @@ mod tests {
         assert!(bad(vec![(1.0, -0.1)]));
         assert!(series_chart(&[], "t", "x", "y", &png, &svg).is_err());
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn panel_chart_puts_panels_side_by_side() {
+        let dir = temp_dir("panels");
+        let (png, svg) = (dir.join("p.png"), dir.join("p.svg"));
+        let panel = |t: &str, front| Panel {
+            title: t.into(),
+            y_label: "err/none".into(),
+            points: vec![pt("none", 0.0, 1.0), pt("separable", 0.5, 0.3)],
+            front,
+        };
+        panel_chart(
+            &[
+                panel("interior", true),
+                panel("silhouette", false),
+                panel("depth step", false),
+            ],
+            "bands",
+            "GPU ms",
+            &png,
+            &svg,
+        )
+        .unwrap();
+        assert_eq!(image::image_dimensions(&png).unwrap(), (1800, 800));
+        let svg = fs::read_to_string(&svg).unwrap();
+        assert!(svg.contains("silhouette") && svg.contains("Pareto front"));
+        assert!(panel_chart(&[], "t", "x", &png, &dir.join("q.svg")).is_err());
     }
 
     #[test]

@@ -3,6 +3,8 @@
 //!
 //! Kept apart from the renderer so that the numbers a comparison reports come from
 //! plain, unit-tested CPU code that never touches Vulkan:
+//! - `bands`: where on the skin an error is (interior, silhouette, depth steps)
+//!   and the per-band err/none, gain and FLIP;
 //! - `metrics`: image error measures (energy-normalised relative RMSE on linear
 //!   radiance, NVIDIA FLIP on the tone-mapped sRGB frame, per-pixel error maps and
 //!   their false-colour visualisation, masked energy for halo/leak checks);
@@ -10,6 +12,7 @@
 //! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows;
 //! - `sweep`: the sweep of every registered method and setting over a scene set;
 //! - `study`: `dermis eval` and `dermis compare`: scene sets, outputs, charts.
+pub mod bands;
 pub mod chart;
 pub mod metrics;
 pub mod pareto;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context as _, Result};
 use serde::Serialize;
 
+use super::bands::{bands, Band, BandErrors, BandInput};
 use super::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
 use super::{chart, pareto, sweep};
 use crate::render::RenderSettings;
@@ -52,7 +53,7 @@ const DOLLY_LINES: [(&str, &str); 6] = [
 
 /// What `eval` wrote.
 pub struct EvalOutcome {
-    pub summary: Vec<pareto::EvalPoint>,
+    pub summary: Vec<sweep::SummaryRow>,
     pub files: Vec<PathBuf>,
 }
 
@@ -72,17 +73,38 @@ pub fn eval(
     let mut files = vec![out.join("eval.csv"), out.join("eval.json")];
     pareto::write_csv(&files[0], &points)?;
     let summary = sweep::summarise(&rows);
+    // The ranking is made on the interior: the bands are shown beside it.
+    let interior: Vec<pareto::EvalPoint> =
+        summary.iter().map(|r| r.point(Band::Interior)).collect();
     let report = serde_json::json!({
         "device": ctx.facts.name, "driver": ctx.facts.driver, "command": command,
+        "error": "err/none over the interior band: the method's RMS error against the ground truth over the no-SSS frame's (0 perfect, 1 no better than no SSS)",
         "scenes": specs, "rows": rows, "summary": summary,
-        "pareto_front": pareto::pareto_front(&summary).iter().map(|&i| &summary[i]).collect::<Vec<_>>(),
+        "pareto_front": pareto::pareto_front(&interior).iter().map(|&i| &summary[i]).collect::<Vec<_>>(),
     });
     std::fs::write(&files[1], serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", files[1].display()))?;
-    chart::cost_error_chart(
-        &summary,
+    let panels: Vec<chart::Panel> = Band::ALL
+        .iter()
+        .map(|&band| chart::Panel {
+            title: match band {
+                Band::Interior => "interior (ranking, Pareto front)".into(),
+                b => b.name().into(),
+            },
+            y_label: format!("err/none, {}", band.name()),
+            points: summary
+                .iter()
+                .filter(|r| r.band(band).scenes > 0)
+                .map(|r| r.point(band))
+                .collect(),
+            front: band == Band::Interior,
+        })
+        .filter(|p| !p.points.is_empty())
+        .collect();
+    chart::panel_chart(
+        &panels,
         &format!(
-            "SSS cost vs error ({}, {} scene(s))",
+            "SSS cost vs error relative to no SSS ({}, {} scene(s))",
             ctx.facts.name,
             specs.len()
         ),
@@ -117,7 +139,7 @@ pub fn eval(
             &series,
             &format!("SSS error along a dolly ({})", ctx.facts.name),
             "camera distance (head heights)",
-            "relative RMSE against the reference",
+            "err/none over the interior",
             &out.join("distance.png"),
             &out.join("distance.svg"),
         )?;
@@ -131,36 +153,115 @@ pub fn eval(
 pub struct Comparison {
     pub test: String,
     pub reference: String,
+    /// The no-SSS output err/none and the gains are relative to, if given.
+    pub none: Option<String>,
     pub skin_pixels: usize,
+    /// Over all skin.
     pub relative_rmse: f64,
+    /// Over the whole frame.
     pub flip_mean: f64,
+    /// Per band: relative RMSE, FLIP, and with a no-SSS output err/none and gain.
+    pub bands: BandErrors,
+}
+
+/// A render output directory: diffuse.exr, depth.exr, frame.png, report.json.
+struct Output {
+    width: u32,
+    height: u32,
+    diffuse: Vec<[f32; 4]>,
+    frame: Vec<u8>,
+}
+
+impl Output {
+    fn read(d: &Path) -> Result<Self> {
+        let (width, height, diffuse) = read_exr(&d.join("diffuse.exr"))?;
+        let p = d.join("frame.png");
+        let frame = image::open(&p)
+            .with_context(|| format!("reading {}", p.display()))?
+            .to_rgba8()
+            .into_raw();
+        Ok(Output {
+            width,
+            height,
+            diffuse,
+            frame,
+        })
+    }
+
+    fn same_size(&self, other: &Output, a: &Path, b: &Path) -> Result<()> {
+        if (self.width, self.height) != (other.width, other.height) {
+            bail!(
+                "{} is {}x{} but {} is {}x{}",
+                a.display(),
+                self.width,
+                self.height,
+                b.display(),
+                other.width,
+                other.height
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The bands of the reference output in `b`: its skin (diffuse alpha), its
+/// depth.exr and its report's field of view and scale.
+fn reference_bands(b: &Path, r: &Output, mask: &[bool]) -> Result<Vec<Option<Band>>> {
+    let (w, h, depth) = read_exr(&b.join("depth.exr"))?;
+    if (w, h) != (r.width, r.height) {
+        bail!(
+            "{}: depth.exr is {w}x{h}, diffuse.exr {}x{}",
+            b.display(),
+            r.width,
+            r.height
+        );
+    }
+    let p = b.join("report.json");
+    let report: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(&p).with_context(|| format!("reading {}", p.display()))?,
+    )
+    .with_context(|| format!("parsing {}", p.display()))?;
+    let number = |k: &str| {
+        report[k]
+            .as_f64()
+            .map(|v| v as f32)
+            .with_context(|| format!("{} has no number '{k}'", p.display()))
+    };
+    let depth: Vec<f32> = depth.iter().map(|d| d[0]).collect();
+    Ok(bands(&BandInput::for_view(
+        (w as usize, h as usize),
+        mask,
+        &depth,
+        number("fovy_deg")?,
+        number("mm_per_unit")?,
+    )))
 }
 
 /// Compares the render output in `a` with the reference output in `b` (each a
-/// directory with diffuse.exr and frame.png): relative RMSE of the linear
-/// diffuse over skin pixels (skin from B) and FLIP of the tone-mapped frames;
-/// writes error images and compare.json into `out`.
-pub fn compare(a: &Path, b: &Path, out: &Path) -> Result<Comparison> {
-    let (wa, ha, da) = read_exr(&a.join("diffuse.exr"))?;
-    let (wb, hb, db) = read_exr(&b.join("diffuse.exr"))?;
-    if (wa, ha) != (wb, hb) {
-        bail!(
-            "{} is {wa}x{ha} but {} is {wb}x{hb}",
-            a.display(),
-            b.display()
-        );
+/// directory with diffuse.exr, depth.exr, frame.png and report.json): relative
+/// RMSE of the linear diffuse over skin pixels (skin from B), FLIP of the
+/// tone-mapped frames, and both per band (interior, silhouette, depth step);
+/// with `none` (the no-SSS output) also err/none and the per-channel gain per
+/// band. Writes error images and compare.json into `out`.
+pub fn compare(a: &Path, b: &Path, none: Option<&Path>, out: &Path) -> Result<Comparison> {
+    let (ta, rb) = (Output::read(a)?, Output::read(b)?);
+    ta.same_size(&rb, a, b)?;
+    let zero = none.map(Output::read).transpose()?;
+    if let (Some(z), Some(n)) = (&zero, none) {
+        z.same_size(&rb, n, b)?;
     }
-    let load_png = |d: &Path| -> Result<Vec<u8>> {
-        let p = d.join("frame.png");
-        Ok(image::open(&p)
-            .with_context(|| format!("reading {}", p.display()))?
-            .to_rgba8()
-            .into_raw())
-    };
-    let (fa, fb) = (load_png(a)?, load_png(b)?);
-    let mask: Vec<bool> = db.iter().map(|p| p[3] > 0.0).collect();
-    let rmse = relative_rmse(&da, &db, &mask)?;
-    let flip = flip_ldr(&fa, &fb, wa, ha)?;
+    let (wa, ha) = (ta.width, ta.height);
+    let mask: Vec<bool> = rb.diffuse.iter().map(|p| p[3] > 0.0).collect();
+    let rmse = relative_rmse(&ta.diffuse, &rb.diffuse, &mask)?;
+    let flip = flip_ldr(&ta.frame, &rb.frame, wa, ha)?;
+    let band_of = reference_bands(b, &rb, &mask)?;
+    let band_errors = BandErrors::of(
+        &ta.diffuse,
+        &rb.diffuse,
+        zero.as_ref().map(|z| z.diffuse.as_slice()),
+        &flip.error_map,
+        &band_of,
+    );
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let save = |name: &str, rgba: Vec<u8>| -> Result<()> {
         let p = out.join(name);
@@ -173,18 +274,69 @@ pub fn compare(a: &Path, b: &Path, out: &Path) -> Result<Comparison> {
     const DIFFUSE_RAMP_MAX: f32 = 0.1;
     save(
         "error_diffuse.png",
-        false_colour(&abs_error_map(&da, &db, &mask), wa, ha, DIFFUSE_RAMP_MAX),
+        false_colour(
+            &abs_error_map(&ta.diffuse, &rb.diffuse, &mask),
+            wa,
+            ha,
+            DIFFUSE_RAMP_MAX,
+        ),
     )?;
     save("error_flip.png", false_colour(&flip.error_map, wa, ha, 1.0))?;
+    save("bands.png", band_picture(&band_of))?;
     let c = Comparison {
         test: a.display().to_string(),
         reference: b.display().to_string(),
+        none: none.map(|n| n.display().to_string()),
         skin_pixels: mask.iter().filter(|&&m| m).count(),
         relative_rmse: rmse,
         flip_mean: flip.mean,
+        bands: band_errors,
     };
     let p = out.join("compare.json");
     std::fs::write(&p, serde_json::to_string_pretty(&c)?)
         .with_context(|| format!("writing {}", p.display()))?;
     Ok(c)
+}
+
+/// The bands as a picture: interior grey, silhouette orange, depth steps blue,
+/// off skin black.
+fn band_picture(band_of: &[Option<Band>]) -> Vec<u8> {
+    band_of
+        .iter()
+        .flat_map(|b| match b {
+            None => [0, 0, 0, 255],
+            Some(Band::Interior) => [150, 150, 150, 255],
+            Some(Band::Silhouette) => [230, 159, 0, 255],
+            Some(Band::DepthStep) => [0, 114, 178, 255],
+        })
+        .collect()
+}
+
+/// The comparison as the CLI prints it.
+pub fn comparison_table(c: &Comparison) -> String {
+    let mut s = format!(
+        "skin pixels {}: relative RMSE {:.4e}, FLIP (frame) {:.4}\n",
+        c.skin_pixels, c.relative_rmse, c.flip_mean
+    );
+    s.push_str(&format!(
+        "{:<11} {:>8} {:>10} {:>8} {:>9} {:>17}\n",
+        "band", "pixels", "rel. RMSE", "FLIP", "err/none", "gain R/G/B"
+    ));
+    for band in Band::ALL {
+        let e = c.bands.get(band);
+        let err_none = e.err_none.map_or("-".into(), |v| format!("{v:.3}"));
+        let gain = e.gain.map_or("-".into(), |g| {
+            format!("{:.2}/{:.2}/{:.2}", g[0], g[1], g[2])
+        });
+        s.push_str(&format!(
+            "{:<11} {:>8} {:>10.4e} {:>8.4} {:>9} {:>17}\n",
+            band.name(),
+            e.pixels,
+            e.rel_rmse,
+            e.flip,
+            err_none,
+            gain
+        ));
+    }
+    s
 }

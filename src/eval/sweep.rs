@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use anyhow::{Context as _, Result};
 use serde::Serialize;
 
-use super::metrics::relative_rmse;
+use super::bands::{bands, Band, BandErrors, BandInput};
+use super::metrics::{flip_ldr, relative_rmse};
 use super::pareto::EvalPoint;
-use crate::method::{ground_truth, EvalSetting, MethodEntry, METHODS};
+use crate::method::{ground_truth, lookup, EvalSetting, MethodEntry, METHODS};
 use crate::render::RenderSettings;
 use crate::run::{run, RunOptions};
 use crate::scene::gltf_load::TextureOverrides;
@@ -110,13 +111,17 @@ pub fn procedural_scene() -> SceneSpec {
     }
 }
 
-/// One row of the detailed report.
+/// One row of the detailed report: `point.error` is the interior err/none.
 #[derive(Clone, Debug, Serialize)]
 pub struct EvalRow {
     #[serde(flatten)]
     pub point: EvalPoint,
     pub skin_pixels: usize,
     pub frame_ms: f64,
+    /// Relative RMSE over all skin (what the chart ranked by before the bands).
+    pub rel_rmse_all_skin: f64,
+    /// err/none, gain, FLIP and relative RMSE per band.
+    pub bands: BandErrors,
 }
 
 pub struct EvalOptions {
@@ -157,9 +162,12 @@ pub fn sweep(
         base.light.azimuth_deg = spec.azimuth_deg;
         base.light.elevation_deg = spec.elevation_deg;
         let once = RunOptions::capture_once("eval");
-        if let Some(b) = &bar {
-            b.set_message(format!("{}: reference", spec.name));
-        }
+        let step = |what: &str| {
+            if let Some(b) = &bar {
+                b.set_message(format!("{}: {what}", spec.name));
+            }
+        };
+        step("reference");
         let reference = run(
             ctx,
             &scene,
@@ -169,19 +177,39 @@ pub fn sweep(
             },
             &once,
         )?;
-        let ref_diffuse = reference.capture.context("reference capture")?.diffuse;
-        let mask: Vec<bool> = ref_diffuse.iter().map(|p| p[3] > 0.0).collect();
+        let view = (
+            reference.report.width as usize,
+            reference.report.height as usize,
+        );
+        let (fovy, mm_per_unit) = (reference.report.fovy_deg, reference.report.mm_per_unit);
+        let reference = reference.capture.context("reference capture")?;
+        // The no-SSS frame every err/none and gain is relative to.
+        let none = run(
+            ctx,
+            &scene,
+            &RenderSettings {
+                method: lookup("none")?,
+                ..base.clone()
+            },
+            &once,
+        )?
+        .capture
+        .context("no-SSS capture")?
+        .diffuse;
+        let mask: Vec<bool> = reference.diffuse.iter().map(|p| p[3] > 0.0).collect();
         let skin = mask.iter().filter(|&&m| m).count();
+        let band_of = bands(&BandInput::for_view(
+            view,
+            &mask,
+            &reference.depth,
+            fovy,
+            mm_per_unit,
+        ));
         if let Some(b) = &bar {
             b.inc(1);
         }
         for c in configs {
-            if let Some(b) = &bar {
-                b.set_message(format!(
-                    "{}: {} {}",
-                    spec.name, c.method.name, c.setting.label
-                ));
-            }
+            step(&format!("{} {}", c.method.name, c.setting.label));
             let s = base.clone().with(c.method, c.setting.options);
             let o = RunOptions {
                 warmup: opts.warmup,
@@ -192,10 +220,18 @@ pub fn sweep(
             let out = run(ctx, &scene, &s, &o).with_context(|| {
                 format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
             })?;
-            let diffuse = out.capture.context("capture")?.diffuse;
+            let cap = out.capture.context("capture")?;
+            let flip = flip_ldr(&cap.ldr, &reference.ldr, cap.width, cap.height)?;
+            let band_errors = BandErrors::of(
+                &cap.diffuse,
+                &reference.diffuse,
+                Some(&none),
+                &flip.error_map,
+                &band_of,
+            );
             // With no skin in view there is nothing to score.
-            let error = if skin > 0 {
-                relative_rmse(&diffuse, &ref_diffuse, &mask)?
+            let rel_rmse = if skin > 0 {
+                relative_rmse(&cap.diffuse, &reference.diffuse, &mask)?
             } else {
                 0.0
             };
@@ -205,10 +241,12 @@ pub fn sweep(
                     setting: c.setting.label.to_string(),
                     scene: spec.name.clone(),
                     gpu_ms: out.report.sss_total_ms.map_or(0.0, |s| s.median),
-                    error,
+                    error: band_errors.interior.err_none.unwrap_or(0.0),
                 },
                 skin_pixels: skin,
                 frame_ms: out.report.frame.map_or(0.0, |f| f.gpu_ms.median),
+                rel_rmse_all_skin: rel_rmse,
+                bands: band_errors,
             });
             if let Some(b) = &bar {
                 b.inc(1);
@@ -221,23 +259,73 @@ pub fn sweep(
     Ok(rows)
 }
 
-/// The summary as the CLI prints it.
-pub fn summary_table(summary: &[EvalPoint]) -> String {
+/// The summary as the CLI prints it: cost, then err/none per band and the
+/// interior's per-channel gain and FLIP.
+pub fn summary_table(summary: &[SummaryRow]) -> String {
     let mut s = format!(
-        "{:<12} {:<26} {:>10} {:>12}\n",
-        "method", "setting", "SSS ms", "rel. RMSE"
+        "{:<12} {:<26} {:>8} {:>9} {:>9} {:>9} {:>17} {:>7}\n",
+        "method", "setting", "SSS ms", "interior", "silhou.", "d.step", "gain R/G/B", "FLIP"
     );
-    for p in summary {
+    s.push_str(&format!(
+        "{:<12} {:<26} {:>8} {:>29} {:>17} {:>7}\n",
+        "", "", "", "--- err/none ---", "-- interior --", "interior"
+    ));
+    for r in summary {
+        let [i, si, d] = Band::ALL.map(|b| r.band(b).err_none);
+        let g = r.interior.gain;
         s.push_str(&format!(
-            "{:<12} {:<26} {:>10.4} {:>12.4e}\n",
-            p.method, p.setting, p.gpu_ms, p.error
+            "{:<12} {:<26} {:>8.4} {:>9.3} {:>9.3} {:>9.3} {:>5.2}/{:>5.2}/{:>5.2} {:>7.4}\n",
+            r.method, r.setting, r.gpu_ms, i, si, d, g[0], g[1], g[2], r.interior.flip
         ));
     }
     s
 }
 
-/// Mean cost and error of each (method, setting) over the scenes, for the chart.
-pub fn summarise(rows: &[EvalRow]) -> Vec<EvalPoint> {
+/// A band's errors averaged over the scenes where the band has pixels.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct BandMean {
+    /// Scenes in which the band had pixels.
+    pub scenes: usize,
+    pub err_none: f64,
+    pub gain: [f64; 3],
+    pub flip: f64,
+    pub rel_rmse: f64,
+}
+
+/// One (method, setting) over the scene set.
+#[derive(Clone, Debug, Serialize)]
+pub struct SummaryRow {
+    pub method: String,
+    pub setting: String,
+    pub gpu_ms: f64,
+    pub interior: BandMean,
+    pub silhouette: BandMean,
+    pub depth_step: BandMean,
+}
+
+impl SummaryRow {
+    pub fn band(&self, band: Band) -> &BandMean {
+        match band {
+            Band::Interior => &self.interior,
+            Band::Silhouette => &self.silhouette,
+            Band::DepthStep => &self.depth_step,
+        }
+    }
+
+    /// The chart's point for `band`: mean cost against the band's err/none.
+    pub fn point(&self, band: Band) -> EvalPoint {
+        EvalPoint {
+            method: self.method.clone(),
+            setting: self.setting.clone(),
+            scene: "mean over scenes".into(),
+            gpu_ms: self.gpu_ms,
+            error: self.band(band).err_none,
+        }
+    }
+}
+
+/// Mean cost and per-band errors of each (method, setting) over the scenes.
+pub fn summarise(rows: &[EvalRow]) -> Vec<SummaryRow> {
     let mut keys: Vec<(String, String)> = Vec::new();
     for r in rows {
         let k = (r.point.method.clone(), r.point.setting.clone());
@@ -251,11 +339,29 @@ pub fn summarise(rows: &[EvalRow]) -> Vec<EvalPoint> {
                 .iter()
                 .filter(|r| r.point.method == method && r.point.setting == setting)
                 .collect();
-            let n = sel.len() as f64;
-            EvalPoint {
-                gpu_ms: sel.iter().map(|r| r.point.gpu_ms).sum::<f64>() / n,
-                error: sel.iter().map(|r| r.point.error).sum::<f64>() / n,
-                scene: "mean over scenes".into(),
+            let mean_band = |band: Band| {
+                let with: Vec<_> = sel
+                    .iter()
+                    .map(|r| r.bands.get(band))
+                    .filter(|e| e.pixels > 0)
+                    .collect();
+                let n = with.len().max(1) as f64;
+                let sum = |f: &dyn Fn(&super::bands::BandError) -> f64| {
+                    with.iter().map(|e| f(e)).sum::<f64>() / n
+                };
+                BandMean {
+                    scenes: with.len(),
+                    err_none: sum(&|e| e.err_none.unwrap_or(0.0)),
+                    gain: [0, 1, 2].map(|c| sum(&|e| e.gain.map_or(0.0, |g| g[c]))),
+                    flip: sum(&|e| e.flip),
+                    rel_rmse: sum(&|e| e.rel_rmse),
+                }
+            };
+            SummaryRow {
+                gpu_ms: sel.iter().map(|r| r.point.gpu_ms).sum::<f64>() / sel.len() as f64,
+                interior: mean_band(Band::Interior),
+                silhouette: mean_band(Band::Silhouette),
+                depth_step: mean_band(Band::DepthStep),
                 method,
                 setting,
             }
@@ -320,7 +426,14 @@ mod tests {
 
     #[test]
     fn summary_averages_per_setting() {
-        let row = |scene: &str, ms: f64, e: f64| EvalRow {
+        use super::super::bands::BandError;
+        let band = |pixels, e: f64| BandError {
+            pixels,
+            err_none: Some(e),
+            gain: Some([e, 1.0, 1.0]),
+            ..Default::default()
+        };
+        let row = |scene: &str, ms: f64, e: f64, depth_step_pixels| EvalRow {
             point: EvalPoint {
                 method: "m".into(),
                 setting: "s".into(),
@@ -330,9 +443,23 @@ mod tests {
             },
             skin_pixels: 1,
             frame_ms: 0.0,
+            rel_rmse_all_skin: 0.0,
+            bands: BandErrors {
+                interior: band(10, e),
+                silhouette: band(3, 2.0 * e),
+                depth_step: band(depth_step_pixels, 5.0),
+            },
         };
-        let s = summarise(&[row("a", 1.0, 0.1), row("b", 3.0, 0.3)]);
+        let s = summarise(&[row("a", 1.0, 0.1, 0), row("b", 3.0, 0.3, 2)]);
         assert_eq!(s.len(), 1);
-        assert!((s[0].gpu_ms - 2.0).abs() < 1e-12 && (s[0].error - 0.2).abs() < 1e-12);
+        assert!((s[0].gpu_ms - 2.0).abs() < 1e-12);
+        assert!((s[0].interior.err_none - 0.2).abs() < 1e-12);
+        assert!((s[0].point(Band::Interior).error - 0.2).abs() < 1e-12);
+        assert!((s[0].silhouette.err_none - 0.4).abs() < 1e-12);
+        assert!((s[0].interior.gain[0] - 0.2).abs() < 1e-12);
+        // A band without pixels in a scene does not pull its mean to zero.
+        assert_eq!(s[0].depth_step.scenes, 1);
+        assert!((s[0].depth_step.err_none - 5.0).abs() < 1e-12);
+        assert!(summary_table(&s).contains("interior"));
     }
 }

@@ -111,8 +111,8 @@ pub fn gather_f64(
                         let e = (-r2 / (2.0 * SIX_GAUSSIAN_VARIANCES_MM2[g] as f64)).exp()
                             * p[3] as f64;
                         norm[g] += e;
-                        for ch in 0..3 {
-                            sum[g][ch] += e * surface.radiance[q][ch] as f64;
+                        for (s, &l) in sum[g].iter_mut().zip(&surface.radiance[q][..3]) {
+                            *s += e * l as f64;
                         }
                     }
                 }
@@ -158,7 +158,8 @@ pub fn gather_f64(
             for (g, w) in wide.iter().enumerate() {
                 if w[3] > 0.0 {
                     for ch in 0..3 {
-                        acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[NARROW_GAUSSIANS + g][ch] as f64 * w[ch]
+                        acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[NARROW_GAUSSIANS + g][ch] as f64
+                            * w[ch]
                             / w[3];
                     }
                 }

@@ -38,7 +38,8 @@ pub fn sigma_mm(i: usize) -> f32 {
 /// (Gaussian 1 holds little of the light moved: w_1 sigma_1 is 12-18% of green's
 /// and blue's moved energy), at most [`MAX_SUPERSAMPLING`].
 pub fn supersampling(px_per_mm: f32) -> u32 {
-    if !(px_per_mm > 0.0) {
+    // NaN and non-positive scales (no skin in view) need no supersampling.
+    if px_per_mm.is_nan() || px_per_mm <= 0.0 {
         return 1;
     }
     let need = SAMPLES_PER_SIGMA / (px_per_mm * sigma_mm(1));

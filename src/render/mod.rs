@@ -39,6 +39,9 @@ pub struct Capture {
     /// The diffuse light after SSS (what the composite reads), linear float;
     /// alpha is the SSS strength, so alpha > 0 marks skin.
     pub diffuse: Vec<[f32; 4]>,
+    /// Linear view depth of every pixel, scene units (where the accuracy
+    /// bands find depth steps).
+    pub depth: Vec<f32>,
 }
 
 /// The submission objects of a renderer.
@@ -296,6 +299,11 @@ impl<'c> Renderer<'c> {
             .filter(|s| s.role != PassRole::Readback)
             .collect();
         let diffuse = self.read_back(self.method.output())?;
+        let depth = self
+            .read_back(self.frame.targets.linear_depth)?
+            .iter()
+            .map(|p| p[0])
+            .collect();
         Ok(Capture {
             ldr,
             width: self.frame.extent.width,
@@ -303,6 +311,7 @@ impl<'c> Renderer<'c> {
             dumps,
             samples,
             diffuse,
+            depth,
         })
     }
 
