@@ -18,6 +18,7 @@ pub mod region;
 pub mod screen;
 pub mod separable;
 pub mod ssg;
+pub mod tsd;
 
 use std::any::Any;
 
@@ -240,6 +241,8 @@ pub static METHODS: &[&MethodEntry] = &[
     &ssg::ENTRY,
     &jittered::ENTRY,
     &poisson::ENTRY,
+    &tsd::ENTRY,
+    &tsd::OPT_ENTRY,
     &reference::ENTRY,
     &none::ENTRY,
 ];

@@ -19,3 +19,4 @@ pub mod ssg;
 pub mod ssg_ref;
 pub mod texel;
 pub mod transmittance;
+pub mod tsd_ref;

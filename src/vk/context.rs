@@ -61,6 +61,9 @@ pub struct DeviceFacts {
     /// Whether fragment shaders may write storage buffers (enabled when present:
     /// the fetch-counting build of the shaders needs it).
     pub fragment_stores_and_atomics: bool,
+    /// Whether shaders may write clip distances (enabled when present:
+    /// texture-space diffusion clips its unwrapped meshes with them).
+    pub shader_clip_distance: bool,
 }
 
 /// Validation messages collected by the debug messenger. Any message is an error:
@@ -355,6 +358,9 @@ impl Context {
             .independent_blend(features.independent_blend == vk::TRUE)
             // The fetch-counting build of the shaders counts with atomics.
             .fragment_stores_and_atomics(features.fragment_stores_and_atomics == vk::TRUE)
+            // Texture-space diffusion clips its unwrapped meshes by the view
+            // frustum with clip distances (thesis eq. 3.4).
+            .shader_clip_distance(features.shader_clip_distance == vk::TRUE)
             .sampler_anisotropy(false);
         let mut features2 = vk::PhysicalDeviceFeatures2::default().features(base_features);
         let device_info = vk::DeviceCreateInfo::default()
@@ -420,6 +426,7 @@ impl Context {
                     .unwrap_or(0)
             },
             fragment_stores_and_atomics: features.fragment_stores_and_atomics == vk::TRUE,
+            shader_clip_distance: features.shader_clip_distance == vk::TRUE,
         };
 
         let ctx = Context {
