@@ -394,6 +394,7 @@ impl Reference {
                 height: (texels / RADIANCE_WIDTH as u64) as u32,
                 triangles: draws,
                 msaa: 1,
+                clears: vec![],
             });
         for c in &self.chunks {
             pass = pass
@@ -438,6 +439,7 @@ fn material_fetch(texture: &str) -> Fetch {
         filter: Filter::Bilinear,
         count: 1.0,
         exact: false,
+        coherent: true,
     }
 }
 
