@@ -166,6 +166,42 @@ fn every_method_is_priced_on_the_xbox_360() {
     assert_eq!(methods, registered, "every registered method is priced");
 }
 
+/// A new-format bench report (what the H200 matrix will commit) reads back
+/// into the model's frame: every pass with its role and work.
+#[test]
+fn a_bench_report_reads_back_as_a_frame() {
+    let out = tmp("bench");
+    let report = out.join("r.json");
+    let o = dermis()
+        .args([
+            "bench",
+            "--device",
+            "llvmpipe",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--shadow-size",
+            "128",
+            "--warmup",
+            "0",
+            "--frames",
+            "1",
+            "--method",
+            "poisson",
+            "--report",
+        ])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rec = dermis::budget::record::RunRecord::load(&report).unwrap();
+    let f = dermis::budget::record::frame_from_record(&rec, None, "bench").unwrap();
+    assert_eq!(f.passes.len(), rec.passes.len());
+    assert!(f.passes.iter().all(|p| p.measured_ms.is_some()));
+    assert!(f.provenance[1].contains("declared"));
+}
+
 #[test]
 fn a_bad_profile_is_one_error_line() {
     let out = tmp("bad");

@@ -7,8 +7,10 @@
 #               counted fetches; the H100's own counts and times come from the report)
 #   matrix/     tools/bench_matrix.sh's configurations, paired with docs/perf/h200/ (or any
 #               directory of new-format bench reports of that matrix)
+#   porting/    docs/budget.md's frames: the head at 1280x720, 1/3/5 characters, close/mid/far,
+#               every real-time method (h{N}_{shot}_{method}.json)
 #
-#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix (default: all)
+#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix porting (default: all)
 #
 # BIN defaults to target/release/dermis. Existing frames are kept (delete to redo).
 set -uo pipefail
@@ -17,7 +19,7 @@ shift || true
 ASSET=${ASSET:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 D=docs/budget/frames
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix)
+[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting)
 
 # frame DIR NAME dermis-budget-args...: one frame on lavapipe.
 frame() {
@@ -95,11 +97,52 @@ matrix() {
   DEADLINE=100000 tools/bench_matrix.sh "$BIN" "$D/matrix" --frames
 }
 
+porting() {
+  mkdir -p "$D/porting"
+  for h in 1 3 5; do
+    for shot in close mid far; do
+      local name="h${h}_${shot}"
+      ls "$D/porting/${name}_"*.json > /dev/null 2>&1 && continue
+      local tmp
+      tmp=$(mktemp -d)
+      if "$BIN" budget --device llvmpipe --profile xbox360 --compare-methods --warmup 0 --frames 1 \
+          --scene "$ASSET" --width 1280 --height 720 --heads "$h" --shot "$shot" \
+          --out "$tmp" > "$tmp/log.txt" 2>&1; then
+        for f in "$tmp"/frames/*.json; do cp "$f" "$D/porting/${name}_$(basename "$f")"; done
+        echo "ok: porting/$name"
+      else
+        echo "FAILED: porting/$name: $(tail -1 "$tmp/log.txt")" >&2
+      fi
+      rm -rf "$tmp"
+    done
+  done
+  # What a port of the separable method would ship: 9 samples, no depth taps (the SSSS
+  # demo's default).
+  for h in 1 3 5; do
+    for shot in close mid far; do
+      local target="$D/porting/h${h}_${shot}_separable-s9nf.json"
+      [ -e "$target" ] && continue
+      local tmp
+      tmp=$(mktemp -d)
+      if "$BIN" budget --device llvmpipe --profile xbox360 --warmup 0 --frames 1 --scene "$ASSET" \
+          --width 1280 --height 720 --heads "$h" --shot "$shot" --samples 9 --no-follow-surface \
+          --out "$tmp" > "$tmp/log.txt" 2>&1; then
+        cp "$tmp/frames/separable.json" "$target"
+        echo "ok: $target"
+      else
+        echo "FAILED: $target: $(tail -1 "$tmp/log.txt")" >&2
+      fi
+      rm -rf "$tmp"
+    done
+  done
+}
+
 for p in "${parts[@]}"; do
   case $p in
     published) published ;;
     h100) h100 ;;
     matrix) matrix ;;
-    *) echo "unknown part '$p' (valid: published h100 matrix)" >&2; exit 2 ;;
+    porting) porting ;;
+    *) echo "unknown part '$p' (valid: published h100 matrix porting)" >&2; exit 2 ;;
   esac
 done

@@ -578,7 +578,21 @@ mod tests {
         }
         let c = calibrate(&pts);
         println!("{}", markdown(&c, std::env::var_os("ALL_ROWS").is_some()));
-        println!("fitted (all points): {:#?}", c.fitted_all);
+        // Ready to paste into params.rs when the points change.
+        let f = |m: &ModelParams| {
+            let v = m.to_vec();
+            format!(
+                "ModelParams {{ texture_scale: {:.5}, alu_scale: {:.5}, fill_scale: {:.5}, \
+                 memory_scale: {:.5}, reject_scale: {:.5}, hiz_reject_scale: {:.5}, \
+                 incoherent_factor: {:.5}, fixed_kpix_per_pass: {:.5}, rect_kpix: {:.5} }}",
+                v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]
+            )
+        };
+        println!(
+            "pub const FITTED: ParamSet = ParamSet {{ peak: {}, probed: {} }};",
+            f(&c.fitted_all.peak),
+            f(&c.fitted_all.probed)
+        );
         println!("fitted (probed, first benchmark half): {:?}", c.fitted_half);
         let mut worst: Vec<(&Row, &Priced)> = c
             .rows

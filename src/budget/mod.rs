@@ -12,7 +12,8 @@
 //! frames, the pairing of bench reports with them, the transformations into
 //! the implementations the sources timed, first-principles frames),
 //! [`points`] (the published and benchmark points), [`calibration`] (fit,
-//! held-out scores), [`table`] (the printed table).
+//! held-out scores), [`porting`] (docs/budget.md's tables), [`table`] (the
+//! printed table).
 //!
 //! With a device: [`run`] (`dermis budget`: run, count fetches, price, print,
 //! write) and [`chart`] (the stacked-bar chart).
@@ -25,6 +26,7 @@ pub mod input;
 pub mod model;
 pub mod params;
 pub mod points;
+pub mod porting;
 pub mod profile;
 pub mod record;
 pub mod run;

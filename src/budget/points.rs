@@ -23,9 +23,11 @@ use crate::budget::frames::{
 use crate::budget::input::FrameInput;
 use crate::budget::record::{frame_from_record, RunRecord};
 
-/// Directories of new-format bench reports under `docs/perf/`, with the
-/// profile of the GPU that ran them; a missing one contributes nothing.
-pub const BENCH_DIRS: &[(&str, &str)] = &[("h200", "nvidia-h200")];
+/// Directories of new-format bench reports under `docs/perf/`: (directory,
+/// profile of the GPU that ran them, a word its device name must contain).
+/// A missing directory contributes nothing; a report from another device is
+/// left out (named in the skipped list).
+pub const BENCH_DIRS: &[(&str, &str, &str)] = &[("h200", "nvidia-h200", "H200")];
 
 /// Where a point comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -260,13 +262,18 @@ pub fn benchmark() -> Result<(Vec<Point>, Vec<String>)> {
             Err(e) => skipped.push(format!("h100/{name}: {e:#}")),
         }
     }
-    for (dir, profile) in BENCH_DIRS {
+    for (dir, profile, device) in BENCH_DIRS {
         let set = dir.to_uppercase();
         let source = format!("docs/perf/{dir}");
         for path in json_files(&perf_dir().join(dir))? {
             let name = path.file_stem().unwrap_or_default().to_string_lossy();
             let frame = RunRecord::load(&path)
-                .and_then(|r| frame_from_record(&r, None, &name))
+                .and_then(|r| {
+                    if !r.device.contains(device) {
+                        anyhow::bail!("run on {}, not an {device}", r.device);
+                    }
+                    frame_from_record(&r, None, &name)
+                })
                 .with_context(|| format!("{dir}/{name}"));
             let frame = match frame {
                 Ok(f) => f,
