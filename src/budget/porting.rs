@@ -106,6 +106,50 @@ pub fn summary_table(
     Ok(s)
 }
 
+/// One row per configuration, one column per method: skin SSS ms (frame ms),
+/// marked when the skin fits `skin_budget_ms`.
+pub fn compact_table(
+    profile: &str,
+    frames: &[(String, String, FrameInput)],
+    skin_budget_ms: f64,
+) -> Result<String> {
+    let prof = Profile::load(profile)?;
+    let set = ParamSet::fitted();
+    let mut methods: Vec<&str> = Vec::new();
+    let mut configs: Vec<&str> = Vec::new();
+    for (c, m, _) in frames.iter().filter(|f| f.1 != "none") {
+        if !methods.contains(&m.as_str()) {
+            methods.push(m);
+        }
+        if !configs.contains(&c.as_str()) {
+            configs.push(c);
+        }
+    }
+    let mut s = format!("| characters, shot | {} |\n", methods.join(" | "));
+    s.push_str(&format!("|---|{}\n", "---|".repeat(methods.len())));
+    for c in &configs {
+        let mut row = format!("| {c} |");
+        for m in &methods {
+            let cell = match frames.iter().find(|f| f.0 == *c && f.1 == *m) {
+                Some((_, _, f)) => {
+                    let b = price_frame(&prof, f, &set, Rescale::ToProfile);
+                    let fits = if b.sss_ms <= skin_budget_ms {
+                        " ok"
+                    } else {
+                        ""
+                    };
+                    format!(" {:.2} ({:.1}){fits} |", b.sss_ms, b.total_ms)
+                }
+                None => " - |".into(),
+            };
+            row.push_str(&cell);
+        }
+        s.push_str(&row);
+        s.push('\n');
+    }
+    Ok(s)
+}
+
 /// Per pass of one frame on `profile`: role, ms, bound, tiles, resolves.
 pub fn pass_table(profile: &str, f: &FrameInput) -> Result<String> {
     let prof = Profile::load(profile)?;
@@ -166,8 +210,15 @@ mod tests {
             !frames.is_empty(),
             "run tools/budget_frames.sh porting first"
         );
+        println!(
+            "### xbox360\n\n{}",
+            summary_table("xbox360", &frames, 2.0).unwrap()
+        );
         for p in ["xbox360", "switch-handheld", "switch-docked", "steam-deck"] {
-            println!("### {p}\n\n{}", summary_table(p, &frames, 2.0).unwrap());
+            println!(
+                "### {p} (compact)\n\n{}",
+                compact_table(p, &frames, 2.0).unwrap()
+            );
         }
         for (config, method, f) in &frames {
             if config == "h1 mid" && method != "none" {
