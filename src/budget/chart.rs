@@ -125,21 +125,27 @@ fn draw_panel<DB: DrawingBackend>(
         panel.profile, panel.skin_budget_ms
     );
     let labels: Vec<String> = panel.bars.iter().map(|b| b.label.clone()).collect();
+    // Bar i is centred on x = i; the labels sit at the integers.
+    let x = -0.5..(n as f64 - 0.5);
     let mut chart = ChartBuilder::on(area)
         .caption(caption, ("sans-serif", 20))
         .margin(14)
         .x_label_area_size(70)
         .y_label_area_size(60)
-        .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+        .build_cartesian_2d(x, 0.0..top)
         .map_err(plot_err)?;
-    let fmt = move |v: &SegmentValue<usize>| match v {
-        SegmentValue::CenterOf(i) => labels.get(*i).cloned().unwrap_or_default(),
-        _ => String::new(),
+    let fmt = move |v: &f64| {
+        let i = v.round();
+        if (v - i).abs() < 1e-6 && i >= 0.0 {
+            labels.get(i as usize).cloned().unwrap_or_default()
+        } else {
+            String::new()
+        }
     };
     chart
         .configure_mesh()
         .disable_x_mesh()
-        .x_labels(n + 1)
+        .x_labels(n)
         .x_label_formatter(&fmt)
         .y_desc("modelled GPU ms")
         .axis_desc_style(("sans-serif", 18))
@@ -149,23 +155,14 @@ fn draw_panel<DB: DrawingBackend>(
         .map_err(plot_err)?;
     for (s, name) in SEGMENTS.iter().enumerate() {
         let colour = COLOURS[s % COLOURS.len()];
-        let rects: Vec<Rectangle<(SegmentValue<usize>, f64)>> = panel
-            .bars
-            .iter()
-            .enumerate()
-            .map(|(i, b)| {
-                let y0: f64 = b.segments[..s].iter().sum();
-                let mut r = Rectangle::new(
-                    [
-                        (SegmentValue::Exact(i), y0),
-                        (SegmentValue::Exact(i + 1), y0 + b.segments[s]),
-                    ],
-                    colour.filled(),
-                );
-                r.set_margin(0, 0, 14, 14);
-                r
-            })
-            .collect();
+        let rects = panel.bars.iter().enumerate().map(|(i, b)| {
+            let y0: f64 = b.segments[..s].iter().sum();
+            let c = i as f64;
+            Rectangle::new(
+                [(c - 0.35, y0), (c + 0.35, y0 + b.segments[s])],
+                colour.filled(),
+            )
+        });
         let series = chart.draw_series(rects).map_err(plot_err)?;
         if legend {
             series.label(*name).legend(move |(x, y)| {
@@ -176,7 +173,7 @@ fn draw_panel<DB: DrawingBackend>(
     let totals = panel.bars.iter().enumerate().map(|(i, b)| {
         Text::new(
             format!("{:.2}", b.total()),
-            (SegmentValue::CenterOf(i), b.total() + top * 0.01),
+            (i as f64, b.total() + top * 0.01),
             ("sans-serif", 15)
                 .into_font()
                 .color(&BLACK)
@@ -187,10 +184,7 @@ fn draw_panel<DB: DrawingBackend>(
     let line = ShapeStyle::from(&RGBColor(200, 0, 0)).stroke_width(2);
     let budget = chart
         .draw_series(LineSeries::new(
-            [
-                (SegmentValue::Exact(0), panel.frame_ms),
-                (SegmentValue::Last, panel.frame_ms),
-            ],
+            [(-0.5, panel.frame_ms), (n as f64 - 0.5, panel.frame_ms)],
             line,
         ))
         .map_err(plot_err)?;
