@@ -8,13 +8,15 @@
 //! `scene`, `skin`, `reference` (pure CPU: meshes, framing, profiles, kernels,
 //! CPU references, the ground truth's sampling) -> `method` (the SSS methods,
 //! one module each behind one trait, and their registry) -> `render` (the frame
-//! around a method) -> `report`, `bench`, `run` (runs, statistics, floors) ->
+//! around a method) -> `report`, `bench`, `run`, `budget`, `plot` (runs, statistics, floors,
+//! the console budget model, the chart writer) ->
 //! `eval` (ground-truth comparisons, charts). `main.rs` parses arguments only.
 pub mod bench;
 pub mod budget;
 pub mod eval;
 pub mod graph;
 pub mod method;
+pub mod plot;
 pub mod reference;
 pub mod render;
 pub mod report;

@@ -7,6 +7,8 @@ use std::process::ExitCode;
 use anyhow::{bail, Result};
 use clap::{Arg, ArgAction, ArgMatches, Args, Parser, Subcommand, ValueEnum};
 
+use dermis::budget::run::BudgetOptions;
+use dermis::budget::Rescale;
 use dermis::eval::{study, sweep};
 use dermis::method::{all_options, foreign_options, ground_truth, lookup, MethodOptions, OptKind};
 use dermis::render::RenderSettings;
@@ -102,6 +104,34 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         warmup: usize,
         #[arg(long, default_value_t = 10)]
+        frames: usize,
+    },
+    /// Price the frame on hardware budget profiles (profiles/*.toml): runs it on this
+    /// device (lavapipe included) and again with the fetch-counting build, prints each
+    /// pass's modelled ms, bound, eDRAM tiles and resolves, shares of the frame and of
+    /// the skin budget beside the ms measured here, and writes DIR/budget.json,
+    /// DIR/frames/METHOD.json and the stacked-bar chart DIR/budget.png and .svg.
+    Budget {
+        #[command(flatten)]
+        common: Common,
+        /// Profile name (profiles/NAME.toml) or path; several (repeated or comma-separated)
+        /// price the same frame on each target side by side.
+        #[arg(long = "profile", required = true, value_delimiter = ',')]
+        profiles: Vec<String>,
+        /// Run every registered method and chart their frames side by side.
+        #[arg(long)]
+        compare_methods: bool,
+        #[arg(long, default_value = "out/budget")]
+        out: PathBuf,
+        /// Price at the run's resolution instead of rescaling the counts to the profile's.
+        #[arg(long)]
+        as_run: bool,
+        /// Keep the declared fetch counts (skip the fetch-counting run).
+        #[arg(long)]
+        declared_fetches: bool,
+        #[arg(long, default_value_t = 1)]
+        warmup: usize,
+        #[arg(long, default_value_t = 3)]
         frames: usize,
     },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
@@ -325,8 +355,8 @@ impl Common {
         }
     }
 
-    fn context(&self) -> Result<Context> {
-        Context::new(&ContextDesc {
+    fn context_desc(&self) -> ContextDesc {
+        ContextDesc {
             device: self
                 .device
                 .as_deref()
@@ -334,7 +364,11 @@ impl Common {
                 .unwrap_or_default(),
             validate: self.validate,
             ..Default::default()
-        })
+        }
+    }
+
+    fn context(&self) -> Result<Context> {
+        Context::new(&self.context_desc())
     }
 }
 
@@ -437,6 +471,33 @@ fn main_result() -> Result<()> {
             }
             println!("wrote {}", report.display());
         }
+        Command::Budget {
+            common,
+            profiles,
+            compare_methods,
+            out,
+            as_run,
+            declared_fetches,
+            warmup,
+            frames,
+        } => {
+            let opts = BudgetOptions {
+                profiles,
+                compare_methods,
+                out,
+                warmup,
+                measured: frames,
+                rescale: if as_run {
+                    Rescale::AsRun
+                } else {
+                    Rescale::ToProfile
+                },
+                count_fetches: !declared_fetches,
+                print: true,
+                command: command_line(),
+            };
+            budget(&common, &opts)?;
+        }
         Command::Kernel {
             samples,
             preset,
@@ -498,6 +559,22 @@ fn render(
         out.join("frame.png").display(),
         out.join("diffuse.exr").display(),
         out.join("report.json").display()
+    );
+    Ok(())
+}
+
+fn budget(common: &Common, opts: &BudgetOptions) -> Result<()> {
+    let settings = common.settings()?;
+    if !opts.compare_methods {
+        warn_foreign(&settings);
+    }
+    let scene = common.scene()?;
+    let r = dermis::budget::run::budget(&common.context_desc(), &scene, &settings, opts)?;
+    println!(
+        "priced {} method(s) on {} profile(s); wrote budget.json, frames/, budget.png and budget.svg in {}",
+        r.runs.len(),
+        r.profiles.len(),
+        opts.out.display()
     );
     Ok(())
 }

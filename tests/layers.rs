@@ -15,7 +15,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "skin", "reference"],
     &["method"],
     &["render"],
-    &["report", "bench", "run", "budget"],
+    &["report", "bench", "run", "budget", "plot"],
     &["eval"],
 ];
 

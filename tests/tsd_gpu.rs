@@ -627,73 +627,28 @@ fn optimisations_change_the_image_within_tolerance() {
 
 // --- The budget model -----------------------------------------------------------------
 
-/// A frame as the budget model prices it, from a renderer made with a
-/// fetch-counting context: each pass's declared work and images, its exact
-/// shaded fragments (the counting build's invocations), samples passed, and
-/// for `tsd` the clears its passes begin with and the texels its masked passes
-/// reject.
-fn frame_input(r: &mut Renderer, label: &str) -> dermis::budget::FrameInput {
-    use dermis::budget::{ClearInput, PassInput};
-    use dermis::graph::work_format;
-    let samples = r.frames(1, |_| {}).unwrap().remove(0);
-    let counted = r.count_fetches().unwrap();
-    let tsd_info = r.method_as::<Tsd>().map(|m| {
-        let fmt = |id| work_format(r.resources.format(id)).unwrap();
-        (
-            m.config.masked(),
-            m.maps,
-            m.characters.clone(),
-            fmt(m.maps.irradiance),
-            fmt(m.maps.stretch_u),
-            m.maps.mask.map(fmt),
-        )
-    });
-    let passes = r.passes();
-    let mut out = Vec::new();
-    for ((p, s), c) in passes.iter().zip(&samples).zip(&counted) {
-        let mut q = PassInput::new(
-            &p.name,
-            p.role,
-            p.work.clone().expect("frame passes declare work"),
-        );
-        q.images = r.resources.image_uses(&p.images);
-        q.fragments = c.invocations;
-        q.samples_passed = s.samples_passed;
-        if let Some((masked, _, chars, map_fmt, stretch_fmt, mask_fmt)) = &tsd_info {
-            let k: Option<usize> = p.name.rsplit(" c").next().and_then(|n| n.parse().ok());
-            if let Some(k) = k.filter(|_| p.name.starts_with("tsd ")) {
-                let texels = (chars[k].size as u64).pow(2);
-                let clear = |format| ClearInput { format, texels };
-                if p.name.starts_with("tsd mask") {
-                    q.clears.push(clear(mask_fmt.unwrap()));
-                } else if p.name.starts_with("tsd irradiance") {
-                    q.clears
-                        .extend([clear(*map_fmt), clear(*stretch_fmt), clear(*stretch_fmt)]);
-                } else if p.name.starts_with("tsd g1 u") && *masked {
-                    q.clears.push(clear(*map_fmt));
-                } else if p.name.starts_with("tsd g1 v") {
-                    q.clears.push(clear(*map_fmt));
-                    if *masked {
-                        q.clears.push(clear(*map_fmt));
-                    }
-                }
-                if *masked && !p.name.starts_with("tsd mask") {
-                    q.rasterized_pixels = Some(if p.name.starts_with("tsd g") {
-                        texels
-                    } else {
-                        c.invocations.max(s.samples_passed)
-                    });
-                }
-            }
-        }
-        out.push(q);
-    }
-    dermis::budget::FrameInput {
-        label: label.to_string(),
-        width: r.frame.extent.width,
-        height: r.frame.extent.height,
-        passes: out,
-    }
+/// A frame as `dermis budget` prices it: the run's report (declared work,
+/// its clears, the images, samples passed) with each pass's fetches and shaded
+/// fragments from the fetch-counting build.
+fn frame_input(
+    scene: &dermis::scene::Scene,
+    s: &RenderSettings,
+    label: &str,
+) -> dermis::budget::FrameInput {
+    use dermis::budget::run::{method_frame, BudgetOptions};
+    let (ctx, counting) = (common::ctx(), common::counting_ctx());
+    let opts = BudgetOptions {
+        profiles: Vec::new(),
+        compare_methods: false,
+        out: std::env::temp_dir(),
+        warmup: 0,
+        measured: 1,
+        rescale: dermis::budget::Rescale::AsRun,
+        count_fetches: true,
+        print: false,
+        command: label.to_string(),
+    };
+    method_frame(&ctx, Some(&counting), scene, s, &opts).expect("the budget's frame")
 }
 
 // Every texture-space pass of every character is priced on every hardware
@@ -701,14 +656,12 @@ fn frame_input(r: &mut Renderer, label: &str) -> dermis::budget::FrameInput {
 // before the next pass samples them.
 #[test]
 fn the_budget_model_prices_every_texture_space_pass_on_every_profile() {
-    use dermis::budget::model::{price_frame, ModelParams, Rescale};
     use dermis::budget::profile::{list_profiles, Profile};
-    let ctx = common::counting_ctx();
+    use dermis::budget::{price_frame, ParamSet, Rescale};
     let scene = dermis::scene::default_scene();
     let mut s = settings("tsd-opt", &[("irradiance-size", "128")], 96, 64, 3.0);
     s.heads = 2;
-    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-    let frame = frame_input(&mut r, "tsd-opt, 2 heads");
+    let frame = frame_input(&scene, &s, "tsd-opt, 2 heads");
     let per_character = frame
         .passes
         .iter()
@@ -719,7 +672,7 @@ fn the_budget_model_prices_every_texture_space_pass_on_every_profile() {
     assert!(profiles.len() >= 10, "{profiles:?}");
     for name in &profiles {
         let prof = Profile::load(name).unwrap();
-        let b = price_frame(&prof, &frame, &ModelParams::fitted(), Rescale::AsRun);
+        let b = price_frame(&prof, &frame, &ParamSet::fitted(), Rescale::AsRun);
         let mut tsd_ms = 0.0;
         for p in b.passes.iter().filter(|p| p.name.starts_with("tsd")) {
             let ms = p
@@ -754,14 +707,13 @@ fn the_budget_model_prices_every_texture_space_pass_on_every_profile() {
 #[test]
 #[ignore]
 fn table_4_4_shape_modelled() {
-    use dermis::budget::model::{price_frame, ModelParams, Rescale};
     use dermis::budget::profile::Profile;
+    use dermis::budget::{price_frame, ParamSet, Rescale};
     let Some(head) = common::lps_path() else {
         return;
     };
     let scene =
         dermis::scene::load_gltf_scene(&head, &Default::default(), None).expect("the head scan");
-    let ctx = common::counting_ctx();
     let profiles =
         ["geforce-8600m-gs", "xbox360", "nvidia-h200"].map(|p| Profile::load(p).unwrap());
     println!(
@@ -781,12 +733,11 @@ fn table_4_4_shape_modelled() {
             };
             let mut s = settings(m, opts, 1280, 720, 4.0);
             s.heads = heads;
-            let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-            let frame = frame_input(&mut r, m);
+            let frame = frame_input(&scene, &s, m);
             let ms: Vec<String> = profiles
                 .iter()
                 .map(|p| {
-                    let b = price_frame(p, &frame, &ModelParams::fitted(), Rescale::AsRun);
+                    let b = price_frame(p, &frame, &ParamSet::fitted(), Rescale::AsRun);
                     format!("{:.2}", b.total_ms)
                 })
                 .collect();

@@ -311,6 +311,7 @@ impl<'p> Probe<'p> {
                 filter,
                 count: PROBE_TAPS as f64,
                 exact: true,
+                coherent: true,
             }],
             None => Vec::new(),
         };
@@ -335,6 +336,7 @@ impl<'p> Probe<'p> {
             height: e.height,
             triangles: 1,
             msaa: 1,
+            clears: vec![],
         };
         Pass::new(name, PassRole::Probe)
             .image(target, self.access)

@@ -106,6 +106,7 @@ mod tests {
             filter,
             count,
             exact: true,
+            coherent: true,
         }
     }
 
@@ -122,6 +123,7 @@ mod tests {
             height: 1080,
             triangles: 1,
             msaa: 1,
+            clears: vec![],
         }
     }
 
@@ -207,6 +209,7 @@ mod tests {
         let copy = Work::Copy {
             texels: 10,
             bytes_per_texel: 8,
+            rects: 1,
         };
         assert_eq!(floor_ms(&copy, 100, &h100_like()), None);
     }

@@ -1,16 +1,10 @@
 //! What the model prices: a frame's passes as the renderer declared them
-//! (role, work, images) with the counts of one run.
+//! (role, work, images) with the counts of one run (`record` builds it from a
+//! run's report, with the fetch-counting build's counts where there are some).
 
 use serde::{Deserialize, Serialize};
 
-use crate::graph::work::{Format, ImageUse, PassRole, Work};
-
-/// Attachment texels a pass clears when it begins (load-op clears).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ClearInput {
-    pub format: Format,
-    pub texels: u64,
-}
+use crate::graph::work::{ImageUse, PassRole, Work};
 
 /// One pass of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -19,19 +13,17 @@ pub struct PassInput {
     pub role: PassRole,
     pub work: Work,
     pub images: Vec<ImageUse>,
-    /// Fragment-shader invocations (pipeline statistics): shaded fragments.
+    /// Shaded fragments (see `record::FRAGMENTS_RULE` for where they come from).
     pub fragments: u64,
     /// Samples that passed the depth/stencil tests (precise occlusion).
     pub samples_passed: u64,
     /// Pixels the pass's triangles cover before the early tests (stencil- or
     /// depth-rejected ones cost the Z rate). `None`: nothing is rejected.
     pub rasterized_pixels: Option<u64>,
-    /// Attachments cleared at the start of the pass.
-    pub clears: Vec<ClearInput>,
-    /// Textures whose taps are rotated per pixel, so neighbouring fragments
-    /// share no texels (ss-jittered): their fetches miss the texture cache.
-    /// Stands in for a field `work.rs` lacks (see docs/budget-calibration.md).
-    pub incoherent_textures: Vec<String>,
+    /// Whether the work's fetch counts are the fetch-counting build's
+    /// (fetches made / invocations) rather than the declared ones.
+    #[serde(default)]
+    pub fetches_counted: bool,
     /// GPU time measured for the pass, if the run measured it.
     pub measured_ms: Option<f64>,
 }
@@ -47,8 +39,7 @@ impl PassInput {
             fragments: 0,
             samples_passed: 0,
             rasterized_pixels: None,
-            clears: Vec::new(),
-            incoherent_textures: Vec::new(),
+            fetches_counted: false,
             measured_ms: None,
         }
     }
@@ -62,14 +53,17 @@ pub struct FrameInput {
     pub width: u32,
     pub height: u32,
     pub passes: Vec<PassInput>,
+    /// Where the fragment counts and fetch counts come from (`record`).
+    #[serde(default)]
+    pub provenance: Vec<String>,
 }
 
 /// The rescaling rule, written out for reports.
 pub const RESCALE_RULE: &str = "a pass whose render area (draws) or first image (copies, \
 clears, dispatches) is the frame's size halved k >= 0 times follows the screen: its \
-fragments, samples, rasterised pixels, clears, texels and invocations scale by the pixel \
-ratio (w'h')/(wh) and its sizes by w'/w and h'/h; other passes (shadow maps, LUTs) keep \
-their counts; triangle counts never scale";
+fragments, samples, rasterised pixels, texels and invocations scale by the pixel ratio \
+(w'h')/(wh) and its sizes (hence its clears) by w'/w and h'/h; other passes (shadow maps, \
+LUTs) keep their counts; triangle and rectangle counts never scale";
 
 fn follows_screen(w: u32, h: u32, fw: u32, fh: u32) -> bool {
     (0..=12).any(|k| w == fw.div_ceil(1 << k).max(1) && h == fh.div_ceil(1 << k).max(1))
@@ -111,9 +105,6 @@ impl FrameInput {
                 q.fragments = n(p.fragments);
                 q.samples_passed = n(p.samples_passed);
                 q.rasterized_pixels = p.rasterized_pixels.map(n);
-                for c in &mut q.clears {
-                    c.texels = n(c.texels);
-                }
                 match &mut q.work {
                     Work::Raster { width, height, .. } => {
                         *width = sz(*width, sx);
@@ -136,6 +127,7 @@ impl FrameInput {
             width,
             height,
             passes,
+            provenance: self.provenance.clone(),
         }
     }
 }
@@ -143,7 +135,7 @@ impl FrameInput {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::work::ImageUseKind;
+    use crate::graph::work::{Format, ImageUseKind};
 
     fn raster(w: u32, h: u32) -> Work {
         Work::Raster {
@@ -154,6 +146,7 @@ mod tests {
             height: h,
             triangles: 100,
             msaa: 1,
+            clears: vec![],
         }
     }
 
@@ -172,6 +165,7 @@ mod tests {
             Work::Copy {
                 texels: 2_073_600,
                 bytes_per_texel: 8,
+                rects: 1,
             },
         );
         copy.images.push(ImageUse {
@@ -186,6 +180,7 @@ mod tests {
             width: 1920,
             height: 1080,
             passes: vec![shadow, blur, mip, copy],
+            provenance: vec![],
         };
         let g = f.rescaled(1280, 720);
         assert_eq!(g.passes[0], f.passes[0]);

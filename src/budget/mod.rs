@@ -1,27 +1,41 @@
 //! Console budget model (issue 10): what the frame dermis renders would cost on
 //! a target GPU (Xbox 360, PS3, Switch, Steam Deck, the GPUs of the sources, the
-//! benchmark GPU), pass by pass, from the passes' declared work and the counts
-//! of a run, calibrated against published timings.
+//! benchmark GPUs), pass by pass, from the passes' declared work and the counts
+//! of a run, calibrated against published timings and bench reports.
 //!
-//! - [`profile`]: hardware profiles (`profiles/*.toml`), strict parsing.
-//! - [`input`]: the model's input ([`FrameInput`], [`PassInput`]) and the
-//!   rescaling rule to a profile's resolution.
-//! - [`edram`]: tiles, predicated tiling, resolves.
-//! - [`model`]: per-unit times, the combining rule, format substitution, the
-//!   JSON-ready results ([`FrameBudget`]).
-//! - [`calibration`]: the published points as data, frames for them, the fit
-//!   of the model's free parameters and its held-out scores.
+//! Pure (no device): [`profile`] (hardware profiles, `profiles/*.toml`, strict
+//! parsing), [`input`] (the model's input and the rescaling rule), [`record`]
+//! (a run's report read back, the fragments and fetch-count rules), [`edram`]
+//! (tiles, resolves), [`units`] (unit times of a pass and the combining rule),
+//! [`transfers`] (eDRAM resolves and restores over a frame), [`params`] (the
+//! fitted parameters), [`model`] (the priced frame), [`frames`] (stored
+//! frames, the pairing of bench reports with them, the transformations into
+//! the implementations the sources timed, first-principles frames),
+//! [`points`] (the published and benchmark points), [`calibration`] (fit,
+//! held-out scores), [`porting`] (docs/budget.md's tables), [`table`] (the
+//! printed table).
 //!
-//! The CLI's call: `Profile::load(name)?`, a `FrameInput` from a run, then
-//! [`model::price_frame`] with [`model::ModelParams::fitted`].
+//! With a device: [`run`] (`dermis budget`: run, count fetches, price, print,
+//! write) and [`chart`] (the stacked-bar chart).
 
 pub mod calibration;
+pub mod chart;
 pub mod edram;
 pub mod frames;
 pub mod input;
 pub mod model;
+pub mod params;
+pub mod points;
+pub mod porting;
 pub mod profile;
+pub mod record;
+pub mod run;
+pub mod table;
+pub mod transfers;
+pub mod units;
 
-pub use input::{ClearInput, FrameInput, PassInput};
-pub use model::{price_frame, Bound, FrameBudget, ModelParams, PassBudget, Rescale};
+pub use input::{FrameInput, PassInput};
+pub use model::{price_frame, FrameBudget, PassBudget, Rescale};
+pub use params::{ModelParams, ParamSet};
 pub use profile::Profile;
+pub use units::Bound;

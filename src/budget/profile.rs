@@ -233,6 +233,19 @@ pub struct Meta {
     pub name: String,
     pub description: String,
     pub kind: ProfileKind,
+    /// Where the rates come from: the model's efficiency parameters are
+    /// fitted apart for the two (a spec sheet's peak is not reached, a probe is).
+    pub rates: RateSource,
+}
+
+/// Where a profile's rates come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RateSource {
+    /// Spec sheets and unit counts: peak rates (the consoles, the sources' GPUs).
+    Peak,
+    /// Measured by `dermis bench`'s probes (the benchmark GPUs).
+    Probed,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

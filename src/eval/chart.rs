@@ -2,38 +2,22 @@
 //! with the Pareto front drawn through the settings worth using.
 //!
 //! Written as PNG (for a quick look and for reports that embed bitmaps) and SVG
-//! (sharp at any size, for papers). Text needs a font: plotters' `ab_glyph`
-//! backend is used because it is pure Rust (no fontconfig or freetype to link),
-//! with a TrueType font read from the system at run time (`DERMIS_FONT`, or
-//! DejaVu Sans / Liberation Sans from their usual places) rather than shipped
-//! in the repository.
+//! (sharp at any size, for papers), through `crate::plot` (the writer and the
+//! font every chart shares).
 
-use std::fs;
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::path::Path;
 
-use anyhow::{anyhow, bail, ensure, Context, Result};
+use anyhow::{ensure, Context as _, Result};
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::pareto::{pareto_front, EvalPoint};
+use crate::plot::{plot_err, write_png_svg, Plot, COLOURS};
 
 /// Pixel size of both outputs.
 const SIZE: (u32, u32) = (1200, 800);
-
-/// Marker colours, one per method in order of first appearance (Okabe-Ito:
-/// distinguishable with the common colour-vision deficiencies).
-const COLOURS: [RGBColor; 7] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-    RGBColor(120, 120, 120),
-];
 
 /// Marker shapes, cycled with the colours so methods differ also in grey print.
 #[derive(Clone, Copy)]
@@ -72,7 +56,7 @@ pub fn cost_error_chart(
         title,
         x_label,
     };
-    write_png_svg(&plot, png_path, svg_path)
+    write_png_svg(&plot, SIZE, png_path, svg_path)
 }
 
 /// One panel of a [`panel_chart`].
@@ -109,7 +93,8 @@ pub fn panel_chart(
         title,
         x_label,
     };
-    write_png_svg(&plot, png_path, svg_path)
+    let size = (600 * panels.len() as u32, SIZE.1);
+    write_png_svg(&plot, size, png_path, svg_path)
 }
 
 struct PanelPlot<'a> {
@@ -120,10 +105,6 @@ struct PanelPlot<'a> {
 }
 
 impl Plot for PanelPlot<'_> {
-    fn size(&self) -> (u32, u32) {
-        (600 * self.panels.len() as u32, SIZE.1)
-    }
-
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(plot_err)?;
         let inner = root
@@ -141,16 +122,6 @@ impl Plot for PanelPlot<'_> {
         }
         Ok(())
     }
-}
-
-/// A chart that can draw itself on any plotters backend: the PNG and the SVG
-/// of one chart come from the same code.
-trait Plot {
-    /// Pixel size of both outputs.
-    fn size(&self) -> (u32, u32) {
-        SIZE
-    }
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
 }
 
 /// The texts of one cost/error chart, and whether it shows the Pareto front.
@@ -179,37 +150,6 @@ impl Plot for CostErrorPlot<'_> {
         };
         draw(root, self.points, self.layout, &labels)
     }
-}
-
-/// Draws `plot` into a `SIZE` PNG and SVG, creating their folders.
-fn write_png_svg(plot: &impl Plot, png_path: &Path, svg_path: &Path) -> Result<()> {
-    ensure_font()?;
-    let size = plot.size();
-    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        plot.draw_on(&root).context("drawing the PNG chart")?;
-        root.present()
-            .map_err(plot_err)
-            .context("finishing the PNG chart")?;
-    }
-    let image = image::RgbImage::from_raw(size.0, size.1, rgb)
-        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", size.0, size.1))?;
-    create_parent(png_path)?;
-    image
-        .save_with_format(png_path, image::ImageFormat::Png)
-        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
-
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        plot.draw_on(&root).context("drawing the SVG chart")?;
-        root.present()
-            .map_err(plot_err)
-            .context("finishing the SVG chart")?;
-    }
-    create_parent(svg_path)?;
-    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
 }
 
 /// Axis ranges and scale, decided once so PNG and SVG show the same chart.
@@ -389,7 +329,7 @@ pub fn series_chart(
         x: (x_lo / 1.05)..(x_hi * 1.05),
         y: 0.0..(if y_hi > 0.0 { y_hi * 1.1 } else { 1.0 }),
     };
-    write_png_svg(&plot, png_path, svg_path)
+    write_png_svg(&plot, SIZE, png_path, svg_path)
 }
 
 struct LinePlot<'a> {
@@ -487,63 +427,11 @@ fn outline(shape: Shape) -> Vec<(i32, i32)> {
     }
 }
 
-/// plotters' errors borrow nothing but are not always `Send + Sync`: keep the text.
-fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow!("plotting: {e}")
-}
-
-fn create_parent(path: &Path) -> Result<()> {
-    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        Some(parent) => fs::create_dir_all(parent)
-            .with_context(|| format!("creating folder {}", parent.display())),
-        None => Ok(()),
-    }
-}
-
-/// Where to look for a sans-serif TrueType font, in order, after `DERMIS_FONT`.
-const FONT_PATHS: [&str; 6] = [
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/liberation-sans/LiberationSans-Regular.ttf",
-];
-
-/// Registers a font with plotters once per process. The bytes are leaked on
-/// purpose: plotters keeps a `'static` reference, and it is one font file.
-fn ensure_font() -> Result<()> {
-    static FONT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
-    FONT.get_or_init(|| register_system_font().map_err(|e| format!("{e:#}")))
-        .clone()
-        .map_err(|e| anyhow!(e))
-}
-
-fn register_system_font() -> Result<()> {
-    let mut candidates: Vec<PathBuf> = Vec::new();
-    if let Some(p) = std::env::var_os("DERMIS_FONT") {
-        candidates.push(p.into());
-    }
-    candidates.extend(FONT_PATHS.iter().map(PathBuf::from));
-    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
-        bail!(
-            "no font for chart text: set DERMIS_FONT to a .ttf file or install \
-             fonts-dejavu-core (looked in {})",
-            FONT_PATHS.join(", ")
-        );
-    };
-    let bytes = fs::read(path).with_context(|| format!("reading font {}", path.display()))?;
-    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-    for family in ["sans-serif", "serif", "monospace"] {
-        plotters::style::register_font(family, FontStyle::Normal, bytes)
-            .map_err(|_| anyhow!("{} is not a usable TrueType font", path.display()))?;
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
+    use std::path::PathBuf;
 
     fn pt(method: &str, gpu_ms: f64, error: f64) -> EvalPoint {
         EvalPoint {

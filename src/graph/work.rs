@@ -103,10 +103,19 @@ pub struct Fetch {
     pub count: f64,
     #[serde(default = "yes")]
     pub exact: bool,
+    /// Neighbouring invocations fetch neighbouring texels (false: taps rotated
+    /// or jittered per pixel, so a pixel's neighbours share no texels and the
+    /// texture cache misses; the budget model charges such fetches more).
+    #[serde(default = "yes")]
+    pub coherent: bool,
 }
 
 fn yes() -> bool {
     true
+}
+
+fn one() -> u32 {
+    1
 }
 
 /// One colour attachment written by every shaded fragment.
@@ -160,14 +169,25 @@ pub enum Work {
         triangles: u64,
         /// Samples per pixel.
         msaa: u32,
+        /// Attachments the pass clears when it begins (load-op clears), by
+        /// format: each clear writes the whole render area.
+        #[serde(default)]
+        clears: Vec<Format>,
     },
     /// Dispatches: `shader` runs `invocations` times per frame.
     Compute {
         shader: ShaderWork,
         invocations: u64,
     },
-    /// Image or buffer copies: `texels` texels of `bytes_per_texel` per frame.
-    Copy { texels: u64, bytes_per_texel: u32 },
+    /// Image or buffer copies: `texels` texels of `bytes_per_texel` per frame,
+    /// in `rects` copy regions (rectangles; a region-limited seed copy has one
+    /// per rectangle of the region and destination).
+    Copy {
+        texels: u64,
+        bytes_per_texel: u32,
+        #[serde(default = "one")]
+        rects: u32,
+    },
     /// Clears of `texels` texels of `bytes_per_texel`.
     Clear { texels: u64, bytes_per_texel: u32 },
 }
@@ -235,6 +255,7 @@ mod tests {
                     filter: Filter::Bilinear,
                     count: 16.0,
                     exact: true,
+                    coherent: true,
                 }],
                 alu: 120.0,
                 ..Default::default()
@@ -248,11 +269,37 @@ mod tests {
             height: 720,
             triangles: 1,
             msaa: 1,
+            clears: vec![Format::Rgba16Float],
         };
         let json = serde_json::to_string(&w).unwrap();
         assert!(json.contains("\"kind\":\"raster\""), "{json}");
         assert_eq!(serde_json::from_str::<Work>(&json).unwrap(), w);
         assert_eq!(Format::Rgba16Float.bytes_per_texel(), 8);
         assert!(Format::D24UnormS8Uint.is_depth() && !Format::R32Float.is_depth());
+    }
+
+    #[test]
+    fn fields_added_later_default_when_absent() {
+        // Reports written before `coherent`, `clears` and `rects` existed still read.
+        let f: Fetch = serde_json::from_str(
+            r#"{"texture":"t","format":"r32-float","filter":"point","count":1.0}"#,
+        )
+        .unwrap();
+        assert!(f.exact && f.coherent);
+        let c: Work =
+            serde_json::from_str(r#"{"kind":"copy","texels":10,"bytes_per_texel":8}"#).unwrap();
+        assert_eq!(
+            c,
+            Work::Copy {
+                texels: 10,
+                bytes_per_texel: 8,
+                rects: 1
+            }
+        );
+        let r: Work = serde_json::from_str(
+            r#"{"kind":"raster","shader":null,"color":[],"depth_stencil":null,"width":4,"height":4,"triangles":2,"msaa":1}"#,
+        )
+        .unwrap();
+        assert!(matches!(r, Work::Raster { clears, .. } if clears.is_empty()));
     }
 }

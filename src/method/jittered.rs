@@ -16,7 +16,7 @@ use super::{
     SssMethod, STENCIL_SKIN,
 };
 use crate::graph::draw::fullscreen_stencil_draw;
-use crate::graph::work::{Filter, PassRole};
+use crate::graph::work::{Fetch, Filter, PassRole};
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
@@ -101,7 +101,11 @@ impl SssMethod for Jittered {
             vec![
                 fetch(f.res, src, "colorTex", Filter::Point, 1.0),
                 fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
-                fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64),
+                // Rings rotated per pixel: neighbours share no texels.
+                Fetch {
+                    coherent: false,
+                    ..fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
+                },
             ],
             vec![color_write(f.res, diffuse, false)],
             true,

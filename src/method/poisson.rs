@@ -205,6 +205,7 @@ impl SssMethod for Poisson {
                 height: e.height,
                 triangles: 1,
                 msaa: 1,
+                clears: vec![],
             };
             let set = self.mip_sets.get(l - 1).copied().unwrap_or_default();
             passes.push(pass.work(work).record(move |pc: &PassContext| {

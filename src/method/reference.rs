@@ -594,6 +594,7 @@ impl Reference {
                 height: (texels / RADIANCE_WIDTH as u64) as u32,
                 triangles: draws,
                 msaa: 1,
+                clears: vec![],
             });
         for c in &self.chunks {
             pass = pass
@@ -672,6 +673,13 @@ impl Reference {
             height: e.height,
             triangles: sf.index_count as u64 / 3 * self.instances.len() as u64,
             msaa: 1,
+            // The three subsample targets and the depth start cleared.
+            clears: vec![
+                Format::Rgba32Float,
+                Format::Rgba32Float,
+                Format::Rgba32Float,
+                Format::D32Float,
+            ],
         };
         let targets = [sf.radiance, sf.position, sf.normal];
         let depth = sf.depth;
@@ -838,6 +846,7 @@ fn material_fetch(texture: &str) -> Fetch {
         filter: Filter::Bilinear,
         count: 1.0,
         exact: false,
+        coherent: true,
     }
 }
 

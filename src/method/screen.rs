@@ -34,6 +34,7 @@ pub fn fetch(res: &Resources, image: ImageId, texture: &str, filter: Filter, cou
         filter,
         count,
         exact: true,
+        coherent: true,
     }
 }
 
@@ -92,6 +93,7 @@ pub fn masked_work(
         height: f.extent.height,
         triangles: f.region.len() as u64,
         msaa: 1,
+        clears: vec![],
     }
 }
 
@@ -126,6 +128,7 @@ pub fn seed_copy<'a>(
         .work(Work::Copy {
             texels,
             bytes_per_texel,
+            rects: (region.len() * dsts.len()) as u32,
         });
     for &d in dsts {
         pass = pass.image(d, write);

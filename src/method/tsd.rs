@@ -675,6 +675,8 @@ impl Tsd {
             height: c.size,
             triangles: self.triangles() * draws,
             msaa: 1,
+            // Depth 1 and stencil 0 everywhere first.
+            clears: vec![work_format(self.mask_format).expect("depth formats have work formats")],
         };
         let size = c.size;
         Pass::new(format!("tsd mask c{k}"), PassRole::Sss)
@@ -751,6 +753,11 @@ impl Tsd {
             height: c.size,
             triangles: self.triangles(),
             msaa: 1,
+            // An updated character's maps start cleared (coverage 0 off the mesh).
+            clears: [m.irradiance, m.stretch_u, m.stretch_v]
+                .iter()
+                .filter_map(|&i| work_format(f.res.format(i)))
+                .collect(),
         };
         let mut pass = Pass::new(format!("tsd irradiance c{k}"), PassRole::Sss)
             .image(f.targets.shadow, AccessKind::FragmentSampledRead)
@@ -837,10 +844,22 @@ impl Tsd {
             height: c.size,
             triangles: 1,
             msaa: 1,
+            clears: Vec::new(),
         };
         // The first Gaussian's passes start their targets (cleared when only
         // masked texels are written); later ones keep the zeros outside the mask.
         let masked = cfg.masked();
+        // The first Gaussian clears its masked target, and along v the
+        // character's map (see the recording below).
+        let mut work = work;
+        if let Work::Raster { clears, .. } = &mut work {
+            if g == 0 && masked {
+                clears.extend(work_format(f.res.format(dst)));
+            }
+            if g == 0 && v {
+                clears.extend(work_format(f.res.format(c.map)));
+            }
+        }
         let dst_access = if g == 0 || !masked {
             AccessKind::ColorAttachmentWrite
         } else {
@@ -945,6 +964,7 @@ impl Tsd {
             height: f.extent.height,
             triangles: self.triangles() * self.characters.len() as u64,
             msaa: 1,
+            clears: Vec::new(),
         };
         let mut pass = Pass::new("tsd final", PassRole::Sss)
             .image(self.diffuse, AccessKind::ColorAttachmentLoadWrite)
@@ -1005,6 +1025,8 @@ fn material_fetch(texture: &str, exact: bool) -> Fetch {
         filter: Filter::Bilinear,
         count: 1.0,
         exact,
+        // Texels are shaded in the map's own order: neighbours fetch neighbours.
+        coherent: true,
     }
 }
 

@@ -486,6 +486,7 @@ impl Frame {
                 height: e.height,
                 triangles: self.triangles(true),
                 msaa: 1,
+                clears: vec![Format::D32Float],
             })
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
@@ -527,6 +528,7 @@ impl Frame {
             filter: Filter::Bilinear,
             count: 1.0,
             exact,
+            coherent: true,
         };
         let shadow_format = work_format(res.format(t.shadow)).expect("shadow format");
         // Per fragment: the 3x3 PCF, the three material maps (the normal map
@@ -539,6 +541,7 @@ impl Frame {
                 filter: Filter::DepthCompare,
                 count: 9.0,
                 exact: true,
+                coherent: true,
             },
             rgba8("normalTex", false),
             rgba8("albedoTex", true),
@@ -548,6 +551,7 @@ impl Frame {
                 filter: Filter::Point,
                 count: 1.0,
                 exact: false,
+                coherent: true,
             },
             rgba8("specTex", true),
             Fetch {
@@ -556,8 +560,19 @@ impl Frame {
                 filter: Filter::Bilinear,
                 count: 1.0,
                 exact: false,
+                coherent: true,
             },
         ];
+        let color: Vec<ColorWrite> = colors
+            .iter()
+            .map(|&c| ColorWrite {
+                format: work_format(res.format(c)).expect("colour formats"),
+                blend: false,
+            })
+            .collect();
+        let ds_format = work_format(res.format(t.depth_stencil)).expect("depth formats");
+        // Every target is cleared when the pass begins (see the record below).
+        let clears = color.iter().map(|c| c.format).chain([ds_format]).collect();
         let work = Work::Raster {
             shader: Some(ShaderWork {
                 shader: shader.into(),
@@ -565,15 +580,9 @@ impl Frame {
                 alu: alu_estimate(shader, &PCF_TRIPS),
                 ..Default::default()
             }),
-            color: colors
-                .iter()
-                .map(|&c| ColorWrite {
-                    format: work_format(res.format(c)).expect("colour formats"),
-                    blend: false,
-                })
-                .collect(),
+            color,
             depth_stencil: Some(DepthStencilUse {
-                format: work_format(res.format(t.depth_stencil)).expect("depth formats"),
+                format: ds_format,
                 depth_test: true,
                 depth_write: true,
                 stencil_test: false,
@@ -583,6 +592,7 @@ impl Frame {
             height: self.extent.height,
             triangles: self.triangles(false),
             msaa: 1,
+            clears,
         };
         let mut pass = Pass::new("geometry", PassRole::Geometry)
             .image(t.shadow, AccessKind::FragmentSampledRead)
@@ -658,6 +668,7 @@ impl Frame {
                         filter: Filter::Point,
                         count: 1.0,
                         exact: true,
+                        coherent: true,
                     })
                     .collect(),
                 alu: alu_estimate(shader, &[]),
@@ -672,6 +683,7 @@ impl Frame {
             height: self.extent.height,
             triangles: 1,
             msaa: 1,
+            clears: vec![],
         };
         let mut pass = Pass::new(name, PassRole::Post).work(work);
         for &(r, _) in reads {

@@ -46,6 +46,7 @@ fn upload_pass<'a>(
         .work(Work::Copy {
             texels: extent.width as u64 * extent.height as u64,
             bytes_per_texel: (bytes / (extent.width as u64 * extent.height as u64).max(1)) as u32,
+            rects: aspects.len() as u32,
         })
         .record(move |pc: &PassContext| {
             let regions: Vec<vk::BufferImageCopy> = aspects

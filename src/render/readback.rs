@@ -167,6 +167,7 @@ impl ReadbackPlan {
                 .work(Work::Copy {
                     texels: extent.width as u64 * extent.height as u64,
                     bytes_per_texel: bpt as u32,
+                    rects: 1,
                 })
                 .record(move |pc: &PassContext| {
                     let region = vk::BufferImageCopy::default()

@@ -1,0 +1,435 @@
+//! A run's report as the model reads it ([`RunRecord`]: the JSON of `dermis
+//! render`/`bench`/`budget`, live or from a file) and the [`FrameInput`] built
+//! from it: each pass's role, declared work and images, its counts and its
+//! measured time, with two rules stated here and written into the frame's
+//! provenance:
+//!
+//! - **Fragments shaded** ([`FRAGMENTS_RULE`]). Drivers count fragment-shader
+//!   invocations differently: NVIDIA after the early tests (the count is what
+//!   ran), llvmpipe (lavapipe) for whole rasterised blocks before them (up to
+//!   1.4x what ran). So on NVIDIA the model takes the invocation count; on any
+//!   other driver, for a pass that writes depth (the geometry pass) the samples
+//!   that passed the depth test (what an early-Z GPU shades: a fragment hidden
+//!   by one drawn earlier is not shaded, one hidden by one drawn later is, as
+//!   on the GPU), and for every other pass with a shader the invocations the
+//!   fetch-counting build counted in `main` (exact: helper invocations count
+//!   nothing; equal to the samples passed on stencil-masked passes, and right
+//!   where a shader discards), or the samples passed when there was no
+//!   counting run.
+//! - **Fetches** ([`apply_counts`]): with a counting run, every declared
+//!   fetch's count becomes what its shader really fetched per invocation
+//!   (fetches at its binding and filter / invocations), so a declared upper
+//!   bound (Poisson's 32 taps, the geometry pass's branches) is replaced by
+//!   the average the frame really took.
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::budget::input::{FrameInput, PassInput};
+use crate::graph::work::{Filter, ImageUse, PassRole, ShaderWork, Work};
+
+/// The fragments rule (module docs), for reports.
+pub const FRAGMENTS_RULE: &str = "fragments shaded = the pipeline-statistics invocation count on \
+NVIDIA (it counts after the early tests); on other drivers (llvmpipe counts rasterised blocks \
+before them) the samples that passed the depth test for a pass that writes depth (what an \
+early-Z GPU shades), and for other passes with a shader the invocations the fetch-counting \
+build counted in main (the samples passed when there was no counting run)";
+
+/// The GPU time statistics of a pass as reports write them.
+#[derive(Clone, Copy, Debug, Deserialize)]
+pub struct TimeRecord {
+    pub median: f64,
+}
+
+/// One pass of a report.
+#[derive(Clone, Debug, Deserialize)]
+pub struct PassRecord {
+    pub name: String,
+    /// Absent in reports from before passes declared their role and work.
+    #[serde(default)]
+    pub role: Option<PassRole>,
+    #[serde(default)]
+    pub work: Option<Work>,
+    #[serde(default)]
+    pub images: Vec<ImageUse>,
+    #[serde(default)]
+    pub gpu_ms: Option<TimeRecord>,
+    #[serde(default)]
+    pub fragment_invocations: Option<u64>,
+    #[serde(default)]
+    pub samples_passed: u64,
+}
+
+/// A run's report, as much of it as the model reads.
+#[derive(Clone, Debug, Deserialize)]
+pub struct RunRecord {
+    #[serde(default)]
+    pub command: String,
+    pub device: String,
+    #[serde(default)]
+    pub driver: String,
+    pub width: u32,
+    pub height: u32,
+    pub method: String,
+    #[serde(default)]
+    pub scene: String,
+    #[serde(default)]
+    pub heads: u32,
+    #[serde(default)]
+    pub sss_region_pixels: Option<u64>,
+    #[serde(default)]
+    pub sss_region_rects: Option<u64>,
+    pub passes: Vec<PassRecord>,
+}
+
+impl RunRecord {
+    /// Reads a report (JSON) from a file.
+    pub fn load(path: &std::path::Path) -> Result<RunRecord> {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+    }
+
+    /// The record of any serialisable report (a live `run::Report`).
+    pub fn of<T: Serialize>(report: &T) -> Result<RunRecord> {
+        serde_json::from_value(serde_json::to_value(report)?).context("reading the run's report")
+    }
+
+    /// How this record's driver counts fragment invocations.
+    pub fn counting(&self) -> FragmentCounting {
+        FragmentCounting::of(&self.device, &self.driver)
+    }
+}
+
+/// When a driver's pipeline statistics count fragment-shader invocations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FragmentCounting {
+    /// After the early depth/stencil tests: what ran (NVIDIA).
+    AfterEarlyTests,
+    /// Before them, for whole rasterised blocks (llvmpipe), or not known.
+    BeforeEarlyTests,
+}
+
+impl FragmentCounting {
+    pub fn of(device: &str, driver: &str) -> FragmentCounting {
+        let nvidia = |s: &str| s.to_ascii_lowercase().contains("nvidia");
+        if nvidia(device) || nvidia(driver) {
+            FragmentCounting::AfterEarlyTests
+        } else {
+            FragmentCounting::BeforeEarlyTests
+        }
+    }
+}
+
+/// What the fetch-counting build counted in one pass, by texture variable.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CountedPass {
+    pub name: String,
+    /// Shader invocations that reached `main`.
+    pub invocations: u64,
+    /// (texture variable, filter, fetches made).
+    pub fetches: Vec<(String, Filter, u64)>,
+}
+
+/// Replaces every declared fetch count of `s` with what was fetched per
+/// invocation (declared fetches sharing a texture and filter share its count
+/// in proportion to their declared counts). `false` (nothing changed) when the
+/// pass ran no invocation.
+pub fn apply_counts(s: &mut ShaderWork, c: &CountedPass) -> bool {
+    if c.invocations == 0 {
+        return false;
+    }
+    let declared: Vec<f64> = s
+        .fetches
+        .iter()
+        .map(|f| {
+            s.fetches
+                .iter()
+                .filter(|g| g.texture == f.texture && g.filter == f.filter)
+                .map(|g| g.count)
+                .sum()
+        })
+        .collect();
+    for (f, total_declared) in s.fetches.iter_mut().zip(declared) {
+        let made: u64 = c
+            .fetches
+            .iter()
+            .filter(|(t, filter, _)| *t == f.texture && *filter == f.filter)
+            .map(|x| x.2)
+            .sum();
+        let share = if total_declared > 0.0 {
+            f.count / total_declared
+        } else {
+            1.0
+        };
+        f.count = made as f64 / c.invocations as f64 * share;
+        f.exact = true;
+    }
+    true
+}
+
+/// Shaded fragments of one pass (module docs).
+fn fragments(
+    p: &PassRecord,
+    work: &Work,
+    counting: FragmentCounting,
+    counted: Option<&CountedPass>,
+) -> u64 {
+    let Work::Raster {
+        shader: Some(_),
+        depth_stencil,
+        msaa,
+        ..
+    } = work
+    else {
+        return match work {
+            Work::Compute { invocations, .. } => *invocations,
+            _ => 0,
+        };
+    };
+    let passed = p.samples_passed / u64::from((*msaa).max(1));
+    if counting == FragmentCounting::AfterEarlyTests {
+        return p.fragment_invocations.unwrap_or(passed);
+    }
+    if depth_stencil.is_some_and(|d| d.depth_write) {
+        return passed;
+    }
+    counted.map_or(passed, |c| c.invocations)
+}
+
+/// Pixels a pass's triangles cover before its early tests, for passes that
+/// test without writing depth (the stencil-masked SSS passes): the SSS
+/// region's pixels when it draws one triangle per rectangle of the region,
+/// else its whole render area. `None` for passes that reject nothing early.
+fn rasterized(rec: &RunRecord, work: &Work) -> Option<u64> {
+    let Work::Raster {
+        depth_stencil: Some(ds),
+        width,
+        height,
+        triangles,
+        ..
+    } = work
+    else {
+        return None;
+    };
+    if ds.depth_write || !(ds.depth_test || ds.stencil_test) {
+        return None;
+    }
+    let area = u64::from(*width) * u64::from(*height);
+    match (rec.sss_region_pixels, rec.sss_region_rects) {
+        (Some(px), Some(rects)) if rects == *triangles => Some(px),
+        _ => Some(area),
+    }
+}
+
+/// The frame of a run: every pass with its declaration and counts, fetch
+/// counts from `counted` (one per pass, in order) when given.
+pub fn frame_from_record(
+    rec: &RunRecord,
+    counted: Option<&[CountedPass]>,
+    label: &str,
+) -> Result<FrameInput> {
+    if let Some(c) = counted {
+        if c.len() != rec.passes.len() {
+            bail!(
+                "the counting run has {} passes, the run {}",
+                c.len(),
+                rec.passes.len()
+            );
+        }
+    }
+    let counting = rec.counting();
+    let mut passes = Vec::new();
+    let mut any_counted = false;
+    for (i, p) in rec.passes.iter().enumerate() {
+        let (Some(role), Some(work)) = (p.role, p.work.clone()) else {
+            bail!(
+                "pass `{}` declares no role or work (a report from before passes declared them)",
+                p.name
+            );
+        };
+        let c = counted.map(|c| &c[i]);
+        let mut q = PassInput::new(&p.name, role, work);
+        q.fragments = fragments(p, &q.work, counting, c);
+        q.samples_passed = p.samples_passed;
+        q.rasterized_pixels = rasterized(rec, &q.work);
+        q.images = p.images.clone();
+        q.measured_ms = p.gpu_ms.map(|t| t.median);
+        if let Some(c) = c {
+            let shader = match &mut q.work {
+                Work::Raster {
+                    shader: Some(s), ..
+                } => Some(s),
+                Work::Compute { shader, .. } => Some(shader),
+                _ => None,
+            };
+            if let Some(s) = shader {
+                q.fetches_counted = apply_counts(s, c);
+                any_counted |= q.fetches_counted;
+            }
+        }
+        passes.push(q);
+    }
+    let mut provenance = vec![format!(
+        "run on {} ({}); fragments: {}",
+        rec.device,
+        rec.driver,
+        match counting {
+            FragmentCounting::AfterEarlyTests => "invocation counts (this driver counts after the early tests)",
+            FragmentCounting::BeforeEarlyTests =>
+                "samples passed for depth-writing passes, the counting build's invocations for the others (this driver counts before the early tests)",
+        }
+    )];
+    provenance.push(if any_counted {
+        "fetches: counted by the fetch-counting build (fetches made / invocations, per pass)".into()
+    } else {
+        "fetches: as declared (upper bounds where a shader branches)".into()
+    });
+    Ok(FrameInput {
+        label: label.to_string(),
+        width: rec.width,
+        height: rec.height,
+        passes,
+        provenance,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::work::{DepthStencilUse, Fetch, Format};
+
+    fn shader(taps: f64) -> ShaderWork {
+        let f = |texture: &str, filter, count| Fetch {
+            texture: texture.into(),
+            format: Format::Rgba16Float,
+            filter,
+            count,
+            exact: false,
+            coherent: true,
+        };
+        ShaderWork {
+            shader: "poisson.frag".into(),
+            fetches: vec![
+                f("colorChain", Filter::Point, 1.0),
+                f("colorChain", Filter::Bilinear, taps),
+            ],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn counted_fetches_replace_declared_bounds() {
+        let mut s = shader(32.0);
+        let c = CountedPass {
+            name: "poisson".into(),
+            invocations: 1000,
+            fetches: vec![
+                ("colorChain".into(), Filter::Point, 1000),
+                ("colorChain".into(), Filter::Bilinear, 12_000),
+            ],
+        };
+        assert!(apply_counts(&mut s, &c));
+        assert_eq!(s.fetches[0].count, 1.0);
+        assert_eq!(s.fetches[1].count, 12.0);
+        assert!(s.fetches.iter().all(|f| f.exact));
+        // A pass that shaded nothing keeps its declaration.
+        let mut t = shader(32.0);
+        assert!(!apply_counts(&mut t, &CountedPass::default()));
+        assert_eq!(t.fetches[1].count, 32.0);
+    }
+
+    fn record(device: &str) -> RunRecord {
+        let ds = |write| DepthStencilUse {
+            format: Format::D32FloatS8Uint,
+            depth_test: true,
+            depth_write: write,
+            stencil_test: !write,
+            stencil_write: write,
+        };
+        let raster = |write, triangles| Work::Raster {
+            shader: Some(shader(8.0)),
+            color: vec![],
+            depth_stencil: Some(ds(write)),
+            width: 100,
+            height: 50,
+            triangles,
+            msaa: 1,
+            clears: vec![],
+        };
+        let pass = |name: &str, role, work| PassRecord {
+            name: name.into(),
+            role: Some(role),
+            work: Some(work),
+            images: vec![],
+            gpu_ms: Some(TimeRecord { median: 0.5 }),
+            fragment_invocations: Some(4000),
+            samples_passed: 3000,
+        };
+        RunRecord {
+            command: String::new(),
+            device: device.into(),
+            driver: String::new(),
+            width: 100,
+            height: 50,
+            method: "poisson".into(),
+            scene: String::new(),
+            heads: 1,
+            sss_region_pixels: Some(2000),
+            sss_region_rects: Some(3),
+            passes: vec![
+                pass("geometry", PassRole::Geometry, raster(true, 5000)),
+                pass("poisson", PassRole::Sss, raster(false, 3)),
+            ],
+        }
+    }
+
+    #[test]
+    fn fragments_follow_the_driver_rule() {
+        let counted = [
+            CountedPass {
+                name: "geometry".into(),
+                invocations: 4500,
+                fetches: vec![],
+            },
+            CountedPass {
+                name: "poisson".into(),
+                invocations: 1500,
+                fetches: vec![("colorChain".into(), Filter::Bilinear, 15_000)],
+            },
+        ];
+        let nv = frame_from_record(&record("NVIDIA H200"), Some(&counted), "t").unwrap();
+        assert_eq!(nv.passes[0].fragments, 4000);
+        assert_eq!(nv.passes[1].fragments, 4000);
+        let lp = frame_from_record(&record("llvmpipe (LLVM 15)"), Some(&counted), "t").unwrap();
+        // Depth-writing pass: samples passed; others: the counting build's invocations.
+        assert_eq!(lp.passes[0].fragments, 3000);
+        assert_eq!(lp.passes[1].fragments, 1500);
+        let bare = frame_from_record(&record("llvmpipe"), None, "t").unwrap();
+        assert_eq!(bare.passes[1].fragments, 3000);
+        // The stencil pass covers the region (3 rectangles = its 3 triangles).
+        assert_eq!(lp.passes[1].rasterized_pixels, Some(2000));
+        assert_eq!(lp.passes[0].rasterized_pixels, None);
+        assert!(lp.passes[1].fetches_counted);
+        let Work::Raster {
+            shader: Some(s), ..
+        } = &lp.passes[1].work
+        else {
+            panic!()
+        };
+        assert_eq!(s.fetches[1].count, 10.0);
+        assert_eq!(lp.passes[1].measured_ms, Some(0.5));
+        assert!(lp.provenance[1].contains("counted"));
+    }
+
+    #[test]
+    fn old_reports_without_declarations_are_refused() {
+        let mut r = record("NVIDIA H100");
+        r.passes[0].work = None;
+        let e = frame_from_record(&r, None, "t").unwrap_err().to_string();
+        assert!(
+            e.contains("geometry") && e.contains("no role or work"),
+            "{e}"
+        );
+    }
+}

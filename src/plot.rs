@@ -1,0 +1,123 @@
+//! What every chart shares: one PNG + SVG writer over a [`Plot`] (a chart that
+//! draws itself on any plotters backend, so both files come from the same
+//! code), the colour cycle, and the font. Text needs a font: plotters'
+//! `ab_glyph` backend is used because it is pure Rust (no fontconfig or
+//! freetype to link), with a TrueType font read from the system at run time
+//! (`DERMIS_FONT`, or DejaVu Sans / Liberation Sans from their usual places)
+//! rather than shipped in the repository. The charts themselves live with what
+//! they show (`eval::chart`, `budget::chart`).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use anyhow::{anyhow, bail, Context, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Marker colours, one per series in order of first appearance (Okabe-Ito:
+/// distinguishable with the common colour-vision deficiencies).
+pub const COLOURS: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(120, 120, 120),
+];
+
+/// A chart that can draw itself on any plotters backend: the PNG and the SVG
+/// of one chart come from the same code.
+pub trait Plot {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
+}
+
+/// Draws `plot` into a PNG and an SVG of `size` pixels, creating their folders.
+pub fn write_png_svg(
+    plot: &impl Plot,
+    size: (u32, u32),
+    png_path: &Path,
+    svg_path: &Path,
+) -> Result<()> {
+    ensure_font()?;
+    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        plot.draw_on(&root).context("drawing the PNG chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the PNG chart")?;
+    }
+    let image = image::RgbImage::from_raw(size.0, size.1, rgb)
+        .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", size.0, size.1))?;
+    create_parent(png_path)?;
+    image
+        .save_with_format(png_path, image::ImageFormat::Png)
+        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        plot.draw_on(&root).context("drawing the SVG chart")?;
+        root.present()
+            .map_err(plot_err)
+            .context("finishing the SVG chart")?;
+    }
+    create_parent(svg_path)?;
+    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
+}
+
+/// plotters' errors borrow nothing but are not always `Send + Sync`: keep the text.
+pub fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("plotting: {e}")
+}
+
+fn create_parent(path: &Path) -> Result<()> {
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(parent) => fs::create_dir_all(parent)
+            .with_context(|| format!("creating folder {}", parent.display())),
+        None => Ok(()),
+    }
+}
+
+/// Where to look for a sans-serif TrueType font, in order, after `DERMIS_FONT`.
+const FONT_PATHS: [&str; 6] = [
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/liberation-sans/LiberationSans-Regular.ttf",
+];
+
+/// Registers a font with plotters once per process. The bytes are leaked on
+/// purpose: plotters keeps a `'static` reference, and it is one font file.
+fn ensure_font() -> Result<()> {
+    static FONT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
+    FONT.get_or_init(|| register_system_font().map_err(|e| format!("{e:#}")))
+        .clone()
+        .map_err(|e| anyhow!(e))
+}
+
+fn register_system_font() -> Result<()> {
+    let mut candidates: Vec<PathBuf> = Vec::new();
+    if let Some(p) = std::env::var_os("DERMIS_FONT") {
+        candidates.push(p.into());
+    }
+    candidates.extend(FONT_PATHS.iter().map(PathBuf::from));
+    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+        bail!(
+            "no font for chart text: set DERMIS_FONT to a .ttf file or install \
+             fonts-dejavu-core (looked in {})",
+            FONT_PATHS.join(", ")
+        );
+    };
+    let bytes = fs::read(path).with_context(|| format!("reading font {}", path.display()))?;
+    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+    for family in ["sans-serif", "serif", "monospace"] {
+        plotters::style::register_font(family, FontStyle::Normal, bytes)
+            .map_err(|_| anyhow!("{} is not a usable TrueType font", path.display()))?;
+    }
+    Ok(())
+}
