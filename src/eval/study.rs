@@ -42,9 +42,10 @@ pub fn scene_set(
 }
 
 /// The curves of the dolly chart: one method at its default setting each.
-const DOLLY_LINES: [(&str, &str); 6] = [
+const DOLLY_LINES: [(&str, &str); 7] = [
     ("none", "-"),
     ("separable", "17 samples"),
+    ("separable", "physical, 17 samples"),
     ("ssg", "6 Gaussians, LOD"),
     ("ssg", "6 Gaussians, no LOD"),
     ("ss-jittered", "13 taps"),

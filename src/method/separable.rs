@@ -82,6 +82,16 @@ pub static ENTRY: MethodEntry = MethodEntry {
             label: "33 samples",
             options: &[("samples", "33")],
         },
+        // The physically fitted preset (the profile's per-channel marginal)
+        // beside the sources' artist preset.
+        EvalSetting {
+            label: "physical, 17 samples",
+            options: &[("preset", "physical"), ("samples", "17")],
+        },
+        EvalSetting {
+            label: "physical, 33 samples",
+            options: &[("preset", "physical"), ("samples", "33")],
+        },
     ],
     ground_truth: false,
     needs: |_, _| Needs::PLAIN,
