@@ -109,9 +109,14 @@ fn destroy_all(
 }
 
 /// Query slots a frame may need: its passes, and with `--dump` one readback
-/// pass per image written, plus the host-visibility step.
-fn profiler_slots(frame_passes: usize) -> u32 {
-    (3 * frame_passes + 8) as u32
+/// pass per image each pass writes (see `ReadbackPlan::interleave`), the
+/// final image's copy and the host-visibility step.
+fn profiler_slots(passes: &[Pass]) -> u32 {
+    let writes: usize = passes
+        .iter()
+        .map(|p| p.images.iter().filter(|(_, a)| a.is_write()).count())
+        .sum();
+    (passes.len() + writes + 2) as u32
 }
 
 impl<'c> Renderer<'c> {
@@ -176,7 +181,7 @@ impl<'c> Renderer<'c> {
             .iter()
             .flat_map(|q| q.images.iter().copied())
             .collect();
-        let slots = profiler_slots(passes.len());
+        let slots = profiler_slots(&passes);
         drop(passes);
         accesses.extend(inputs::upload_accesses(&frame.targets));
         accesses.extend(
