@@ -28,9 +28,12 @@ use super::{
 use crate::graph::draw::{begin_rendering, Load};
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{BufferId, ImageDesc, ImageId, Pass, PassContext};
-use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface, Grid, SurfaceSample};
+use crate::reference::sampling::{
+    build_grid, cutoff_mm, sample_count, sample_surface, Grid, SurfaceSample,
+};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
@@ -180,6 +183,13 @@ struct Chunk {
     gather_set: vk::DescriptorSet,
 }
 
+impl Destroy for Chunk {
+    fn destroy(&mut self, ctx: &Context) {
+        self.samples.destroy(ctx);
+        self.positions.destroy(ctx);
+    }
+}
+
 pub struct Reference {
     irradiance: Pipeline,
     gather: Pipeline,
@@ -209,6 +219,15 @@ impl Reference {
         let Some(skin) = skin else {
             bail!("the reference found no skin surface to sample");
         };
+        // Bounded before a sample exists: a far (corrupt) vertex makes a
+        // triangle of astronomical area.
+        let wanted = sample_count(&skin.mesh, s.instances, mm, density);
+        let budget = s.ctx.facts.device_local_bytes / 2 / 96;
+        if wanted > budget.min(u32::MAX as u64) as f64 {
+            bail!(
+                "the reference would take {wanted:.3e} samples at {density} per mm^2, more than this device holds ({budget}); lower --density or the number of heads (or check the mesh for far outlier vertices)"
+            );
+        }
         let mut surface = sample_surface(&skin.mesh, s.instances, mm, density);
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
@@ -236,15 +255,19 @@ impl Reference {
         if cells_bytes > f.max_storage_buffer_range as u64 {
             bail!("the reference grid has {} cells, more than this device's storage-buffer range holds", grid.cell_start.len());
         }
-        let irradiance = Pipeline::graphics(
+        // Guarded: a later step that fails frees what was made.
+        let irradiance = Guard::new(s.ctx, Pipeline::graphics(
             s.ctx,
             &GraphicsDesc::fullscreen(
                 "reference irradiance",
                 IRRADIANCE_SHADER,
                 vk::Format::R32G32B32A32_SFLOAT,
             ),
-        )?;
-        let gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
+        )?);
+        let gather = Guard::new(
+            s.ctx,
+            Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?,
+        );
         let cam = &s.view.camera;
         let p = GatherParams {
             inv_view: cam.view().inverse().to_cols_array_2d(),
@@ -252,25 +275,31 @@ impl Reference {
             grid_dims: [grid.dims[0], grid.dims[1], grid.dims[2], RADIANCE_WIDTH],
             view: [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()],
         };
-        let params = Buffer::with_data(
+        let params = Guard::new(
             s.ctx,
-            "reference gather params",
-            bytemuck::bytes_of(&p),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
+            Buffer::with_data(
+                s.ctx,
+                "reference gather params",
+                bytemuck::bytes_of(&p),
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?,
+        );
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let cells = device_buffer(
+        let cells = Guard::new(
             s.ctx,
-            "reference grid cells",
-            bytemuck::cast_slice(&grid.cell_start),
-            storage,
-            AccessKind::ComputeStorageRead,
-        )?;
+            device_buffer(
+                s.ctx,
+                "reference grid cells",
+                bytemuck::cast_slice(&grid.cell_start),
+                storage,
+                AccessKind::ComputeStorageRead,
+            )?,
+        );
         let cells_id = s.res.add_buffer("reference grid cells", cells.raw);
         s.res
             .set_buffer_uploaded(cells_id, AccessKind::ComputeStorageRead);
         let one = plan.chunks.len() == 1;
-        let mut chunks = Vec::with_capacity(plan.chunks.len());
+        let mut chunks = Guard::new(s.ctx, Vec::with_capacity(plan.chunks.len()));
         for (k, &(first, n)) in plan.chunks.iter().enumerate() {
             let name = |what: &str| {
                 if one {
@@ -280,13 +309,16 @@ impl Reference {
                 }
             };
             let range = &surface[first as usize..(first + n) as usize];
-            let samples = device_buffer(
+            let samples = Guard::new(
                 s.ctx,
-                &name("samples"),
-                bytemuck::cast_slice(range),
-                storage,
-                AccessKind::FragmentStorageRead,
-            )?;
+                device_buffer(
+                    s.ctx,
+                    &name("samples"),
+                    bytemuck::cast_slice(range),
+                    storage,
+                    AccessKind::FragmentStorageRead,
+                )?,
+            );
             let pos: Vec<[f32; 4]> = range.iter().map(|s| s.pos_area).collect();
             let positions = device_buffer(
                 s.ctx,
@@ -314,7 +346,7 @@ impl Reference {
             chunks.push(Chunk {
                 first,
                 count: n,
-                samples,
+                samples: samples.keep(),
                 positions,
                 buffer_ids,
                 radiance,
@@ -328,15 +360,15 @@ impl Reference {
             vk::Format::R32G32B32A32_SFLOAT,
         ));
         Ok(Reference {
-            irradiance,
-            gather,
+            irradiance: irradiance.keep(),
+            gather: gather.keep(),
             material_set: vk::DescriptorSet::null(),
-            chunks,
+            chunks: chunks.keep(),
             draw_samples: plan.draw_samples,
             max_candidates: max_slab_candidates(&grid),
-            cells,
+            cells: cells.keep(),
             cells_id,
-            params,
+            params: params.keep(),
             out,
             sample_count: count,
             grid,
