@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::{Arg, ArgAction, ArgMatches, Args, Parser, Subcommand, ValueEnum};
 
 use dermis::eval::{study, sweep};
@@ -309,9 +309,7 @@ impl Common {
             (_, name) => {
                 let mut s = builtin(name.unwrap_or("face"))?;
                 if let Some(mm) = self.mm_per_unit {
-                    if !mm.is_finite() || mm <= 0.0 {
-                        bail!("mm_per_unit must be a positive number, got {mm}");
-                    }
+                    dermis::scene::check_mm_per_unit(mm)?;
                     s.mm_per_unit = mm;
                 }
                 Ok(s)
@@ -353,6 +351,7 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
             let settings = common.settings()?;
             warn_foreign(&settings);
             render(&common, settings, &out, dump, warmup, frames)?;
@@ -382,6 +381,7 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
             let base = common.settings()?;
             let specs = study::scene_set(&scenes, common.scene.as_deref(), &base)?;
             dermis::run::prepare_out_dir(&out)?;
@@ -399,7 +399,8 @@ fn main_result() -> Result<()> {
                 &out,
                 &command_line(),
                 scenes == "dolly",
-            )?;
+            );
+            let outcome = ctx.finish_with(outcome)?;
             print!("{}", sweep::summary_table(&outcome.summary));
             let names: Vec<String> = outcome
                 .files
@@ -414,6 +415,8 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
+            dermis::run::prepare_report_path(&report)?;
             let settings = common.settings()?;
             warn_foreign(&settings);
             let scene = common.scene()?;
@@ -427,7 +430,8 @@ fn main_result() -> Result<()> {
                 command: command_line(),
                 progress: true,
             };
-            let r = bench_run(&ctx, &scene, &settings, &opts, &report)?;
+            let r = bench_run(&ctx, &scene, &settings, &opts, &report);
+            let r = ctx.finish_with(r)?;
             println!("{}", header(&r));
             print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
             if let Some(c) = &r.ceilings {
@@ -460,7 +464,8 @@ fn main_result() -> Result<()> {
                 validate,
                 ..Default::default()
             })?;
-            for (i, name, kind) in ctx.devices()? {
+            let devices = ctx.devices();
+            for (i, name, kind) in ctx.finish_with(devices)? {
                 println!("{i}: {name} ({kind})");
             }
         }
@@ -476,7 +481,7 @@ fn render(
     warmup: usize,
     frames: usize,
 ) -> Result<()> {
-    dermis::run::prepare_out_dir(out)?;
+    dermis::run::prepare_render_dir(out, dump)?;
     let scene = common.scene()?;
     let ctx = common.context()?;
     let opts = RunOptions {
@@ -488,7 +493,8 @@ fn render(
         command: command_line(),
         progress: true,
     };
-    let r = render_to_dir(&ctx, &scene, &settings, out, &opts)?.report;
+    let r = render_to_dir(&ctx, &scene, &settings, out, &opts);
+    let r = ctx.finish_with(r)?.report;
     println!("{}", header(&r));
     print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
     println!(

@@ -196,7 +196,7 @@ fn missing_and_corrupt_textures() {
 #[test]
 fn bad_sizes_and_parameters() {
     fails_with(&["--width", "0"], "width must be at least 1");
-    fails_with(&["--height", "100000"], "exceeds the device limit");
+    fails_with(&["--height", "100000"], "exceeds the limit of 16384");
     fails_with(&["--sss-width-mm", "NaN"], "width");
     fails_with(&["--sss-width-mm=-2"], "width");
     fails_with(&["--strength", "1.5,0.5,0.5"], "strength");
