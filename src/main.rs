@@ -13,7 +13,7 @@ use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::gltf_load::TextureOverrides;
-use dermis::scene::{builtin, load_gltf_scene, Scene};
+use dermis::scene::{builtin_scene, load_gltf_scene, Scene};
 
 /// `--scene builtin:NAME` names a built-in scene instead of a file.
 const BUILTIN: &str = "builtin:";
@@ -295,25 +295,15 @@ impl Common {
             .as_ref()
             .and_then(|p| p.to_str())
             .and_then(|p| p.strip_prefix(BUILTIN));
+        let overrides = TextureOverrides {
+            albedo: self.albedo.clone(),
+            normal_map: self.normal_map.clone(),
+            specular_map: self.spec_map.clone(),
+            sidecar_top_down: self.sidecar_top_down,
+        };
         match (&self.scene, builtin_name) {
-            (Some(p), None) => load_gltf_scene(
-                p,
-                &TextureOverrides {
-                    albedo: self.albedo.clone(),
-                    normal_map: self.normal_map.clone(),
-                    specular_map: self.spec_map.clone(),
-                    sidecar_top_down: self.sidecar_top_down,
-                },
-                self.mm_per_unit,
-            ),
-            (_, name) => {
-                let mut s = builtin(name.unwrap_or("face"))?;
-                if let Some(mm) = self.mm_per_unit {
-                    dermis::scene::check_mm_per_unit(mm)?;
-                    s.mm_per_unit = mm;
-                }
-                Ok(s)
-            }
+            (Some(p), None) => load_gltf_scene(p, &overrides, self.mm_per_unit),
+            (_, name) => builtin_scene(name.unwrap_or("face"), &overrides, self.mm_per_unit),
         }
     }
 

@@ -118,6 +118,18 @@ impl RenderSettings {
         }
         (self.method.check)(&self.method.opts(&self.options))
             .with_context(|| format!("method {}", self.method.name))?;
+        // An option of another method is ignored (the CLI says so), but its
+        // value must still be one it would accept: no NaN slips through unread.
+        for m in crate::method::METHODS {
+            let given = m
+                .options
+                .iter()
+                .any(|o| self.options.given(o.key).is_some());
+            if m.name != self.method.name && given {
+                (m.check)(&m.opts(&self.options))
+                    .with_context(|| format!("method {} (an option of it was given)", m.name))?;
+            }
+        }
         if !(1..=1024).contains(&self.sss_region_tile) {
             bail!(
                 "the SSS region's tile must be 1..=1024 pixels, got {}",
@@ -195,9 +207,10 @@ mod tests {
         let b = s.clone().with(sep, &[("samples", "16")]);
         let e = format!("{:#}", b.validate(16384).unwrap_err());
         assert!(e.contains("odd"), "{e}");
-        // An option of another method is not this method's business.
+        // An option of another method is checked too, though not read.
         let b = s.clone().with(lookup("ssg").unwrap(), &[("samples", "16")]);
-        b.validate(16384).unwrap();
+        let e = format!("{:#}", b.validate(16384).unwrap_err());
+        assert!(e.contains("method separable") && e.contains("odd"), "{e}");
         let mut b = s.clone();
         b.light.intensity = f32::NAN;
         assert!(b.validate(16384).is_err());

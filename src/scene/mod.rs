@@ -71,6 +71,26 @@ pub fn builtin(name: &str) -> Result<Scene> {
     }
 }
 
+/// A built-in scene for the command line: `name`, scaled by `mm_per_unit` when
+/// given. Texture overrides apply to a glTF scene only: given here, they are an
+/// error rather than silently unused.
+pub fn builtin_scene(
+    name: &str,
+    overrides: &gltf_load::TextureOverrides,
+    mm_per_unit: Option<f32>,
+) -> Result<Scene> {
+    let o = overrides;
+    if o.albedo.is_some() || o.normal_map.is_some() || o.specular_map.is_some() || o.sidecar_top_down {
+        bail!("--albedo, --normal-map, --spec-map and --sidecar-top-down apply to a glTF --scene, not to builtin:{name}");
+    }
+    let mut s = builtin(name)?;
+    if let Some(mm) = mm_per_unit {
+        check_mm_per_unit(mm)?;
+        s.mm_per_unit = mm;
+    }
+    Ok(s)
+}
+
 /// The first procedural scene: an egg-shaped head with disc ears and a flat
 /// backdrop.
 pub fn egg_scene() -> Scene {
