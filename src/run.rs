@@ -297,7 +297,10 @@ pub fn prepare_report_path(path: &Path) -> Result<()> {
 /// it exists (it is opened for appending, which changes nothing).
 fn check_writable_file(path: &Path) -> Result<()> {
     if path.is_dir() {
-        anyhow::bail!("{} is a directory, not a file dermis can write", path.display());
+        anyhow::bail!(
+            "{} is a directory, not a file dermis can write",
+            path.display()
+        );
     }
     if path.exists() {
         std::fs::OpenOptions::new()
@@ -535,7 +538,12 @@ mod tests {
     fn frame_counts_are_bounded() {
         check_frame_counts(0, 1).unwrap();
         check_frame_counts(MAX_WARMUP_FRAMES, MAX_MEASURED_FRAMES).unwrap();
-        for (w, m) in [(0, 0), (0, MAX_MEASURED_FRAMES + 1), (MAX_WARMUP_FRAMES + 1, 1), (usize::MAX, usize::MAX)] {
+        for (w, m) in [
+            (0, 0),
+            (0, MAX_MEASURED_FRAMES + 1),
+            (MAX_WARMUP_FRAMES + 1, 1),
+            (usize::MAX, usize::MAX),
+        ] {
             let e = check_frame_counts(w, m).unwrap_err().to_string();
             assert!(e.contains("must be within"), "{e}");
         }

@@ -418,9 +418,14 @@ fn eval_writes_csv_json_and_chart() {
 fn try_value(args: &[&str]) -> (bool, String) {
     let d = tmp("sweep");
     let mut c = dermis();
-    c.args(["render", "--device", "no-such-gpu", "--out"]).arg(&d).args(args);
+    c.args(["render", "--device", "no-such-gpu", "--out"])
+        .arg(&d)
+        .args(args);
     let o = c.output().unwrap();
-    (o.status.success(), String::from_utf8_lossy(&o.stderr).into_owned())
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
 }
 
 // Issue 11: every flag at 0, negative, NaN, inf and huge values. Each must end
@@ -485,10 +490,7 @@ fn every_flag_at_hostile_values() {
                 .collect();
             let errors = lines.iter().filter(|l| l.starts_with("error:")).count();
             let clap_hint = lines.len() == 2 && lines[1].contains("--help");
-            if ok
-                || stderr.contains("panicked")
-                || errors != 1
-                || !(lines.len() == 1 || clap_hint)
+            if ok || stderr.contains("panicked") || errors != 1 || !(lines.len() == 1 || clap_hint)
             {
                 bad.push(format!("{arg}: {stderr}"));
                 continue;

@@ -116,7 +116,11 @@ fn a_flat_object_is_seen_face_on() {
         // Two heads' distance from a card two units wide: a third of the frame
         // or more is card (edge-on: none).
         let frac = skin_pixels(&c) as f64 / (64.0 * 36.0);
-        assert!(frac > 0.3, "{name}: {:.0}% of the frame is card", frac * 100.0);
+        assert!(
+            frac > 0.3,
+            "{name}: {:.0}% of the frame is card",
+            frac * 100.0
+        );
         assert_finite(&c, name);
     }
     ctx.finish().unwrap();
@@ -162,13 +166,23 @@ fn the_ends_of_every_range_render_finite_images() {
     let base = small();
     type Edit = fn(&mut RenderSettings);
     let cases: Vec<(&str, Edit)> = vec![
-        ("exposure max", |s| s.exposure = *dermis::render::settings::EXPOSURE_RANGE.end()),
-        ("exposure min", |s| s.exposure = *dermis::render::settings::EXPOSURE_RANGE.start()),
-        ("light max", |s| s.light.intensity = dermis::scene::light::MAX_INTENSITY),
+        ("exposure max", |s| {
+            s.exposure = *dermis::render::settings::EXPOSURE_RANGE.end()
+        }),
+        ("exposure min", |s| {
+            s.exposure = *dermis::render::settings::EXPOSURE_RANGE.start()
+        }),
+        ("light max", |s| {
+            s.light.intensity = dermis::scene::light::MAX_INTENSITY
+        }),
         ("light 0", |s| s.light.intensity = 0.0),
-        ("ambient max", |s| s.ambient = dermis::render::settings::MAX_AMBIENT),
+        ("ambient max", |s| {
+            s.ambient = dermis::render::settings::MAX_AMBIENT
+        }),
         ("ambient 0", |s| s.ambient = 0.0),
-        ("distance max", |s| s.distance_heads = dermis::render::settings::MAX_DISTANCE_HEADS),
+        ("distance max", |s| {
+            s.distance_heads = dermis::render::settings::MAX_DISTANCE_HEADS
+        }),
         ("distance 1e-30", |s| s.distance_heads = 1e-30),
         ("light from below", |s| s.light.elevation_deg = -90.0),
         ("light behind", |s| s.light.azimuth_deg = -180.0),
@@ -182,22 +196,31 @@ fn the_ends_of_every_range_render_finite_images() {
             )
         }),
         ("falloff 1e-30", |s| {
-            *s = s.clone().with(common::m("separable"), &[("falloff", "1e-30,1e-30,1e-30")])
+            *s = s
+                .clone()
+                .with(common::m("separable"), &[("falloff", "1e-30,1e-30,1e-30")])
         }),
         ("width max", |s| {
-            *s = s.clone().with(common::m("separable"), &[("sss-width-mm", "1000")])
+            *s = s
+                .clone()
+                .with(common::m("separable"), &[("sss-width-mm", "1000")])
         }),
         ("width 1e-30", |s| {
-            *s = s.clone().with(common::m("separable"), &[("sss-width-mm", "1e-30")])
+            *s = s
+                .clone()
+                .with(common::m("separable"), &[("sss-width-mm", "1e-30")])
         }),
         ("strength 0", |s| {
-            *s = s.clone().with(common::m("separable"), &[("strength", "0,0,0")])
+            *s = s
+                .clone()
+                .with(common::m("separable"), &[("strength", "0,0,0")])
         }),
     ];
     for (what, edit) in cases {
         let mut s = base.clone().with(sep, &[]);
         edit(&mut s);
-        s.validate(u32::MAX).unwrap_or_else(|e| panic!("{what}: {e:#}"));
+        s.validate(u32::MAX)
+            .unwrap_or_else(|e| panic!("{what}: {e:#}"));
         let c = capture(&ctx, &scene, &s);
         assert_finite(&c, what);
     }

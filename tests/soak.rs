@@ -113,7 +113,14 @@ fn frames_and_renders_stay_flat() {
     );
     eprintln!(
         "  {:<12} {:>6} {:>9} {:>9} {:>10} {:>24} {:>7} {:>8}",
-        "method", "frames", "RSS MiB", "growth", "KiB/frame", "by quarter (MiB)", "allocs", "created"
+        "method",
+        "frames",
+        "RSS MiB",
+        "growth",
+        "KiB/frame",
+        "by quarter (MiB)",
+        "allocs",
+        "created"
     );
     for method in methods() {
         let (scene, settings) = setup(&method);

@@ -82,8 +82,7 @@ fn every_method_tears_down_clean() {
             measured: 2,
             ..RunOptions::capture_once("teardown")
         };
-        run(&ctx, &scene, &settings, &opts)
-            .unwrap_or_else(|e| panic!("{}: {e:#}", m.name));
+        run(&ctx, &scene, &settings, &opts).unwrap_or_else(|e| panic!("{}: {e:#}", m.name));
         ctx.finish()
             .unwrap_or_else(|e| panic!("{}: teardown: {e:#}", m.name));
     }
@@ -134,7 +133,10 @@ fn every_setup_failure_tears_down_clean() {
         ctx.fail_creation_after(None);
         ctx.finish()
             .unwrap_or_else(|e| panic!("{}: teardown after {tried} failures: {e:#}", m.name));
-        eprintln!("{}: {steps} creation steps, {tried} failed in turn, clean", m.name);
+        eprintln!(
+            "{}: {steps} creation steps, {tried} failed in turn, clean",
+            m.name
+        );
         total += tried;
     }
     eprintln!(
@@ -175,7 +177,11 @@ fn named_error_paths_tear_down_clean() {
     ctx.fail_creation_after(Some(1));
     let e = format!("{:#}", r.capture(true).err().unwrap());
     assert!(e.contains("injected failure"), "{e}");
-    assert_eq!(live_allocations(&ctx), base, "the failed capture left memory");
+    assert_eq!(
+        live_allocations(&ctx),
+        base,
+        "the failed capture left memory"
+    );
     // The renderer still works after it.
     r.capture(false).unwrap();
     drop(r);

@@ -29,7 +29,7 @@ use crate::graph::draw::{begin_rendering, Load};
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{BufferId, ImageDesc, ImageId, Pass, PassContext};
 use crate::reference::sampling::{
-    build_grid, cutoff_mm, sample_count, sample_surface, Grid, SurfaceSample,
+    build_grid, cutoff_mm, sample_surface_within, Grid, SurfaceSample,
 };
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
@@ -219,16 +219,8 @@ impl Reference {
         let Some(skin) = skin else {
             bail!("the reference found no skin surface to sample");
         };
-        // Bounded before a sample exists: a far (corrupt) vertex makes a
-        // triangle of astronomical area.
-        let wanted = sample_count(&skin.mesh, s.instances, mm, density);
-        let budget = s.ctx.facts.device_local_bytes / 2 / 96;
-        if wanted > budget.min(u32::MAX as u64) as f64 {
-            bail!(
-                "the reference would take {wanted:.3e} samples at {density} per mm^2, more than this device holds ({budget}); lower --density or the number of heads (or check the mesh for far outlier vertices)"
-            );
-        }
-        let mut surface = sample_surface(&skin.mesh, s.instances, mm, density);
+        let budget = s.ctx.facts.device_local_bytes / 2 / 96; // 96 B a sample (below)
+        let mut surface = sample_surface_within(&skin.mesh, s.instances, mm, density, budget)?;
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
         }
@@ -255,19 +247,17 @@ impl Reference {
         if cells_bytes > f.max_storage_buffer_range as u64 {
             bail!("the reference grid has {} cells, more than this device's storage-buffer range holds", grid.cell_start.len());
         }
-        // Guarded: a later step that fails frees what was made.
-        let irradiance = Guard::new(s.ctx, Pipeline::graphics(
+        let irradiance = Pipeline::graphics(
             s.ctx,
             &GraphicsDesc::fullscreen(
                 "reference irradiance",
                 IRRADIANCE_SHADER,
                 vk::Format::R32G32B32A32_SFLOAT,
             ),
-        )?);
-        let gather = Guard::new(
-            s.ctx,
-            Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?,
-        );
+        )?;
+        let irradiance = Guard::new(s.ctx, irradiance); // freed if a later step fails
+        let gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
+        let gather = Guard::new(s.ctx, gather);
         let cam = &s.view.camera;
         let p = GatherParams {
             inv_view: cam.view().inverse().to_cols_array_2d(),
@@ -275,26 +265,22 @@ impl Reference {
             grid_dims: [grid.dims[0], grid.dims[1], grid.dims[2], RADIANCE_WIDTH],
             view: [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()],
         };
-        let params = Guard::new(
+        let params = Buffer::with_data(
             s.ctx,
-            Buffer::with_data(
-                s.ctx,
-                "reference gather params",
-                bytemuck::bytes_of(&p),
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-            )?,
-        );
+            "reference gather params",
+            bytemuck::bytes_of(&p),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let params = Guard::new(s.ctx, params);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let cells = Guard::new(
+        let cells = device_buffer(
             s.ctx,
-            device_buffer(
-                s.ctx,
-                "reference grid cells",
-                bytemuck::cast_slice(&grid.cell_start),
-                storage,
-                AccessKind::ComputeStorageRead,
-            )?,
-        );
+            "reference grid cells",
+            bytemuck::cast_slice(&grid.cell_start),
+            storage,
+            AccessKind::ComputeStorageRead,
+        )?;
+        let cells = Guard::new(s.ctx, cells);
         let cells_id = s.res.add_buffer("reference grid cells", cells.raw);
         s.res
             .set_buffer_uploaded(cells_id, AccessKind::ComputeStorageRead);
@@ -309,16 +295,14 @@ impl Reference {
                 }
             };
             let range = &surface[first as usize..(first + n) as usize];
-            let samples = Guard::new(
+            let samples = device_buffer(
                 s.ctx,
-                device_buffer(
-                    s.ctx,
-                    &name("samples"),
-                    bytemuck::cast_slice(range),
-                    storage,
-                    AccessKind::FragmentStorageRead,
-                )?,
-            );
+                &name("samples"),
+                bytemuck::cast_slice(range),
+                storage,
+                AccessKind::FragmentStorageRead,
+            )?;
+            let samples = Guard::new(s.ctx, samples);
             let pos: Vec<[f32; 4]> = range.iter().map(|s| s.pos_area).collect();
             let positions = device_buffer(
                 s.ctx,

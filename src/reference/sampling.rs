@@ -79,6 +79,24 @@ pub fn sample_count(mesh: &Mesh, transforms: &[Mat4], mm_per_unit: f32, density:
     total
 }
 
+/// `sample_surface`, refused when it would make more than `max_samples`
+/// (counted first: a far, corrupt vertex makes a triangle of astronomical area).
+pub fn sample_surface_within(
+    mesh: &Mesh,
+    transforms: &[Mat4],
+    mm_per_unit: f32,
+    density: f32,
+    max_samples: u64,
+) -> anyhow::Result<Vec<SurfaceSample>> {
+    let wanted = sample_count(mesh, transforms, mm_per_unit, density);
+    if wanted > max_samples.min(u32::MAX as u64) as f64 {
+        anyhow::bail!(
+            "the reference would take {wanted:.3e} samples at {density} per mm^2, more than this device holds ({max_samples}); lower --density or the number of heads (or check the mesh for far outlier vertices)"
+        );
+    }
+    Ok(sample_surface(mesh, transforms, mm_per_unit, density))
+}
+
 /// Area of a triangle in mm^2, in f64 (f32 overflows on a far vertex).
 fn triangle_area_mm2(p: [Vec3; 3], mm_per_unit: f32) -> f64 {
     let q = p.map(|v| v.as_dvec3());

@@ -352,7 +352,10 @@ impl<'c> Renderer<'c> {
             dumps,
             samples,
             diffuse,
-            hdr_nonfinite: hdr.iter().filter(|p| !p.iter().all(|c| c.is_finite())).count(),
+            hdr_nonfinite: hdr
+                .iter()
+                .filter(|p| !p.iter().all(|c| c.is_finite()))
+                .count(),
         })
     }
 

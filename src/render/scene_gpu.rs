@@ -129,14 +129,24 @@ impl GpuObject {
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [
-            ("albedo", m.base_color.as_ref(), [255; 4], vk::Format::R8G8B8A8_SRGB),
+            (
+                "albedo",
+                m.base_color.as_ref(),
+                [255; 4],
+                vk::Format::R8G8B8A8_SRGB,
+            ),
             (
                 "normal map",
                 m.normal_map.as_ref(),
                 [128, 128, 255, 255],
                 vk::Format::R8G8B8A8_UNORM,
             ),
-            ("specular map", m.specular_map.as_ref(), [255; 4], vk::Format::R8G8B8A8_UNORM),
+            (
+                "specular map",
+                m.specular_map.as_ref(),
+                [255; 4],
+                vk::Format::R8G8B8A8_UNORM,
+            ),
         ];
         for (what, tex, fallback, format) in maps {
             let t = upload_texture(ctx, &format!("{name} {what}"), tex, fallback, format)?;

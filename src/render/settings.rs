@@ -156,7 +156,10 @@ impl RenderSettings {
         }
         self.light.validate()?;
         if !self.ambient.is_finite() || !(0.0..=MAX_AMBIENT).contains(&self.ambient) {
-            bail!("ambient must be within 0..={MAX_AMBIENT}, got {}", self.ambient);
+            bail!(
+                "ambient must be within 0..={MAX_AMBIENT}, got {}",
+                self.ambient
+            );
         }
         if !self.exposure.is_finite() || !EXPOSURE_RANGE.contains(&self.exposure) {
             bail!(

@@ -265,7 +265,11 @@ mod tests {
             (Mat4::from_rotation_x(-FRAC_PI_2), Vec3::Y),
         ] {
             let s = crate::scene::scene_from_head("card", card(2.0, 1.0, m), None).unwrap();
-            assert!((s.forward - facing).length() < 1e-5, "{facing}: {}", s.forward);
+            assert!(
+                (s.forward - facing).length() < 1e-5,
+                "{facing}: {}",
+                s.forward
+            );
             assert!((s.head_height_units() - 2.0).abs() < 1e-5);
             let f = frame(&s, &shot(Layout::Crowd, 1));
             let vp = f.camera.view_proj(16.0 / 9.0);
@@ -281,10 +285,16 @@ mod tests {
             let size = hi - lo;
             // On screen, between the planes, and seen face on: its projection is
             // a rectangle of aspect about 2, not a line.
-            assert!(lo.x > -1.0 && hi.x < 1.0 && lo.y > -1.0 && hi.y < 1.0, "{facing}: {lo} {hi}");
+            assert!(
+                lo.x > -1.0 && hi.x < 1.0 && lo.y > -1.0 && hi.y < 1.0,
+                "{facing}: {lo} {hi}"
+            );
             assert!(lo.z > 0.0 && hi.z < 1.0, "{facing}: {lo} {hi}");
             let (wide, tall) = (size.x * 16.0 / 9.0, size.y);
-            assert!(wide.min(tall) > 0.2, "{facing}: seen edge-on ({wide} x {tall})");
+            assert!(
+                wide.min(tall) > 0.2,
+                "{facing}: seen edge-on ({wide} x {tall})"
+            );
         }
     }
 
@@ -295,8 +305,15 @@ mod tests {
     fn a_far_outlier_vertex_does_not_move_the_framing() {
         let clean = crate::scene::egg_scene();
         let good = crate::scene::scene_from_head("clean", clean.head.clone(), None).unwrap();
-        assert_eq!(crate::scene::head_measure::inlier_bounds(&good.head.mesh).1, 0);
-        for far in [Vec3::new(0.0, 1e31, 0.0), Vec3::new(-3e30, 0.0, 1e31), Vec3::splat(1e4)] {
+        assert_eq!(
+            crate::scene::head_measure::inlier_bounds(&good.head.mesh).1,
+            0
+        );
+        for far in [
+            Vec3::new(0.0, 1e31, 0.0),
+            Vec3::new(-3e30, 0.0, 1e31),
+            Vec3::splat(1e4),
+        ] {
             let mut head = clean.head.clone();
             head.mesh.vertices[100].position = far.into();
             let bad = crate::scene::scene_from_head("outlier", head, None).unwrap();
@@ -307,10 +324,19 @@ mod tests {
             );
             let h = good.head_height_units();
             assert!((bad.head_height_units() - h).abs() < 0.02 * h, "{far}");
-            assert!((bad.mm_per_unit / good.mm_per_unit - 1.0).abs() < 0.02, "{far}");
+            assert!(
+                (bad.mm_per_unit / good.mm_per_unit - 1.0).abs() < 0.02,
+                "{far}"
+            );
             assert!(a.camera.eye.distance(b.camera.eye) < 0.05 * h, "{far}");
-            assert!(a.camera.target.distance(b.camera.target) < 0.05 * h, "{far}");
-            assert!((b.bounds.size() - a.bounds.size()).length() < 0.05 * h, "{far}");
+            assert!(
+                a.camera.target.distance(b.camera.target) < 0.05 * h,
+                "{far}"
+            );
+            assert!(
+                (b.bounds.size() - a.bounds.size()).length() < 0.05 * h,
+                "{far}"
+            );
             assert!((b.light.depth_range_units / a.light.depth_range_units - 1.0).abs() < 0.05);
         }
     }

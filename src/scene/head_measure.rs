@@ -56,7 +56,11 @@ pub fn flat_axis(mesh: &Mesh) -> Option<Vec3> {
     for tri in mesh.indices.chunks_exact(3) {
         let p: Option<Vec<Vec3>> = tri
             .iter()
-            .map(|&i| mesh.vertices.get(i as usize).map(|v| Vec3::from(v.position)))
+            .map(|&i| {
+                mesh.vertices
+                    .get(i as usize)
+                    .map(|v| Vec3::from(v.position))
+            })
             .collect();
         let Some(p) = p.filter(|p| p.iter().all(|&q| inside(&b, q))) else {
             continue;

@@ -80,7 +80,11 @@ pub fn builtin_scene(
     mm_per_unit: Option<f32>,
 ) -> Result<Scene> {
     let o = overrides;
-    if o.albedo.is_some() || o.normal_map.is_some() || o.specular_map.is_some() || o.sidecar_top_down {
+    if o.albedo.is_some()
+        || o.normal_map.is_some()
+        || o.specular_map.is_some()
+        || o.sidecar_top_down
+    {
         bail!("--albedo, --normal-map, --spec-map and --sidecar-top-down apply to a glTF --scene, not to builtin:{name}");
     }
     let mut s = builtin(name)?;

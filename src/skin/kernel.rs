@@ -343,7 +343,9 @@ impl SeparableKernel {
         // The checked ranges keep every weight finite; a weight that is not
         // would put NaN in every skin pixel.
         anyhow::ensure!(
-            samples.iter().all(|s| s.weight.iter().all(|w| w.is_finite())),
+            samples
+                .iter()
+                .all(|s| s.weight.iter().all(|w| w.is_finite())),
             "SSS kernel weights are not finite for {params:?}"
         );
         Ok(Self { params, samples })

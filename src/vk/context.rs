@@ -572,12 +572,12 @@ impl Context {
         let mut problems: Vec<String> = Vec::new();
         if let Some(a) = self.allocator.take() {
             if let Ok(a) = a.into_inner() {
-                problems.extend(
-                    a.generate_report()
-                        .allocations
-                        .iter()
-                        .map(|r| format!("memory allocation '{}' ({} bytes) was never freed", r.name, r.size)),
-                );
+                problems.extend(a.generate_report().allocations.iter().map(|r| {
+                    format!(
+                        "memory allocation '{}' ({} bytes) was never freed",
+                        r.name, r.size
+                    )
+                }));
             }
             // The allocator (and its memory blocks) goes before the device.
         }

@@ -55,20 +55,26 @@ impl<'c, T: Destroy> Guard<'c, T> {
 
     /// The value, no longer guarded: its owner destroys it from now on.
     pub fn keep(mut self) -> T {
-        self.value.take().expect("a guard holds its value until kept")
+        self.value
+            .take()
+            .expect("a guard holds its value until kept")
     }
 }
 
 impl<T: Destroy> Deref for Guard<'_, T> {
     type Target = T;
     fn deref(&self) -> &T {
-        self.value.as_ref().expect("a guard holds its value until kept")
+        self.value
+            .as_ref()
+            .expect("a guard holds its value until kept")
     }
 }
 
 impl<T: Destroy> DerefMut for Guard<'_, T> {
     fn deref_mut(&mut self) -> &mut T {
-        self.value.as_mut().expect("a guard holds its value until kept")
+        self.value
+            .as_mut()
+            .expect("a guard holds its value until kept")
     }
 }
 

@@ -283,7 +283,9 @@ impl Buffer {
                         linear: true,
                         allocation_scheme: AllocationScheme::GpuAllocatorManaged,
                     })
-                    .with_context(|| format!("allocating memory for buffer '{name}' ({size} bytes)"))
+                    .with_context(|| {
+                        format!("allocating memory for buffer '{name}' ({size} bytes)")
+                    })
             })
             .and_then(|a| {
                 let (memory, offset) = (unsafe { a.memory() }, a.offset());

@@ -223,7 +223,12 @@ impl Pipeline {
     /// The shader modules, the pipeline and the counter set of `graphics`.
     // Long because it is one Vulkan create-info, state block by state block, in
     // the order the structure nests them.
-    fn build_graphics(&mut self, ctx: &Context, d: &GraphicsDesc, frag: Option<&str>) -> Result<()> {
+    fn build_graphics(
+        &mut self,
+        ctx: &Context,
+        d: &GraphicsDesc,
+        frag: Option<&str>,
+    ) -> Result<()> {
         let layout = self.layout;
         let vs = create_module(ctx, d.vert)?;
         let fs = match frag.map(|f| create_module(ctx, f)).transpose() {
@@ -389,8 +394,11 @@ impl Pipeline {
                 .creation_step(&format!("compute pipeline '{name}'"))
                 .and_then(|()| {
                     unsafe {
-                        ctx.device
-                            .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+                        ctx.device.create_compute_pipelines(
+                            vk::PipelineCache::null(),
+                            &[info],
+                            None,
+                        )
                     }
                     .map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))
                 });
@@ -411,7 +419,8 @@ impl Pipeline {
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_pipeline(std::mem::take(&mut self.raw), None);
+            ctx.device
+                .destroy_pipeline(std::mem::take(&mut self.raw), None);
             ctx.device
                 .destroy_pipeline_layout(std::mem::take(&mut self.layout), None);
             if let Some((pool, _)) = self.count_set.take() {

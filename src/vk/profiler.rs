@@ -63,7 +63,9 @@ impl Profiler {
                 "pass fragment invocations",
                 vk::QueryPoolCreateInfo::default()
                     .query_type(vk::QueryType::PIPELINE_STATISTICS)
-                    .pipeline_statistics(vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS)
+                    .pipeline_statistics(
+                        vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                    )
                     .query_count(max_passes),
             ) {
                 Ok(p) => Some(p),
