@@ -130,10 +130,12 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
     }
 }
 
-/// Millimetres per scene unit dermis accepts: from a micrometre (a head 230,000
-/// units tall) to a kilometre (0.00023 units). Outside it f32 positions lose
-/// the head's shape, and the ground truth's areas in mm^2 overflow.
-pub const MM_PER_UNIT_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e6;
+/// Millimetres per scene unit dermis accepts, given or derived from the head:
+/// 1e-12..=1e12, so millimetres, their squares (the ground truth's areas) and
+/// their inverses stay normal f32 numbers with room to spare. A file in any
+/// real unit (a femtometre to a million kilometres) fits; outside, a scale is a corrupt
+/// file or a typo.
+pub const MM_PER_UNIT_RANGE: std::ops::RangeInclusive<f32> = 1e-12..=1e12;
 
 /// Checks a scene scale (given with `--mm-per-unit` or derived from the head).
 pub fn check_mm_per_unit(mm: f32) -> Result<()> {
