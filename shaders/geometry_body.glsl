@@ -1,5 +1,6 @@
 // The geometry pass body, shared by geometry.frag and geometry_normals.frag.
 #include "lighting.glsl"
+#include "driver_workarounds.glsl"
 
 layout(location = 0) in vec3 vWorldPos;
 layout(location = 1) in vec3 vNormal;
@@ -24,11 +25,14 @@ void main() {
     vec3 V = normalize(frame.cameraPos.xyz - vWorldPos);
     float shadow = shadowPcf(vWorldPos, Nv);
     vec3 light = frame.lightColor.rgb;
-    bool skin = material.params.w > 0.5;
+    // Both flags are uniform values: NOT_UNIFORM_ZERO keeps lavapipe from
+    // compiling (and leaking) a copy of this shader per material bind.
+    bool skin = material.params.w + NOT_UNIFORM_ZERO > 0.5;
+    bool transmit = frame.params.w + NOT_UNIFORM_ZERO > 0.5;
 
     vec3 diffuse = diffuseLight(albedo, N, shadow);
 
-    if (skin && frame.params.w > 0.5) {
+    if (skin && transmit) {
         // Listing 5.1: shrink along the vertex normal, read the light-side depth,
         // distance in millimetres, back irradiance from the reversed vertex normal.
         vec3 c = shadowCoord(vWorldPos - frame.params.z * Nv);

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::{Arg, ArgAction, ArgMatches, Args, Parser, Subcommand, ValueEnum};
 
 use dermis::budget::run::BudgetOptions;
@@ -15,7 +15,7 @@ use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::gltf_load::TextureOverrides;
-use dermis::scene::{builtin, load_gltf_scene, Scene};
+use dermis::scene::{builtin_scene, load_gltf_scene, Scene};
 
 /// `--scene builtin:NAME` names a built-in scene instead of a file.
 const BUILTIN: &str = "builtin:";
@@ -331,27 +331,15 @@ impl Common {
             .as_ref()
             .and_then(|p| p.to_str())
             .and_then(|p| p.strip_prefix(BUILTIN));
+        let overrides = TextureOverrides {
+            albedo: self.albedo.clone(),
+            normal_map: self.normal_map.clone(),
+            specular_map: self.spec_map.clone(),
+            sidecar_top_down: self.sidecar_top_down,
+        };
         match (&self.scene, builtin_name) {
-            (Some(p), None) => load_gltf_scene(
-                p,
-                &TextureOverrides {
-                    albedo: self.albedo.clone(),
-                    normal_map: self.normal_map.clone(),
-                    specular_map: self.spec_map.clone(),
-                    sidecar_top_down: self.sidecar_top_down,
-                },
-                self.mm_per_unit,
-            ),
-            (_, name) => {
-                let mut s = builtin(name.unwrap_or("face"))?;
-                if let Some(mm) = self.mm_per_unit {
-                    if !mm.is_finite() || mm <= 0.0 {
-                        bail!("mm_per_unit must be a positive number, got {mm}");
-                    }
-                    s.mm_per_unit = mm;
-                }
-                Ok(s)
-            }
+            (Some(p), None) => load_gltf_scene(p, &overrides, self.mm_per_unit),
+            (_, name) => builtin_scene(name.unwrap_or("face"), &overrides, self.mm_per_unit),
         }
     }
 
@@ -393,6 +381,7 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
             let settings = common.settings()?;
             warn_foreign(&settings);
             render(&common, settings, &out, dump, warmup, frames)?;
@@ -418,6 +407,7 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
             let base = common.settings()?;
             let specs = study::scene_set(&scenes, common.scene.as_deref(), &base)?;
             dermis::run::prepare_out_dir(&out)?;
@@ -435,7 +425,8 @@ fn main_result() -> Result<()> {
                 &out,
                 &command_line(),
                 scenes == "dolly",
-            )?;
+            );
+            let outcome = ctx.finish_with(outcome)?;
             print!("{}", sweep::summary_table(&outcome.summary));
             let names: Vec<String> = outcome
                 .files
@@ -450,6 +441,8 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => {
+            dermis::run::check_frame_counts(warmup, frames)?;
+            dermis::run::prepare_report_path(&report)?;
             let settings = common.settings()?;
             warn_foreign(&settings);
             let scene = common.scene()?;
@@ -463,7 +456,8 @@ fn main_result() -> Result<()> {
                 command: command_line(),
                 progress: true,
             };
-            let r = bench_run(&ctx, &scene, &settings, &opts, &report)?;
+            let r = bench_run(&ctx, &scene, &settings, &opts, &report);
+            let r = ctx.finish_with(r)?;
             println!("{}", header(&r));
             print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
             if let Some(c) = &r.ceilings {
@@ -523,7 +517,8 @@ fn main_result() -> Result<()> {
                 validate,
                 ..Default::default()
             })?;
-            for (i, name, kind) in ctx.devices()? {
+            let devices = ctx.devices();
+            for (i, name, kind) in ctx.finish_with(devices)? {
                 println!("{i}: {name} ({kind})");
             }
         }
@@ -539,7 +534,7 @@ fn render(
     warmup: usize,
     frames: usize,
 ) -> Result<()> {
-    dermis::run::prepare_out_dir(out)?;
+    dermis::run::prepare_render_dir(out, dump)?;
     let scene = common.scene()?;
     let ctx = common.context()?;
     let opts = RunOptions {
@@ -551,7 +546,8 @@ fn render(
         command: command_line(),
         progress: true,
     };
-    let r = render_to_dir(&ctx, &scene, &settings, out, &opts)?.report;
+    let r = render_to_dir(&ctx, &scene, &settings, out, &opts);
+    let r = ctx.finish_with(r)?.report;
     println!("{}", header(&r));
     print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
     println!(

@@ -87,7 +87,31 @@ pub struct RunOptions {
     pub progress: bool,
 }
 
+/// Most measured frames a run takes statistics over: each keeps its pass
+/// samples (about 1 KB) until the report is made, so 100,000 frames hold about
+/// 100 MB. (A p95 over more frames says nothing new.)
+pub const MAX_MEASURED_FRAMES: usize = 100_000;
+/// Most warm-up frames (they keep nothing; the bound only catches a mistyped
+/// count that would run for days).
+pub const MAX_WARMUP_FRAMES: usize = 100_000;
+
+/// Checks `--warmup` and `--frames` (before any device opens).
+pub fn check_frame_counts(warmup: usize, measured: usize) -> Result<()> {
+    if warmup > MAX_WARMUP_FRAMES {
+        anyhow::bail!("--warmup must be within 0..={MAX_WARMUP_FRAMES}, got {warmup}");
+    }
+    if !(1..=MAX_MEASURED_FRAMES).contains(&measured) {
+        anyhow::bail!("--frames must be within 1..={MAX_MEASURED_FRAMES}, got {measured}");
+    }
+    Ok(())
+}
+
 impl RunOptions {
+    /// The frame counts' ranges (`check_frame_counts`).
+    pub fn validate(&self) -> Result<()> {
+        check_frame_counts(self.warmup, self.measured)
+    }
+
     /// One captured frame, no warm-up, quiet: what comparisons need.
     pub fn capture_once(command: &str) -> Self {
         RunOptions {
@@ -108,6 +132,7 @@ pub fn run(
     settings: &RenderSettings,
     opts: &RunOptions,
 ) -> Result<RunOutput> {
+    opts.validate()?;
     let mut renderer = Renderer::new(ctx, scene, settings)?;
     let total = opts.warmup + opts.measured;
     let bar = if opts.progress && total > 20 {
@@ -128,8 +153,8 @@ pub fn run(
             b.inc(1)
         }
     };
-    renderer.frames(opts.warmup, tick)?;
-    let frames = renderer.frames(opts.measured.max(1), tick)?;
+    renderer.run_frames(opts.warmup, tick)?;
+    let frames = renderer.frames(opts.measured, tick)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -214,7 +239,7 @@ pub fn run(
             intensity: settings.light.intensity,
         },
         warmup_frames: opts.warmup,
-        measured_frames: opts.measured.max(1),
+        measured_frames: opts.measured,
         passes,
         frame,
         sss_total_ms: if has_sss {
@@ -241,6 +266,51 @@ pub fn prepare_out_dir(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The files `render_to_dir` writes into its folder.
+pub const RENDER_OUTPUTS: [&str; 3] = ["frame.png", "diffuse.exr", "report.json"];
+
+/// `prepare_out_dir`, and the files a render writes there (with `dump`, the
+/// passes/ folder) can be written: each is checked before any GPU work, so a
+/// bad `--out` never costs a render.
+pub fn prepare_render_dir(dir: &Path, dump: bool) -> Result<()> {
+    prepare_out_dir(dir)?;
+    for name in RENDER_OUTPUTS {
+        check_writable_file(&dir.join(name))?;
+    }
+    let passes = dir.join("passes");
+    if dump && passes.exists() && !passes.is_dir() {
+        anyhow::bail!("--out: {} exists and is not a directory", passes.display());
+    }
+    Ok(())
+}
+
+/// The report path of `bench`: its folder exists (or is made) and is
+/// writable, and the path itself is not a folder. Checked before any GPU work.
+pub fn prepare_report_path(path: &Path) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        prepare_out_dir(parent)?;
+    }
+    check_writable_file(path)
+}
+
+/// A file that is about to be (over)written: not a folder, and writable if
+/// it exists (it is opened for appending, which changes nothing).
+fn check_writable_file(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        anyhow::bail!(
+            "{} is a directory, not a file dermis can write",
+            path.display()
+        );
+    }
+    if path.exists() {
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .with_context(|| format!("{} is not writable", path.display()))?;
+    }
+    Ok(())
+}
+
 /// The one-line header of a run's table.
 pub fn header(r: &Report) -> String {
     format!(
@@ -258,7 +328,7 @@ pub fn render_to_dir(
     out: &Path,
     opts: &RunOptions,
 ) -> Result<RunOutput> {
-    prepare_out_dir(out)?;
+    prepare_render_dir(out, opts.dump)?;
     let output = run(ctx, scene, settings, opts)?;
     let capture = output.capture.as_ref().context("no frame was captured")?;
     write_png(&out.join("frame.png"), capture)?;
@@ -286,9 +356,7 @@ pub fn bench_run(
     opts: &RunOptions,
     path: &Path,
 ) -> Result<Report> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        prepare_out_dir(parent)?;
-    }
+    prepare_report_path(path)?;
     let output = run(ctx, scene, settings, opts)?;
     write_report(path, &output.report)?;
     Ok(output.report)
@@ -304,8 +372,28 @@ pub fn write_report(path: &Path, report: &Report) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Writes the tone-mapped frame as an sRGB PNG.
+/// Where the first non-finite (NaN or infinite) texel of `rgba` is, and how
+/// many there are.
+pub fn first_nonfinite(rgba: &[[f32; 4]], width: u32) -> Option<(usize, u32, u32)> {
+    let count = rgba
+        .iter()
+        .filter(|p| !p.iter().all(|c| c.is_finite()))
+        .count();
+    let at = rgba.iter().position(|p| !p.iter().all(|c| c.is_finite()))?;
+    let w = width.max(1) as usize;
+    Some((count, (at % w) as u32, (at / w) as u32))
+}
+
+/// Writes the tone-mapped frame as an sRGB PNG. Refuses a frame whose HDR
+/// composite held NaN or infinite values (they would be black pixels).
 pub fn write_png(path: &Path, c: &Capture) -> Result<()> {
+    if c.hdr_nonfinite > 0 {
+        anyhow::bail!(
+            "not writing {}: {} pixel(s) of the frame before tone mapping are NaN or infinite (a renderer defect: please report it)",
+            path.display(),
+            c.hdr_nonfinite
+        );
+    }
     let mut rgba = c.ldr.clone();
     for px in rgba.chunks_exact_mut(4) {
         px[3] = 255;
@@ -315,8 +403,17 @@ pub fn write_png(path: &Path, c: &Capture) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Writes one pass output as a linear float EXR.
+/// Writes one pass output as a linear float EXR. Refuses an image holding NaN
+/// or infinite values: no output of dermis ever does.
 pub fn write_exr(path: &Path, d: &DumpedImage) -> Result<()> {
+    if let Some((n, x, y)) = first_nonfinite(&d.rgba, d.width) {
+        anyhow::bail!(
+            "not writing {}: {n} texel(s) of '{}' after '{}' are NaN or infinite, the first at ({x}, {y}) (a renderer defect: please report it)",
+            path.display(),
+            d.image,
+            d.pass
+        );
+    }
     let data: Vec<f32> = d.rgba.iter().flatten().copied().collect();
     let img =
         image::Rgba32FImage::from_raw(d.width, d.height, data).context("dump size mismatch")?;
@@ -384,6 +481,90 @@ pub fn slug(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("dermis-run-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    // Issue 11: NaN texture coordinates gave NaN pixels in diffuse.exr. The
+    // writers refuse non-finite images with a clear error, and write nothing.
+    #[test]
+    fn writers_refuse_nan_and_inf() {
+        let d = tmp("nan");
+        let mut img = DumpedImage {
+            pass: "final".into(),
+            image: "diffuse".into(),
+            width: 3,
+            height: 2,
+            rgba: vec![[0.5; 4]; 6],
+        };
+        write_exr(&d.join("ok.exr"), &img).unwrap();
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            img.rgba[4][1] = bad;
+            let p = d.join("bad.exr");
+            let e = write_exr(&p, &img).unwrap_err().to_string();
+            assert!(e.contains("1 texel(s)") && e.contains("(1, 1)"), "{e}");
+            assert!(!p.exists());
+        }
+        let mut c = Capture {
+            ldr: vec![0; 6 * 4],
+            width: 3,
+            height: 2,
+            dumps: Vec::new(),
+            samples: Vec::new(),
+            diffuse: vec![[0.0; 4]; 6],
+            hdr_nonfinite: 0,
+        };
+        write_png(&d.join("ok.png"), &c).unwrap();
+        c.hdr_nonfinite = 2;
+        let e = write_png(&d.join("bad.png"), &c).unwrap_err().to_string();
+        assert!(e.contains("2 pixel(s)"), "{e}");
+        assert!(!d.join("bad.png").exists());
+        let _ = std::fs::remove_dir_all(d);
+    }
+
+    // Issue 11: `--out` problems were found only after the render.
+    #[test]
+    fn output_paths_are_checked_before_any_work() {
+        let d = tmp("out");
+        let file = d.join("a-file");
+        std::fs::write(&file, b"x").unwrap();
+        let e = prepare_render_dir(&file, false).unwrap_err().to_string();
+        assert!(e.contains("not a directory"), "{e}");
+        let e = prepare_render_dir(&file.join("below"), false).unwrap_err();
+        assert!(format!("{e:#}").contains("creating"), "{e:#}");
+        // An output name taken by a folder.
+        let out = d.join("out");
+        std::fs::create_dir_all(out.join("frame.png")).unwrap();
+        let e = prepare_render_dir(&out, false).unwrap_err().to_string();
+        assert!(e.contains("frame.png is a directory"), "{e}");
+        prepare_render_dir(&d.join("fresh"), true).unwrap();
+        // bench --report: a folder, or below a file.
+        let e = prepare_report_path(&out).unwrap_err().to_string();
+        assert!(e.contains("is a directory"), "{e}");
+        assert!(prepare_report_path(&file.join("r.json")).is_err());
+        prepare_report_path(&d.join("new/r.json")).unwrap();
+        let _ = std::fs::remove_dir_all(d);
+    }
+
+    // Issue 11: huge --frames/--warmup aborted on a 100 GB allocation.
+    #[test]
+    fn frame_counts_are_bounded() {
+        check_frame_counts(0, 1).unwrap();
+        check_frame_counts(MAX_WARMUP_FRAMES, MAX_MEASURED_FRAMES).unwrap();
+        for (w, m) in [
+            (0, 0),
+            (0, MAX_MEASURED_FRAMES + 1),
+            (MAX_WARMUP_FRAMES + 1, 1),
+            (usize::MAX, usize::MAX),
+        ] {
+            let e = check_frame_counts(w, m).unwrap_err().to_string();
+            assert!(e.contains("must be within"), "{e}");
+        }
+    }
 
     #[test]
     fn slugs_are_file_safe() {

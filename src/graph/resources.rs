@@ -159,6 +159,28 @@ impl Resources {
         Ok(())
     }
 
+    /// Bytes the declared images take once created (mip chains included; a
+    /// format dermis does not read back is counted at 8 bytes a texel).
+    pub fn declared_bytes(&self) -> u64 {
+        self.slots
+            .iter()
+            .map(|s| {
+                let d = &s.desc;
+                let texel = match crate::vk::memory::bytes_per_texel(d.format) {
+                    0 => 8,
+                    b => b as u64,
+                };
+                let level0 = d.extent.width as u64 * d.extent.height as u64 * texel;
+                // A full chain adds a third.
+                if d.levels > 1 {
+                    level0 + level0 / 3
+                } else {
+                    level0
+                }
+            })
+            .sum()
+    }
+
     /// Destroys every image the graph created (after the GPU is done with them).
     pub fn destroy(&mut self, ctx: &Context) {
         for s in &mut self.slots {

@@ -34,7 +34,9 @@ use crate::graph::work::{
 };
 use crate::graph::{BufferId, ImageDesc, ImageId, Pass, PassContext};
 use crate::reference::narrow::{radius, supersampling};
-use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface, Grid, SurfaceSample};
+use crate::reference::sampling::{
+    build_grid, cutoff_mm, sample_surface_within, Grid, SurfaceSample,
+};
 use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
@@ -305,13 +307,18 @@ impl Reference {
         let Some(skin) = skin else {
             bail!("the reference found no skin surface to sample");
         };
-        let mut surface = sample_surface(&skin.mesh, s.instances, mm, self.density);
+        // Samples (64 B), positions (16 B), normals (16 B) and radiance (16 B)
+        // per sample, within half of the device's memory: checked before any
+        // sample exists (a far outlier vertex would otherwise ask for billions).
+        let f = &s.ctx.facts;
+        let budget = f.device_local_bytes / 2 / 112;
+        let mut surface =
+            sample_surface_within(&skin.mesh, s.instances, mm, self.density, budget)?;
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
         }
         let grid = build_grid(&mut surface, cutoff_mm() / mm);
         let count = surface.len() as u32;
-        let f = &s.ctx.facts;
         let plan = plan_chunks(
             count,
             ChunkLimits {
@@ -319,16 +326,6 @@ impl Reference {
                 max_image_dimension: f.max_image_dimension_2d,
             },
         )?;
-        // Samples (64 B), positions (16 B), normals (16 B) and radiance (16 B) per sample.
-        let need = count as u64 * 112;
-        if need > f.device_local_bytes / 2 {
-            bail!(
-                "{count} reference samples ({:.1} GB at {} per mm^2) are more than half of this device's memory ({:.1} GB); lower --density or the number of heads",
-                need as f64 / 1e9,
-                self.density,
-                f.device_local_bytes as f64 / 1e9
-            );
-        }
         let cells_bytes = grid.cell_start.len() as u64 * 4;
         if cells_bytes > f.max_storage_buffer_range as u64 {
             bail!("the reference grid has {} cells, more than this device's storage-buffer range holds", grid.cell_start.len());

@@ -65,6 +65,48 @@ pub fn narrow_weight() -> [f64; 3] {
     out
 }
 
+/// How many samples [`sample_surface`] makes (in f64: a corrupt mesh can ask
+/// for more than any integer holds), so a caller can refuse before allocating.
+pub fn sample_count(mesh: &Mesh, transforms: &[Mat4], mm_per_unit: f32, density: f32) -> f64 {
+    let mut total = 0.0f64;
+    for m in transforms {
+        for tri in mesh.indices.chunks_exact(3) {
+            let p = [tri[0], tri[1], tri[2]]
+                .map(|i| m.transform_point3(Vec3::from(mesh.vertices[i as usize].position)));
+            let area_mm2 = triangle_area_mm2(p, mm_per_unit);
+            if area_mm2.is_nan() || area_mm2 <= 0.0 {
+                continue;
+            }
+            total += (area_mm2 * f64::from(density)).round().max(1.0);
+        }
+    }
+    total
+}
+
+/// `sample_surface`, refused when it would make more than `max_samples`
+/// (counted first: a far, corrupt vertex makes a triangle of astronomical area).
+pub fn sample_surface_within(
+    mesh: &Mesh,
+    transforms: &[Mat4],
+    mm_per_unit: f32,
+    density: f32,
+    max_samples: u64,
+) -> anyhow::Result<Vec<SurfaceSample>> {
+    let wanted = sample_count(mesh, transforms, mm_per_unit, density);
+    if wanted > max_samples.min(u32::MAX as u64) as f64 {
+        anyhow::bail!(
+            "the reference would take {wanted:.3e} samples at {density} per mm^2, more than this device holds ({max_samples}); lower --density or the number of heads (or check the mesh for far outlier vertices)"
+        );
+    }
+    Ok(sample_surface(mesh, transforms, mm_per_unit, density))
+}
+
+/// Area of a triangle in mm^2, in f64 (f32 overflows on a far vertex).
+fn triangle_area_mm2(p: [Vec3; 3], mm_per_unit: f32) -> f64 {
+    let q = p.map(|v| v.as_dvec3());
+    0.5 * (q[1] - q[0]).cross(q[2] - q[0]).length() * f64::from(mm_per_unit).powi(2)
+}
+
 /// Stratified samples over every triangle of `mesh` placed by each of
 /// `transforms` (uniform scale and translation), about `density` samples per mm^2,
 /// at least one per triangle; each carries the area it stands for. Deterministic:
@@ -84,8 +126,10 @@ pub fn sample_surface(
             let p = v.map(|x| m.transform_point3(Vec3::from(x.position)));
             let area_units = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
             let area_mm2 = area_units * mm_per_unit * mm_per_unit;
-            // Degenerate (or non-finite) triangles stand for no surface.
-            if area_mm2.is_nan() || area_mm2 <= 0.0 {
+            // Degenerate (or non-finite) triangles stand for no surface. (Callers
+            // bound the total with `sample_count` first: an infinite area would
+            // otherwise ask for usize::MAX samples.)
+            if !area_mm2.is_finite() || area_mm2 <= 0.0 {
                 continue;
             }
             let n = ((area_mm2 * density).round() as usize).max(1);

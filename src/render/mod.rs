@@ -42,6 +42,9 @@ pub struct Capture {
     /// Linear view depth of every pixel, scene units (where the accuracy
     /// bands find depth steps).
     pub depth: Vec<f32>,
+    /// Texels of the HDR composite (what the tone map reads) that are NaN or
+    /// infinite: the tone map turns them into black pixels of `ldr`.
+    pub hdr_nonfinite: usize,
 }
 
 /// The submission objects of a renderer.
@@ -106,6 +109,27 @@ fn destroy_all(
         f.destroy(ctx);
     }
     resources.destroy(ctx);
+}
+
+/// Refuses a frame whose images (and the readback of its output) would take
+/// more than half the device's memory: the allocation would fail late, or on a
+/// CPU device succeed and then exhaust the host. Checked before any image exists.
+fn check_memory(ctx: &Context, res: &Resources, extent: vk::Extent2D) -> Result<()> {
+    let pixels = extent.width as u64 * extent.height as u64;
+    // Readback of the tone-mapped frame (RGBA8) and the diffuse light (RGBA16F
+    // staged, then f32 on the host).
+    let need = res.declared_bytes() + pixels * (4 + 8 + 16);
+    let have = ctx.facts.device_local_bytes;
+    if have > 0 && need > have / 2 {
+        bail!(
+            "a {}x{} frame needs {:.1} GB of images, more than half of this device's {:.1} GB; lower --width/--height or --shadow-size",
+            extent.width,
+            extent.height,
+            need as f64 / 1e9,
+            have as f64 / 1e9
+        );
+    }
+    Ok(())
 }
 
 /// Query slots a frame may need: its passes, and with `--dump` one readback
@@ -191,6 +215,7 @@ impl<'c> Renderer<'c> {
                 .map(|i| (i, inputs::FILL_ACCESS)),
         );
         p.resources.allow(&accesses);
+        check_memory(ctx, &p.resources, extent)?;
         // 3. Create the images and write what reads them.
         p.resources.create(ctx)?;
         frame.bind(ctx, &p.resources, method.output())?;
@@ -204,29 +229,35 @@ impl<'c> Renderer<'c> {
             skin_material_binds: skin_material_binds(frame),
         })?;
         let profiler = Profiler::new(ctx, slots)?;
-        let cmd = match unsafe {
-            ctx.device.allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(ctx.command_pool)
-                    .command_buffer_count(1),
-            )
-        } {
+        let cmd = match ctx.creation_step("frame commands").and_then(|()| {
+            unsafe {
+                ctx.device.allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(ctx.command_pool)
+                        .command_buffer_count(1),
+                )
+            }
+            .map_err(Into::into)
+        }) {
             Ok(c) => c[0],
             Err(e) => {
                 profiler.destroy(ctx);
-                return Err(e.into());
+                return Err(e);
             }
         };
         ctx.name(cmd, "frame commands");
-        let fence = match unsafe {
-            ctx.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        } {
+        let fence = match ctx.creation_step("frame fence").and_then(|()| {
+            unsafe {
+                ctx.device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+            }
+            .map_err(Into::into)
+        }) {
             Ok(f) => f,
             Err(e) => {
                 profiler.destroy(ctx);
                 unsafe { ctx.device.free_command_buffers(ctx.command_pool, &[cmd]) };
-                return Err(e.into());
+                return Err(e);
             }
         };
         ctx.name(fence, "frame fence");
@@ -279,13 +310,14 @@ impl<'c> Renderer<'c> {
         )
     }
 
-    /// Renders `n` frames and returns each frame's pass samples.
+    /// Renders `n` frames and returns each frame's pass samples (memory grows
+    /// with `n`: the run bounds it, see `run::MAX_MEASURED_FRAMES`).
     pub fn frames(
         &mut self,
         n: usize,
         mut progress: impl FnMut(usize),
     ) -> Result<Vec<Vec<PassSample>>> {
-        let mut all = Vec::with_capacity(n);
+        let mut all = Vec::new();
         for i in 0..n {
             all.push(self.run_frame(None)?);
             progress(i + 1);
@@ -293,11 +325,27 @@ impl<'c> Renderer<'c> {
         Ok(all)
     }
 
+    /// Renders `n` frames and keeps nothing of them (warm-up, soak): memory
+    /// stays flat however large `n` is.
+    pub fn run_frames(&mut self, n: usize, mut progress: impl FnMut(usize)) -> Result<()> {
+        for i in 0..n {
+            self.run_frame(None)?;
+            progress(i + 1);
+        }
+        Ok(())
+    }
+
     /// Renders one frame and reads back the tone-mapped image, and with `dump`
     /// every pass output.
     pub fn capture(&mut self, dump: bool) -> Result<Capture> {
         let mut plan = ReadbackPlan::new(dump, self.frame.targets.ldr);
-        let samples = self.run_frame(Some(&mut plan))?;
+        let samples = match self.run_frame(Some(&mut plan)) {
+            Ok(s) => s,
+            Err(e) => {
+                plan.discard(self.ctx, &mut self.resources);
+                return Err(e);
+            }
+        };
         let (ldr, dumps) = plan.finish(self.ctx, &mut self.resources)?;
         let samples = samples
             .into_iter()
@@ -309,6 +357,7 @@ impl<'c> Renderer<'c> {
             .iter()
             .map(|p| p[0])
             .collect();
+        let hdr = self.read_back(self.frame.targets.hdr)?;
         Ok(Capture {
             ldr,
             width: self.frame.extent.width,
@@ -317,6 +366,10 @@ impl<'c> Renderer<'c> {
             samples,
             diffuse,
             depth,
+            hdr_nonfinite: hdr
+                .iter()
+                .filter(|p| !p.iter().all(|c| c.is_finite()))
+                .count(),
         })
     }
 
@@ -337,16 +390,22 @@ impl<'c> Renderer<'c> {
     /// contents stay until the next frame writes them).
     pub fn read_back(&mut self, id: ImageId) -> Result<Vec<[f32; 4]>> {
         let mut plan = ReadbackPlan::single(id);
-        let passes = plan.interleave(self.ctx, &mut self.resources, Vec::new())?;
-        submit_passes(
-            self.ctx,
-            &self.submit,
-            &mut self.resources,
-            &passes,
-            false,
-            "while reading back an image",
-        )?;
-        drop(passes);
+        let done = plan
+            .interleave(self.ctx, &mut self.resources, Vec::new())
+            .and_then(|passes| {
+                submit_passes(
+                    self.ctx,
+                    &self.submit,
+                    &mut self.resources,
+                    &passes,
+                    false,
+                    "while reading back an image",
+                )
+            });
+        if let Err(e) = done {
+            plan.discard(self.ctx, &mut self.resources);
+            return Err(e);
+        }
         plan.finish_single(self.ctx, &mut self.resources)
     }
 
@@ -363,16 +422,25 @@ impl<'c> Renderer<'c> {
             bail!("the SSS-only run needs a method with passes");
         }
         let mut plan = ReadbackPlan::single(self.method.output());
-        let passes = plan.interleave(self.ctx, &mut self.resources, passes)?;
-        let samples = submit_passes(
-            self.ctx,
-            &self.submit,
-            &mut self.resources,
-            &passes,
-            true,
-            "during the SSS-only run",
-        )?;
-        drop(passes);
+        let done = plan
+            .interleave(self.ctx, &mut self.resources, passes)
+            .and_then(|passes| {
+                submit_passes(
+                    self.ctx,
+                    &self.submit,
+                    &mut self.resources,
+                    &passes,
+                    true,
+                    "during the SSS-only run",
+                )
+            });
+        let samples = match done {
+            Ok(s) => s,
+            Err(e) => {
+                plan.discard(self.ctx, &mut self.resources);
+                return Err(e);
+            }
+        };
         let img = plan.finish_single(self.ctx, &mut self.resources)?;
         Ok((
             img,

@@ -246,11 +246,18 @@ impl ReadbackPlan {
     }
 
     /// After the fence: the final image's raw bytes and every dump as float.
+    /// The readback buffers are freed whatever happens.
     pub fn finish(
         mut self,
         ctx: &Context,
         res: &mut Resources,
     ) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
+        let out = self.collect(res);
+        self.release(ctx, res);
+        out
+    }
+
+    fn collect(&self, res: &Resources) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
         let mut final_bytes = None;
         let mut dumps = Vec::new();
         for p in &self.pending {
@@ -269,7 +276,6 @@ impl ReadbackPlan {
                 });
             }
         }
-        self.release(ctx, res);
         Ok((
             final_bytes.context("the final image was not read back")?,
             dumps,
@@ -278,11 +284,19 @@ impl ReadbackPlan {
 
     /// After the fence: the single image as float RGBA.
     pub fn finish_single(mut self, ctx: &Context, res: &mut Resources) -> Result<Vec<[f32; 4]>> {
-        let p = self.pending.first().context("nothing was read back")?;
-        let (_, _, format, bytes) = self.read(p, res)?;
-        let out = to_rgba_f32(format, &bytes);
+        let out = self
+            .pending
+            .first()
+            .context("nothing was read back")
+            .and_then(|p| self.read(p, res))
+            .and_then(|(_, _, format, bytes)| to_rgba_f32(format, &bytes));
         self.release(ctx, res);
         out
+    }
+
+    /// Frees the readback buffers of a plan whose submission failed.
+    pub fn discard(mut self, ctx: &Context, res: &mut Resources) {
+        self.release(ctx, res);
     }
 
     fn release(&mut self, ctx: &Context, res: &mut Resources) {

@@ -36,31 +36,45 @@ fn upload_texture(
     fallback: [u8; 4],
     format: vk::Format,
 ) -> Result<Image> {
-    match tex {
-        Some(t) => texture(
-            ctx,
-            name,
-            vk::Extent2D {
-                width: t.width,
-                height: t.height,
-            },
-            format,
-            &t.rgba8,
-        ),
-        None => texture(
-            ctx,
-            name,
-            vk::Extent2D {
-                width: 1,
-                height: 1,
-            },
-            format,
-            &fallback,
-        ),
+    let Some(t) = tex else {
+        let one = vk::Extent2D {
+            width: 1,
+            height: 1,
+        };
+        return texture(ctx, name, one, format, &fallback);
+    };
+    let max = ctx.facts.max_image_dimension_2d;
+    let fitted = fit_to_device(name, t, max);
+    let t = fitted.as_ref().unwrap_or(t);
+    texture(
+        ctx,
+        name,
+        vk::Extent2D {
+            width: t.width,
+            height: t.height,
+        },
+        format,
+        &t.rgba8,
+    )
+}
+
+/// A copy of `t` box-filtered down to `max` texels a side when it is larger
+/// (a device cannot create a bigger image), with a warning; `None` when it fits.
+pub fn fit_to_device(name: &str, t: &Texture, max: u32) -> Option<Texture> {
+    if t.width <= max && t.height <= max {
+        return None;
     }
+    let mut small = t.clone();
+    small.downscale_to_fit(max);
+    eprintln!(
+        "warning: texture '{name}' is {}x{}, more than this device's {max} texels a side: downscaled to {}x{}",
+        t.width, t.height, small.width, small.height
+    );
+    Some(small)
 }
 
 impl GpuObject {
+    /// Uploads `object`; on an error, whatever was made is destroyed.
     pub fn new(
         ctx: &Context,
         name: &str,
@@ -69,15 +83,43 @@ impl GpuObject {
         geometry: &Pipeline,
         samplers: &Samplers,
     ) -> Result<Self> {
+        let mut g = GpuObject {
+            name: name.to_string(),
+            vertices: Buffer::default(),
+            indices: Buffer::default(),
+            index_count: object.mesh.indices.len() as u32,
+            skin: object.material.skin,
+            textures: Vec::new(),
+            uniforms: Buffer::default(),
+            material_set: vk::DescriptorSet::null(),
+        };
+        match g.upload(ctx, object, pool, geometry, samplers) {
+            Ok(()) => Ok(g),
+            Err(e) => {
+                g.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn upload(
+        &mut self,
+        ctx: &Context,
+        object: &Object,
+        pool: &DescriptorPool,
+        geometry: &Pipeline,
+        samplers: &Samplers,
+    ) -> Result<()> {
+        let name = self.name.clone();
         let mesh = &object.mesh;
-        let vertices = device_buffer(
+        self.vertices = device_buffer(
             ctx,
             &format!("{name} vertices"),
             bytemuck::cast_slice(&mesh.vertices),
             vk::BufferUsageFlags::VERTEX_BUFFER,
             AccessKind::VertexInputRead,
         )?;
-        let indices = device_buffer(
+        self.indices = device_buffer(
             ctx,
             &format!("{name} indices"),
             bytemuck::cast_slice(&mesh.indices),
@@ -86,27 +128,30 @@ impl GpuObject {
         )?;
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
-        let albedo = upload_texture(
-            ctx,
-            &format!("{name} albedo"),
-            m.base_color.as_ref(),
-            [255; 4],
-            vk::Format::R8G8B8A8_SRGB,
-        )?;
-        let normal = upload_texture(
-            ctx,
-            &format!("{name} normal map"),
-            m.normal_map.as_ref(),
-            [128, 128, 255, 255],
-            vk::Format::R8G8B8A8_UNORM,
-        )?;
-        let spec = upload_texture(
-            ctx,
-            &format!("{name} specular map"),
-            m.specular_map.as_ref(),
-            [255; 4],
-            vk::Format::R8G8B8A8_UNORM,
-        )?;
+        let maps = [
+            (
+                "albedo",
+                m.base_color.as_ref(),
+                [255; 4],
+                vk::Format::R8G8B8A8_SRGB,
+            ),
+            (
+                "normal map",
+                m.normal_map.as_ref(),
+                [128, 128, 255, 255],
+                vk::Format::R8G8B8A8_UNORM,
+            ),
+            (
+                "specular map",
+                m.specular_map.as_ref(),
+                [255; 4],
+                vk::Format::R8G8B8A8_UNORM,
+            ),
+        ];
+        for (what, tex, fallback, format) in maps {
+            let t = upload_texture(ctx, &format!("{name} {what}"), tex, fallback, format)?;
+            self.textures.push(t);
+        }
         let u = MaterialUniforms {
             base_color: [
                 m.base_color_factor[0],
@@ -121,40 +166,14 @@ impl GpuObject {
                 if m.skin { 1.0 } else { 0.0 },
             ],
         };
-        let uniforms = Buffer::with_data(
+        self.uniforms = Buffer::with_data(
             ctx,
             &format!("{name} material"),
             bytemuck::bytes_of(&u),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
-        let material_set = pool.write_set(
-            ctx,
-            geometry,
-            1,
-            &[
-                ("albedoTex", Bind::Texture(albedo.view)),
-                ("normalTex", Bind::Texture(normal.view)),
-                ("specTex", Bind::Texture(spec.view)),
-                ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
-                (
-                    "material",
-                    Bind::Uniform {
-                        buffer: uniforms.raw,
-                        size: std::mem::size_of::<MaterialUniforms>() as u64,
-                    },
-                ),
-            ],
-        )?;
-        Ok(GpuObject {
-            name: name.to_string(),
-            vertices,
-            indices,
-            index_count: mesh.indices.len() as u32,
-            skin: m.skin,
-            textures: vec![albedo, normal, spec],
-            uniforms,
-            material_set,
-        })
+        self.material_set = pool.write_set(ctx, geometry, 1, &self.material_binds(samplers))?;
+        Ok(())
     }
 
     /// The material's bindings (set 1 of the shaders that include lighting.glsl).

@@ -9,11 +9,21 @@ use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
 
-/// Largest frame side and shadow map dermis accepts before the device says
-/// more (its maxImageDimension2D is checked once it is open).
+/// Largest frame side and shadow map dermis accepts (a device may allow
+/// less: its maxImageDimension2D is checked once it is open).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 /// Most characters a scene may hold.
 pub const MAX_HEADS: u32 = 1024;
+/// Exposure (a factor on linear light before the tone curve): 2^-10..=2^10
+/// around the default 2. Past it the frame is black or white whatever the
+/// scene (the issue's `--exposure 1e30` was a black frame).
+pub const EXPOSURE_RANGE: std::ops::RangeInclusive<f32> = (1.0 / 1024.0)..=1024.0;
+/// Largest ambient irradiance (default 0.08): like the key light's intensity
+/// (`scene::light::MAX_INTENSITY`), bounded so RGBA16F targets cannot overflow.
+pub const MAX_AMBIENT: f32 = 100.0;
+/// Farthest camera, in head heights (the far shot is 14): at 1000 a head is a
+/// few pixels high in a 4K frame, and f32 still separates near and far planes.
+pub const MAX_DISTANCE_HEADS: f32 = 1000.0;
 
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -79,24 +89,47 @@ impl RenderSettings {
     }
 
     /// Rejects settings that would give a bad frame or a driver error, with one
-    /// clear message each.
+    /// clear message each. Every number has a range (README, "Valid ranges"):
+    /// width, height, shadow map 1..=the device's maxImageDimension2D (16384
+    /// before a device is open); heads 1..=1024; distance (0, 1000] head
+    /// heights; field of view (0.5, 170) degrees; light azimuth -360..=360,
+    /// elevation -90..=90, intensity 0..=100; ambient 0..=100; exposure
+    /// 2^-10..=2^10; SSS region tile 1..=1024; the method's own options in
+    /// its `Config::parse`.
     pub fn validate(&self, max_image_dimension: u32) -> Result<()> {
+        let (limit, whose) = if max_image_dimension <= MAX_IMAGE_SIDE {
+            (max_image_dimension, "the device limit")
+        } else {
+            (MAX_IMAGE_SIDE, "the limit")
+        };
         for (what, v) in [("width", self.width), ("height", self.height)] {
             if v == 0 {
                 bail!("{what} must be at least 1 pixel");
             }
-            if v > max_image_dimension {
-                bail!("{what} {v} exceeds the device limit of {max_image_dimension} pixels");
+            if v > limit {
+                bail!("{what} {v} exceeds {whose} of {limit} pixels");
             }
         }
-        if self.shadow_size == 0 || self.shadow_size > max_image_dimension {
+        if self.shadow_size == 0 || self.shadow_size > limit {
             bail!(
-                "shadow map size must be within 1..={max_image_dimension}, got {}",
+                "shadow map size must be within 1..={limit}, got {}",
                 self.shadow_size
             );
         }
         (self.method.check)(&self.method.opts(&self.options))
             .with_context(|| format!("method {}", self.method.name))?;
+        // An option of another method is ignored (the CLI says so), but its
+        // value must still be one it would accept: no NaN slips through unread.
+        for m in crate::method::METHODS {
+            let given = m
+                .options
+                .iter()
+                .any(|o| self.options.given(o.key).is_some());
+            if m.name != self.method.name && given {
+                (m.check)(&m.opts(&self.options))
+                    .with_context(|| format!("method {} (an option of it was given)", m.name))?;
+            }
+        }
         if !(1..=1024).contains(&self.sss_region_tile) {
             bail!(
                 "the SSS region's tile must be 1..=1024 pixels, got {}",
@@ -106,9 +139,12 @@ impl RenderSettings {
         if self.heads == 0 || self.heads > MAX_HEADS {
             bail!("heads must be within 1..={MAX_HEADS}, got {}", self.heads);
         }
-        if !self.distance_heads.is_finite() || self.distance_heads <= 0.0 {
+        if !self.distance_heads.is_finite()
+            || self.distance_heads <= 0.0
+            || self.distance_heads > MAX_DISTANCE_HEADS
+        {
             bail!(
-                "camera distance must be a positive number of head heights, got {}",
+                "camera distance must be within (0, {MAX_DISTANCE_HEADS}] head heights, got {}",
                 self.distance_heads
             );
         }
@@ -119,14 +155,19 @@ impl RenderSettings {
             );
         }
         self.light.validate()?;
-        if !self.ambient.is_finite() || self.ambient < 0.0 {
+        if !self.ambient.is_finite() || !(0.0..=MAX_AMBIENT).contains(&self.ambient) {
             bail!(
-                "ambient must be finite and non-negative, got {}",
+                "ambient must be within 0..={MAX_AMBIENT}, got {}",
                 self.ambient
             );
         }
-        if !self.exposure.is_finite() || self.exposure <= 0.0 {
-            bail!("exposure must be a positive number, got {}", self.exposure);
+        if !self.exposure.is_finite() || !EXPOSURE_RANGE.contains(&self.exposure) {
+            bail!(
+                "exposure must be within {}..={}, got {}",
+                EXPOSURE_RANGE.start(),
+                EXPOSURE_RANGE.end(),
+                self.exposure
+            );
         }
         Ok(())
     }
@@ -169,11 +210,46 @@ mod tests {
         let b = s.clone().with(sep, &[("samples", "16")]);
         let e = format!("{:#}", b.validate(16384).unwrap_err());
         assert!(e.contains("odd"), "{e}");
-        // An option of another method is not this method's business.
+        // An option of another method is checked too, though not read.
         let b = s.clone().with(lookup("ssg").unwrap(), &[("samples", "16")]);
-        b.validate(16384).unwrap();
-        let mut b = s;
+        let e = format!("{:#}", b.validate(16384).unwrap_err());
+        assert!(e.contains("method separable") && e.contains("odd"), "{e}");
+        let mut b = s.clone();
         b.light.intensity = f32::NAN;
         assert!(b.validate(16384).is_err());
+    }
+
+    // Issue 11: every number has an upper bound too; huge values gave black
+    // frames (exposure 1e30) or NaN pixels (falloff 1e30, light 1e30).
+    #[test]
+    fn huge_values_are_refused_before_a_device_opens() {
+        let s = RenderSettings::default();
+        let refused = |f: &dyn Fn(&mut RenderSettings), what: &str| {
+            let mut b = s.clone();
+            f(&mut b);
+            let e = format!("{:#}", b.validate(u32::MAX).unwrap_err());
+            assert!(e.contains(what), "{e}");
+        };
+        for v in [1e30, f32::INFINITY, 1025.0, 0.0, -1.0, 1e-4] {
+            refused(&|b| b.exposure = v, "exposure must be within");
+        }
+        for v in [1e30, 100.5, -0.1, f32::NAN] {
+            refused(&|b| b.ambient = v, "ambient must be within");
+            refused(&|b| b.light.intensity = v, "intensity must be within");
+        }
+        refused(&|b| b.distance_heads = 1e30, "distance");
+        refused(&|b| b.light.azimuth_deg = 1e30, "azimuth");
+        refused(&|b| b.width = u32::MAX, "exceeds");
+        let sep = lookup("separable").unwrap();
+        let b = s.clone().with(sep, &[("falloff", "1e30,0.5,0.5")]);
+        let e = format!("{:#}", b.validate(u32::MAX).unwrap_err());
+        assert!(e.contains("falloff"), "{e}");
+        // The bounds themselves are accepted.
+        let mut b = s;
+        b.exposure = *EXPOSURE_RANGE.end();
+        b.ambient = MAX_AMBIENT;
+        b.light.intensity = crate::scene::light::MAX_INTENSITY;
+        b.distance_heads = MAX_DISTANCE_HEADS;
+        b.validate(u32::MAX).unwrap();
     }
 }

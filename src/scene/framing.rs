@@ -217,4 +217,127 @@ mod tests {
                 > one.camera.eye.distance(one.camera.target)
         );
     }
+
+    /// A `w` x `h` card of 8x4 quads in the XY plane, facing +Z, moved by `m`.
+    pub(crate) fn card(w: f32, h: f32, m: Mat4) -> crate::scene::mesh::Object {
+        use crate::scene::mesh::{Material, Mesh, Object, Vertex};
+        let (nx, ny) = (8u32, 4u32);
+        let mut mesh = Mesh::default();
+        for j in 0..=ny {
+            for i in 0..=nx {
+                let p = Vec3::new(
+                    (i as f32 / nx as f32 - 0.5) * w,
+                    (j as f32 / ny as f32 - 0.5) * h,
+                    0.0,
+                );
+                mesh.vertices.push(Vertex {
+                    position: m.transform_point3(p).into(),
+                    normal: m.transform_vector3(Vec3::Z).into(),
+                    uv: [i as f32 / nx as f32, j as f32 / ny as f32],
+                    tangent: [1.0, 0.0, 0.0, 1.0],
+                });
+            }
+        }
+        for j in 0..ny {
+            for i in 0..nx {
+                let at = |i: u32, j: u32| j * (nx + 1) + i;
+                mesh.indices
+                    .extend([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                mesh.indices
+                    .extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        Object {
+            mesh,
+            material: Material::skin([0.6, 0.4, 0.3]),
+        }
+    }
+
+    // Issue 11: a flat object was framed edge-on (only its shadow showed). It
+    // now faces the camera with its largest extent, whichever way it lies.
+    #[test]
+    fn a_flat_object_faces_the_camera_with_its_largest_extent() {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        for (m, facing) in [
+            (Mat4::IDENTITY, Vec3::Z),
+            (Mat4::from_rotation_y(PI), Vec3::NEG_Z),
+            (Mat4::from_rotation_y(FRAC_PI_2), Vec3::X),
+            (Mat4::from_rotation_x(-FRAC_PI_2), Vec3::Y),
+        ] {
+            let s = crate::scene::scene_from_head("card", card(2.0, 1.0, m), None).unwrap();
+            assert!(
+                (s.forward - facing).length() < 1e-5,
+                "{facing}: {}",
+                s.forward
+            );
+            assert!((s.head_height_units() - 2.0).abs() < 1e-5);
+            let f = frame(&s, &shot(Layout::Crowd, 1));
+            let vp = f.camera.view_proj(16.0 / 9.0);
+            let ndc: Vec<Vec3> = s
+                .head
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| project(&vp, Vec3::from(v.position)))
+                .collect();
+            let lo = ndc.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
+            let hi = ndc.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
+            let size = hi - lo;
+            // On screen, between the planes, and seen face on: its projection is
+            // a rectangle of aspect about 2, not a line.
+            assert!(
+                lo.x > -1.0 && hi.x < 1.0 && lo.y > -1.0 && hi.y < 1.0,
+                "{facing}: {lo} {hi}"
+            );
+            assert!(lo.z > 0.0 && hi.z < 1.0, "{facing}: {lo} {hi}");
+            let (wide, tall) = (size.x * 16.0 / 9.0, size.y);
+            assert!(
+                wide.min(tall) > 0.2,
+                "{facing}: seen edge-on ({wide} x {tall})"
+            );
+        }
+    }
+
+    // Issue 11: one vertex at 1e31 (one flipped exponent bit) made the plain
+    // bounds a universe: the head was a point, the shadow map covered 1e31 and
+    // the frame was black. The framing now leaves the vertex out.
+    #[test]
+    fn a_far_outlier_vertex_does_not_move_the_framing() {
+        let clean = crate::scene::egg_scene();
+        let good = crate::scene::scene_from_head("clean", clean.head.clone(), None).unwrap();
+        assert_eq!(
+            crate::scene::head_measure::inlier_bounds(&good.head.mesh).1,
+            0
+        );
+        for far in [
+            Vec3::new(0.0, 1e31, 0.0),
+            Vec3::new(-3e30, 0.0, 1e31),
+            Vec3::splat(1e4),
+        ] {
+            let mut head = clean.head.clone();
+            head.mesh.vertices[100].position = far.into();
+            let bad = crate::scene::scene_from_head("outlier", head, None).unwrap();
+            assert_eq!(bad.forward, good.forward);
+            let (a, b) = (
+                frame(&good, &shot(Layout::Crowd, 1)),
+                frame(&bad, &shot(Layout::Crowd, 1)),
+            );
+            let h = good.head_height_units();
+            assert!((bad.head_height_units() - h).abs() < 0.02 * h, "{far}");
+            assert!(
+                (bad.mm_per_unit / good.mm_per_unit - 1.0).abs() < 0.02,
+                "{far}"
+            );
+            assert!(a.camera.eye.distance(b.camera.eye) < 0.05 * h, "{far}");
+            assert!(
+                a.camera.target.distance(b.camera.target) < 0.05 * h,
+                "{far}"
+            );
+            assert!(
+                (b.bounds.size() - a.bounds.size()).length() < 0.05 * h,
+                "{far}"
+            );
+            assert!((b.light.depth_range_units / a.light.depth_range_units - 1.0).abs() < 0.05);
+        }
+    }
 }

@@ -22,8 +22,8 @@
 //! - Non-finite positions, normals, tangents, texture coordinates or node transforms
 //!   are errors. Node transforms are composed in f64, and a model far from the origin
 //!   for its size (a scan placed at 1e7) is moved to it, so f32 keeps its shape.
-//! - Far outlier vertices (one flipped exponent bit) load with a warning; framing code
-//!   should use `robust_bounds` to ignore them.
+//! - Far outlier vertices (one flipped exponent bit) load with a warning; the framing
+//!   (`head_measure`, the scene's bounds) leaves them out.
 
 use super::gltf_accessor::{read_attribute, read_indices, view_bytes, Use};
 use super::gltf_source::{read_uri, short, Source};
@@ -656,7 +656,7 @@ fn place(c: &mut Collected, warn: &mut Warnings) -> Result<()> {
             .unwrap_or(0);
         let p = c.world_pos[far];
         warn.push(format!(
-            "{} vertices lie far outside the rest of the mesh (vertex {far} at ({:e}, {:e}, {:e})): corrupt data? Frame with scene::robust_bounds",
+            "{} vertices lie far outside the rest of the mesh (vertex {far} at ({:e}, {:e}, {:e})): corrupt data? Left out of the camera's and the shadow map's framing",
             rb.ignored, p.x, p.y, p.z
         ));
     }

@@ -3,36 +3,117 @@
 //! the chin-to-crown height (a human head is ~230 mm); scans often carry a neck and
 //! shoulders, which is why the plain vertical extent is not good enough.
 
+//!
+//! Every measurement ignores far outlier vertices (`robust_bounds`: one flipped
+//! exponent bit puts a vertex at 1e31, and the plain bounding box then frames a
+//! universe with the head as one invisible point). A flat object (a card, a sheet)
+//! has no face or chin: it is framed along its thin axis, its largest extent facing
+//! the camera.
+
 use super::mesh::{Aabb, Mesh};
+use super::robust_bounds::robust_bounds;
 use glam::Vec3;
 
 /// Human chin-to-crown height in millimetres, used to derive `mm_per_unit`.
 pub const HEAD_HEIGHT_MM: f32 = 230.0;
+
+/// A mesh whose smallest extent is below this fraction of its largest is flat:
+/// a head is never thinner than half its height, a card or a sheet is.
+pub const FLAT_RATIO: f32 = 0.1;
+
+/// Bounds of the mesh without its far outlier vertices, and how many were left
+/// out (the plain bounds, and 0, when there is nothing to judge by).
+pub fn inlier_bounds(mesh: &Mesh) -> (Aabb, usize) {
+    match robust_bounds(mesh.vertices.iter().map(|v| Vec3::from(v.position))) {
+        Some(r) => (r.aabb, r.ignored),
+        None => (mesh.bounds(), 0),
+    }
+}
+
+/// Whether `p` lies inside `b` (the inliers of `inlier_bounds`).
+fn inside(b: &Aabb, p: Vec3) -> bool {
+    p.cmpge(b.min).all() && p.cmple(b.max).all()
+}
+
+/// For a flat mesh, the unit axis it is thin along, pointing to the side its
+/// triangles face (area-weighted normals; +axis when they cancel); `None` for
+/// a solid.
+pub fn flat_axis(mesh: &Mesh) -> Option<Vec3> {
+    let (b, _) = inlier_bounds(mesh);
+    let size = b.size();
+    let largest = size.max_element();
+    if !(largest > 0.0 && largest.is_finite()) || size.min_element() >= FLAT_RATIO * largest {
+        return None;
+    }
+    let axis = if size.x <= size.y && size.x <= size.z {
+        Vec3::X
+    } else if size.y <= size.z {
+        Vec3::Y
+    } else {
+        Vec3::Z
+    };
+    let mut facing = 0.0f64;
+    for tri in mesh.indices.chunks_exact(3) {
+        let p: Option<Vec<Vec3>> = tri
+            .iter()
+            .map(|&i| {
+                mesh.vertices
+                    .get(i as usize)
+                    .map(|v| Vec3::from(v.position))
+            })
+            .collect();
+        let Some(p) = p.filter(|p| p.iter().all(|&q| inside(&b, q))) else {
+            continue;
+        };
+        facing += f64::from((p[1] - p[0]).cross(p[2] - p[0]).dot(axis));
+    }
+    Some(if facing < 0.0 { -axis } else { axis })
+}
+
+/// Where the camera frames a head: the centre and height (scene units) of the
+/// part from the chin up; for a flat mesh, its centre and largest extent.
+pub fn framed_part(mesh: &Mesh, forward: Vec3) -> (Vec3, f32) {
+    if flat_axis(mesh).is_some() {
+        let (b, _) = inlier_bounds(mesh);
+        return (b.center(), b.size().max_element());
+    }
+    let (chin, crown) = chin_and_crown(mesh, forward);
+    (head_part_bounds(mesh, forward).center(), crown - chin)
+}
 
 /// Unit horizontal vector from the head's centre toward its face. Y is taken as up (glTF's
 /// convention). The nose is the narrowest protrusion of a head: for each horizontal axis
 /// direction, the vertices within 5% of the size of the mesh from its extreme plane are
 /// collected and their sideways spread measured; the face is the direction whose extreme
 /// is narrowest (the back of the skull, the shoulders, and the side of the skull are all
-/// broad). Falls back to +Z, the glTF "front", for empty meshes.
+/// broad). Falls back to +Z, the glTF "front", for empty meshes. A flat mesh
+/// faces along its thin axis (`flat_axis`), so its largest extent faces the
+/// camera instead of its edge. Far outlier vertices are ignored.
 pub fn face_direction(mesh: &Mesh) -> Vec3 {
-    let bounds = mesh.bounds();
+    if let Some(axis) = flat_axis(mesh) {
+        return axis;
+    }
+    let (bounds, _) = inlier_bounds(mesh);
     let delta = 0.05 * bounds.size().max_element();
     if mesh.vertices.is_empty() || delta <= 0.0 || !delta.is_finite() {
         return Vec3::Z;
     }
+    let inliers: Vec<Vec3> = mesh
+        .vertices
+        .iter()
+        .map(|v| Vec3::from(v.position))
+        .filter(|&p| inside(&bounds, p))
+        .collect();
     let candidates = [Vec3::Z, Vec3::NEG_Z, Vec3::X, Vec3::NEG_X];
     let mut best = (f32::INFINITY, Vec3::Z);
     for dir in candidates {
         let side = dir.cross(Vec3::Y);
-        let extreme = mesh
-            .vertices
+        let extreme = inliers
             .iter()
-            .map(|v| Vec3::from(v.position).dot(dir))
+            .map(|p| p.dot(dir))
             .fold(f32::NEG_INFINITY, f32::max);
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-        for v in &mesh.vertices {
-            let p = Vec3::from(v.position);
+        for &p in &inliers {
             if p.dot(dir) >= extreme - delta {
                 let s = p.dot(side);
                 lo = lo.min(s);
@@ -57,7 +138,7 @@ pub fn face_direction(mesh: &Mesh) -> Vec3 {
 /// bottom (the menton) on the Lee Perry-Smith scan. A mesh whose bottom narrows to a
 /// point (no neck, like the procedural head) has its chin at its lowest point.
 pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
-    let b = mesh.bounds();
+    let (b, _) = inlier_bounds(mesh);
     let (bottom, crown) = (b.min.y, b.max.y);
     let extent = crown - bottom;
     if mesh.vertices.is_empty() || extent <= 0.0 || !extent.is_finite() {
@@ -69,7 +150,7 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
         .vertices
         .iter()
         .map(|v| Vec3::from(v.position))
-        .filter(|p| p.y <= bottom + 0.02 * extent)
+        .filter(|&p| inside(&b, p) && p.y <= bottom + 0.02 * extent)
         .collect();
     if let Some(bb) = Aabb::from_points(band) {
         let base = bb.size().x.max(bb.size().z);
@@ -91,6 +172,7 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
                     .map(|v| Vec3::from(v.position))
             })
             .collect::<Option<Vec<Vec3>>>()
+            .filter(|p| p.iter().all(|&q| inside(&b, q)))
         else {
             continue;
         };
@@ -153,13 +235,14 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
 /// which is what a camera should frame.
 pub fn head_part_bounds(mesh: &Mesh, forward: Vec3) -> Aabb {
     let (chin, _) = chin_and_crown(mesh, forward);
+    let (b, _) = inlier_bounds(mesh);
     Aabb::from_points(
         mesh.vertices
             .iter()
             .map(|v| Vec3::from(v.position))
-            .filter(|p| p.y >= chin),
+            .filter(|&p| inside(&b, p) && p.y >= chin),
     )
-    .unwrap_or_else(|| mesh.bounds())
+    .unwrap_or(b)
 }
 
 #[cfg(test)]

@@ -3,6 +3,13 @@
 use anyhow::{bail, Result};
 use glam::{Mat4, Quat, Vec3};
 
+/// Largest key-light intensity accepted. The geometry pass writes light x
+/// albedo and the specular lobe into RGBA16F (largest value 65504): at 100 the
+/// brightest specular highlight stays an order of magnitude below it, while
+/// the default is 2.5. Beyond, highlights overflow to infinity and the tone map
+/// turns them into NaN.
+pub const MAX_INTENSITY: f32 = 100.0;
+
 /// A directional key light placed relative to the face, so light setups read the same
 /// for any head orientation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,8 +39,11 @@ impl KeyLight {
     /// User-facing settings come from the command line: reject values that would
     /// produce NaNs or negative light.
     pub fn validate(&self) -> Result<()> {
-        if !self.azimuth_deg.is_finite() {
-            bail!("light azimuth must be finite, got {}", self.azimuth_deg);
+        if !self.azimuth_deg.is_finite() || self.azimuth_deg.abs() > 360.0 {
+            bail!(
+                "light azimuth must be within -360..=360 degrees, got {}",
+                self.azimuth_deg
+            );
         }
         if !self.elevation_deg.is_finite() || self.elevation_deg.abs() > 90.0 {
             bail!(
@@ -47,9 +57,9 @@ impl KeyLight {
                 self.color
             );
         }
-        if !self.intensity.is_finite() || self.intensity < 0.0 {
+        if !self.intensity.is_finite() || !(0.0..=MAX_INTENSITY).contains(&self.intensity) {
             bail!(
-                "light intensity must be finite and non-negative, got {}",
+                "light intensity must be within 0..={MAX_INTENSITY}, got {}",
                 self.intensity
             );
         }

@@ -28,23 +28,24 @@ pub struct Scene {
     pub head: mesh::Object,
     pub backdrop: Option<mesh::Object>,
     /// Bounds of the whole head object, neck and shoulders included when a scan has them
-    /// (what shadows must cover); frame the camera with `head_center`/`head_height_units`.
+    /// (what shadows must cover), far outlier vertices left out (a loaded scene says
+    /// how many); frame the camera with `head_center`/`head_height_units`.
     pub head_bounds: mesh::Aabb,
     /// Unit vector from the head centre toward the face: where the camera goes.
     pub forward: Vec3,
 }
 
 impl Scene {
-    /// Chin-to-crown extent along +Y in scene units. Measured from the mesh on every
-    /// call (a few hundred microseconds): keep the result if you need it per frame.
+    /// Chin-to-crown extent along +Y in scene units (a flat object's largest extent).
+    /// Measured from the mesh on every call (a few milliseconds on a large scan): keep
+    /// the result if you need it per frame.
     pub fn head_height_units(&self) -> f32 {
-        let (chin, crown) = head_measure::chin_and_crown(&self.head.mesh, self.forward);
-        crown - chin
+        head_measure::framed_part(&self.head.mesh, self.forward).1
     }
 
     /// Centre of the head from the chin up (not of a scan's shoulders): the camera target.
     pub fn head_center(&self) -> Vec3 {
-        head_measure::head_part_bounds(&self.head.mesh, self.forward).center()
+        head_measure::framed_part(&self.head.mesh, self.forward).0
     }
 }
 
@@ -68,6 +69,30 @@ pub fn builtin(name: &str) -> Result<Scene> {
             BUILTIN_SCENES.join(", ")
         ),
     }
+}
+
+/// A built-in scene for the command line: `name`, scaled by `mm_per_unit` when
+/// given. Texture overrides apply to a glTF scene only: given here, they are an
+/// error rather than silently unused.
+pub fn builtin_scene(
+    name: &str,
+    overrides: &gltf_load::TextureOverrides,
+    mm_per_unit: Option<f32>,
+) -> Result<Scene> {
+    let o = overrides;
+    if o.albedo.is_some()
+        || o.normal_map.is_some()
+        || o.specular_map.is_some()
+        || o.sidecar_top_down
+    {
+        bail!("--albedo, --normal-map, --spec-map and --sidecar-top-down apply to a glTF --scene, not to builtin:{name}");
+    }
+    let mut s = builtin(name)?;
+    if let Some(mm) = mm_per_unit {
+        check_mm_per_unit(mm)?;
+        s.mm_per_unit = mm;
+    }
+    Ok(s)
 }
 
 /// The first procedural scene: an egg-shaped head with disc ears and a flat
@@ -105,6 +130,25 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
     }
 }
 
+/// Millimetres per scene unit dermis accepts, given or derived from the head:
+/// 1e-12..=1e12, so millimetres, their squares (the ground truth's areas) and
+/// their inverses stay normal f32 numbers with room to spare. A file in any
+/// real unit (a femtometre to a million kilometres) fits; outside, a scale is a corrupt
+/// file or a typo.
+pub const MM_PER_UNIT_RANGE: std::ops::RangeInclusive<f32> = 1e-12..=1e12;
+
+/// Checks a scene scale (given with `--mm-per-unit` or derived from the head).
+pub fn check_mm_per_unit(mm: f32) -> Result<()> {
+    if !mm.is_finite() || !MM_PER_UNIT_RANGE.contains(&mm) {
+        bail!(
+            "mm_per_unit must be a number within {}..={}, got {mm}",
+            MM_PER_UNIT_RANGE.start(),
+            MM_PER_UNIT_RANGE.end()
+        );
+    }
+    Ok(())
+}
+
 /// Loads a head scan. `mm_per_unit` defaults to 230 mm over the measured chin-to-crown
 /// height, since a human head is ~230 mm tall and most scans carry no usable unit.
 pub fn load_gltf_scene(
@@ -113,43 +157,51 @@ pub fn load_gltf_scene(
     mm_per_unit: Option<f32>,
 ) -> Result<Scene> {
     if let Some(mm) = mm_per_unit {
-        if !mm.is_finite() || mm <= 0.0 {
-            bail!("mm_per_unit must be a finite number > 0, got {mm}");
-        }
+        check_mm_per_unit(mm)?;
     }
     let head = gltf_load::load_head(path, overrides)
         .with_context(|| format!("loading scene {}", path.display()))?;
-    let forward = gltf_load::face_direction(&head.mesh);
-    let head_part = head_measure::head_part_bounds(&head.mesh, forward);
-    let height = head_part.size().y;
-    let mm_per_unit = match mm_per_unit {
-        Some(mm) => mm,
-        None if height.is_finite() && height > 0.0 => head_measure::HEAD_HEIGHT_MM / height,
-        // Say what was measured: an overflowing extent is not "no height".
-        None if !height.is_finite() => bail!(
-            "cannot derive mm_per_unit: the head in {} is too large to measure in f32 (from y = {} to {})",
-            path.display(),
-            head_part.min.y,
-            head_part.max.y
-        ),
-        None => bail!(
-            "cannot derive mm_per_unit: the head in {} has no height above its chin (chin and crown both at y = {})",
-            path.display(),
-            head_part.min.y
-        ),
-    };
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
+    scene_from_head(&name, head, mm_per_unit)
+        .with_context(|| format!("framing the head in {}", path.display()))
+}
+
+/// A scene around a loaded head: which way it faces, its scale (given, or 230 mm
+/// over its measured height), its bounds and a backdrop behind it. Far outlier
+/// vertices are left out of every measurement; a flat object faces the camera
+/// with its largest extent (`head_measure`).
+pub fn scene_from_head(name: &str, head: mesh::Object, mm_per_unit: Option<f32>) -> Result<Scene> {
+    let forward = gltf_load::face_direction(&head.mesh);
+    let (center, height) = head_measure::framed_part(&head.mesh, forward);
+    let mm_per_unit = match mm_per_unit {
+        Some(mm) => mm,
+        None if height.is_finite() && height > 0.0 => {
+            let mm = head_measure::HEAD_HEIGHT_MM / height;
+            check_mm_per_unit(mm).with_context(|| {
+                format!(
+                    "the head is {height:e} units tall, so 230 mm would make {mm:e} mm a unit; give --mm-per-unit"
+                )
+            })?;
+            mm
+        }
+        // Say what was measured: an overflowing extent is not "no height".
+        None if !height.is_finite() => bail!(
+            "cannot derive mm_per_unit: the head is too large to measure in f32 (centre {center})"
+        ),
+        None => bail!(
+            "cannot derive mm_per_unit: the head has no height above its chin (chin and crown both at y = {})",
+            center.y
+        ),
+    };
     Ok(Scene {
-        name,
+        name: name.to_string(),
         mm_per_unit,
-        head_bounds: head.mesh.bounds(),
+        head_bounds: head_measure::inlier_bounds(&head.mesh).0,
         backdrop: Some(backdrop(procedural::backdrop_behind(
-            head_part.center(),
-            forward,
-            height,
+            center, forward, height,
         ))),
         head,
         forward,

@@ -178,6 +178,10 @@ impl FromStr for Preset {
 impl SssParams {
     /// Largest accepted width: anything wider than a metre is a unit mistake.
     pub const MAX_WIDTH_MM: f32 = 1000.0;
+    /// Largest accepted falloff. Eq. 6.1 stretches the red profile by
+    /// 1 / (0.001 + f): past f = 40 its narrowest Gaussian (0.08 mm) spans the
+    /// whole kernel, which is then a box; at 1e30 the weights underflow to 0/0.
+    pub const MAX_FALLOFF: f32 = 100.0;
 
     /// Checks ranges so that kernel construction never produces NaN.
     pub fn validate(&self) -> Result<()> {
@@ -197,8 +201,11 @@ impl SssParams {
             }
         }
         for (name, &f) in CHANNELS.iter().zip(&self.falloff) {
-            if !f.is_finite() || f < 0.0 {
-                bail!("SSS falloff ({name}) must be finite and >= 0, got {f}");
+            if !f.is_finite() || !(0.0..=Self::MAX_FALLOFF).contains(&f) {
+                bail!(
+                    "SSS falloff ({name}) must be within 0..={}, got {f}",
+                    Self::MAX_FALLOFF
+                );
             }
             if self.shape == KernelShape::Marginal && f != 0.0 {
                 bail!(
@@ -333,6 +340,14 @@ impl SeparableKernel {
         samples.push(tap(0, 1.0));
         samples.extend((1..=half).rev().map(|j| tap(j, -1.0)));
         samples.extend((1..=half).map(|j| tap(j, 1.0)));
+        // The checked ranges keep every weight finite; a weight that is not
+        // would put NaN in every skin pixel.
+        anyhow::ensure!(
+            samples
+                .iter()
+                .all(|s| s.weight.iter().all(|w| w.is_finite())),
+            "SSS kernel weights are not finite for {params:?}"
+        );
         Ok(Self { params, samples })
     }
 
@@ -528,6 +543,14 @@ mod tests {
             (
                 SssParams {
                     falloff: [f32::INFINITY, 0.5, 0.1],
+                    ..ok
+                },
+                "falloff (red)",
+            ),
+            // Issue 11: --falloff 1e30 gave NaN pixels.
+            (
+                SssParams {
+                    falloff: [1e30, 0.5, 0.1],
                     ..ok
                 },
                 "falloff (red)",
@@ -842,4 +865,29 @@ mod tests {
         0xee34_9daf_4b08_b388,
         0xa572_d77a_9a6c_66ea,
     ];
+
+    // Every corner of the accepted ranges gives finite weights summing to 1
+    // per channel (issue 11: out-of-range falloffs gave NaN).
+    #[test]
+    fn the_accepted_ranges_give_finite_normalised_kernels() {
+        for width in [0.0, 1e-6, 1e-3, 3.0, SssParams::MAX_WIDTH_MM] {
+            for f in [0.0, 1e-6, 1.0, 40.0, SssParams::MAX_FALLOFF] {
+                for t in [0.0, 0.5, 1.0] {
+                    for n in [3, 17, SeparableKernel::MAX_SAMPLES] {
+                        let p = SssParams {
+                            width_mm: width,
+                            strength: [t; 3],
+                            falloff: [f; 3],
+                            shape: KernelShape::RedSlice,
+                        };
+                        let k = SeparableKernel::build(p, n).unwrap();
+                        for c in 0..3 {
+                            let sum: f32 = k.samples.iter().map(|s| s.weight[c]).sum();
+                            assert!((sum - 1.0).abs() < 1e-4, "{p:?} n={n}: {sum}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! validation messenger. Headless: no surface, no swapchain.
 
 use std::ffi::{c_void, CStr, CString};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -88,6 +89,13 @@ pub struct Context {
     pub fetch_counts: Option<FetchCounters>,
     pub command_pool: vk::CommandPool,
     pub validation: bool,
+    /// Test hook: object creations left before one is made to fail (see
+    /// [`Context::fail_creation_after`]); `usize::MAX` when off.
+    fail_countdown: AtomicUsize,
+    /// Object creations so far (see [`Context::creation_step`]).
+    creations: AtomicUsize,
+    /// Set once the device and instance are destroyed.
+    torn_down: bool,
 }
 
 unsafe extern "system" fn debug_callback(
@@ -127,6 +135,7 @@ pub struct FetchCounters {
 
 impl FetchCounters {
     fn new(ctx: &Context) -> Result<Self> {
+        ctx.creation_step("fetch counters")?;
         let raw = unsafe {
             ctx.device.create_buffer(
                 &vk::BufferCreateInfo::default()
@@ -155,10 +164,14 @@ impl FetchCounters {
                 return Err(e).context("allocating the fetch counters");
             }
         };
-        unsafe {
+        if let Err(e) = unsafe {
             ctx.device
                 .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        }?;
+        } {
+            unsafe { ctx.device.destroy_buffer(raw, None) };
+            let _ = ctx.allocator().free(allocation);
+            return Err(e).context("binding the fetch counters' memory");
+        }
         ctx.name(raw, "fetch counters");
         Ok(FetchCounters { raw, allocation })
     }
@@ -377,24 +390,38 @@ impl Context {
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_utils = ext::debug_utils::Device::new(&instance, &device);
 
-        let allocator = Allocator::new(&AllocatorCreateDesc {
+        let allocator = match Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        })
-        .context("creating the GPU memory allocator")?;
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { device.destroy_device(None) };
+                destroy_instance(&instance, &debug_instance);
+                return Err(e).context("creating the GPU memory allocator");
+            }
+        };
 
-        let command_pool = unsafe {
+        let command_pool = match unsafe {
             device.create_command_pool(
                 &vk::CommandPoolCreateInfo::default()
                     .queue_family_index(queue_family)
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
                 None,
             )
-        }?;
+        } {
+            Ok(p) => p,
+            Err(e) => {
+                drop(allocator);
+                unsafe { device.destroy_device(None) };
+                destroy_instance(&instance, &debug_instance);
+                return Err(e).context("creating the command pool");
+            }
+        };
 
         let device_type = format!("{:?}", props.device_type);
         let facts = DeviceFacts {
@@ -445,6 +472,9 @@ impl Context {
             fetch_counts: None,
             command_pool,
             validation: desc.validate,
+            fail_countdown: AtomicUsize::new(usize::MAX),
+            creations: AtomicUsize::new(0),
+            torn_down: false,
         };
         ctx.name(ctx.queue, "main queue");
         ctx.name(ctx.command_pool, "main command pool");
@@ -502,6 +532,110 @@ impl Context {
         )
     }
 
+    /// Tears the context down and reports what teardown revealed: waits for the
+    /// device, checks that every memory allocation was freed, destroys the
+    /// device while the validation layer still listens (it names every object
+    /// left undestroyed, VUID-vkDestroyDevice-device-00378), then the messenger
+    /// and the instance. Messages not yet drained are included. `Drop` does the
+    /// same for a context that is not finished, without an error to return.
+    pub fn finish(mut self) -> Result<()> {
+        let problems = self.teardown();
+        if problems.is_empty() {
+            return Ok(());
+        }
+        bail!(
+            "{} problem(s) at Vulkan teardown:\n{}",
+            problems.len(),
+            problems.join("\n")
+        )
+    }
+
+    /// The result of work done with this context, then [`Context::finish`]: a
+    /// run reports what its teardown revealed even when the work failed.
+    pub fn finish_with<T>(self, result: Result<T>) -> Result<T> {
+        match (result, self.finish()) {
+            (Ok(v), Ok(())) => Ok(v),
+            (Err(e), Ok(())) => Err(e),
+            (Ok(_), Err(t)) => Err(t),
+            (Err(e), Err(t)) => Err(anyhow!("{e:#}\nand at teardown: {t:#}")),
+        }
+    }
+
+    /// Destroys everything the context owns; returns the validation messages
+    /// received until the instance went (pending ones included) and the
+    /// memory allocations nobody freed.
+    fn teardown(&mut self) -> Vec<String> {
+        self.torn_down = true;
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+        }
+        if let Some(c) = self.fetch_counts.take() {
+            unsafe { self.device.destroy_buffer(c.raw, None) };
+            if let Some(a) = self.allocator.as_ref() {
+                let _ = a.lock().map(|mut a| a.free(c.allocation));
+            }
+        }
+        let mut problems: Vec<String> = Vec::new();
+        if let Some(a) = self.allocator.take() {
+            if let Ok(a) = a.into_inner() {
+                problems.extend(a.generate_report().allocations.iter().map(|r| {
+                    format!(
+                        "memory allocation '{}' ({} bytes) was never freed",
+                        r.name, r.size
+                    )
+                }));
+            }
+            // The allocator (and its memory blocks) goes before the device.
+        }
+        unsafe { self.device.destroy_device(None) };
+        problems.extend(self.take_messages());
+        unsafe {
+            if let Some((l, m)) = self.debug_instance.take() {
+                l.destroy_debug_utils_messenger(m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+        problems
+    }
+
+    fn take_messages(&self) -> Vec<String> {
+        self.messages
+            .lock()
+            .map(|mut v| std::mem::take(&mut *v))
+            .unwrap_or_default()
+    }
+
+    /// Test hook: the creation `n` steps from now (0: the next) fails with an
+    /// error, as a driver's out-of-memory would; `None` turns it off. Drives
+    /// every error path of set-up (tests/teardown.rs).
+    pub fn fail_creation_after(&self, n: Option<usize>) {
+        self.fail_countdown
+            .store(n.unwrap_or(usize::MAX), Ordering::SeqCst);
+    }
+
+    /// Object creations made so far (each call of [`Context::creation_step`]).
+    pub fn creations(&self) -> usize {
+        self.creations.load(Ordering::SeqCst)
+    }
+
+    /// Called before every Vulkan object (or group made in one call) is
+    /// created after the device opens: counts it, and fails it when the test
+    /// hook says so.
+    pub fn creation_step(&self, what: &str) -> Result<()> {
+        self.creations.fetch_add(1, Ordering::SeqCst);
+        let left = self.fail_countdown.load(Ordering::SeqCst);
+        if left == usize::MAX {
+            return Ok(());
+        }
+        if left == 0 {
+            self.fail_countdown.store(usize::MAX, Ordering::SeqCst);
+            bail!("creating {what}: injected failure (test hook)");
+        }
+        self.fail_countdown.store(left - 1, Ordering::SeqCst);
+        Ok(())
+    }
+
     /// Image format support for the given usage features.
     pub fn format_supports(&self, format: vk::Format, features: vk::FormatFeatureFlags) -> bool {
         let p = unsafe {
@@ -513,6 +647,7 @@ impl Context {
 
     /// Records and submits one command buffer and waits for it.
     pub fn one_shot(&self, label: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        self.creation_step(label)?;
         let cmd = unsafe {
             self.device.allocate_command_buffers(
                 &vk::CommandBufferAllocateInfo::default()
@@ -521,12 +656,15 @@ impl Context {
             )
         }?[0];
         self.name(cmd, label);
-        unsafe {
+        if let Err(e) = unsafe {
             self.device.begin_command_buffer(
                 cmd,
                 &vk::CommandBufferBeginInfo::default()
                     .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )?;
+            )
+        } {
+            unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+            return Err(e).with_context(|| format!("beginning '{label}'"));
         }
         record(cmd);
         let result = self.submit_and_wait(cmd);
@@ -618,25 +756,19 @@ fn pick_physical(instance: &ash::Instance, choice: &DeviceChoice) -> Result<vk::
 }
 
 impl Drop for Context {
+    /// The fallback for a context that was not [finished](Context::finish): the
+    /// same teardown; what it reveals goes to stderr when validation is on.
     fn drop(&mut self) {
-        unsafe {
-            let _ = self.device.device_wait_idle();
-            self.device.destroy_command_pool(self.command_pool, None);
+        if self.torn_down {
+            return;
         }
-        if let Some(c) = self.fetch_counts.take() {
-            unsafe { self.device.destroy_buffer(c.raw, None) };
-            if let Some(a) = self.allocator.as_ref() {
-                let _ = a.lock().map(|mut a| a.free(c.allocation));
-            }
-        }
-        unsafe {
-            // The allocator must go before the device.
-            self.allocator.take();
-            self.device.destroy_device(None);
-            if let Some((l, m)) = self.debug_instance.take() {
-                l.destroy_debug_utils_messenger(m, None);
-            }
-            self.instance.destroy_instance(None);
+        let problems = self.teardown();
+        if self.validation && !problems.is_empty() {
+            eprintln!(
+                "warning: {} problem(s) at Vulkan teardown:\n{}",
+                problems.len(),
+                problems.join("\n")
+            );
         }
     }
 }

@@ -107,73 +107,86 @@ impl Image {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        ctx.creation_step(&format!("image '{name}'"))?;
         let raw = unsafe { ctx.device.create_image(&info, None) }.with_context(|| {
             format!(
                 "creating image '{name}' {}x{} {format:?}",
                 extent.width, extent.height
             )
         })?;
+        // Filled in step by step: on an error, `destroy` frees what exists.
+        let mut image = Image {
+            raw,
+            levels,
+            format,
+            extent,
+            aspect,
+            name: name.to_string(),
+            ..Default::default()
+        };
+        match image.bind_and_view(ctx, usage) {
+            Ok(()) => Ok(image),
+            Err(e) => {
+                image.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Memory and views of a fresh image (`with_levels`).
+    fn bind_and_view(&mut self, ctx: &Context, usage: vk::ImageUsageFlags) -> Result<()> {
+        let (raw, name, format, aspect) = (self.raw, self.name.clone(), self.format, self.aspect);
         let req = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        ctx.creation_step(&format!("memory of image '{name}'"))?;
         let allocation = ctx
             .allocator()
             .allocate(&AllocationCreateDesc {
-                name,
+                name: &name,
                 requirements: req,
                 location: MemoryLocation::GpuOnly,
                 linear: false,
                 allocation_scheme: AllocationScheme::DedicatedImage(raw),
             })
             .with_context(|| format!("allocating memory for image '{name}'"))?;
-        unsafe {
-            ctx.device
-                .bind_image_memory(raw, allocation.memory(), allocation.offset())
-        }?;
-        let make_view = |aspect: vk::ImageAspectFlags, base: u32, count: u32| unsafe {
-            ctx.device.create_image_view(
-                &vk::ImageViewCreateInfo::default()
-                    .image(raw)
-                    .view_type(vk::ImageViewType::TYPE_2D)
-                    .format(format)
-                    .subresource_range(
-                        vk::ImageSubresourceRange::default()
-                            .aspect_mask(aspect)
-                            .base_mip_level(base)
-                            .level_count(count)
-                            .layer_count(1),
-                    ),
-                None,
-            )
+        let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
+        self.allocation = Some(allocation);
+        unsafe { ctx.device.bind_image_memory(raw, memory, offset) }
+            .with_context(|| format!("binding the memory of image '{name}'"))?;
+        let make_view = |aspect: vk::ImageAspectFlags, base: u32, count: u32| {
+            ctx.creation_step(&format!("a view of image '{name}'"))?;
+            unsafe {
+                ctx.device.create_image_view(
+                    &vk::ImageViewCreateInfo::default()
+                        .image(raw)
+                        .view_type(vk::ImageViewType::TYPE_2D)
+                        .format(format)
+                        .subresource_range(
+                            vk::ImageSubresourceRange::default()
+                                .aspect_mask(aspect)
+                                .base_mip_level(base)
+                                .level_count(count)
+                                .layer_count(1),
+                        ),
+                    None,
+                )
+            }
+            .with_context(|| format!("creating a view of image '{name}'"))
         };
-        let mut level_views = Vec::new();
-        for l in 0..levels {
-            level_views.push(make_view(aspect, l, 1)?);
+        for l in 0..self.levels {
+            let v = make_view(aspect, l, 1)?;
+            self.level_views.push(v);
         }
-        let view = level_views[0];
-        let chain_view = if levels > 1 {
-            make_view(aspect, 0, levels)?
-        } else {
-            view
-        };
-        let depth_view = if has_stencil(format) && usage.contains(vk::ImageUsageFlags::SAMPLED) {
-            Some(make_view(vk::ImageAspectFlags::DEPTH, 0, 1)?)
-        } else {
-            None
-        };
-        ctx.name(raw, name);
-        ctx.name(view, &format!("{name} view"));
-        Ok(Image {
-            raw,
-            view,
-            levels,
-            level_views,
-            chain_view,
-            format,
-            extent,
-            aspect,
-            depth_view,
-            name: name.to_string(),
-            allocation: Some(allocation),
-        })
+        self.view = self.level_views[0];
+        self.chain_view = self.view;
+        if self.levels > 1 {
+            self.chain_view = make_view(aspect, 0, self.levels)?;
+        }
+        if has_stencil(format) && usage.contains(vk::ImageUsageFlags::SAMPLED) {
+            self.depth_view = Some(make_view(vk::ImageAspectFlags::DEPTH, 0, 1)?);
+        }
+        ctx.name(raw, &name);
+        ctx.name(self.view, &format!("{name} view"));
+        Ok(())
     }
 
     /// The view to sample: the depth aspect for depth/stencil images.
@@ -208,7 +221,7 @@ impl Image {
             if let Some(v) = self.depth_view.take() {
                 ctx.device.destroy_image_view(v, None);
             }
-            if self.levels > 1 {
+            if self.chain_view != self.view {
                 ctx.device.destroy_image_view(self.chain_view, None);
             }
             for v in self.level_views.drain(..) {
@@ -216,6 +229,9 @@ impl Image {
             }
             ctx.device.destroy_image(self.raw, None);
         }
+        self.raw = vk::Image::null();
+        self.view = vk::ImageView::null();
+        self.chain_view = vk::ImageView::null();
         if let Some(a) = self.allocation.take() {
             let _ = ctx.allocator().free(a);
         }
@@ -239,6 +255,7 @@ impl Buffer {
         usage: vk::BufferUsageFlags,
         location: MemoryLocation,
     ) -> Result<Self> {
+        ctx.creation_step(&format!("buffer '{name}'"))?;
         let raw = unsafe {
             ctx.device.create_buffer(
                 &vk::BufferCreateInfo::default()
@@ -249,27 +266,39 @@ impl Buffer {
             )
         }
         .with_context(|| format!("creating buffer '{name}' ({size} bytes)"))?;
-        let req = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements: req,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .with_context(|| format!("allocating memory for buffer '{name}'"))?;
-        unsafe {
-            ctx.device
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        }?;
-        ctx.name(raw, name);
-        Ok(Buffer {
+        let mut buffer = Buffer {
             raw,
             size,
-            allocation: Some(allocation),
-        })
+            allocation: None,
+        };
+        let req = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let bound = ctx
+            .creation_step(&format!("memory of buffer '{name}'"))
+            .and_then(|()| {
+                ctx.allocator()
+                    .allocate(&AllocationCreateDesc {
+                        name,
+                        requirements: req,
+                        location,
+                        linear: true,
+                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                    })
+                    .with_context(|| {
+                        format!("allocating memory for buffer '{name}' ({size} bytes)")
+                    })
+            })
+            .and_then(|a| {
+                let (memory, offset) = (unsafe { a.memory() }, a.offset());
+                buffer.allocation = Some(a);
+                unsafe { ctx.device.bind_buffer_memory(raw, memory, offset) }
+                    .with_context(|| format!("binding the memory of buffer '{name}'"))
+            });
+        if let Err(e) = bound {
+            buffer.destroy(ctx);
+            return Err(e);
+        }
+        ctx.name(raw, name);
+        Ok(buffer)
     }
 
     /// A host-visible buffer filled with `data`.
@@ -286,7 +315,10 @@ impl Buffer {
             usage,
             MemoryLocation::CpuToGpu,
         )?;
-        b.write(data)?;
+        if let Err(e) = b.write(data) {
+            b.destroy(ctx);
+            return Err(e);
+        }
         Ok(b)
     }
 
@@ -308,6 +340,7 @@ impl Buffer {
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe { ctx.device.destroy_buffer(self.raw, None) };
+        self.raw = vk::Buffer::null();
         if let Some(a) = self.allocation.take() {
             let _ = ctx.allocator().free(a);
         }

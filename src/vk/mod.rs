@@ -1,7 +1,9 @@
 //! The Vulkan layer: one file per concept (context, barrier table, memory,
-//! shaders and reflection, pipelines, profiler, set-up uploads).
+//! shaders and reflection, pipelines, profiler, set-up uploads, the guard that
+//! frees a failed set-up's objects).
 pub mod barrier;
 pub mod context;
+pub mod guard;
 pub mod memory;
 pub mod pipeline;
 pub mod profiler;

@@ -112,6 +112,7 @@ fn count_set(
         ty: b.descriptor_type,
         descriptor_count: 1,
     }];
+    ctx.creation_step("the fetch counters' descriptor pool")?;
     let pool = unsafe {
         ctx.device.create_descriptor_pool(
             &vk::DescriptorPoolCreateInfo::default()
@@ -120,13 +121,19 @@ fn count_set(
             None,
         )
     }?;
-    let set = unsafe {
+    let set = match unsafe {
         ctx.device.allocate_descriptor_sets(
             &vk::DescriptorSetAllocateInfo::default()
                 .descriptor_pool(pool)
                 .set_layouts(&set_layouts[COUNT_SET as usize..=COUNT_SET as usize]),
         )
-    }?[0];
+    } {
+        Ok(s) => s[0],
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            return Err(e.into());
+        }
+    };
     let info = [vk::DescriptorBufferInfo {
         buffer: buffer.raw,
         offset: 0,
@@ -156,16 +163,31 @@ fn make_layout(
             size,
         })
         .collect();
-    let layout = unsafe {
-        ctx.device.create_pipeline_layout(
-            &vk::PipelineLayoutCreateInfo::default()
-                .set_layouts(&set_layouts)
-                .push_constant_ranges(&ranges),
-            None,
-        )
-    }?;
-    ctx.name(layout, &format!("{name} layout"));
-    Ok((layout, set_layouts))
+    let layout = ctx
+        .creation_step(&format!("pipeline layout of '{name}'"))
+        .and_then(|()| {
+            unsafe {
+                ctx.device.create_pipeline_layout(
+                    &vk::PipelineLayoutCreateInfo::default()
+                        .set_layouts(&set_layouts)
+                        .push_constant_ranges(&ranges),
+                    None,
+                )
+            }
+            .map_err(Into::into)
+        });
+    match layout {
+        Ok(layout) => {
+            ctx.name(layout, &format!("{name} layout"));
+            Ok((layout, set_layouts))
+        }
+        Err(e) => {
+            for l in set_layouts {
+                unsafe { ctx.device.destroy_descriptor_set_layout(l, None) };
+            }
+            Err(e)
+        }
+    }
 }
 
 impl Pipeline {
@@ -178,8 +200,44 @@ impl Pipeline {
         let reflection =
             reflect(&stages_names).with_context(|| format!("pipeline '{}'", d.name))?;
         let (layout, set_layouts) = make_layout(ctx, &d.name, &reflection)?;
+        // Filled in step by step: on an error, `destroy` frees what exists.
+        let mut p = Pipeline {
+            layout,
+            set_layouts,
+            reflection,
+            bind_point: vk::PipelineBindPoint::GRAPHICS,
+            name: d.name.clone(),
+            has_stencil: d.stencil.is_some(),
+            has_blend_constants: matches!(d.blend, Blend::ConstantMix(_)),
+            ..Default::default()
+        };
+        match p.build_graphics(ctx, d, frag.as_deref()) {
+            Ok(()) => Ok(p),
+            Err(e) => {
+                p.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// The shader modules, the pipeline and the counter set of `graphics`.
+    // Long because it is one Vulkan create-info, state block by state block, in
+    // the order the structure nests them.
+    fn build_graphics(
+        &mut self,
+        ctx: &Context,
+        d: &GraphicsDesc,
+        frag: Option<&str>,
+    ) -> Result<()> {
+        let layout = self.layout;
         let vs = create_module(ctx, d.vert)?;
-        let fs = frag.as_deref().map(|f| create_module(ctx, f)).transpose()?;
+        let fs = match frag.map(|f| create_module(ctx, f)).transpose() {
+            Ok(fs) => fs,
+            Err(e) => {
+                unsafe { ctx.device.destroy_shader_module(vs, None) };
+                return Err(e);
+            }
+        };
         let entry = c"main";
         let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
@@ -290,29 +348,25 @@ impl Pipeline {
             .dynamic_state(&dyn_state)
             .layout(layout)
             .push_next(&mut rendering);
-        let result = unsafe {
-            ctx.device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
+        let result = ctx
+            .creation_step(&format!("pipeline '{}'", d.name))
+            .and_then(|()| {
+                unsafe {
+                    ctx.device
+                        .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+                }
+                .map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))
+            });
         unsafe {
             ctx.device.destroy_shader_module(vs, None);
             if let Some(fs) = fs {
                 ctx.device.destroy_shader_module(fs, None);
             }
         }
-        let raw = result.map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))?[0];
-        ctx.name(raw, &d.name);
-        Ok(Pipeline {
-            raw,
-            layout,
-            count_set: count_set(ctx, &reflection, &set_layouts)?,
-            set_layouts,
-            reflection,
-            bind_point: vk::PipelineBindPoint::GRAPHICS,
-            name: d.name.clone(),
-            has_stencil: d.stencil.is_some(),
-            has_blend_constants: matches!(d.blend, Blend::ConstantMix(_)),
-        })
+        self.raw = result?[0];
+        ctx.name(self.raw, &d.name);
+        self.count_set = count_set(ctx, &self.reflection, &self.set_layouts)?;
+        Ok(())
     }
 
     /// A compute pipeline from one shader, its layout reflected.
@@ -320,38 +374,55 @@ impl Pipeline {
         let shader = variant(ctx, shader);
         let reflection = reflect(&[&shader]).with_context(|| format!("pipeline '{name}'"))?;
         let (layout, set_layouts) = make_layout(ctx, name, &reflection)?;
-        let module = create_module(ctx, &shader)?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout);
-        let result = unsafe {
-            ctx.device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
-        unsafe { ctx.device.destroy_shader_module(module, None) };
-        let raw = result.map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))?[0];
-        ctx.name(raw, name);
-        Ok(Pipeline {
-            raw,
+        let mut p = Pipeline {
             layout,
-            count_set: count_set(ctx, &reflection, &set_layouts)?,
             set_layouts,
             reflection,
             bind_point: vk::PipelineBindPoint::COMPUTE,
             name: name.to_string(),
-            has_stencil: false,
-            has_blend_constants: false,
-        })
+            ..Default::default()
+        };
+        let built = create_module(ctx, &shader).and_then(|module| {
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(c"main");
+            let info = vk::ComputePipelineCreateInfo::default()
+                .stage(stage)
+                .layout(layout);
+            let result = ctx
+                .creation_step(&format!("compute pipeline '{name}'"))
+                .and_then(|()| {
+                    unsafe {
+                        ctx.device.create_compute_pipelines(
+                            vk::PipelineCache::null(),
+                            &[info],
+                            None,
+                        )
+                    }
+                    .map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))
+                });
+            unsafe { ctx.device.destroy_shader_module(module, None) };
+            p.raw = result?[0];
+            ctx.name(p.raw, name);
+            p.count_set = count_set(ctx, &p.reflection, &p.set_layouts)?;
+            Ok(())
+        });
+        match built {
+            Ok(()) => Ok(p),
+            Err(e) => {
+                p.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_pipeline(self.raw, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device
+                .destroy_pipeline(std::mem::take(&mut self.raw), None);
+            ctx.device
+                .destroy_pipeline_layout(std::mem::take(&mut self.layout), None);
             if let Some((pool, _)) = self.count_set.take() {
                 ctx.device.destroy_descriptor_pool(pool, None);
             }
@@ -469,6 +540,7 @@ impl DescriptorPool {
                 descriptor_count: max_sets * 4,
             },
         ];
+        ctx.creation_step("descriptor pool")?;
         let raw = unsafe {
             ctx.device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
@@ -494,6 +566,7 @@ impl DescriptorPool {
             .set_layouts
             .get(set as usize)
             .ok_or_else(|| anyhow!("pipeline '{}' has no descriptor set {set}", pipeline.name))?;
+        ctx.creation_step(&format!("set {set} of '{}'", pipeline.name))?;
         let ds = unsafe {
             ctx.device.allocate_descriptor_sets(
                 &vk::DescriptorSetAllocateInfo::default()
@@ -611,7 +684,10 @@ impl DescriptorPool {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        unsafe { ctx.device.destroy_descriptor_pool(self.raw, None) };
+        unsafe {
+            ctx.device
+                .destroy_descriptor_pool(std::mem::take(&mut self.raw), None)
+        };
     }
 }
 
@@ -651,19 +727,29 @@ impl Samplers {
                     .compare_enable(true)
                     .compare_op(vk::CompareOp::LESS_OR_EQUAL);
             }
+            ctx.creation_step(&format!("sampler '{name}'"))?;
             let s = unsafe { ctx.device.create_sampler(&info, None) }?;
             ctx.name(s, name);
             Ok(s)
         };
         use vk::Filter as F;
         use vk::SamplerAddressMode as M;
-        Ok(Samplers {
-            linear_clamp: make("linear clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 0.0)?,
-            nearest_clamp: make("nearest clamp", F::NEAREST, M::CLAMP_TO_EDGE, false, 0.0)?,
-            linear_repeat: make("linear repeat", F::LINEAR, M::REPEAT, false, 0.0)?,
-            shadow_compare: make("shadow compare", F::LINEAR, M::CLAMP_TO_BORDER, true, 0.0)?,
-            mip_clamp: make("mip clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 16.0)?,
-        })
+        let mut s = Samplers::default();
+        let made = (|| -> Result<()> {
+            s.linear_clamp = make("linear clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 0.0)?;
+            s.nearest_clamp = make("nearest clamp", F::NEAREST, M::CLAMP_TO_EDGE, false, 0.0)?;
+            s.linear_repeat = make("linear repeat", F::LINEAR, M::REPEAT, false, 0.0)?;
+            s.shadow_compare = make("shadow compare", F::LINEAR, M::CLAMP_TO_BORDER, true, 0.0)?;
+            s.mip_clamp = make("mip clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 16.0)?;
+            Ok(())
+        })();
+        match made {
+            Ok(()) => Ok(s),
+            Err(e) => {
+                s.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
     pub fn destroy(&self, ctx: &Context) {

@@ -40,41 +40,56 @@ impl Profiler {
                 ctx.facts.name
             );
         }
-        let timestamps = unsafe {
-            ctx.device.create_query_pool(
-                &vk::QueryPoolCreateInfo::default()
-                    .query_type(vk::QueryType::TIMESTAMP)
-                    .query_count(max_passes * 3),
-                None,
-            )
-        }?;
-        ctx.name(timestamps, "pass timestamps");
+        let pool = |name: &str, info: vk::QueryPoolCreateInfo| -> Result<vk::QueryPool> {
+            ctx.creation_step(&format!("query pool '{name}'"))?;
+            let p = unsafe { ctx.device.create_query_pool(&info, None) }
+                .with_context(|| format!("creating query pool '{name}'"))?;
+            ctx.name(p, name);
+            Ok(p)
+        };
+        let timestamps = pool(
+            "pass timestamps",
+            vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::TIMESTAMP)
+                .query_count(max_passes * 3),
+        )?;
+        let destroy = |pools: &[vk::QueryPool]| {
+            for &p in pools {
+                unsafe { ctx.device.destroy_query_pool(p, None) };
+            }
+        };
         let stats = if ctx.facts.pipeline_statistics {
-            let p = unsafe {
-                ctx.device.create_query_pool(
-                    &vk::QueryPoolCreateInfo::default()
-                        .query_type(vk::QueryType::PIPELINE_STATISTICS)
-                        .pipeline_statistics(
-                            vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
-                        )
-                        .query_count(max_passes),
-                    None,
-                )
-            }?;
-            ctx.name(p, "pass fragment invocations");
-            Some(p)
+            match pool(
+                "pass fragment invocations",
+                vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                    .pipeline_statistics(
+                        vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                    )
+                    .query_count(max_passes),
+            ) {
+                Ok(p) => Some(p),
+                Err(e) => {
+                    destroy(&[timestamps]);
+                    return Err(e);
+                }
+            }
         } else {
             None
         };
-        let occlusion = unsafe {
-            ctx.device.create_query_pool(
-                &vk::QueryPoolCreateInfo::default()
-                    .query_type(vk::QueryType::OCCLUSION)
-                    .query_count(max_passes),
-                None,
-            )
-        }?;
-        ctx.name(occlusion, "pass samples passed");
+        let occlusion = match pool(
+            "pass samples passed",
+            vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::OCCLUSION)
+                .query_count(max_passes),
+        ) {
+            Ok(p) => p,
+            Err(e) => {
+                destroy(&[timestamps]);
+                destroy(stats.as_slice());
+                return Err(e);
+            }
+        };
         let bits = ctx.facts.timestamp_valid_bits;
         Ok(Profiler {
             timestamps,

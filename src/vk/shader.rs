@@ -152,35 +152,51 @@ impl Reflection {
         ctx: &super::context::Context,
         label: &str,
     ) -> Result<Vec<vk::DescriptorSetLayout>> {
-        (0..self.set_count())
-            .map(|set| {
-                let bindings: Vec<vk::DescriptorSetLayoutBinding> = self
-                    .bindings
-                    .iter()
-                    .filter(|b| b.set == set)
-                    .map(|b| {
-                        vk::DescriptorSetLayoutBinding::default()
-                            .binding(b.binding)
-                            .descriptor_type(b.descriptor_type)
-                            .descriptor_count(b.count)
-                            .stage_flags(b.stages)
-                    })
-                    .collect();
-                let l = unsafe {
-                    ctx.device.create_descriptor_set_layout(
-                        &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                        None,
-                    )
-                }?;
-                ctx.name(l, &format!("{label} set {set}"));
-                Ok(l)
-            })
-            .collect()
+        let mut layouts = Vec::new();
+        for set in 0..self.set_count() {
+            let bindings: Vec<vk::DescriptorSetLayoutBinding> = self
+                .bindings
+                .iter()
+                .filter(|b| b.set == set)
+                .map(|b| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(b.binding)
+                        .descriptor_type(b.descriptor_type)
+                        .descriptor_count(b.count)
+                        .stage_flags(b.stages)
+                })
+                .collect();
+            let made = ctx
+                .creation_step(&format!("descriptor set layout {set} of '{label}'"))
+                .and_then(|()| {
+                    unsafe {
+                        ctx.device.create_descriptor_set_layout(
+                            &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                            None,
+                        )
+                    }
+                    .map_err(Into::into)
+                });
+            match made {
+                Ok(l) => {
+                    ctx.name(l, &format!("{label} set {set}"));
+                    layouts.push(l);
+                }
+                Err(e) => {
+                    for l in layouts {
+                        unsafe { ctx.device.destroy_descriptor_set_layout(l, None) };
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        Ok(layouts)
     }
 }
 
 pub fn create_module(ctx: &super::context::Context, name: &str) -> Result<vk::ShaderModule> {
     let code = words(spirv(name)?)?;
+    ctx.creation_step(&format!("shader module {name}"))?;
     let m = unsafe {
         ctx.device
             .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None)
