@@ -516,6 +516,7 @@ mod tests {
             dumps: Vec::new(),
             samples: Vec::new(),
             diffuse: vec![[0.0; 4]; 6],
+            depth: vec![1.0; 6],
             hdr_nonfinite: 0,
         };
         write_png(&d.join("ok.png"), &c).unwrap();

@@ -5,6 +5,7 @@
 #     smoke    GPU facts; every method (tsd and tsd-opt too) under the validation layer
 #     card     the card and uniform-light tests (tests/accuracy_gpu.rs) on the GPU
 #     eval     the cost/error chart: thesis scene set, 1280x720 (tools/perf_h100.sh eval)
+#     dolly    the error along a camera dolly, 1280x720 (tools/perf_h100.sh dolly)
 #     matrix   the bench matrix the budget calibration pairs (tools/bench_matrix.sh)
 #     t31 apart t44   texture-space diffusion (tools/tsd_table31.sh)
 #
@@ -63,14 +64,14 @@ for part in "$@"; do
         --nocapture --test-threads 1 > "$STORE/card.txt" 2>&1
       echo "rc $?" >> "$STORE/card.txt"
       unset VK_LAYER_PATH ;;
-    eval)
-      STORE=$STORE/core OUT=$STORE/core DEADLINE=$(left) B=$B bash tools/perf_h100.sh eval > /dev/null 2>&1
+    eval | dolly)
+      STORE=$STORE/core OUT=$STORE/core DEADLINE=$(left) B=$B bash tools/perf_h100.sh "$part" > /dev/null 2>&1
       rm -f "$STORE/core/perf.tgz" ;;
     matrix)
       DEADLINE=$(left) bash tools/bench_matrix.sh "$B" "$STORE/matrix" > "$STORE/matrix.log" 2>&1 ;;
     t31 | apart | t44)
       DEADLINE=$(left) bash tools/tsd_table31.sh "$B" "$STORE/tsd" "$part" > "$STORE/tsd-$part.log" 2>&1 ;;
-    *) echo "unknown part '$part' (valid: smoke card eval matrix t31 apart t44)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke card eval dolly matrix t31 apart t44)" >&2; exit 2 ;;
   esac
   echo "$part: $((SECONDS - t0)) s" >> "$STORE/parts.txt"
 done
