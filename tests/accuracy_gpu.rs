@@ -79,15 +79,35 @@ fn card_settings(scene: &Scene, px_per_mm: f32) -> RenderSettings {
     s
 }
 
-/// Energy moved per channel over the closed form's, both sampled at the pixel
-/// centres, averaged over the rows. The closed form takes its levels (E a) from
-/// the unscattered image far from the edge; each rendered row is measured
-/// against its own far levels and scaled to the unscattered contrast. (Measured
-/// against the unscattered levels, a whole-card gain of 0.16%, what half-float
-/// rounding loses on one GPU, showed as 14% of blue's moved energy: the dark
-/// half is 15 mm wide and blue moves 0.05 mm of contrast. The energy a method
-/// keeps is checked apart, as `out / in`.)
-fn energy_ratio(out: &[[f32; 4]], diffuse: &[[f32; 4]], w: usize, mm_per_px: f64) -> [f64; 3] {
+/// What a method's output samples: the exitance at pixel centres (the ground
+/// truth evaluates the integral there), or a discrete filter of the pixel
+/// irradiance (the screen-space methods). A filter applied to the pixel step
+/// moves exactly what the continuous kernel moves (linear interpolation of a
+/// step moves `d` for a tap at `d`), so its yardstick is the closed form's
+/// integral; point samples of the exitance are summed by the midpoint rule,
+/// which at 8.5 px/mm falls short of the integral by 0.3% (red), 2.3% (green)
+/// and 4.5% (blue, whose profile moves 0.4 px), so theirs is that sum.
+#[derive(Clone, Copy, PartialEq)]
+enum Output {
+    PointSamples,
+    PixelFilter,
+}
+
+/// Energy moved per channel over the closed form's, averaged over the rows.
+/// The closed form takes its levels (E a) from the unscattered image far from
+/// the edge; each rendered row is measured against its own far levels and
+/// scaled to the unscattered contrast. (Measured against the unscattered
+/// levels, a whole-card gain of 0.16%, what half-float rounding loses on one
+/// GPU, showed as 14% of blue's moved energy: the dark half is 15 mm wide and
+/// blue moves 0.05 mm of contrast. The energy a method keeps is checked apart,
+/// as `out / in`.)
+fn energy_ratio(
+    out: &[[f32; 4]],
+    diffuse: &[[f32; 4]],
+    w: usize,
+    mm_per_px: f64,
+    kind: Output,
+) -> [f64; 3] {
     let rows = out.len() / w;
     let mut ratio = [0.0; 3];
     for c in 0..3 {
@@ -101,12 +121,15 @@ fn energy_ratio(out: &[[f32; 4]], diffuse: &[[f32; 4]], w: usize, mm_per_px: f64
         let exact: Vec<f64> = (0..w)
             .map(|x| card.exitance((x as f64 + 0.5 - (w / 2) as f64) * mm_per_px)[c])
             .collect();
-        let exact = Row {
-            values: &exact,
-            edge_px: w / 2,
-            mm_per_px,
-        }
-        .energy_moved(right);
+        let exact = match kind {
+            Output::PointSamples => Row {
+                values: &exact,
+                edge_px: w / 2,
+                mm_per_px,
+            }
+            .energy_moved(right),
+            Output::PixelFilter => card.energy_moved()[c],
+        };
         for y in 0..rows {
             let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
             let mean =
@@ -158,7 +181,12 @@ fn edge_response_of_every_method_against_the_closed_form() {
         // levels come from `none`'s frame instead.
         let (none, _, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
         let _ = diffuse;
-        let r = energy_ratio(&out, &none, s.width as usize, mm_per_px);
+        let kind = if label == "reference" {
+            Output::PointSamples
+        } else {
+            Output::PixelFilter
+        };
+        let r = energy_ratio(&out, &none, s.width as usize, mm_per_px, kind);
         // Energy kept over the whole card (what half-float rounding loses).
         let kept = [0, 1, 2].map(|c| {
             out.iter().map(|p| p[c] as f64).sum::<f64>()
@@ -205,10 +233,11 @@ fn edge_response_of_every_method_against_the_closed_form() {
     for c in 0..3 {
         // The ground truth: within 3% in every channel.
         assert!((reference[c] - 1.0).abs() < 0.03, "reference {reference:?}");
-        // The physical preset is the profile's marginal: within 5% (blue moves
-        // 0.05 mm of its contrast, half a pixel's tenth: f16 storage and the
-        // sampler's 8-bit bilinear weights move that by a few percent).
-        assert!((physical[c] - 1.0).abs() < 0.05, "physical {physical:?}");
+        // The physical preset is the profile's marginal: within 3% (measured
+        // [0.998, 0.996, 0.994] on lavapipe, [0.993, 0.992, 1.012] on the H200,
+        // whose sampler's 8-bit bilinear weights and f16 rounding move blue's
+        // 0.4 px of moved contrast by 2%).
+        assert!((physical[c] - 1.0).abs() < 0.03, "physical {physical:?}");
         assert_eq!(none[c], 0.0);
         // Table 6.1 is an artist's preset: far narrower than the profile.
         assert!(table[c] < 0.2, "table6.1 {table:?}");
