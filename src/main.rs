@@ -1,7 +1,7 @@
 //! The `dermis` command line: argument parsing and dispatch only; the work is
 //! in the library (`dermis::run`, `dermis::eval::study`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Result;
@@ -406,65 +406,13 @@ fn main_result() -> Result<()> {
             scenes,
             warmup,
             frames,
-        } => {
-            dermis::run::check_frame_counts(warmup, frames)?;
-            let base = common.settings()?;
-            let specs = study::scene_set(&scenes, common.scene.as_deref(), &base)?;
-            dermis::run::prepare_out_dir(&out)?;
-            let ctx = common.context()?;
-            let opts = sweep::EvalOptions {
-                base,
-                warmup,
-                measured: frames,
-                progress: true,
-            };
-            let outcome = study::eval(
-                &ctx,
-                &specs,
-                &opts,
-                &out,
-                &command_line(),
-                scenes == "dolly",
-            );
-            let outcome = ctx.finish_with(outcome)?;
-            print!("{}", sweep::summary_table(&outcome.summary));
-            let names: Vec<String> = outcome
-                .files
-                .iter()
-                .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-                .collect();
-            println!("wrote {} in {}", names.join(", "), out.display());
-        }
+        } => eval(&common, &out, &scenes, warmup, frames)?,
         Command::Bench {
             common,
             report,
             warmup,
             frames,
-        } => {
-            dermis::run::check_frame_counts(warmup, frames)?;
-            dermis::run::prepare_report_path(&report)?;
-            let settings = common.settings()?;
-            warn_foreign(&settings);
-            let scene = common.scene()?;
-            let ctx = common.context()?;
-            let opts = RunOptions {
-                warmup,
-                measured: frames,
-                capture: false,
-                dump: false,
-                ceilings: true,
-                command: command_line(),
-                progress: true,
-            };
-            let r = bench_run(&ctx, &scene, &settings, &opts, &report);
-            let r = ctx.finish_with(r)?;
-            println!("{}", header(&r));
-            print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
-            if let Some(c) = &r.ceilings {
-                println!("{}", c.summary());
-            }
-            println!("wrote {}", report.display());
-        }
+        } => bench(&common, &report, warmup, frames)?,
         Command::Budget {
             common,
             profiles,
@@ -523,6 +471,59 @@ fn main_result() -> Result<()> {
             }
         }
     }
+    Ok(())
+}
+
+/// `dermis eval`: the sweep, its summary table and the files it wrote.
+fn eval(common: &Common, out: &Path, scenes: &str, warmup: usize, frames: usize) -> Result<()> {
+    dermis::run::check_frame_counts(warmup, frames)?;
+    let base = common.settings()?;
+    let specs = study::scene_set(scenes, common.scene.as_deref(), &base)?;
+    dermis::run::prepare_out_dir(out)?;
+    let ctx = common.context()?;
+    let opts = sweep::EvalOptions {
+        base,
+        warmup,
+        measured: frames,
+        progress: true,
+    };
+    let outcome = study::eval(&ctx, &specs, &opts, out, &command_line(), scenes == "dolly");
+    let outcome = ctx.finish_with(outcome)?;
+    print!("{}", sweep::summary_table(&outcome.summary));
+    let names: Vec<String> = outcome
+        .files
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} in {}", names.join(", "), out.display());
+    Ok(())
+}
+
+/// `dermis bench`: many frames and the device ceilings, the report only.
+fn bench(common: &Common, report: &Path, warmup: usize, frames: usize) -> Result<()> {
+    dermis::run::check_frame_counts(warmup, frames)?;
+    dermis::run::prepare_report_path(report)?;
+    let settings = common.settings()?;
+    warn_foreign(&settings);
+    let scene = common.scene()?;
+    let ctx = common.context()?;
+    let opts = RunOptions {
+        warmup,
+        measured: frames,
+        capture: false,
+        dump: false,
+        ceilings: true,
+        command: command_line(),
+        progress: true,
+    };
+    let r = bench_run(&ctx, &scene, &settings, &opts, report);
+    let r = ctx.finish_with(r)?;
+    println!("{}", header(&r));
+    print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
+    if let Some(c) = &r.ceilings {
+        println!("{}", c.summary());
+    }
+    println!("wrote {}", report.display());
     Ok(())
 }
 
