@@ -65,7 +65,7 @@ const OPTIONS: &[OptSpec] = &[OptSpec {
     key: "density",
     kind: OptKind::Value,
     default: "32",
-    help: "surface samples per mm^2, within (0, 256] (32 is converged: doubling it changes the image by 5e-4 relative RMSE)",
+    help: "surface samples per mm^2, within (0, 256] (32 is converged: doubling it changes the image by 1e-4 relative RMSE)",
 }];
 
 pub static ENTRY: MethodEntry = MethodEntry {
