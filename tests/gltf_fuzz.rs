@@ -1193,7 +1193,12 @@ fn gltf_fuzz() {
         );
     }
     eprintln!("  total {:.1?}", start.elapsed());
-    let _ = std::fs::remove_dir_all(&dir);
+    // Failing cases stay on disk to be reproduced.
+    if fz.failures.is_empty() {
+        let _ = std::fs::remove_dir_all(&dir);
+    } else {
+        eprintln!("  the failing cases are kept in {}", dir.display());
+    }
     assert!(
         fz.failures.is_empty(),
         "{} failures:\n{}",

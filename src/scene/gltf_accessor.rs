@@ -249,6 +249,16 @@ fn read<T: Copy + Default>(
                 );
             }
             let offset = acc.offset();
+            // glTF: an accessor's offset into its view and into its buffer MUST be a
+            // multiple of its component size (a float read two bytes off is garbage,
+            // not data; the fuzzer found coordinates of 5e36 that way).
+            if (view.offset() + offset) % csize != 0 {
+                bail!(
+                    "{what} accessor {a}: its data starts at byte {} of buffer {}, not a multiple of its {csize}-byte components, which glTF forbids",
+                    view.offset() + offset,
+                    view.buffer().index()
+                );
+            }
             span(offset, stride, elem, count, bytes.len()).ok_or_else(|| {
                 anyhow!(
                     "{what} accessor {a} ({count} x {elem} bytes, stride {stride}, offset {offset}) runs past the end of bufferView {} ({} bytes)",

@@ -20,7 +20,8 @@
 //!   (gltfpack's quantized coordinates need it); KHR_mesh_quantization storage is read.
 //!   Any other required extension is refused by name.
 //! - Non-finite positions, normals, tangents, texture coordinates or node transforms
-//!   are errors. Node transforms are composed in f64, and a model far from the origin
+//!   are errors, and so are texture coordinates of 2^24 or more (no texel left to
+//!   address; the sampler's arithmetic overflows). Node transforms are composed in f64, and a model far from the origin
 //!   for its size (a scan placed at 1e7) is moved to it, so f32 keeps its shape.
 //! - Far outlier vertices (one flipped exponent bit) load with a warning; the framing
 //!   (`head_measure`, the scene's bounds) leaves them out.
@@ -186,6 +187,27 @@ fn triangulate(mode: Mode, idx: &[u32], label: &str) -> Result<Vec<u32>> {
     Ok(out)
 }
 
+/// Largest texture coordinate dermis samples with: at 2^24 an f32 keeps no
+/// fraction to address a texel, and far beyond it the sampler's own arithmetic
+/// (coordinate x texture size, the derivatives between pixels) overflows to
+/// infinity and filters NaN into the frame (found by the fuzzer: a coordinate
+/// accessor misread four bytes off gave 5e36).
+const MAX_TEXCOORD: f32 = 16_777_216.0;
+
+/// A texture coordinate too large to sample, as an error naming it.
+fn check_texcoord_range(values: &[[f32; 2]], what: &str) -> Result<()> {
+    if let Some(i) = values
+        .iter()
+        .position(|v| v.iter().any(|c| c.abs() >= MAX_TEXCOORD))
+    {
+        let [u, v] = values[i];
+        bail!(
+            "{what} of vertex {i} is ({u:e}, {v:e}): beyond {MAX_TEXCOORD:e} a coordinate has no fraction left to address a texel"
+        );
+    }
+    Ok(())
+}
+
 /// The first non-finite value of an attribute, as an error naming it.
 fn check_finite<const N: usize>(values: &[[f32; N]], what: &str) -> Result<()> {
     if let Some(i) = values.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
@@ -264,6 +286,7 @@ fn read_primitive(
     }
     if let Some(v) = &mut uvs {
         check_finite(v, &format!("{label}: TEXCOORD_0"))?;
+        check_texcoord_range(v, &format!("{label}: TEXCOORD_0"))?;
         // Baked in here, where each primitive's own material is known; tangents are
         // then generated from the coordinates the textures are really sampled with.
         if let Some(t) = texture_transform(src, prim.material().index())? {
@@ -1324,6 +1347,58 @@ pub(super) mod tests {
         );
         let e = load_err(&p);
         assert!(e.contains("indices accessor 3 (6 x 2 bytes, stride 2, offset 0) runs past the end of bufferView 3 (6 bytes)"), "{e}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    // Found by the long fuzz run (seed 1, case json7324): a TEXCOORD_0 accessor
+    // two bytes into its buffer read floats out of step (5e36), and the sampler's
+    // arithmetic turned them into NaN pixels. Both the misalignment (a glTF MUST)
+    // and such coordinates are now one-line errors.
+    #[test]
+    fn misaligned_accessors_and_huge_texcoords_are_refused() {
+        let dir = temp_dir("align");
+        let uv: Vec<u8> = [0u8, 0]
+            .into_iter()
+            .chain(bytes_f32(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]))
+            .collect();
+        let p = quad_file(
+            &dir,
+            "misaligned.gltf",
+            serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 3}}),
+            serde_json::json!([{"bufferView": 3, "byteOffset": 2, "componentType": 5126, "count": 4, "type": "VEC2"}]),
+            &uv,
+            None,
+        );
+        let e = load_err(&p);
+        assert!(
+            e.contains("TEXCOORD_0 accessor 3: its data starts at byte 130 of buffer 0, not a multiple of its 4-byte components"),
+            "{e}"
+        );
+        let huge = bytes_f32(&[0.0, 1.0, 5e36, 1.0, 1.0, 0.0, 0.0, 0.0]);
+        let p = quad_file(
+            &dir,
+            "huge.gltf",
+            serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 3}}),
+            serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2"}]),
+            &huge,
+            None,
+        );
+        let e = load_err(&p);
+        assert!(
+            e.contains("TEXCOORD_0 of vertex 1 is (5e36, 1e0): beyond 1.6777216e7"),
+            "{e}"
+        );
+        // Large but addressable coordinates (a tiling texture) still load.
+        let tiled = bytes_f32(&[0.0, 1.0, 4096.0, 1.0, 4096.0, 0.0, 0.0, 0.0]);
+        let p = quad_file(
+            &dir,
+            "tiled.gltf",
+            serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 3}}),
+            serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2"}]),
+            &tiled,
+            None,
+        );
+        assert!(load_head(&p, &Default::default()).is_ok());
         let _ = std::fs::remove_dir_all(dir);
     }
 
