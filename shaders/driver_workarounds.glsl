@@ -7,5 +7,5 @@
 // frame. Adding NOT_UNIFORM_ZERO to such a value keeps the branch off that list:
 // fragment coordinates are never negative, so it is exactly 0 in every fragment,
 // but the driver cannot know that. See docs/reliability.md and
-// examples/lavapipe_inline_leak.rs (the minimal program).
+// tools/examples/lavapipe_inline_leak.rs (the minimal program).
 #define NOT_UNIFORM_ZERO min(gl_FragCoord.x, 0.0)
