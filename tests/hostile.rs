@@ -7,7 +7,8 @@ mod common;
 
 use dermis::render::{Capture, RenderSettings};
 use dermis::run::{run, RunOptions};
-use dermis::scene::mesh::{Material, Mesh, Object, Texture, Vertex};
+use dermis::scene::mesh::Texture;
+use dermis::scene::procedural::flat_card;
 use dermis::scene::{default_scene, egg_scene, scene_from_head, Scene};
 use dermis::vk::context::Context;
 use glam::{Mat4, Vec3};
@@ -61,40 +62,6 @@ fn a_texture_larger_than_the_device_allows_is_downscaled() {
     ctx.finish().unwrap();
 }
 
-/// A `w` x `h` card of 8x4 quads in the XY plane, facing +Z, moved by `m`.
-fn card(w: f32, h: f32, m: Mat4) -> Object {
-    let (nx, ny) = (8u32, 4u32);
-    let mut mesh = Mesh::default();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let p = Vec3::new(
-                (i as f32 / nx as f32 - 0.5) * w,
-                (j as f32 / ny as f32 - 0.5) * h,
-                0.0,
-            );
-            mesh.vertices.push(Vertex {
-                position: m.transform_point3(p).into(),
-                normal: m.transform_vector3(Vec3::Z).into(),
-                uv: [i as f32 / nx as f32, j as f32 / ny as f32],
-                tangent: [1.0, 0.0, 0.0, 1.0],
-            });
-        }
-    }
-    for j in 0..ny {
-        for i in 0..nx {
-            let at = |i: u32, j: u32| j * (nx + 1) + i;
-            mesh.indices
-                .extend([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-            mesh.indices
-                .extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-        }
-    }
-    Object {
-        mesh,
-        material: Material::skin([0.6, 0.45, 0.4]),
-    }
-}
-
 // Issue 11: a flat object was framed edge-on, so only its shadow showed. It now
 // faces the camera with its largest extent, however it lies.
 #[test]
@@ -111,7 +78,7 @@ fn a_flat_object_is_seen_face_on() {
         (Mat4::from_rotation_y(PI), "facing -Z"),
         (Mat4::from_rotation_x(-FRAC_PI_2), "lying flat"),
     ] {
-        let scene = scene_from_head(name, card(2.0, 1.0, m), None).unwrap();
+        let scene = scene_from_head(name, flat_card(2.0, 1.0, m, [0.6, 0.45, 0.4]), None).unwrap();
         let c = capture(&ctx, &scene, &s);
         // Two heads' distance from a card two units wide: a third of the frame
         // or more is card (edge-on: none).

@@ -293,7 +293,11 @@ fn thin_parts_need_transmittance() {
     );
     // Mean red over the thin parts: what light came through the ears.
     let red = |img: &[[f32; 4]]| {
-        img.iter().zip(&thin).filter(|(_, &t)| t).map(|(p, _)| p[0] as f64).sum::<f64>()
+        img.iter()
+            .zip(&thin)
+            .filter(|(_, &t)| t)
+            .map(|(p, _)| p[0] as f64)
+            .sum::<f64>()
             / n_thin as f64
     };
     let (red_ref, red_direct) = (red(&reference), red(&direct));

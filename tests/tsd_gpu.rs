@@ -851,7 +851,12 @@ fn thin_parts_with_and_without_transmittance() {
     assert!(thin.iter().filter(|&&t| t).count() > 10);
     let n_thin = thin.iter().filter(|&&t| t).count() as f64;
     let red = |img: &[[f32; 4]]| {
-        img.iter().zip(&thin).filter(|(_, &t)| t).map(|(p, _)| p[0] as f64).sum::<f64>() / n_thin
+        img.iter()
+            .zip(&thin)
+            .filter(|(_, &t)| t)
+            .map(|(p, _)| p[0] as f64)
+            .sum::<f64>()
+            / n_thin
     };
     let red_ref = red(&reference);
     for method in ["tsd", "tsd-opt"] {
@@ -880,6 +885,9 @@ fn thin_parts_with_and_without_transmittance() {
             red_on > red_off + 0.25 * (red_ref - red_off),
             "{method}: transmittance added too little light ({red_off} -> {red_on}, reference {red_ref})"
         );
-        assert!(thin_on < 1.5 * thin_off, "{method}: {thin_on} vs {thin_off}");
+        assert!(
+            thin_on < 1.5 * thin_off,
+            "{method}: {thin_on} vs {thin_off}"
+        );
     }
 }

@@ -39,7 +39,7 @@ use crate::reference::sampling::{
 };
 use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
-use crate::vk::context::Context;
+use crate::vk::context::{Context, DeviceFacts};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
@@ -89,6 +89,18 @@ fn density(o: &Opts) -> Result<f32> {
         bail!("--density must be within (0, 256] samples per mm^2, got {d}");
     }
     Ok(d)
+}
+
+/// Bytes the ground truth keeps per surface sample: the sample (64 B),
+/// positions (16 B), normals (16 B) and radiance (16 B).
+const BYTES_PER_SAMPLE: u64 = 112;
+
+/// The most surface samples the ground truth takes on a device: three quarters
+/// of its memory. Not the frame's half: the ground truth is a run of its own
+/// beside a few frame-sized images, and the Lee Perry-Smith bust at the default
+/// density (1.09e7 samples, 1.2 GB) must fit lavapipe's 2 GiB heap.
+pub fn sample_budget(facts: &DeviceFacts) -> u64 {
+    facts.device_local_bytes / 4 * 3 / BYTES_PER_SAMPLE
 }
 
 /// std140 layout of `GatherParams` (reference_gather.comp).
@@ -307,13 +319,11 @@ impl Reference {
         let Some(skin) = skin else {
             bail!("the reference found no skin surface to sample");
         };
-        // Samples (64 B), positions (16 B), normals (16 B) and radiance (16 B)
-        // per sample, within half of the device's memory: checked before any
-        // sample exists (a far outlier vertex would otherwise ask for billions).
+        // Checked before any sample exists (a far outlier vertex would
+        // otherwise ask for billions).
         let f = &s.ctx.facts;
-        let budget = f.device_local_bytes / 2 / 112;
-        let mut surface =
-            sample_surface_within(&skin.mesh, s.instances, mm, self.density, budget)?;
+        let budget = sample_budget(f);
+        let mut surface = sample_surface_within(&skin.mesh, s.instances, mm, self.density, budget)?;
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
         }

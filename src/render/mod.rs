@@ -389,24 +389,17 @@ impl<'c> Renderer<'c> {
     /// Reads one frame image back as linear float RGBA (after a frame: its
     /// contents stay until the next frame writes them).
     pub fn read_back(&mut self, id: ImageId) -> Result<Vec<[f32; 4]>> {
-        let mut plan = ReadbackPlan::single(id);
-        let done = plan
-            .interleave(self.ctx, &mut self.resources, Vec::new())
-            .and_then(|passes| {
-                submit_passes(
-                    self.ctx,
-                    &self.submit,
-                    &mut self.resources,
-                    &passes,
-                    false,
-                    "while reading back an image",
-                )
-            });
-        if let Err(e) = done {
-            plan.discard(self.ctx, &mut self.resources);
-            return Err(e);
-        }
-        plan.finish_single(self.ctx, &mut self.resources)
+        let (ctx, submit) = (self.ctx, &self.submit);
+        submit_and_read(
+            ctx,
+            submit,
+            &mut self.resources,
+            id,
+            Vec::new(),
+            false,
+            "while reading back an image",
+        )
+        .map(|(img, _)| img)
     }
 
     /// The depth-buffer value of a surface at linear view depth `d` (this camera).
@@ -421,34 +414,16 @@ impl<'c> Renderer<'c> {
         if passes.is_empty() {
             bail!("the SSS-only run needs a method with passes");
         }
-        let mut plan = ReadbackPlan::single(self.method.output());
-        let done = plan
-            .interleave(self.ctx, &mut self.resources, passes)
-            .and_then(|passes| {
-                submit_passes(
-                    self.ctx,
-                    &self.submit,
-                    &mut self.resources,
-                    &passes,
-                    true,
-                    "during the SSS-only run",
-                )
-            });
-        let samples = match done {
-            Ok(s) => s,
-            Err(e) => {
-                plan.discard(self.ctx, &mut self.resources);
-                return Err(e);
-            }
-        };
-        let img = plan.finish_single(self.ctx, &mut self.resources)?;
-        Ok((
-            img,
-            samples
-                .into_iter()
-                .filter(|s| s.role != PassRole::Readback)
-                .collect(),
-        ))
+        let output = self.method.output();
+        submit_and_read(
+            self.ctx,
+            &self.submit,
+            &mut self.resources,
+            output,
+            passes,
+            true,
+            "during the SSS-only run",
+        )
     }
 }
 
@@ -462,6 +437,39 @@ impl Drop for Renderer<'_> {
             Some(&self.submit),
         );
     }
+}
+
+/// Submits `passes` followed by the readback of `id`; the image as f32 RGBA
+/// and the pass samples (readback passes left out). On a failed submission
+/// the readback buffers are freed before the error returns.
+// The renderer's fields come apart so that passes borrowed from its method can
+// be submitted.
+fn submit_and_read(
+    ctx: &Context,
+    submit: &Submit,
+    resources: &mut Resources,
+    id: ImageId,
+    passes: Vec<Pass>,
+    timed: bool,
+    when: &str,
+) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
+    let mut plan = ReadbackPlan::single(id);
+    let done = plan
+        .interleave(ctx, resources, passes)
+        .and_then(|passes| submit_passes(ctx, submit, resources, &passes, timed, when));
+    let samples = match done {
+        Ok(s) => s,
+        Err(e) => {
+            plan.discard(ctx, resources);
+            return Err(e);
+        }
+    };
+    let img = plan.finish_single(ctx, resources)?;
+    let samples = samples
+        .into_iter()
+        .filter(|s| s.role != PassRole::Readback)
+        .collect();
+    Ok((img, samples))
 }
 
 /// Records `passes` into the renderer's command buffer, submits them, waits on

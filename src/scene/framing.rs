@@ -218,41 +218,6 @@ mod tests {
         );
     }
 
-    /// A `w` x `h` card of 8x4 quads in the XY plane, facing +Z, moved by `m`.
-    pub(crate) fn card(w: f32, h: f32, m: Mat4) -> crate::scene::mesh::Object {
-        use crate::scene::mesh::{Material, Mesh, Object, Vertex};
-        let (nx, ny) = (8u32, 4u32);
-        let mut mesh = Mesh::default();
-        for j in 0..=ny {
-            for i in 0..=nx {
-                let p = Vec3::new(
-                    (i as f32 / nx as f32 - 0.5) * w,
-                    (j as f32 / ny as f32 - 0.5) * h,
-                    0.0,
-                );
-                mesh.vertices.push(Vertex {
-                    position: m.transform_point3(p).into(),
-                    normal: m.transform_vector3(Vec3::Z).into(),
-                    uv: [i as f32 / nx as f32, j as f32 / ny as f32],
-                    tangent: [1.0, 0.0, 0.0, 1.0],
-                });
-            }
-        }
-        for j in 0..ny {
-            for i in 0..nx {
-                let at = |i: u32, j: u32| j * (nx + 1) + i;
-                mesh.indices
-                    .extend([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                mesh.indices
-                    .extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-        Object {
-            mesh,
-            material: Material::skin([0.6, 0.4, 0.3]),
-        }
-    }
-
     // Issue 11: a flat object was framed edge-on (only its shadow showed). It
     // now faces the camera with its largest extent, whichever way it lies.
     #[test]
@@ -264,7 +229,12 @@ mod tests {
             (Mat4::from_rotation_y(FRAC_PI_2), Vec3::X),
             (Mat4::from_rotation_x(-FRAC_PI_2), Vec3::Y),
         ] {
-            let s = crate::scene::scene_from_head("card", card(2.0, 1.0, m), None).unwrap();
+            let s = crate::scene::scene_from_head(
+                "card",
+                crate::scene::procedural::flat_card(2.0, 1.0, m, [0.6, 0.4, 0.3]),
+                None,
+            )
+            .unwrap();
             assert!(
                 (s.forward - facing).length() < 1e-5,
                 "{facing}: {}",

@@ -6,7 +6,7 @@
 //! skull (a tapered, displaced sphere with a nose) and two thin ear slabs ~3 mm thick that
 //! poke into the side of the skull, so light visibly passes through them.
 
-use super::mesh::{Mesh, Vertex};
+use super::mesh::{Material, Mesh, Object, Vertex};
 use glam::{Mat4, Quat, Vec3};
 use std::f32::consts::{PI, TAU};
 
@@ -162,6 +162,41 @@ fn ear_shell(ear: &Ear) -> Mesh {
             + n * (0.5 * EAR_THICKNESS * h)
             + up * (EAR_HALF_HEIGHT * r * cp)
     })
+}
+
+/// A flat `w` x `h` skin card of 8x4 quads in the XY plane, facing +Z, moved by
+/// `m` (framing and hostile-input tests: a flat object must be seen face on).
+pub fn flat_card(w: f32, h: f32, m: Mat4, albedo: [f32; 3]) -> Object {
+    let (nx, ny) = (8u32, 4u32);
+    let mut mesh = Mesh::default();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let p = Vec3::new(
+                (i as f32 / nx as f32 - 0.5) * w,
+                (j as f32 / ny as f32 - 0.5) * h,
+                0.0,
+            );
+            mesh.vertices.push(Vertex {
+                position: m.transform_point3(p).into(),
+                normal: m.transform_vector3(Vec3::Z).into(),
+                uv: [i as f32 / nx as f32, j as f32 / ny as f32],
+                tangent: [1.0, 0.0, 0.0, 1.0],
+            });
+        }
+    }
+    let at = |i: u32, j: u32| j * (nx + 1) + i;
+    for j in 0..ny {
+        for i in 0..nx {
+            mesh.indices
+                .extend([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            mesh.indices
+                .extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Object {
+        mesh,
+        material: Material::skin(albedo),
+    }
 }
 
 /// The procedural head: skull plus both ears in one mesh, smooth normals, tangents from

@@ -42,8 +42,12 @@ fn speedups(dir: &Path) -> Result<BTreeMap<u32, Vec<(f64, f64)>>> {
         let Some((heads, dist)) = rest.split_once("h_d") else {
             continue;
         };
-        let heads: u32 = heads.parse().with_context(|| format!("head count in {name}"))?;
-        let dist: f64 = dist.parse().with_context(|| format!("distance in {name}"))?;
+        let heads: u32 = heads
+            .parse()
+            .with_context(|| format!("head count in {name}"))?;
+        let dist: f64 = dist
+            .parse()
+            .with_context(|| format!("distance in {name}"))?;
         let opt = dir.join(format!("opt_{rest}.json"));
         let s = frame_ms(&dir.join(&name))? / frame_ms(&opt)?;
         out.entry(heads).or_default().push((dist, s));
@@ -65,9 +69,7 @@ impl Plot for Table31 {
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(plot_err)?;
         let points = self.lines.values().flatten();
-        let (lo, hi) = points.fold((f64::MAX, 0.0f64), |(lo, hi), p| {
-            (lo.min(p.0), hi.max(p.0))
-        });
+        let (lo, hi) = points.fold((f64::MAX, 0.0f64), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
         let top = self
             .lines
             .values()
@@ -119,10 +121,15 @@ impl Plot for Table31 {
         for (i, (heads, line)) in self.lines.iter().enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
             chart
-                .draw_series(LineSeries::new(line.iter().copied(), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    line.iter().copied(),
+                    colour.stroke_width(2),
+                ))
                 .map_err(plot_err)?
                 .label(format!("{heads} head(s)"))
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
             chart
                 .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
                 .map_err(plot_err)?;
