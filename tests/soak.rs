@@ -9,9 +9,9 @@
 //!
 //! Default (about 30 s of CI on two cores): 64x36, per method 20 warm-up frames,
 //! then 120 frames (the reference: 3 and 12, at 4 samples per mm^2); 8 renders
-//! of 2 frames each in a row. Bounds: resident memory grows at most
-//! QUARTER_BOUND_MIB in at least three of the four quarters of the frames and at
-//! most TOTAL_BOUND_MIB in all (a leak grows in every quarter; a driver cache or a
+//! of 2 frames each in a row. Bounds: the highest resident memory so far grows
+//! at most QUARTER_BOUND_MIB in at least three of the four quarters of the
+//! frames and at most TOTAL_BOUND_MIB in all (a leak grows in every quarter; a driver cache or a
 //! new malloc arena of a rasteriser thread, once: lavapipe takes a 12-14 MiB step
 //! at a random frame in about one run of three); after the renders, at most
 //! TOTAL_BOUND_MIB above the value after the first; live allocations exactly
@@ -142,7 +142,21 @@ fn frames_and_renders_stay_flat() {
         let (rss1, live1, made1) = (rss_mib(), live(&ctx), ctx.creations());
         let growth = rss1 - rss0;
         let quarters: Vec<f64> = rss.windows(2).map(|w| w[1] - w[0]).collect();
-        let steady = quarters.iter().filter(|&&g| g <= QUARTER_BOUND_MIB).count();
+        // A leak sets a new high every quarter; the allocator handing a few MiB
+        // back and forth (measured: -2.5, +2.5, -2.5, +2.5 MiB over four quarters
+        // of ss-jittered, net 0) or one arena step sets at most one. So what each
+        // quarter adds to the highest resident memory so far is bounded.
+        let highs: Vec<f64> = rss
+            .iter()
+            .scan(f64::MIN, |hi, &r| {
+                *hi = hi.max(r);
+                Some(*hi)
+            })
+            .collect();
+        let steady = highs
+            .windows(2)
+            .filter(|w| w[1] - w[0] <= QUARTER_BOUND_MIB)
+            .count();
         eprintln!(
             "  {method:<12} {n:>6} {rss1:>9.1} {growth:>+9.2} {:>10.2} {:>24} {:>7} {:>8}   ({:.1} frames/s)",
             growth * 1024.0 / n as f64,
