@@ -176,5 +176,8 @@ fn the_head_fits_the_ground_truth_budget_at_the_default_density() {
     let ctx = common::ctx();
     let budget = dermis::method::reference::sample_budget(&ctx.facts);
     println!("the head at {density} per mm^2: {wanted:.3e} samples, budget {budget}");
-    assert!(wanted < budget as f64, "{wanted} samples over a budget of {budget}");
+    assert!(
+        wanted < budget as f64,
+        "{wanted} samples over a budget of {budget}"
+    );
 }

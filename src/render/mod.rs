@@ -24,7 +24,7 @@ use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::profiler::Profiler;
 use frame::{skin_material_binds, Frame};
-use readback::{DumpedImage, ReadbackPlan};
+use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use settings::RenderSettings;
 
 /// A finished frame read back to the host.
@@ -134,14 +134,18 @@ fn check_memory(ctx: &Context, res: &Resources, extent: vk::Extent2D) -> Result<
 
 /// Query slots a frame may need: its passes, and with `--dump` one readback
 /// pass per image each pass writes (see `ReadbackPlan::interleave`), the
-/// final image's copy and the host-visibility step.
+/// copies of a capture's final images and the host-visibility step.
 fn profiler_slots(passes: &[Pass]) -> u32 {
     let writes: usize = passes
         .iter()
         .map(|p| p.images.iter().filter(|(_, a)| a.is_write()).count())
         .sum();
-    (passes.len() + writes + 2) as u32
+    (passes.len() + writes + CAPTURED_IMAGES + 1) as u32
 }
+
+/// Images a capture reads back after the frame: the tone-mapped frame, the
+/// method's output, the linear depth and the HDR composite.
+const CAPTURED_IMAGES: usize = 4;
 
 impl<'c> Renderer<'c> {
     pub fn new(ctx: &'c Context, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
@@ -338,7 +342,11 @@ impl<'c> Renderer<'c> {
     /// Renders one frame and reads back the tone-mapped image, and with `dump`
     /// every pass output.
     pub fn capture(&mut self, dump: bool) -> Result<Capture> {
-        let mut plan = ReadbackPlan::new(dump, self.frame.targets.ldr);
+        // Everything a capture returns, read back in the frame's own submission.
+        let t = &self.frame.targets;
+        let finals: [ImageId; CAPTURED_IMAGES] =
+            [t.ldr, self.method.output(), t.linear_depth, t.hdr];
+        let mut plan = ReadbackPlan::new(dump, &finals);
         let samples = match self.run_frame(Some(&mut plan)) {
             Ok(s) => s,
             Err(e) => {
@@ -346,26 +354,22 @@ impl<'c> Renderer<'c> {
                 return Err(e);
             }
         };
-        let (ldr, dumps) = plan.finish(self.ctx, &mut self.resources)?;
-        let samples = samples
-            .into_iter()
-            .filter(|s| s.role != PassRole::Readback)
-            .collect();
-        let diffuse = self.read_back(self.method.output())?;
-        let depth = self
-            .read_back(self.frame.targets.linear_depth)?
-            .iter()
-            .map(|p| p[0])
-            .collect();
-        let hdr = self.read_back(self.frame.targets.hdr)?;
+        let (finals, dumps) = plan.finish(self.ctx, &mut self.resources)?;
+        let [ldr, diffuse, depth, hdr] = <[_; 4]>::try_from(finals)
+            .map_err(|_| anyhow::anyhow!("the capture read back the wrong number of images"))?;
+        let float = |(format, bytes): readback::RawImage| to_rgba_f32(format, &bytes);
+        let hdr = float(hdr)?;
         Ok(Capture {
-            ldr,
+            ldr: ldr.1,
             width: self.frame.extent.width,
             height: self.frame.extent.height,
             dumps,
-            samples,
-            diffuse,
-            depth,
+            samples: samples
+                .into_iter()
+                .filter(|s| s.role != PassRole::Readback)
+                .collect(),
+            diffuse: float(diffuse)?,
+            depth: float(depth)?.iter().map(|p| p[0]).collect(),
             hdr_nonfinite: hdr
                 .iter()
                 .filter(|p| !p.iter().all(|c| c.is_finite()))

@@ -21,6 +21,9 @@ pub struct DumpedImage {
     pub rgba: Vec<[f32; 4]>,
 }
 
+/// An image read back as it is stored: its format and bytes.
+pub type RawImage = (vk::Format, Vec<u8>);
+
 struct Pending {
     pass: String,
     image: ImageId,
@@ -31,8 +34,11 @@ struct Pending {
 /// Which images to read back and where they land.
 pub struct ReadbackPlan {
     dump: bool,
-    final_image: ImageId,
+    /// Read after the last pass, in this order (one submission for all).
+    finals: Vec<ImageId>,
     pending: Vec<Pending>,
+    /// `pending[..dumped]` are the dumps; the final copies follow.
+    dumped: usize,
     /// Buffer count of the graph before this plan added its own, restored at the end.
     buffers_before: usize,
 }
@@ -113,19 +119,27 @@ pub fn to_rgba_f32(format: vk::Format, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
 }
 
 impl ReadbackPlan {
-    /// The final image, plus every pass output when `dump` is set.
-    pub fn new(dump: bool, final_image: ImageId) -> Self {
+    /// The `finals` as they are after the last pass, plus every pass output
+    /// when `dump` is set.
+    pub fn new(dump: bool, finals: &[ImageId]) -> Self {
         ReadbackPlan {
             dump,
-            final_image,
+            finals: finals.to_vec(),
             pending: Vec::new(),
+            dumped: 0,
             buffers_before: 0,
         }
     }
 
     /// Just one image, read after all passes.
     pub fn single(image: ImageId) -> Self {
-        Self::new(false, image)
+        Self::new(false, &[image])
+    }
+
+    /// The copy holding `id` as the last pass left it: the dump after its last
+    /// writer, or its own final copy.
+    fn last_copy(&self, id: ImageId) -> Option<&Pending> {
+        self.pending.iter().rev().find(|p| p.image == id)
     }
 
     fn copy_pass<'a>(
@@ -221,10 +235,15 @@ impl ReadbackPlan {
                 }
             }
         }
-        if !self.dump || !self.pending.iter().any(|p| p.image == self.final_image) {
+        self.dumped = self.pending.len();
+        for id in self.finals.clone() {
+            // A dump made after the image's last writer already holds it.
+            if self.dump && self.last_copy(id).is_some() {
+                continue;
+            }
             let c = self
-                .copy_pass(ctx, res, "final", self.final_image)?
-                .context("the final image's format cannot be read back")?;
+                .copy_pass(ctx, res, "final", id)?
+                .with_context(|| format!("{} cannot be read back", res.name(id)))?;
             out.push(c);
         }
         let mut host = Pass::new(format!("{PREFIX} to host"), PassRole::Readback);
@@ -245,53 +264,50 @@ impl ReadbackPlan {
         ))
     }
 
-    /// After the fence: the final image's raw bytes and every dump as float.
-    /// The readback buffers are freed whatever happens.
+    /// After the fence: each final image's format and raw bytes, in the order
+    /// given, and every dump as float. The readback buffers are freed whatever
+    /// happens.
     pub fn finish(
         mut self,
         ctx: &Context,
         res: &mut Resources,
-    ) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
+    ) -> Result<(Vec<RawImage>, Vec<DumpedImage>)> {
         let out = self.collect(res);
         self.release(ctx, res);
         out
     }
 
-    fn collect(&self, res: &Resources) -> Result<(Vec<u8>, Vec<DumpedImage>)> {
-        let mut final_bytes = None;
+    fn collect(&self, res: &Resources) -> Result<(Vec<RawImage>, Vec<DumpedImage>)> {
+        let finals = self
+            .finals
+            .iter()
+            .map(|&id| {
+                let p = self
+                    .last_copy(id)
+                    .with_context(|| format!("{} was not read back", res.name(id)))?;
+                let (_, _, format, bytes) = self.read(p, res)?;
+                Ok((format, bytes))
+            })
+            .collect::<Result<Vec<_>>>()?;
         let mut dumps = Vec::new();
-        for p in &self.pending {
+        for p in &self.pending[..self.dumped] {
             let (w, h, format, bytes) = self.read(p, res)?;
-            if p.image == self.final_image {
-                final_bytes = Some(bytes.clone());
-            }
-            if self.dump {
-                let image = res.name(p.image).to_string();
-                dumps.push(DumpedImage {
-                    pass: p.pass.clone(),
-                    image,
-                    width: w,
-                    height: h,
-                    rgba: to_rgba_f32(format, &bytes)?,
-                });
-            }
+            dumps.push(DumpedImage {
+                pass: p.pass.clone(),
+                image: res.name(p.image).to_string(),
+                width: w,
+                height: h,
+                rgba: to_rgba_f32(format, &bytes)?,
+            });
         }
-        Ok((
-            final_bytes.context("the final image was not read back")?,
-            dumps,
-        ))
+        Ok((finals, dumps))
     }
 
-    /// After the fence: the single image as float RGBA.
-    pub fn finish_single(mut self, ctx: &Context, res: &mut Resources) -> Result<Vec<[f32; 4]>> {
-        let out = self
-            .pending
-            .first()
-            .context("nothing was read back")
-            .and_then(|p| self.read(p, res))
-            .and_then(|(_, _, format, bytes)| to_rgba_f32(format, &bytes));
-        self.release(ctx, res);
-        out
+    /// After the fence: the first final image as float RGBA.
+    pub fn finish_single(self, ctx: &Context, res: &mut Resources) -> Result<Vec<[f32; 4]>> {
+        let (finals, _) = self.finish(ctx, res)?;
+        let (format, bytes) = finals.first().context("nothing was read back")?;
+        to_rgba_f32(*format, bytes)
     }
 
     /// Frees the readback buffers of a plan whose submission failed.
