@@ -153,16 +153,14 @@ fn render_card(
     ctx: &dermis::vk::context::Context,
     scene: &Scene,
     s: &RenderSettings,
-) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, f64) {
+) -> (Vec<[f32; 4]>, f64) {
     let mut r = Renderer::new(ctx, scene, s).unwrap();
     let cap = r.capture(false).unwrap();
-    let diffuse = r.read_back(r.frame.targets.diffuse).unwrap();
-    let depth = r.read_back(r.frame.targets.linear_depth).unwrap();
-    let z = depth[depth.len() / 2][0] as f64;
+    let z = cap.depth[cap.depth.len() / 2] as f64;
     let mm_per_px =
         2.0 * z * (0.5 * s.fovy_deg.to_radians() as f64).tan() * scene.mm_per_unit as f64
             / s.height as f64;
-    (cap.diffuse, diffuse, mm_per_px)
+    (cap.diffuse, mm_per_px)
 }
 
 // The card at the eval's close-up scale (8.5 px/mm, the thesis' 720p zoom
@@ -175,12 +173,11 @@ fn edge_response_of_every_method_against_the_closed_form() {
     let scene = card_scene();
     let base = card_settings(&scene, 8.5);
     let mut report = Vec::new();
+    // Geometry pass diffuse of a method is overwritten by SSS: the unscattered
+    // levels come from `none`'s frame instead.
+    let (none, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
     let mut run = |label: &str, s: RenderSettings| {
-        let (out, diffuse, mm_per_px) = render_card(&ctx, &scene, &s);
-        // Geometry pass diffuse of a method is overwritten by SSS: the unscattered
-        // levels come from `none`'s frame instead.
-        let (none, _, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
-        let _ = diffuse;
+        let (out, mm_per_px) = render_card(&ctx, &scene, &s);
         let kind = if label == "reference" {
             Output::PointSamples
         } else {
@@ -272,7 +269,7 @@ fn uniform_light(
     let mut r = Renderer::new(&ctx, scene, s).unwrap();
     let cap = r.capture(false).unwrap();
     let input = r.read_back(r.frame.targets.diffuse).unwrap();
-    let depth = r.read_back(r.frame.targets.linear_depth).unwrap();
+    let depth = &cap.depth;
     let inv_view = r.frame.camera.view().inverse();
     assert!(r.method_as::<Reference>().is_some());
     let (w, h) = (s.width as usize, s.height as usize);
@@ -285,7 +282,7 @@ fn uniform_light(
         if d[3] <= 0.0 || d[0] <= 0.0 {
             continue;
         }
-        let z = depth[i][0];
+        let z = depth[i];
         let (x, y) = ((i % w) as f32, (i / w) as f32);
         let ndc = [
             (x + 0.5) / w as f32 * 2.0 - 1.0,
