@@ -183,19 +183,50 @@ pub fn sweep(
         );
         let (fovy, mm_per_unit) = (reference.report.fovy_deg, reference.report.mm_per_unit);
         let reference = reference.capture.context("reference capture")?;
-        // The no-SSS frame every err/none and gain is relative to.
-        let none = run(
-            ctx,
-            &scene,
-            &RenderSettings {
-                method: lookup("none")?,
-                ..base.clone()
-            },
-            &once,
-        )?
-        .capture
-        .context("no-SSS capture")?
-        .diffuse;
+        // One measured run per config (the progress bar names it).
+        let measure = |c: &Config| {
+            step(&format!("{} {}", c.method.name, c.setting.label));
+            let s = base.clone().with(c.method, c.setting.options);
+            let o = RunOptions {
+                warmup: opts.warmup,
+                measured: opts.measured,
+                capture: true,
+                ..once.clone()
+            };
+            run(ctx, &scene, &s, &o).with_context(|| {
+                format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
+            })
+        };
+        // The no-SSS frame every err/none and gain is relative to: the `none`
+        // config's own measured run when it is swept (rendered once, used twice),
+        // else one captured frame.
+        let none_method = lookup("none")?;
+        let none_at = configs
+            .iter()
+            .position(|c| std::ptr::eq(c.method, none_method));
+        let mut none_run = none_at.map(|i| measure(&configs[i])).transpose()?;
+        let none = match &none_run {
+            Some(out) => out
+                .capture
+                .as_ref()
+                .context("no-SSS capture")?
+                .diffuse
+                .clone(),
+            None => {
+                run(
+                    ctx,
+                    &scene,
+                    &RenderSettings {
+                        method: none_method,
+                        ..base.clone()
+                    },
+                    &once,
+                )?
+                .capture
+                .context("no-SSS capture")?
+                .diffuse
+            }
+        };
         let mask: Vec<bool> = reference.diffuse.iter().map(|p| p[3] > 0.0).collect();
         let skin = mask.iter().filter(|&&m| m).count();
         let band_of = bands(&BandInput::for_view(
@@ -208,18 +239,16 @@ pub fn sweep(
         if let Some(b) = &bar {
             b.inc(1);
         }
-        for c in configs {
-            step(&format!("{} {}", c.method.name, c.setting.label));
-            let s = base.clone().with(c.method, c.setting.options);
-            let o = RunOptions {
-                warmup: opts.warmup,
-                measured: opts.measured,
-                capture: true,
-                ..once.clone()
+        for (i, c) in configs.iter().enumerate() {
+            let reuse = if none_at == Some(i) {
+                none_run.take()
+            } else {
+                None
             };
-            let out = run(ctx, &scene, &s, &o).with_context(|| {
-                format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
-            })?;
+            let out = match reuse {
+                Some(out) => out,
+                None => measure(c)?,
+            };
             let cap = out.capture.context("capture")?;
             let flip = flip_ldr(&cap.ldr, &reference.ldr, cap.width, cap.height)?;
             let band_errors = BandErrors::of(

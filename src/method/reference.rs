@@ -23,7 +23,7 @@ use std::any::Any;
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::region::ReachScale;
+use super::region::{px_per_mm, ReachScale};
 use super::screen::fetch;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
@@ -279,7 +279,8 @@ pub struct Reference {
     surf: Surface,
     instances: Vec<glam::Mat4>,
     pub sample_count: u32,
-    pub grid: Option<Grid>,
+    /// Cells of the sample grid along x, y, z (reported in `details`).
+    pub grid_dims: [u32; 3],
     /// The samples in grid order (for CPU checks).
     pub surface: Vec<SurfaceSample>,
     pub density: f32,
@@ -483,7 +484,7 @@ impl Reference {
         self.draw_samples = plan.draw_samples;
         self.max_candidates = max_slab_candidates(&grid);
         self.sample_count = count;
-        self.grid = Some(grid);
+        self.grid_dims = grid.dims;
         self.surface = surface;
         Ok(())
     }
@@ -507,7 +508,7 @@ impl Reference {
             })
             .fold(f32::INFINITY, f32::min)
             .max(s.view.camera.near);
-        let px_per_mm = s.view.extent.height as f32 / (2.0 * nearest * s.view.tan_half_fovy() * mm);
+        let px_per_mm = px_per_mm(nearest, s.view.extent.height, s.view.tan_half_fovy(), mm);
         let ss = supersampling(px_per_mm);
         let extent = vk::Extent2D {
             width: s.view.extent.width * ss,
@@ -1075,7 +1076,7 @@ impl SssMethod for Reference {
             "density_per_mm2": self.density,
             "samples": self.sample_count,
             "chunks": self.chunks.len(),
-            "grid_dims": self.grid.as_ref().map(|g| g.dims),
+            "grid_dims": self.grid_dims,
             "supersampling": self.surf.s,
             "narrow_window_radius": self.surf.max_radius,
             "tissue_tolerance": TISSUE_TOLERANCE,

@@ -831,6 +831,18 @@ impl Tsd {
         if v {
             color.push(color_write(f.res, c.map, true));
         }
+        // The first Gaussian's passes start their targets (cleared when only
+        // masked texels are written); later ones keep the zeros outside the mask.
+        // The first Gaussian clears its masked target, and along v the
+        // character's map (see the recording below).
+        let masked = cfg.masked();
+        let mut clears = Vec::new();
+        if g == 0 && masked {
+            clears.extend(work_format(f.res.format(dst)));
+        }
+        if g == 0 && v {
+            clears.extend(work_format(f.res.format(c.map)));
+        }
         let work = Work::Raster {
             shader: Some(ShaderWork {
                 shader: shader.into(),
@@ -844,22 +856,8 @@ impl Tsd {
             height: c.size,
             triangles: 1,
             msaa: 1,
-            clears: Vec::new(),
+            clears,
         };
-        // The first Gaussian's passes start their targets (cleared when only
-        // masked texels are written); later ones keep the zeros outside the mask.
-        let masked = cfg.masked();
-        // The first Gaussian clears its masked target, and along v the
-        // character's map (see the recording below).
-        let mut work = work;
-        if let Work::Raster { clears, .. } = &mut work {
-            if g == 0 && masked {
-                clears.extend(work_format(f.res.format(dst)));
-            }
-            if g == 0 && v {
-                clears.extend(work_format(f.res.format(c.map)));
-            }
-        }
         let dst_access = if g == 0 || !masked {
             AccessKind::ColorAttachmentWrite
         } else {

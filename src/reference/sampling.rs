@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::scene::mesh::Mesh;
-use crate::skin::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
+use crate::skin::profile::SIX_GAUSSIAN_VARIANCES_MM2;
 
 /// One surface sample as the compute shaders read it (std430, 64 bytes).
 #[repr(C)]
@@ -35,34 +35,6 @@ pub const NARROW_GAUSSIANS: usize = 3;
 /// 2.6e-5 of the red exitance is dropped (the narrower ones lose far less).
 pub fn cutoff_mm() -> f32 {
     4.0 * SIX_GAUSSIAN_VARIANCES_MM2[5].sqrt()
-}
-
-/// The sampled (wide) part of the profile at squared distance `r2` (mm^2), f64.
-pub fn wide_profile(r2_mm2: f64) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (v, w) in SIX_GAUSSIAN_VARIANCES_MM2
-        .iter()
-        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
-        .skip(NARROW_GAUSSIANS)
-    {
-        let v = *v as f64;
-        let g = (-r2_mm2 / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v);
-        for c in 0..3 {
-            out[c] += w[c] as f64 * g;
-        }
-    }
-    out
-}
-
-/// Weight of the analytic (narrow) part per channel.
-pub fn narrow_weight() -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for w in SIX_GAUSSIAN_WEIGHTS_RGB.iter().take(NARROW_GAUSSIANS) {
-        for c in 0..3 {
-            out[c] += w[c] as f64;
-        }
-    }
-    out
 }
 
 /// How many samples [`sample_surface`] makes (in f64: a corrupt mesh can ask
@@ -223,6 +195,7 @@ pub fn build_grid(samples: &mut Vec<SurfaceSample>, cell: f32) -> Grid {
 mod tests {
     use super::*;
     use crate::scene::mesh::Vertex;
+    use crate::skin::profile::SIX_GAUSSIAN_WEIGHTS_RGB;
 
     fn quad(size: f32) -> Mesh {
         let v = |x: f32, y: f32| Vertex {
@@ -248,6 +221,35 @@ mod tests {
         assert!(s
             .iter()
             .all(|x| (0.0..=2.0).contains(&x.pos_area[0]) && (0.0..=2.0).contains(&x.pos_area[1])));
+    }
+
+    /// The sampled (wide) part of the profile at squared distance `r2` (mm^2), f64
+    /// (what the gather weighs a sample with, written out for the test below).
+    pub fn wide_profile(r2_mm2: f64) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for (v, w) in SIX_GAUSSIAN_VARIANCES_MM2
+            .iter()
+            .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+            .skip(NARROW_GAUSSIANS)
+        {
+            let v = *v as f64;
+            let g = (-r2_mm2 / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v);
+            for c in 0..3 {
+                out[c] += w[c] as f64 * g;
+            }
+        }
+        out
+    }
+
+    /// Weight of the analytic (narrow) part per channel.
+    pub fn narrow_weight() -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for w in SIX_GAUSSIAN_WEIGHTS_RGB.iter().take(NARROW_GAUSSIANS) {
+            for c in 0..3 {
+                out[c] += w[c] as f64;
+            }
+        }
+        out
     }
 
     #[test]
