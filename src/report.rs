@@ -13,6 +13,16 @@ pub struct Stats {
     pub p95: f64,
 }
 
+/// The median of sorted, non-empty `v` (the mean of the middle two when even).
+pub fn median_of_sorted(v: &[f64]) -> f64 {
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
 impl Stats {
     /// Nearest-rank statistics; `None` for an empty set.
     pub fn of(values: &[f64]) -> Option<Stats> {
@@ -22,11 +32,7 @@ impl Stats {
         let mut v = values.to_vec();
         v.sort_by(|a, b| a.total_cmp(b));
         let n = v.len();
-        let median = if n % 2 == 1 {
-            v[n / 2]
-        } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
-        };
+        let median = median_of_sorted(&v);
         let rank = ((0.95 * n as f64).ceil() as usize).clamp(1, n);
         Some(Stats {
             median,

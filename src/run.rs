@@ -364,11 +364,16 @@ pub fn bench_run(
 
 /// Writes a report as pretty JSON, creating its folder.
 pub fn write_report(path: &Path, report: &Report) -> Result<()> {
+    write_json(path, report)
+}
+
+/// `value` as pretty JSON at `path`, its folder made first.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;
     }
-    std::fs::write(path, serde_json::to_string_pretty(report)?)
+    std::fs::write(path, serde_json::to_string_pretty(value)?)
         .with_context(|| format!("writing {}", path.display()))
 }
 

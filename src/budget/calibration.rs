@@ -310,11 +310,7 @@ pub fn summarize(set: &str, errors: &[f64]) -> Summary {
             ..Summary::default()
         };
     }
-    let median = if n % 2 == 1 {
-        e[n / 2]
-    } else {
-        0.5 * (e[n / 2 - 1] + e[n / 2])
-    };
+    let median = crate::report::median_of_sorted(&e);
     Summary {
         set: set.into(),
         points: n,

@@ -102,13 +102,6 @@ impl ParamSet {
         }
     }
 
-    pub fn get_mut(&mut self, rates: RateSource) -> &mut ModelParams {
-        match rates {
-            RateSource::Peak => &mut self.peak,
-            RateSource::Probed => &mut self.probed,
-        }
-    }
-
     /// The parameters fitted on every calibration point (`calibration::fit_all`;
     /// docs/budget-calibration.md lists them and the held-out errors);
     /// `calibration`'s tests check they are what the fit gives.

@@ -6,7 +6,7 @@
 //! chart (`budget.png`, `budget.svg`). Counts (samples passed, fetches) do not
 //! depend on the device's speed, so lavapipe prices a frame as well as a GPU.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context as _, Result};
 use serde::Serialize;
@@ -24,6 +24,7 @@ use crate::graph::work::{Filter, Work};
 use crate::method::METHODS;
 use crate::render::counting::PassCounts;
 use crate::render::{RenderSettings, Renderer};
+use crate::run::write_json;
 use crate::run::{prepare_out_dir, run, RunOptions};
 use crate::scene::Scene;
 use crate::vk::context::{Context, ContextDesc};
@@ -310,13 +311,4 @@ pub fn panels(r: &BudgetReport) -> Vec<Panel> {
                 .collect(),
         })
         .collect()
-}
-
-fn write_json<T: Serialize>(path: &Path, v: &T) -> Result<()> {
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent)
-            .with_context(|| format!("creating {}", parent.display()))?;
-    }
-    std::fs::write(path, serde_json::to_string_pretty(v)?)
-        .with_context(|| format!("writing {}", path.display()))
 }

@@ -75,16 +75,17 @@ pub fn price_units(prof: &Profile, frame: &FrameInput) -> Vec<PassUnits> {
         mem_rate: prof.memory.bandwidth_gbps.value(),
         last_write: HashMap::new(),
     };
+    // Which passes need several screen tiles (set by `pass_units`, fixed here).
+    let tiled: Vec<bool> = out
+        .iter()
+        .map(|u| u.edram.as_ref().is_some_and(|x| x.screen_tiles > 1))
+        .collect();
     let mut prev_draw: Option<usize> = None;
     for (j, p) in frame.passes.iter().enumerate() {
         for iu in p.images.iter().filter(|iu| reads_as_texture(iu.kind)) {
             t.resolve(iu, j, &p.name, &mut out);
         }
         if is_draw(p) {
-            let tiled: Vec<bool> = out
-                .iter()
-                .map(|u| u.edram.as_ref().is_some_and(|x| x.screen_tiles > 1))
-                .collect();
             for iu in p.images.iter().filter(|iu| loads(iu.kind)) {
                 let resident = prev_draw.is_some_and(|k| {
                     !tiled[k]

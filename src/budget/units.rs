@@ -71,10 +71,10 @@ pub struct UnitTimes {
 }
 
 impl UnitTimes {
-    /// The combining rule (module docs).
+    /// The combining rule (module docs), over the scaled terms.
     pub fn combine(&self, p: &ModelParams) -> f64 {
-        let (shading, _) = self.shading(p);
-        self.overhead(p) + shading + self.resolve + self.restore
+        let s = self.scaled(p);
+        s.overhead() + s.shading().0 + s.resolve + s.restore
     }
 
     /// Each term as it enters the sum (parameters applied).
@@ -96,22 +96,23 @@ impl UnitTimes {
         }
     }
 
-    fn overhead(&self, p: &ModelParams) -> f64 {
-        p.fixed_kpix_per_pass * self.fixed_unit
-            + p.rect_kpix * self.fixed_unit * self.copy_rects
-            + p.fill_scale * self.clear
-            + p.reject_scale * self.reject
-            + p.hiz_reject_scale * self.reject_hiz
+    /// The per-pass costs that add to the shading (on scaled terms).
+    fn overhead(&self) -> f64 {
+        self.fixed_unit
+            + self.copy_rects
+            + self.clear
+            + self.reject
+            + self.reject_hiz
             + self.geometry
     }
 
-    fn shading(&self, p: &ModelParams) -> (f64, Bound) {
-        let tex = p.texture_scale * (self.texture + p.incoherent_factor * self.texture_incoherent);
+    /// The busiest shading unit and its time (on scaled terms).
+    fn shading(&self) -> (f64, Bound) {
         let units = [
-            (tex, Bound::Texture),
-            (p.alu_scale * self.alu, Bound::Alu),
-            (p.fill_scale * self.fill, Bound::Fill),
-            (p.memory_scale * self.memory, Bound::Memory),
+            (self.texture + self.texture_incoherent, Bound::Texture),
+            (self.alu, Bound::Alu),
+            (self.fill, Bound::Fill),
+            (self.memory, Bound::Memory),
         ];
         units
             .into_iter()
@@ -120,9 +121,10 @@ impl UnitTimes {
 
     /// The largest of shading, overhead and eDRAM transfers.
     pub fn bound(&self, p: &ModelParams) -> Bound {
-        let (shading, b) = self.shading(p);
-        let overhead = self.overhead(p);
-        let resolve = self.resolve + self.restore;
+        let s = self.scaled(p);
+        let (shading, b) = s.shading();
+        let overhead = s.overhead();
+        let resolve = s.resolve + s.restore;
         if resolve > shading && resolve >= overhead {
             Bound::Resolve
         } else if overhead > shading {
