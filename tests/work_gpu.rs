@@ -8,21 +8,12 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use dermis::graph::work::{Filter, Work};
+use dermis::graph::work::Work;
 use dermis::method::METHODS;
-use dermis::render::counting::site;
+use dermis::render::counting::{filter_kind, site};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::vk::shader::reflect;
-
-fn kind(f: Filter) -> u32 {
-    match f {
-        Filter::Point => 0,
-        Filter::Bilinear => 1,
-        Filter::DepthCompare => 2,
-        Filter::Trilinear => 3,
-    }
-}
 
 #[test]
 fn declared_fetches_are_what_the_shaders_fetch() {
@@ -86,7 +77,7 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                             )
                         });
                     let e = declared
-                        .entry(site(b.set, b.binding, kind(f.filter)))
+                        .entry(site(b.set, b.binding, filter_kind(f.filter)))
                         .or_insert((0.0, true));
                     e.0 += f.count;
                     e.1 &= f.exact;

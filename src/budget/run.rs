@@ -20,9 +20,9 @@ use crate::budget::record::{
     frame_from_record, CountedPass, PassRecord, RunRecord, FRAGMENTS_RULE,
 };
 use crate::budget::table::budget_table;
-use crate::graph::work::{Filter, Work};
+use crate::graph::work::Work;
 use crate::method::METHODS;
-use crate::render::counting::PassCounts;
+use crate::render::counting::{decode_site, PassCounts};
 use crate::render::{RenderSettings, Renderer};
 use crate::run::write_json;
 use crate::run::{prepare_out_dir, run, RunOptions};
@@ -110,14 +110,7 @@ fn counted_pass(p: &PassRecord, c: &PassCounts) -> Result<CountedPass> {
     let refl = reflect(&[&shader.shader])
         .with_context(|| format!("reflecting {} of pass `{}`", shader.shader, p.name))?;
     for &(site, n) in &c.fetches {
-        let k = site - 1;
-        let (set, binding) = ((k / 4) / 16, (k / 4) % 16);
-        let filter = match k % 4 {
-            0 => Filter::Point,
-            1 => Filter::Bilinear,
-            2 => Filter::DepthCompare,
-            _ => Filter::Trilinear,
-        };
+        let (set, binding, filter) = decode_site(site);
         let name = refl
             .bindings
             .iter()

@@ -7,7 +7,7 @@ use anyhow::{bail, Context as _, Result};
 use ash::vk;
 
 use super::Renderer;
-use crate::graph::work::{PassRole, Work};
+use crate::graph::work::{Filter, PassRole, Work};
 use crate::graph::{Pass, PassContext};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::FETCH_COUNTERS;
@@ -22,10 +22,32 @@ pub struct PassCounts {
     pub fetches: Vec<(u32, u64)>,
 }
 
-/// The counter site of a fetch of binding (`set`, `binding`) of `kind` (the
-/// index of `graph::work::Filter`'s variant).
+/// The counter site of a fetch of binding (`set`, `binding`) of `kind` (see
+/// [`filter_kind`]; shaders/fetch_count.glsl's SITE).
 pub fn site(set: u32, binding: u32, kind: u32) -> u32 {
     1 + (set * 16 + binding) * 4 + kind
+}
+
+/// The kind number of a filter in the shaders' counter sites.
+pub fn filter_kind(f: Filter) -> u32 {
+    match f {
+        Filter::Point => 0,
+        Filter::Bilinear => 1,
+        Filter::DepthCompare => 2,
+        Filter::Trilinear => 3,
+    }
+}
+
+/// The binding (`set`, `binding`) and filter of a counter site: [`site`]'s inverse.
+pub fn decode_site(site: u32) -> (u32, u32, Filter) {
+    let k = site - 1;
+    let filter = match k % 4 {
+        0 => Filter::Point,
+        1 => Filter::Bilinear,
+        2 => Filter::DepthCompare,
+        _ => Filter::Trilinear,
+    };
+    ((k / 4) / 16, (k / 4) % 16, filter)
 }
 
 impl Renderer<'_> {
