@@ -33,6 +33,10 @@ configs=(
   "separable screen region|--method separable --sss-region screen"
   "separable 3 heads|--method separable --heads 3 ${GRID:-}"
   "reference|--method reference --density 8"
+  "tsd 512|--method tsd --irradiance-size 512"
+  "tsd-opt 512|--method tsd-opt --irradiance-size 512"
+  "tsd-opt 512 alpha noprepass|--method tsd-opt --irradiance-size 512 --cull alpha --no-z-prepass"
+  "tsd-opt 3 heads|--method tsd-opt --irradiance-size 512 --heads 3 ${GRID:-}"
 )
 : > "$out"
 for scene in procedural head; do
@@ -54,4 +58,26 @@ for p in r["passes"]:
 PY
     echo "done: $scene $name" >&2
   done
+  # Budget figures: every method priced on two targets. Measured times (the only thing
+  # allowed to move) are dropped; every modelled figure, count and resolve is kept.
+  d=$tmp/budget
+  rm -rf "$d"
+  "$B" budget --device llvmpipe --validate --width 256 --height 144 "${sargs[@]}" \
+    --profile xbox360,nvidia-h200 --compare-methods --warmup 0 --frames 1 --out "$d" >/dev/null
+  python3 - "$d" "$scene" >> "$out" <<'PY'
+import json, sys, pathlib, hashlib
+TIME = ("measured", "command", "device", "driver", "provenance")
+def strip(v):
+    if isinstance(v, dict):
+        return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}
+    if isinstance(v, list):
+        return [strip(x) for x in v]
+    return v
+d = pathlib.Path(sys.argv[1])
+for f in [d / "budget.json"] + sorted((d / "frames").glob("*.json")):
+    j = strip(json.load(open(f)))
+    h = hashlib.sha256(json.dumps(j, sort_keys=True).encode()).hexdigest()[:16]
+    print(f"{sys.argv[2]} | budget | {f.name} | {h}")
+PY
+  echo "done: $scene budget" >&2
 done
