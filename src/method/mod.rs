@@ -30,6 +30,7 @@ use crate::graph::{ImageId, Pass, Resources};
 use crate::scene::camera::Camera;
 use crate::scene::Scene;
 use crate::vk::context::Context;
+use crate::vk::guard::Destroy;
 use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
 pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
@@ -181,6 +182,14 @@ pub trait SssMethod {
     fn destroy(&mut self, ctx: &Context);
     /// For tests that inspect one method's state.
     fn as_any(&self) -> &dyn Any;
+}
+
+/// A method is freed like any other Vulkan owner (a set-up `Guard` holds the
+/// renderer's box until the renderer does).
+impl Destroy for dyn SssMethod {
+    fn destroy(&mut self, ctx: &Context) {
+        SssMethod::destroy(self, ctx)
+    }
 }
 
 /// One quality setting `eval` sweeps: a label and the options it sets.

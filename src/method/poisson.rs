@@ -26,6 +26,7 @@ use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::poisson::{poisson_disk_32, PoissonParams};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
@@ -101,35 +102,26 @@ impl Poisson {
         let format = s.res.format(t.diffuse);
         let mut mip = GraphicsDesc::fullscreen("poisson mip", MIP_SHADER, format);
         mip.color_formats = vec![format, s.res.format(t.linear_depth), s.res.format(normals)];
-        let mut mip_pipeline = Pipeline::graphics(s.ctx, &mip)?;
+        // Guarded until the method holds them: an error frees what exists.
+        let mip_pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &mip)?);
         let mut d = GraphicsDesc::fullscreen("poisson", SHADER, format);
         d.depth_format = Some(s.depth_stencil_format);
         d.stencil_format = Some(s.depth_stencil_format);
         d.stencil = Some(skin_stencil_test());
-        let mut pipeline = match Pipeline::graphics(s.ctx, &d) {
-            Ok(p) => p,
-            Err(e) => {
-                mip_pipeline.destroy(s.ctx);
-                return Err(e);
-            }
-        };
+        let pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &d)?);
         let disk: Vec<[f32; 4]> = poisson_disk_32()
             .iter()
             .map(|p| [p[0], p[1], 0.0, 0.0])
             .collect();
-        let disk_buffer = match Buffer::with_data(
+        let disk_buffer = Guard::new(
             s.ctx,
-            "poisson disk",
-            bytemuck::cast_slice(&disk),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        ) {
-            Ok(b) => b,
-            Err(e) => {
-                mip_pipeline.destroy(s.ctx);
-                pipeline.destroy(s.ctx);
-                return Err(e);
-            }
-        };
+            Buffer::with_data(
+                s.ctx,
+                "poisson disk",
+                bytemuck::cast_slice(&disk),
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?,
+        );
         let p = PoissonParams::from_profile();
         let push = PoissonPush {
             size: [s.view.extent.width as f32, s.view.extent.height as f32],
@@ -142,11 +134,11 @@ impl Poisson {
             max_level: levels as i32 - 1,
         };
         Ok(Poisson {
-            mip_pipeline,
-            pipeline,
+            mip_pipeline: mip_pipeline.keep(),
+            pipeline: pipeline.keep(),
             mip_sets: Vec::new(),
             set: vk::DescriptorSet::null(),
-            disk_buffer,
+            disk_buffer: disk_buffer.keep(),
             out,
             push,
             params: p,

@@ -40,6 +40,7 @@ use crate::reference::sampling::{
 use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::{Context, DeviceFacts};
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
@@ -229,7 +230,7 @@ struct Chunk {
     gather_set: vk::DescriptorSet,
 }
 
-impl Chunk {
+impl Destroy for Chunk {
     fn destroy(&mut self, ctx: &Context) {
         self.samples.destroy(ctx);
         self.positions.destroy(ctx);
@@ -252,6 +253,12 @@ struct Surface {
     /// The largest narrow window radius (subsamples) any skin pixel uses.
     max_radius: u32,
     mm_per_subsample_per_depth: f32,
+}
+
+impl Destroy for Reference {
+    fn destroy(&mut self, ctx: &Context) {
+        SssMethod::destroy(self, ctx)
+    }
 }
 
 #[derive(Default)]
@@ -293,22 +300,19 @@ impl Reference {
     }
 
     fn new(s: &mut MethodSetup) -> Result<Self> {
-        let mut r = Reference {
+        let r = Reference {
             density: density(&s.options)?,
             instances: s.instances.to_vec(),
             ..Default::default()
         };
-        match r.build(s) {
-            Ok(()) => Ok(r),
-            Err(e) => {
-                r.destroy(s.ctx);
-                Err(e)
-            }
-        }
+        // Filled in by `build`: on an error, the guard frees what exists.
+        let mut r = Guard::new(s.ctx, r);
+        r.build(s)?;
+        Ok(r.keep())
     }
 
     /// Samples, grid, buffers, pipelines and images, step by step (on an error,
-    /// `destroy` frees whatever exists).
+    /// `new`'s guard frees whatever exists).
     // Long because the set-up is one sequence of checks and creations over
     // shared state (the samples, the grid, the device limits).
     fn build(&mut self, s: &mut MethodSetup) -> Result<()> {
@@ -417,11 +421,13 @@ impl Reference {
                 }
             };
             let range = &surface[first as usize..(first + n) as usize];
-            let mut c = Chunk {
+            let c = Chunk {
                 first,
                 count: n,
                 ..Default::default()
             };
+            // Until the method holds it, an error frees the chunk's buffers.
+            let mut c = Guard::new(s.ctx, c);
             let pos: Vec<[f32; 4]> = range.iter().map(|s| s.pos_area).collect();
             let nrm: Vec<[f32; 4]> = range.iter().map(|s| s.normal).collect();
             let uploads: [(&str, &[u8], AccessKind); 3] = [
@@ -442,14 +448,7 @@ impl Reference {
                 ),
             ];
             for (i, (what, bytes, first_use)) in uploads.into_iter().enumerate() {
-                let b = device_buffer(s.ctx, &name(what), bytes, storage, first_use);
-                let b = match b {
-                    Ok(b) => b,
-                    Err(e) => {
-                        c.destroy(s.ctx);
-                        return Err(e);
-                    }
-                };
+                let b = device_buffer(s.ctx, &name(what), bytes, storage, first_use)?;
                 let id = s.res.add_buffer(&name(what), b.raw);
                 s.res.set_buffer_uploaded(id, first_use);
                 c.buffer_ids.push(id);
@@ -467,7 +466,7 @@ impl Reference {
                 },
                 vk::Format::R32G32B32A32_SFLOAT,
             ));
-            self.chunks.push(c);
+            self.chunks.push(c.keep());
         }
         self.out = s.res.declare(ImageDesc::new(
             "reference",

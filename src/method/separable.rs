@@ -20,6 +20,7 @@ use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 
@@ -173,22 +174,19 @@ impl Separable {
         desc.depth_format = Some(s.depth_stencil_format);
         desc.stencil_format = Some(s.depth_stencil_format);
         desc.stencil = Some(skin_stencil_test());
-        let pipeline = Pipeline::graphics(s.ctx, &desc)?;
+        // Guarded until the method holds them: an error frees what exists.
+        let pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &desc)?);
         let mut data = kernel.gpu_data();
         data.resize(SeparableKernel::MAX_SAMPLES, [0.0; 4]);
-        let kernel_buffer = match Buffer::with_data(
+        let kernel_buffer = Guard::new(
             s.ctx,
-            "sss kernel",
-            bytemuck::cast_slice(&data),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        ) {
-            Ok(b) => b,
-            Err(e) => {
-                let mut p = pipeline;
-                p.destroy(s.ctx);
-                return Err(e);
-            }
-        };
+            Buffer::with_data(
+                s.ctx,
+                "sss kernel",
+                bytemuck::cast_slice(&data),
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?,
+        );
         let tol = config.params.width_mm;
         let push = |dir: [f32; 2]| SssPush {
             dir,
@@ -201,11 +199,11 @@ impl Separable {
             follow_surface: (config.follow_surface && tol > 0.0) as i32,
         };
         Ok(Separable {
-            pipeline,
+            pipeline: pipeline.keep(),
             push: [push([1.0, 0.0]), push([0.0, 1.0])],
             kernel,
             config,
-            kernel_buffer,
+            kernel_buffer: kernel_buffer.keep(),
             tmp,
             diffuse,
             sets: [vk::DescriptorSet::null(); 2],

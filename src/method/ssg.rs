@@ -26,6 +26,7 @@ use crate::graph::{ImageId, Pass, PassContext};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::pipeline::{Blend, GraphicsDesc, Pipeline};
 
 /// Taps per 1D Gaussian (Listing 4.1).
@@ -186,16 +187,15 @@ impl Ssg {
             }
             d
         };
-        let mut horizontal =
-            Pipeline::graphics(s.ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?;
-        let vertical =
-            match Pipeline::graphics(s.ctx, &desc("ssg vertical", "ssg_vertical.frag", 2)) {
-                Ok(p) => p,
-                Err(e) => {
-                    horizontal.destroy(s.ctx);
-                    return Err(e);
-                }
-            };
+        // Guarded until the method holds them: an error frees what exists.
+        let horizontal = Guard::new(
+            s.ctx,
+            Pipeline::graphics(s.ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?,
+        );
+        let vertical = Guard::new(
+            s.ctx,
+            Pipeline::graphics(s.ctx, &desc("ssg vertical", "ssg_vertical.frag", 2))?,
+        );
         let stretch = Stretch::for_view(
             s.view.extent.height,
             s.view.camera.fovy_rad,
@@ -217,8 +217,8 @@ impl Ssg {
             })
             .collect();
         Ok(Ssg {
-            horizontal,
-            vertical,
+            horizontal: horizontal.keep(),
+            vertical: vertical.keep(),
             set_rt1: vk::DescriptorSet::null(),
             set_rt2: vk::DescriptorSet::null(),
             rt1,

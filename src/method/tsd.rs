@@ -61,6 +61,7 @@ use crate::skin::tsd_ref::{
 };
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
@@ -371,6 +372,20 @@ impl Pipelines {
     }
 }
 
+impl Destroy for Pipelines {
+    fn destroy(&mut self, ctx: &Context) {
+        for p in self.all() {
+            p.destroy(ctx);
+        }
+    }
+}
+
+impl Destroy for Tsd {
+    fn destroy(&mut self, ctx: &Context) {
+        SssMethod::destroy(self, ctx)
+    }
+}
+
 /// Descriptor sets shared by every character.
 #[derive(Clone, Copy, Default)]
 struct SharedSets {
@@ -445,7 +460,7 @@ impl Tsd {
                 f.device_local_bytes as f64 / 1e9
             );
         }
-        let mut t = Tsd {
+        let t = Tsd {
             config,
             optimised,
             characters: Vec::new(),
@@ -468,13 +483,10 @@ impl Tsd {
             updating: RefCell::new(vec![true; s.instances.len()]),
             has_map: RefCell::new(vec![false; s.instances.len()]),
         };
-        match t.build(s) {
-            Ok(()) => Ok(t),
-            Err(e) => {
-                t.destroy(s.ctx);
-                Err(e)
-            }
-        }
+        // Filled in by `build`: on an error, the guard frees what exists.
+        let mut t = Guard::new(s.ctx, t);
+        t.build(s)?;
+        Ok(t.keep())
     }
 
     /// Places the characters, uploads the mesh and uniforms, makes the pipelines.
@@ -1141,16 +1153,10 @@ fn make_pipelines(
     mask_format: vk::Format,
     diffuse_format: vk::Format,
 ) -> Result<Pipelines> {
-    let mut p = Pipelines::default();
-    match fill_pipelines(&mut p, ctx, cfg, mask_format, diffuse_format) {
-        Ok(()) => Ok(p),
-        Err(e) => {
-            for q in p.all() {
-                q.destroy(ctx);
-            }
-            Err(e)
-        }
-    }
+    // On an error, the guard frees the pipelines made so far.
+    let mut p = Guard::<Pipelines>::null(ctx);
+    fill_pipelines(&mut p, ctx, cfg, mask_format, diffuse_format)?;
+    Ok(p.keep())
 }
 
 fn uv_desc(name: &str, frag: Option<&'static str>, colors: Vec<vk::Format>) -> GraphicsDesc {
@@ -1411,9 +1417,7 @@ impl SssMethod for Tsd {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        for p in self.pipelines.all() {
-            p.destroy(ctx);
-        }
+        self.pipelines.destroy(ctx);
         self.pool.destroy(ctx);
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);

@@ -13,6 +13,7 @@ use crate::graph::work::{PassRole, Work};
 use crate::graph::{ImageId, Pass, PassContext};
 use crate::method::{FrameTargets, STENCIL_SKIN};
 use crate::vk::barrier::AccessKind;
+use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 
 /// How the uploads write the targets (whole contents).
@@ -188,26 +189,20 @@ impl Renderer<'_> {
     }
 
     fn upload(&mut self, uploads: Vec<Upload>, extent: vk::Extent2D) -> Result<()> {
-        let mut staging = Vec::new();
+        // Freed when this returns: after the upload's fence (`submit_untimed`
+        // waits on it), or at once on an error.
+        let mut staging = Guard::new(self.ctx, Vec::new());
         for (id, bytes, _) in &uploads {
-            match Buffer::with_data(
+            staging.push(Buffer::with_data(
                 self.ctx,
                 &format!("{} upload", self.resources.name(*id)),
                 bytes,
                 vk::BufferUsageFlags::TRANSFER_SRC,
-            ) {
-                Ok(b) => staging.push(b),
-                Err(e) => {
-                    for mut b in staging {
-                        b.destroy(self.ctx);
-                    }
-                    return Err(e);
-                }
-            }
+            )?);
         }
         let passes: Vec<Pass> = uploads
             .into_iter()
-            .zip(&staging)
+            .zip(staging.iter())
             .map(|((id, bytes, aspects), b)| {
                 upload_pass(
                     &format!("upload {}", self.resources.name(id)),
@@ -219,11 +214,6 @@ impl Renderer<'_> {
                 )
             })
             .collect();
-        let result = self.submit_untimed(&passes, "while uploading test inputs");
-        drop(passes);
-        for mut b in staging {
-            b.destroy(self.ctx);
-        }
-        result
+        self.submit_untimed(&passes, "while uploading test inputs")
     }
 }

@@ -22,6 +22,7 @@ use crate::scene::framing::{frame as frame_scene, Shot};
 use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
 use frame::{skin_material_binds, Frame};
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
@@ -54,61 +55,61 @@ struct Submit {
     fence: vk::Fence,
 }
 
+impl Submit {
+    fn new(ctx: &Context, slots: u32) -> Result<Self> {
+        // Each is guarded until the submit holds them all.
+        let profiler = Guard::new(ctx, Profiler::new(ctx, slots)?);
+        let cmd = ctx.create("frame commands", |d| unsafe {
+            d.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(ctx.command_pool)
+                    .command_buffer_count(1),
+            )
+        })?[0];
+        let cmd = Guard::new(ctx, cmd);
+        ctx.name(*cmd, "frame commands");
+        let fence = ctx.create("frame fence", |d| unsafe {
+            d.create_fence(&vk::FenceCreateInfo::default(), None)
+        })?;
+        ctx.name(fence, "frame fence");
+        Ok(Submit {
+            profiler: profiler.keep(),
+            cmd: cmd.keep(),
+            fence,
+        })
+    }
+}
+
+impl Destroy for Submit {
+    fn destroy(&mut self, ctx: &Context) {
+        self.fence.destroy(ctx);
+        self.cmd.destroy(ctx);
+        Destroy::destroy(&mut self.profiler, ctx);
+    }
+}
+
+impl Destroy for Frame {
+    fn destroy(&mut self, ctx: &Context) {
+        Frame::destroy(self, ctx)
+    }
+}
+
+impl Destroy for Resources {
+    fn destroy(&mut self, ctx: &Context) {
+        Resources::destroy(self, ctx)
+    }
+}
+
+/// The renderer's parts. Set-up guards each as it is made (a failed step
+/// frees, newest first, what exists: every set-up submission has waited on
+/// its fence by then); the renderer's drop frees them in the same order
+/// after the device is idle.
 pub struct Renderer<'c> {
     pub ctx: &'c Context,
     pub frame: Frame,
     pub method: Box<dyn SssMethod>,
     pub resources: Resources,
     submit: Submit,
-}
-
-/// What set-up has created so far: destroyed in reverse on an error, so a
-/// failed set-up leaves nothing behind on the device.
-struct Partial<'c> {
-    ctx: &'c Context,
-    resources: Resources,
-    frame: Option<Frame>,
-    method: Option<Box<dyn SssMethod>>,
-    submit: Option<Submit>,
-}
-
-impl Drop for Partial<'_> {
-    fn drop(&mut self) {
-        destroy_all(
-            self.ctx,
-            &mut self.resources,
-            self.frame.as_mut(),
-            self.method.as_mut(),
-            self.submit.as_ref(),
-        );
-    }
-}
-
-/// Destroys everything a renderer holds, after the device is idle.
-fn destroy_all(
-    ctx: &Context,
-    resources: &mut Resources,
-    frame: Option<&mut Frame>,
-    method: Option<&mut Box<dyn SssMethod>>,
-    submit: Option<&Submit>,
-) {
-    unsafe {
-        let _ = ctx.device.device_wait_idle();
-    }
-    if let Some(s) = submit {
-        unsafe {
-            ctx.device.destroy_fence(s.fence, None);
-            ctx.device.free_command_buffers(ctx.command_pool, &[s.cmd]);
-        }
-        s.profiler.destroy(ctx);
-    }
-    if let Some(m) = method {
-        m.destroy(ctx);
-    }
-    if let Some(f) = frame {
-        f.destroy(ctx);
-    }
-    resources.destroy(ctx);
 }
 
 /// Refuses a frame whose images (and the readback of its output) would take
@@ -157,15 +158,9 @@ impl<'c> Renderer<'c> {
         let entry = settings.method;
         let opts = entry.opts(&settings.options);
         let needs = (entry.needs)(&opts, extent);
-        let mut p = Partial {
-            ctx,
-            resources: Resources::default(),
-            frame: None,
-            method: None,
-            submit: None,
-        };
         // 1. Declare the frame's and the method's images.
-        let targets = targets::declare(ctx, &mut p.resources, extent, settings.shadow_size, needs)?;
+        let mut resources = Guard::<Resources>::null(ctx);
+        let targets = targets::declare(ctx, &mut resources, extent, settings.shadow_size, needs)?;
         let framing = frame_scene(
             scene,
             &Shot {
@@ -177,19 +172,22 @@ impl<'c> Renderer<'c> {
                 light_dir: settings.light.direction_to_light(scene.forward),
             },
         );
-        let frame = p.frame.insert(Frame::new(
+        let mut frame = Guard::new(
             ctx,
-            scene,
-            settings,
-            targets,
-            framing,
-            &p.resources,
-            needs.geometry_transmittance,
-        )?);
-        let depth_stencil_format = p.resources.format(frame.targets.depth_stencil);
+            Frame::new(
+                ctx,
+                scene,
+                settings,
+                targets,
+                framing,
+                &resources,
+                needs.geometry_transmittance,
+            )?,
+        );
+        let depth_stencil_format = resources.format(frame.targets.depth_stencil);
         let method = (entry.build)(&mut MethodSetup {
             ctx,
-            res: &mut p.resources,
+            res: &mut resources,
             targets: &frame.targets,
             samplers: &frame.samplers,
             options: opts,
@@ -199,12 +197,12 @@ impl<'c> Renderer<'c> {
             instances: &frame.instances,
         })
         .with_context(|| format!("setting up {}", entry.name))?;
-        let method = p.method.insert(method);
-        let region = frame.region_for(scene, method.as_ref());
+        let mut method = Guard::new(ctx, method);
+        let region = frame.region_for(scene, &**method);
         frame.set_region(region);
         // 2. Every image's usage from the passes that touch it: the frame's, and
         //    the uploads and fills the renderer offers (tests, set-up).
-        let passes = frame.passes(method.as_ref(), &p.resources);
+        let passes = frame.passes(&**method, &resources);
         let mut accesses: Vec<(ImageId, AccessKind)> = passes
             .iter()
             .flat_map(|q| q.images.iter().copied())
@@ -218,66 +216,29 @@ impl<'c> Renderer<'c> {
                 .into_iter()
                 .map(|i| (i, inputs::FILL_ACCESS)),
         );
-        p.resources.allow(&accesses);
-        check_memory(ctx, &p.resources, extent)?;
+        resources.allow(&accesses);
+        check_memory(ctx, &resources, extent)?;
         // 3. Create the images and write what reads them.
-        p.resources.create(ctx)?;
-        frame.bind(ctx, &p.resources, method.output())?;
+        resources.create(ctx)?;
+        frame.bind(ctx, &resources, method.output())?;
         method.bind(&MethodBind {
             ctx,
-            res: &p.resources,
+            res: &resources,
             pool: &frame.pool,
             samplers: &frame.samplers,
             targets: &frame.targets,
-            frame_binds: frame.frame_binds(&p.resources),
-            skin_material_binds: skin_material_binds(frame),
+            frame_binds: frame.frame_binds(&resources),
+            skin_material_binds: skin_material_binds(&frame),
         })?;
-        let profiler = Profiler::new(ctx, slots)?;
-        let cmd = match ctx.creation_step("frame commands").and_then(|()| {
-            unsafe {
-                ctx.device.allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(ctx.command_pool)
-                        .command_buffer_count(1),
-                )
-            }
-            .map_err(Into::into)
-        }) {
-            Ok(c) => c[0],
-            Err(e) => {
-                profiler.destroy(ctx);
-                return Err(e);
-            }
-        };
-        ctx.name(cmd, "frame commands");
-        let fence = match ctx.creation_step("frame fence").and_then(|()| {
-            unsafe {
-                ctx.device
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-            }
-            .map_err(Into::into)
-        }) {
-            Ok(f) => f,
-            Err(e) => {
-                profiler.destroy(ctx);
-                unsafe { ctx.device.free_command_buffers(ctx.command_pool, &[cmd]) };
-                return Err(e);
-            }
-        };
-        ctx.name(fence, "frame fence");
-        p.submit = Some(Submit {
-            profiler,
-            cmd,
-            fence,
-        });
+        let submit = Submit::new(ctx, slots)?;
+        // Complete: the renderer owns (and frees, in its drop) every part.
         let mut r = Renderer {
             ctx,
-            frame: p.frame.take().expect("set above"),
-            method: p.method.take().expect("set above"),
-            resources: std::mem::take(&mut p.resources),
-            submit: p.submit.take().expect("set above"),
+            frame: frame.keep(),
+            method: method.keep(),
+            resources: resources.keep(),
+            submit,
         };
-        drop(p);
         // Texels of the intermediates outside the region are never written: zero
         // them once so a dump of an intermediate shows black there, not old memory.
         let full = PixelRect::full(extent.width, extent.height);
@@ -432,14 +393,17 @@ impl<'c> Renderer<'c> {
 }
 
 impl Drop for Renderer<'_> {
+    /// Frees every part after the device is idle (the GPU may still run the
+    /// last submission when its wait failed), newest part first.
     fn drop(&mut self) {
-        destroy_all(
-            self.ctx,
-            &mut self.resources,
-            Some(&mut self.frame),
-            Some(&mut self.method),
-            Some(&self.submit),
-        );
+        let ctx = self.ctx;
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+        }
+        self.submit.destroy(ctx);
+        self.method.destroy(ctx);
+        self.frame.destroy(ctx);
+        self.resources.destroy(ctx);
     }
 }
 

@@ -6,6 +6,7 @@ use ash::vk;
 use crate::scene::mesh::{Material, Object, Texture};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
 use crate::vk::upload::{device_buffer, texture};
@@ -74,7 +75,7 @@ pub fn fit_to_device(name: &str, t: &Texture, max: u32) -> Option<Texture> {
 }
 
 impl GpuObject {
-    /// Uploads `object`; on an error, whatever was made is destroyed.
+    /// Uploads `object`; on an error, the guard destroys whatever was made.
     pub fn new(
         ctx: &Context,
         name: &str,
@@ -83,23 +84,21 @@ impl GpuObject {
         geometry: &Pipeline,
         samplers: &Samplers,
     ) -> Result<Self> {
-        let mut g = GpuObject {
-            name: name.to_string(),
-            vertices: Buffer::default(),
-            indices: Buffer::default(),
-            index_count: object.mesh.indices.len() as u32,
-            skin: object.material.skin,
-            textures: Vec::new(),
-            uniforms: Buffer::default(),
-            material_set: vk::DescriptorSet::null(),
-        };
-        match g.upload(ctx, object, pool, geometry, samplers) {
-            Ok(()) => Ok(g),
-            Err(e) => {
-                g.destroy(ctx);
-                Err(e)
-            }
-        }
+        let mut g = Guard::new(
+            ctx,
+            GpuObject {
+                name: name.to_string(),
+                vertices: Buffer::default(),
+                indices: Buffer::default(),
+                index_count: object.mesh.indices.len() as u32,
+                skin: object.material.skin,
+                textures: Vec::new(),
+                uniforms: Buffer::default(),
+                material_set: vk::DescriptorSet::null(),
+            },
+        );
+        g.upload(ctx, object, pool, geometry, samplers)?;
+        Ok(g.keep())
     }
 
     fn upload(
@@ -211,5 +210,11 @@ impl GpuObject {
         for t in &mut self.textures {
             t.destroy(ctx);
         }
+    }
+}
+
+impl Destroy for GpuObject {
+    fn destroy(&mut self, ctx: &Context) {
+        GpuObject::destroy(self, ctx)
     }
 }

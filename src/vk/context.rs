@@ -9,6 +9,10 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use ash::{ext, vk};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
+use super::error::{Error, VkResult};
+use super::guard::{Guard, Undo};
+use super::memory::Buffer;
+
 /// How to choose the physical device.
 #[derive(Clone, Debug, Default)]
 pub enum DeviceChoice {
@@ -126,65 +130,41 @@ unsafe extern "system" fn debug_callback(
 /// 1 + (set * 16 + binding) * 4 + kind counts fetches (shaders/fetch_count.glsl).
 pub const FETCH_COUNTERS: u64 = 1 + 4 * 16 * 4;
 
-/// The host-visible counters of the fetch-counting build (kept here, not as a
-/// `memory::Buffer`, because pipelines reach them through the context).
+/// The host-visible counters of the fetch-counting build (the context holds
+/// them: every counting pipeline binds them). Derefs to the buffer.
 pub struct FetchCounters {
-    pub raw: vk::Buffer,
-    allocation: gpu_allocator::vulkan::Allocation,
+    buffer: Buffer,
 }
 
 impl FetchCounters {
     fn new(ctx: &Context) -> Result<Self> {
-        ctx.creation_step("fetch counters")?;
-        let raw = unsafe {
-            ctx.device.create_buffer(
-                &vk::BufferCreateInfo::default()
-                    .size(FETCH_COUNTERS * 4)
-                    // Zeroed by vkCmdFillBuffer before each counted pass.
-                    .usage(
-                        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                    ),
-                None,
-            )
-        }?;
-        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
-                name: "fetch counters",
-                requirements,
-                location: gpu_allocator::MemoryLocation::GpuToCpu,
-                linear: true,
-                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
-                unsafe { ctx.device.destroy_buffer(raw, None) };
-                return Err(e).context("allocating the fetch counters");
-            }
-        };
-        if let Err(e) = unsafe {
-            ctx.device
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        } {
-            unsafe { ctx.device.destroy_buffer(raw, None) };
-            let _ = ctx.allocator().free(allocation);
-            return Err(e).context("binding the fetch counters' memory");
-        }
-        ctx.name(raw, "fetch counters");
-        Ok(FetchCounters { raw, allocation })
+        let buffer = Buffer::new(
+            ctx,
+            "fetch counters",
+            FETCH_COUNTERS * 4,
+            // Zeroed by vkCmdFillBuffer before each counted pass.
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            gpu_allocator::MemoryLocation::GpuToCpu,
+        )?;
+        Ok(FetchCounters { buffer })
     }
 
     /// The counters (after the fence of the submission that wrote them).
     pub fn read(&self) -> Result<Vec<u32>> {
         let bytes = self
-            .allocation
-            .mapped_slice()
+            .buffer
+            .read()
             .context("the fetch counters are not host visible")?;
         Ok(bytemuck::pod_collect_to_vec(
             &bytes[..(FETCH_COUNTERS * 4) as usize],
         ))
+    }
+}
+
+impl std::ops::Deref for FetchCounters {
+    type Target = Buffer;
+    fn deref(&self) -> &Buffer {
+        &self.buffer
     }
 }
 
@@ -258,25 +238,11 @@ impl Context {
             Err(e) => bail!("creating the Vulkan instance: {e}"),
         };
 
-        let debug_instance = if desc.validate {
-            // A fresh create-info: the one above is chained into the instance's pNext.
-            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(messenger_info.message_severity)
-                .message_type(messenger_info.message_type)
-                .pfn_user_callback(Some(debug_callback))
-                .user_data(user_ptr);
-            let loader = ext::debug_utils::Instance::new(&entry, &instance);
-            let m = unsafe { loader.create_debug_utils_messenger(&info, None) }?;
-            Some((loader, m))
-        } else {
-            None
-        };
-
         let mut ctx = Self::with_instance(
             entry,
             instance,
             desc,
-            debug_instance,
+            (messenger_info.message_severity, messenger_info.message_type),
             messages,
             messages_box,
         )?;
@@ -292,39 +258,50 @@ impl Context {
         Ok(ctx)
     }
 
+    /// The messenger, device, allocator and command pool on `instance`. Until
+    /// the context owns them, each is destroyed on an early return (`Undo`:
+    /// there is no context yet to destroy through), newest first.
     // Long because device creation is one sequence of queries and creation
-    // steps whose early exits must each destroy the instance; split up, that
-    // cleanup would have to travel with every piece.
+    // steps over the same physical device.
     fn with_instance(
         entry: ash::Entry,
         instance: ash::Instance,
         desc: &ContextDesc,
-        debug_instance: Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+        (severity, kinds): (
+            vk::DebugUtilsMessageSeverityFlagsEXT,
+            vk::DebugUtilsMessageTypeFlagsEXT,
+        ),
         messages: MessageLog,
         messages_box: Box<MessageLog>,
     ) -> Result<Self> {
-        let destroy_instance =
-            |instance: &ash::Instance,
-             dbg: &Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>| unsafe {
-                if let Some((l, m)) = dbg {
-                    l.destroy_debug_utils_messenger(*m, None);
-                }
-                instance.destroy_instance(None);
-            };
-        let physical = match pick_physical(&instance, &desc.device) {
-            Ok(p) => p,
-            Err(e) => {
-                destroy_instance(&instance, &debug_instance);
-                return Err(e);
-            }
+        let undo_instance = Undo::new(|| unsafe { instance.destroy_instance(None) });
+        let debug_instance = if desc.validate {
+            // A fresh create-info: the instance's own is chained into its pNext.
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(severity)
+                .message_type(kinds)
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(&*messages_box as *const MessageLog as *mut c_void);
+            let loader = ext::debug_utils::Instance::new(&entry, &instance);
+            let m = unsafe { loader.create_debug_utils_messenger(&info, None) }
+                .map_err(Error::from)
+                .context("creating the validation messenger")?;
+            Some((loader, m))
+        } else {
+            None
         };
+        let undo_messenger = Undo::new(|| {
+            if let Some((l, m)) = &debug_instance {
+                unsafe { l.destroy_debug_utils_messenger(*m, None) };
+            }
+        });
+        let physical = pick_physical(&instance, &desc.device)?;
         let props = unsafe { instance.get_physical_device_properties(physical) };
         let name = props
             .device_name_as_c_str()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         if props.api_version < vk::API_VERSION_1_3 {
-            destroy_instance(&instance, &debug_instance);
             bail!(
                 "device '{name}' supports Vulkan {}.{} but dermis needs 1.3 (synchronization2 and dynamic rendering)",
                 vk::api_version_major(props.api_version),
@@ -351,7 +328,6 @@ impl Context {
             f.queue_flags
                 .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
         }) else {
-            destroy_instance(&instance, &debug_instance);
             bail!("device '{name}' has no graphics+compute queue");
         };
         let queue_family = queue_family as u32;
@@ -380,48 +356,35 @@ impl Context {
             .queue_create_infos(&queue_info)
             .push_next(&mut features2)
             .push_next(&mut f13);
-        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
-            Ok(d) => d,
-            Err(e) => {
-                destroy_instance(&instance, &debug_instance);
-                bail!("creating the logical device on '{name}': {e}");
-            }
-        };
+        let device = unsafe { instance.create_device(physical, &device_info, None) }
+            .map_err(Error::from)
+            .with_context(|| format!("creating the logical device on '{name}'"))?;
+        let undo_device = Undo::new(|| unsafe { device.destroy_device(None) });
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_utils = ext::debug_utils::Device::new(&instance, &device);
 
-        let allocator = match Allocator::new(&AllocatorCreateDesc {
+        // Dropped before the device on an early return (declared after it).
+        let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        }) {
-            Ok(a) => a,
-            Err(e) => {
-                unsafe { device.destroy_device(None) };
-                destroy_instance(&instance, &debug_instance);
-                return Err(e).context("creating the GPU memory allocator");
-            }
-        };
+        })
+        .map_err(Error::from)
+        .context("creating the GPU memory allocator")?;
 
-        let command_pool = match unsafe {
+        let command_pool = unsafe {
             device.create_command_pool(
                 &vk::CommandPoolCreateInfo::default()
                     .queue_family_index(queue_family)
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
                 None,
             )
-        } {
-            Ok(p) => p,
-            Err(e) => {
-                drop(allocator);
-                unsafe { device.destroy_device(None) };
-                destroy_instance(&instance, &debug_instance);
-                return Err(e).context("creating the command pool");
-            }
-        };
+        }
+        .map_err(Error::from)
+        .context("creating the command pool")?;
 
         let device_type = format!("{:?}", props.device_type);
         let facts = DeviceFacts {
@@ -456,6 +419,10 @@ impl Context {
             shader_clip_distance: features.shader_clip_distance == vk::TRUE,
         };
 
+        // Everything is made: the context owns (and tears down) it from here.
+        undo_device.disarm();
+        undo_messenger.disarm();
+        undo_instance.disarm();
         let ctx = Context {
             entry,
             instance,
@@ -570,11 +537,8 @@ impl Context {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
         }
-        if let Some(c) = self.fetch_counts.take() {
-            unsafe { self.device.destroy_buffer(c.raw, None) };
-            if let Some(a) = self.allocator.as_ref() {
-                let _ = a.lock().map(|mut a| a.free(c.allocation));
-            }
+        if let Some(mut c) = self.fetch_counts.take() {
+            c.buffer.destroy(self);
         }
         let mut problems: Vec<String> = Vec::new();
         if let Some(a) = self.allocator.take() {
@@ -622,7 +586,7 @@ impl Context {
     /// Called before every Vulkan object (or group made in one call) is
     /// created after the device opens: counts it, and fails it when the test
     /// hook says so.
-    pub fn creation_step(&self, what: &str) -> Result<()> {
+    pub fn creation_step(&self, what: &str) -> VkResult<()> {
         self.creations.fetch_add(1, Ordering::SeqCst);
         let left = self.fail_countdown.load(Ordering::SeqCst);
         if left == usize::MAX {
@@ -630,10 +594,22 @@ impl Context {
         }
         if left == 0 {
             self.fail_countdown.store(usize::MAX, Ordering::SeqCst);
-            bail!("creating {what}: injected failure (test hook)");
+            return Err(Error::Injected(what.to_string()));
         }
         self.fail_countdown.store(left - 1, Ordering::SeqCst);
         Ok(())
+    }
+
+    /// One creation step at the Vulkan boundary: [`Context::creation_step`],
+    /// then `make` with the device. Returns the typed error; callers add the
+    /// context (which object, for what).
+    pub fn create<T>(
+        &self,
+        what: &str,
+        make: impl FnOnce(&ash::Device) -> std::result::Result<T, vk::Result>,
+    ) -> VkResult<T> {
+        self.creation_step(what)?;
+        Ok(make(&self.device)?)
     }
 
     /// Image format support for the given usage features.
@@ -647,48 +623,49 @@ impl Context {
 
     /// Records and submits one command buffer and waits for it.
     pub fn one_shot(&self, label: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
-        self.creation_step(label)?;
-        let cmd = unsafe {
-            self.device.allocate_command_buffers(
+        let cmd = self.create(label, |d| unsafe {
+            d.allocate_command_buffers(
                 &vk::CommandBufferAllocateInfo::default()
                     .command_pool(self.command_pool)
                     .command_buffer_count(1),
             )
-        }?[0];
-        self.name(cmd, label);
-        if let Err(e) = unsafe {
+        })?[0];
+        // Freed when this returns: after the wait, or at once on an error.
+        let cmd = Guard::new(self, cmd);
+        self.name(*cmd, label);
+        unsafe {
             self.device.begin_command_buffer(
-                cmd,
+                *cmd,
                 &vk::CommandBufferBeginInfo::default()
                     .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
             )
-        } {
-            unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
-            return Err(e).with_context(|| format!("beginning '{label}'"));
         }
-        record(cmd);
-        let result = self.submit_and_wait(cmd);
-        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
-        result.with_context(|| format!("submitting '{label}'"))
+        .map_err(Error::from)
+        .with_context(|| format!("beginning '{label}'"))?;
+        record(*cmd);
+        self.submit_and_wait(*cmd)
+            .with_context(|| format!("submitting '{label}'"))
     }
 
     /// Ends, submits and waits for a recorded command buffer.
     pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
-        unsafe {
-            self.device.end_command_buffer(cmd)?;
-            let fence = self
-                .device
-                .create_fence(&vk::FenceCreateInfo::default(), None)?;
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-            let r = self
-                .device
-                .queue_submit2(self.queue, &submit, fence)
-                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX));
-            self.device.destroy_fence(fence, None);
-            r.context("queue submit / wait (device lost?)")?;
+        unsafe { self.device.end_command_buffer(cmd) }.map_err(Error::from)?;
+        let fence = unsafe {
+            self.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
         }
-        Ok(())
+        .map_err(Error::from)?;
+        // Destroyed when this returns, after the wait (or its failure).
+        let fence = Guard::new(self, fence);
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        unsafe {
+            self.device
+                .queue_submit2(self.queue, &submit, *fence)
+                .and_then(|_| self.device.wait_for_fences(&[*fence], true, u64::MAX))
+        }
+        .map_err(Error::from)
+        .context("queue submit / wait (device lost?)")
     }
 
     pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {

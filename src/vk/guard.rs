@@ -1,14 +1,28 @@
-//! A guard that destroys a Vulkan object (or several) unless set-up keeps it:
-//! a constructor that makes objects step by step wraps each in a `Guard`, and
-//! an early return (`?`) then frees what was made instead of leaking it.
+//! Owning handles for set-up. [`Destroy`] says how a Vulkan object (or a struct
+//! of them) is freed; a [`Guard`] owns one while set-up is still making things:
+//! an early return (`?`) drops the guard, which frees what it holds, and
+//! [`Guard::keep`] hands the finished object to its owner. So a constructor
+//! wraps each object as it is made and needs no cleanup code of its own.
+//!
+//! Freeing at run time stays explicit (`destroy`, after the fence or a
+//! wait-idle: see `render::Renderer`'s drop), because a handle cannot know
+//! when the GPU is done with it. A guard frees at once, which is right during
+//! set-up: every set-up submission waits on its own fence
+//! (`Context::one_shot`), so nothing a failed set-up made is still in use.
+//!
+//! [`Undo`] covers the steps before a `Context` exists (instance, device).
 
 use std::ops::{Deref, DerefMut};
 
+use ash::vk;
+
 use super::context::Context;
 use super::memory::{Buffer, Image};
-use super::pipeline::Pipeline;
+use super::pipeline::{DescriptorPool, Pipeline, Samplers};
+use super::profiler::Profiler;
 
 /// Something that frees its Vulkan objects explicitly (after the GPU is done).
+/// Destroying twice, or destroying the null object (`Default`), does nothing.
 pub trait Destroy {
     fn destroy(&mut self, ctx: &Context);
 }
@@ -31,10 +45,79 @@ impl Destroy for Image {
     }
 }
 
+impl Destroy for DescriptorPool {
+    fn destroy(&mut self, ctx: &Context) {
+        DescriptorPool::destroy(self, ctx)
+    }
+}
+
+impl Destroy for Samplers {
+    fn destroy(&mut self, ctx: &Context) {
+        Samplers::destroy(self, ctx);
+        *self = Samplers::default();
+    }
+}
+
+impl Destroy for Profiler {
+    fn destroy(&mut self, ctx: &Context) {
+        Profiler::destroy(self, ctx);
+        self.timestamps = vk::QueryPool::null();
+        self.stats = None;
+        self.occlusion = vk::QueryPool::null();
+    }
+}
+
 impl<T: Destroy> Destroy for Vec<T> {
     fn destroy(&mut self, ctx: &Context) {
         for t in self.iter_mut() {
             t.destroy(ctx);
+        }
+    }
+}
+
+impl<T: Destroy> Destroy for Option<T> {
+    fn destroy(&mut self, ctx: &Context) {
+        if let Some(mut t) = self.take() {
+            t.destroy(ctx);
+        }
+    }
+}
+
+impl<T: Destroy + ?Sized> Destroy for Box<T> {
+    fn destroy(&mut self, ctx: &Context) {
+        (**self).destroy(ctx)
+    }
+}
+
+/// Raw handles that set-up makes on their own: each destroy takes the handle
+/// and leaves the null one (Vulkan ignores the null handle).
+macro_rules! destroy_raw {
+    ($($ty:ty => $f:ident),* $(,)?) => {$(
+        impl Destroy for $ty {
+            fn destroy(&mut self, ctx: &Context) {
+                unsafe { ctx.device.$f(std::mem::take(self), None) }
+            }
+        }
+    )*};
+}
+
+destroy_raw! {
+    vk::ShaderModule => destroy_shader_module,
+    vk::DescriptorSetLayout => destroy_descriptor_set_layout,
+    vk::PipelineLayout => destroy_pipeline_layout,
+    vk::Pipeline => destroy_pipeline,
+    vk::DescriptorPool => destroy_descriptor_pool,
+    vk::QueryPool => destroy_query_pool,
+    vk::Fence => destroy_fence,
+    vk::Sampler => destroy_sampler,
+}
+
+/// Command buffers come from the context's one pool.
+impl Destroy for vk::CommandBuffer {
+    fn destroy(&mut self, ctx: &Context) {
+        let cmd = std::mem::take(self);
+        if cmd != vk::CommandBuffer::null() {
+            unsafe { ctx.device.free_command_buffers(ctx.command_pool, &[cmd]) };
         }
     }
 }
@@ -61,6 +144,13 @@ impl<'c, T: Destroy> Guard<'c, T> {
     }
 }
 
+impl<'c, T: Destroy + Default> Guard<'c, T> {
+    /// The null object, to fill in field by field.
+    pub fn null(ctx: &'c Context) -> Self {
+        Guard::new(ctx, T::default())
+    }
+}
+
 impl<T: Destroy> Deref for Guard<'_, T> {
     type Target = T;
     fn deref(&self) -> &T {
@@ -83,5 +173,49 @@ impl<T: Destroy> Drop for Guard<'_, T> {
         if let Some(mut v) = self.value.take() {
             v.destroy(self.ctx);
         }
+    }
+}
+
+/// Runs `undo` on drop unless [`Undo::disarm`]ed: for what is made before a
+/// `Context` exists to destroy through (the instance, the device).
+pub struct Undo<F: FnOnce()>(Option<F>);
+
+impl<F: FnOnce()> Undo<F> {
+    pub fn new(undo: F) -> Self {
+        Undo(Some(undo))
+    }
+
+    /// Set-up went through: the owner frees the object from now on.
+    pub fn disarm(mut self) {
+        self.0 = None;
+    }
+}
+
+impl<F: FnOnce()> Drop for Undo<F> {
+    fn drop(&mut self) {
+        if let Some(f) = self.0.take() {
+            f();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn undo_runs_unless_disarmed() {
+        let ran = std::cell::Cell::new(0);
+        drop(Undo::new(|| ran.set(ran.get() + 1)));
+        assert_eq!(ran.get(), 1);
+        Undo::new(|| ran.set(ran.get() + 1)).disarm();
+        assert_eq!(ran.get(), 1);
+        let early = || -> Result<(), ()> {
+            let _u = Undo::new(|| ran.set(ran.get() + 10));
+            Err(())?;
+            Ok(())
+        };
+        assert!(early().is_err());
+        assert_eq!(ran.get(), 11);
     }
 }

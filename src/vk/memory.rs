@@ -1,6 +1,7 @@
 //! Images and buffers, all memory through gpu-allocator. Objects are freed
 //! explicitly with `destroy` once the GPU is done with them (after a fence or
-//! wait-idle): a Drop impl could not know that.
+//! wait-idle): a Drop impl could not know that. While they are being made, a
+//! `Guard` holds them (`vk::guard`), so a failed step frees what exists.
 
 use anyhow::{Context as _, Result};
 use ash::vk;
@@ -8,9 +9,11 @@ use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
 use super::context::Context;
+use super::guard::Guard;
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
-/// fields one by one and destroys whatever it made when a step fails).
+/// fields one by one in a `Guard`, which destroys whatever exists when a step
+/// fails).
 #[derive(Default)]
 pub struct Image {
     pub raw: vk::Image,
@@ -114,23 +117,21 @@ impl Image {
                 extent.width, extent.height
             )
         })?;
-        // Filled in step by step: on an error, `destroy` frees what exists.
-        let mut image = Image {
-            raw,
-            levels,
-            format,
-            extent,
-            aspect,
-            name: name.to_string(),
-            ..Default::default()
-        };
-        match image.bind_and_view(ctx, usage) {
-            Ok(()) => Ok(image),
-            Err(e) => {
-                image.destroy(ctx);
-                Err(e)
-            }
-        }
+        // Filled in step by step: on an error, the guard frees what exists.
+        let mut image = Guard::new(
+            ctx,
+            Image {
+                raw,
+                levels,
+                format,
+                extent,
+                aspect,
+                name: name.to_string(),
+                ..Default::default()
+            },
+        );
+        image.bind_and_view(ctx, usage)?;
+        Ok(image.keep())
     }
 
     /// Memory and views of a fresh image (`with_levels`).
@@ -239,7 +240,8 @@ impl Image {
 }
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
-/// fields one by one and destroys whatever it made when a step fails).
+/// fields one by one in a `Guard`, which destroys whatever exists when a step
+/// fails).
 #[derive(Default)]
 pub struct Buffer {
     pub raw: vk::Buffer,
@@ -266,39 +268,33 @@ impl Buffer {
             )
         }
         .with_context(|| format!("creating buffer '{name}' ({size} bytes)"))?;
-        let mut buffer = Buffer {
-            raw,
-            size,
-            allocation: None,
-        };
+        // On an error below, the guard frees the buffer (and memory, once bound).
+        let mut buffer = Guard::new(
+            ctx,
+            Buffer {
+                raw,
+                size,
+                allocation: None,
+            },
+        );
         let req = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let bound = ctx
-            .creation_step(&format!("memory of buffer '{name}'"))
-            .and_then(|()| {
-                ctx.allocator()
-                    .allocate(&AllocationCreateDesc {
-                        name,
-                        requirements: req,
-                        location,
-                        linear: true,
-                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                    })
-                    .with_context(|| {
-                        format!("allocating memory for buffer '{name}' ({size} bytes)")
-                    })
+        ctx.creation_step(&format!("memory of buffer '{name}'"))?;
+        let a = ctx
+            .allocator()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements: req,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .and_then(|a| {
-                let (memory, offset) = (unsafe { a.memory() }, a.offset());
-                buffer.allocation = Some(a);
-                unsafe { ctx.device.bind_buffer_memory(raw, memory, offset) }
-                    .with_context(|| format!("binding the memory of buffer '{name}'"))
-            });
-        if let Err(e) = bound {
-            buffer.destroy(ctx);
-            return Err(e);
-        }
+            .with_context(|| format!("allocating memory for buffer '{name}' ({size} bytes)"))?;
+        let (memory, offset) = (unsafe { a.memory() }, a.offset());
+        buffer.allocation = Some(a);
+        unsafe { ctx.device.bind_buffer_memory(raw, memory, offset) }
+            .with_context(|| format!("binding the memory of buffer '{name}'"))?;
         ctx.name(raw, name);
-        Ok(buffer)
+        Ok(buffer.keep())
     }
 
     /// A host-visible buffer filled with `data`.
@@ -308,18 +304,18 @@ impl Buffer {
         data: &[u8],
         usage: vk::BufferUsageFlags,
     ) -> Result<Self> {
-        let mut b = Buffer::new(
+        let mut b = Guard::new(
             ctx,
-            name,
-            data.len() as u64,
-            usage,
-            MemoryLocation::CpuToGpu,
-        )?;
-        if let Err(e) = b.write(data) {
-            b.destroy(ctx);
-            return Err(e);
-        }
-        Ok(b)
+            Buffer::new(
+                ctx,
+                name,
+                data.len() as u64,
+                usage,
+                MemoryLocation::CpuToGpu,
+            )?,
+        );
+        b.write(data)?;
+        Ok(b.keep())
     }
 
     pub fn write(&mut self, data: &[u8]) -> Result<()> {

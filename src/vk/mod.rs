@@ -1,8 +1,10 @@
 //! The Vulkan layer: one file per concept (context, barrier table, memory,
-//! shaders and reflection, pipelines, profiler, set-up uploads, the guard that
-//! frees a failed set-up's objects).
+//! shaders and reflection, pipelines, profiler, set-up uploads, the typed
+//! error of the boundary, the owning guards that free a failed set-up's
+//! objects).
 pub mod barrier;
 pub mod context;
+pub mod error;
 pub mod guard;
 pub mod memory;
 pub mod pipeline;

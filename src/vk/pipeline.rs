@@ -5,6 +5,8 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 
 use super::context::Context;
+use super::error::Error;
+use super::guard::Guard;
 use super::shader::{create_module, reflect, Reflection};
 
 /// Vertex layout of `scene::mesh::Vertex` (position, normal, uv, tangent; 48 bytes).
@@ -67,7 +69,8 @@ impl GraphicsDesc {
 }
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
-/// fields one by one and destroys whatever it made when a step fails).
+/// fields one by one in a `Guard`, which destroys whatever exists when a step
+/// fails).
 #[derive(Default)]
 pub struct Pipeline {
     pub raw: vk::Pipeline,
@@ -112,28 +115,23 @@ fn count_set(
         ty: b.descriptor_type,
         descriptor_count: 1,
     }];
-    ctx.creation_step("the fetch counters' descriptor pool")?;
-    let pool = unsafe {
-        ctx.device.create_descriptor_pool(
+    let pool = ctx.create("the fetch counters' descriptor pool", |d| unsafe {
+        d.create_descriptor_pool(
             &vk::DescriptorPoolCreateInfo::default()
                 .max_sets(1)
                 .pool_sizes(&sizes),
             None,
         )
-    }?;
-    let set = match unsafe {
+    })?;
+    let pool = Guard::new(ctx, pool);
+    let set = unsafe {
         ctx.device.allocate_descriptor_sets(
             &vk::DescriptorSetAllocateInfo::default()
-                .descriptor_pool(pool)
+                .descriptor_pool(*pool)
                 .set_layouts(&set_layouts[COUNT_SET as usize..=COUNT_SET as usize]),
         )
-    } {
-        Ok(s) => s[0],
-        Err(e) => {
-            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
-            return Err(e.into());
-        }
-    };
+    }
+    .map_err(Error::from)?[0];
     let info = [vk::DescriptorBufferInfo {
         buffer: buffer.raw,
         offset: 0,
@@ -145,7 +143,7 @@ fn count_set(
         .descriptor_type(b.descriptor_type)
         .buffer_info(&info);
     unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
-    Ok(Some((pool, set)))
+    Ok(Some((pool.keep(), set)))
 }
 
 fn make_layout(
@@ -153,7 +151,7 @@ fn make_layout(
     name: &str,
     r: &Reflection,
 ) -> Result<(vk::PipelineLayout, Vec<vk::DescriptorSetLayout>)> {
-    let set_layouts = r.create_set_layouts(ctx, name)?;
+    let set_layouts = Guard::new(ctx, r.create_set_layouts(ctx, name)?);
     let ranges: Vec<vk::PushConstantRange> = r
         .push_constants
         .iter()
@@ -163,31 +161,16 @@ fn make_layout(
             size,
         })
         .collect();
-    let layout = ctx
-        .creation_step(&format!("pipeline layout of '{name}'"))
-        .and_then(|()| {
-            unsafe {
-                ctx.device.create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default()
-                        .set_layouts(&set_layouts)
-                        .push_constant_ranges(&ranges),
-                    None,
-                )
-            }
-            .map_err(Into::into)
-        });
-    match layout {
-        Ok(layout) => {
-            ctx.name(layout, &format!("{name} layout"));
-            Ok((layout, set_layouts))
-        }
-        Err(e) => {
-            for l in set_layouts {
-                unsafe { ctx.device.destroy_descriptor_set_layout(l, None) };
-            }
-            Err(e)
-        }
-    }
+    let layout = ctx.create(&format!("pipeline layout of '{name}'"), |d| unsafe {
+        d.create_pipeline_layout(
+            &vk::PipelineLayoutCreateInfo::default()
+                .set_layouts(&set_layouts)
+                .push_constant_ranges(&ranges),
+            None,
+        )
+    })?;
+    ctx.name(layout, &format!("{name} layout"));
+    Ok((layout, set_layouts.keep()))
 }
 
 impl Pipeline {
@@ -200,24 +183,22 @@ impl Pipeline {
         let reflection =
             reflect(&stages_names).with_context(|| format!("pipeline '{}'", d.name))?;
         let (layout, set_layouts) = make_layout(ctx, &d.name, &reflection)?;
-        // Filled in step by step: on an error, `destroy` frees what exists.
-        let mut p = Pipeline {
-            layout,
-            set_layouts,
-            reflection,
-            bind_point: vk::PipelineBindPoint::GRAPHICS,
-            name: d.name.clone(),
-            has_stencil: d.stencil.is_some(),
-            has_blend_constants: matches!(d.blend, Blend::ConstantMix(_)),
-            ..Default::default()
-        };
-        match p.build_graphics(ctx, d, frag.as_deref()) {
-            Ok(()) => Ok(p),
-            Err(e) => {
-                p.destroy(ctx);
-                Err(e)
-            }
-        }
+        // Filled in step by step: on an error, the guard frees what exists.
+        let mut p = Guard::new(
+            ctx,
+            Pipeline {
+                layout,
+                set_layouts,
+                reflection,
+                bind_point: vk::PipelineBindPoint::GRAPHICS,
+                name: d.name.clone(),
+                has_stencil: d.stencil.is_some(),
+                has_blend_constants: matches!(d.blend, Blend::ConstantMix(_)),
+                ..Default::default()
+            },
+        );
+        p.build_graphics(ctx, d, frag.as_deref())?;
+        Ok(p.keep())
     }
 
     /// The shader modules, the pipeline and the counter set of `graphics`.
@@ -230,20 +211,15 @@ impl Pipeline {
         frag: Option<&str>,
     ) -> Result<()> {
         let layout = self.layout;
-        let vs = create_module(ctx, d.vert)?;
-        let fs = match frag.map(|f| create_module(ctx, f)).transpose() {
-            Ok(fs) => fs,
-            Err(e) => {
-                unsafe { ctx.device.destroy_shader_module(vs, None) };
-                return Err(e);
-            }
-        };
+        // The modules go when this returns: the pipeline does not need them.
+        let vs = Guard::new(ctx, create_module(ctx, d.vert)?);
+        let fs = Guard::new(ctx, frag.map(|f| create_module(ctx, f)).transpose()?);
         let entry = c"main";
         let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
-            .module(vs)
+            .module(*vs)
             .name(entry)];
-        if let Some(fs) = fs {
+        if let Some(fs) = *fs {
             stages.push(
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(vk::ShaderStageFlags::FRAGMENT)
@@ -348,22 +324,12 @@ impl Pipeline {
             .dynamic_state(&dyn_state)
             .layout(layout)
             .push_next(&mut rendering);
-        let result = ctx
-            .creation_step(&format!("pipeline '{}'", d.name))
-            .and_then(|()| {
-                unsafe {
-                    ctx.device
-                        .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-                }
-                .map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))
-            });
-        unsafe {
-            ctx.device.destroy_shader_module(vs, None);
-            if let Some(fs) = fs {
-                ctx.device.destroy_shader_module(fs, None);
-            }
+        ctx.creation_step(&format!("pipeline '{}'", d.name))?;
+        self.raw = unsafe {
+            ctx.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
         }
-        self.raw = result?[0];
+        .map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))?[0];
         ctx.name(self.raw, &d.name);
         self.count_set = count_set(ctx, &self.reflection, &self.set_layouts)?;
         Ok(())
@@ -374,47 +340,36 @@ impl Pipeline {
         let shader = variant(ctx, shader);
         let reflection = reflect(&[&shader]).with_context(|| format!("pipeline '{name}'"))?;
         let (layout, set_layouts) = make_layout(ctx, name, &reflection)?;
-        let mut p = Pipeline {
-            layout,
-            set_layouts,
-            reflection,
-            bind_point: vk::PipelineBindPoint::COMPUTE,
-            name: name.to_string(),
-            ..Default::default()
-        };
-        let built = create_module(ctx, &shader).and_then(|module| {
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(module)
-                .name(c"main");
-            let info = vk::ComputePipelineCreateInfo::default()
-                .stage(stage)
-                .layout(layout);
-            let result = ctx
-                .creation_step(&format!("compute pipeline '{name}'"))
-                .and_then(|()| {
-                    unsafe {
-                        ctx.device.create_compute_pipelines(
-                            vk::PipelineCache::null(),
-                            &[info],
-                            None,
-                        )
-                    }
-                    .map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))
-                });
-            unsafe { ctx.device.destroy_shader_module(module, None) };
-            p.raw = result?[0];
-            ctx.name(p.raw, name);
-            p.count_set = count_set(ctx, &p.reflection, &p.set_layouts)?;
-            Ok(())
-        });
-        match built {
-            Ok(()) => Ok(p),
-            Err(e) => {
-                p.destroy(ctx);
-                Err(e)
-            }
+        // Filled in step by step: on an error, the guard frees what exists.
+        let mut p = Guard::new(
+            ctx,
+            Pipeline {
+                layout,
+                set_layouts,
+                reflection,
+                bind_point: vk::PipelineBindPoint::COMPUTE,
+                name: name.to_string(),
+                ..Default::default()
+            },
+        );
+        // Goes when this returns: the pipeline does not need it.
+        let module = Guard::new(ctx, create_module(ctx, &shader)?);
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(*module)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        ctx.creation_step(&format!("compute pipeline '{name}'"))?;
+        p.raw = unsafe {
+            ctx.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
         }
+        .map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))?[0];
+        ctx.name(p.raw, name);
+        p.count_set = count_set(ctx, &p.reflection, &p.set_layouts)?;
+        Ok(p.keep())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -510,7 +465,8 @@ pub enum Bind {
 
 /// A descriptor pool sized for the whole renderer (everything is allocated once).
 /// `Default` is the null object: destroying it does nothing (set-up fills
-/// fields one by one and destroys whatever it made when a step fails).
+/// fields one by one in a `Guard`, which destroys whatever exists when a step
+/// fails).
 #[derive(Default)]
 pub struct DescriptorPool {
     pub raw: vk::DescriptorPool,
@@ -693,7 +649,8 @@ impl DescriptorPool {
 
 /// Samplers used across the renderer.
 /// `Default` is the null object: destroying it does nothing (set-up fills
-/// fields one by one and destroys whatever it made when a step fails).
+/// fields one by one in a `Guard`, which destroys whatever exists when a step
+/// fails).
 #[derive(Default)]
 pub struct Samplers {
     pub linear_clamp: vk::Sampler,
@@ -734,22 +691,14 @@ impl Samplers {
         };
         use vk::Filter as F;
         use vk::SamplerAddressMode as M;
-        let mut s = Samplers::default();
-        let made = (|| -> Result<()> {
-            s.linear_clamp = make("linear clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 0.0)?;
-            s.nearest_clamp = make("nearest clamp", F::NEAREST, M::CLAMP_TO_EDGE, false, 0.0)?;
-            s.linear_repeat = make("linear repeat", F::LINEAR, M::REPEAT, false, 0.0)?;
-            s.shadow_compare = make("shadow compare", F::LINEAR, M::CLAMP_TO_BORDER, true, 0.0)?;
-            s.mip_clamp = make("mip clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 16.0)?;
-            Ok(())
-        })();
-        match made {
-            Ok(()) => Ok(s),
-            Err(e) => {
-                s.destroy(ctx);
-                Err(e)
-            }
-        }
+        // On an error, the guard frees the samplers made so far.
+        let mut s = Guard::<Samplers>::null(ctx);
+        s.linear_clamp = make("linear clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 0.0)?;
+        s.nearest_clamp = make("nearest clamp", F::NEAREST, M::CLAMP_TO_EDGE, false, 0.0)?;
+        s.linear_repeat = make("linear repeat", F::LINEAR, M::REPEAT, false, 0.0)?;
+        s.shadow_compare = make("shadow compare", F::LINEAR, M::CLAMP_TO_BORDER, true, 0.0)?;
+        s.mip_clamp = make("mip clamp", F::LINEAR, M::CLAMP_TO_EDGE, false, 16.0)?;
+        Ok(s.keep())
     }
 
     pub fn destroy(&self, ctx: &Context) {

@@ -9,6 +9,7 @@ use anyhow::{Context as _, Result};
 use ash::vk;
 
 use super::context::Context;
+use super::guard::Guard;
 
 pub struct Profiler {
     pub timestamps: vk::QueryPool,
@@ -47,53 +48,43 @@ impl Profiler {
             ctx.name(p, name);
             Ok(p)
         };
-        let timestamps = pool(
-            "pass timestamps",
-            vk::QueryPoolCreateInfo::default()
-                .query_type(vk::QueryType::TIMESTAMP)
-                .query_count(max_passes * 3),
-        )?;
-        let destroy = |pools: &[vk::QueryPool]| {
-            for &p in pools {
-                unsafe { ctx.device.destroy_query_pool(p, None) };
-            }
-        };
-        let stats = if ctx.facts.pipeline_statistics {
-            match pool(
-                "pass fragment invocations",
+        // Each pool is guarded until the profiler holds them all.
+        let timestamps = Guard::new(
+            ctx,
+            pool(
+                "pass timestamps",
                 vk::QueryPoolCreateInfo::default()
-                    .query_type(vk::QueryType::PIPELINE_STATISTICS)
-                    .pipeline_statistics(
-                        vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                    .query_type(vk::QueryType::TIMESTAMP)
+                    .query_count(max_passes * 3),
+            )?,
+        );
+        let stats = Guard::new(
+            ctx,
+            ctx.facts
+                .pipeline_statistics
+                .then(|| {
+                    pool(
+                        "pass fragment invocations",
+                        vk::QueryPoolCreateInfo::default()
+                            .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                            .pipeline_statistics(
+                                vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                            )
+                            .query_count(max_passes),
                     )
-                    .query_count(max_passes),
-            ) {
-                Ok(p) => Some(p),
-                Err(e) => {
-                    destroy(&[timestamps]);
-                    return Err(e);
-                }
-            }
-        } else {
-            None
-        };
-        let occlusion = match pool(
+                })
+                .transpose()?,
+        );
+        let occlusion = pool(
             "pass samples passed",
             vk::QueryPoolCreateInfo::default()
                 .query_type(vk::QueryType::OCCLUSION)
                 .query_count(max_passes),
-        ) {
-            Ok(p) => p,
-            Err(e) => {
-                destroy(&[timestamps]);
-                destroy(stats.as_slice());
-                return Err(e);
-            }
-        };
+        )?;
         let bits = ctx.facts.timestamp_valid_bits;
         Ok(Profiler {
-            timestamps,
-            stats,
+            timestamps: timestamps.keep(),
+            stats: stats.keep(),
             occlusion,
             precise: ctx.facts.occlusion_query_precise,
             max_passes,

@@ -152,7 +152,8 @@ impl Reflection {
         ctx: &super::context::Context,
         label: &str,
     ) -> Result<Vec<vk::DescriptorSetLayout>> {
-        let mut layouts = Vec::new();
+        // On an error, the guard frees the layouts made so far.
+        let mut layouts = super::guard::Guard::new(ctx, Vec::new());
         for set in 0..self.set_count() {
             let bindings: Vec<vk::DescriptorSetLayoutBinding> = self
                 .bindings
@@ -166,31 +167,19 @@ impl Reflection {
                         .stage_flags(b.stages)
                 })
                 .collect();
-            let made = ctx
-                .creation_step(&format!("descriptor set layout {set} of '{label}'"))
-                .and_then(|()| {
-                    unsafe {
-                        ctx.device.create_descriptor_set_layout(
-                            &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                            None,
-                        )
-                    }
-                    .map_err(Into::into)
-                });
-            match made {
-                Ok(l) => {
-                    ctx.name(l, &format!("{label} set {set}"));
-                    layouts.push(l);
-                }
-                Err(e) => {
-                    for l in layouts {
-                        unsafe { ctx.device.destroy_descriptor_set_layout(l, None) };
-                    }
-                    return Err(e);
-                }
-            }
+            let l = ctx.create(
+                &format!("descriptor set layout {set} of '{label}'"),
+                |d| unsafe {
+                    d.create_descriptor_set_layout(
+                        &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                        None,
+                    )
+                },
+            )?;
+            ctx.name(l, &format!("{label} set {set}"));
+            layouts.push(l);
         }
-        Ok(layouts)
+        Ok(layouts.keep())
     }
 }
 

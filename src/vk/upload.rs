@@ -7,6 +7,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::barrier::{image_barrier, AccessKind, ResourceState};
 use super::context::Context;
+use super::guard::Guard;
 use super::memory::{Buffer, Image};
 
 /// Creates a sampled image and fills it with `bytes` (tightly packed texels),
@@ -19,29 +20,33 @@ pub fn texture(
     bytes: &[u8],
 ) -> Result<Image> {
     let first_use = AccessKind::AnyShaderSampledRead;
-    let mut image = Image::new(
+    let image = Guard::new(
         ctx,
-        name,
-        extent,
-        format,
-        first_use.image_usage() | AccessKind::TransferWrite.image_usage(),
-    )?;
-    if let Err(e) = fill(ctx, &image, bytes, first_use) {
-        image.destroy(ctx);
-        return Err(e).with_context(|| format!("uploading texture '{name}'"));
-    }
-    Ok(image)
+        Image::new(
+            ctx,
+            name,
+            extent,
+            format,
+            first_use.image_usage() | AccessKind::TransferWrite.image_usage(),
+        )?,
+    );
+    fill(ctx, &image, bytes, first_use).with_context(|| format!("uploading texture '{name}'"))?;
+    Ok(image.keep())
 }
 
 /// Copies `bytes` into the colour aspect of a fresh `image` and leaves it in
 /// `final_access`.
 fn fill(ctx: &Context, image: &Image, bytes: &[u8], final_access: AccessKind) -> Result<()> {
-    let mut staging = Buffer::with_data(
+    // Freed when this returns: after the upload's fence, or at once on an error.
+    let staging = Guard::new(
         ctx,
-        &format!("{} staging", image.name),
-        bytes,
-        vk::BufferUsageFlags::TRANSFER_SRC,
-    )?;
+        Buffer::with_data(
+            ctx,
+            &format!("{} staging", image.name),
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+        )?,
+    );
     let mut state = ResourceState::default();
     let range = image.subresource_range();
     let mut barrier = |cmd, next| {
@@ -51,7 +56,7 @@ fn fill(ctx: &Context, image: &Image, bytes: &[u8], final_access: AccessKind) ->
             unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
         }
     };
-    let result = ctx.one_shot(&format!("upload {}", image.name), |cmd| {
+    ctx.one_shot(&format!("upload {}", image.name), |cmd| {
         barrier(cmd, AccessKind::TransferWrite);
         let region = vk::BufferImageCopy::default()
             .image_subresource(
@@ -74,9 +79,7 @@ fn fill(ctx: &Context, image: &Image, bytes: &[u8], final_access: AccessKind) ->
             )
         };
         barrier(cmd, final_access);
-    });
-    staging.destroy(ctx);
-    result
+    })
 }
 
 /// A device-local buffer with `bytes` in it, ready for `first_use`. (Uniform
@@ -88,25 +91,26 @@ pub fn device_buffer(
     usage: vk::BufferUsageFlags,
     first_use: AccessKind,
 ) -> Result<Buffer> {
-    let mut staging = Buffer::with_data(
+    // Freed when this returns: after the upload's fence, or at once on an error.
+    let staging = Guard::new(
         ctx,
-        &format!("{name} staging"),
-        bytes,
-        vk::BufferUsageFlags::TRANSFER_SRC,
-    )?;
-    let mut buffer = match Buffer::new(
+        Buffer::with_data(
+            ctx,
+            &format!("{name} staging"),
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+        )?,
+    );
+    let buffer = Guard::new(
         ctx,
-        name,
-        bytes.len() as u64,
-        usage | vk::BufferUsageFlags::TRANSFER_DST,
-        MemoryLocation::GpuOnly,
-    ) {
-        Ok(b) => b,
-        Err(e) => {
-            staging.destroy(ctx);
-            return Err(e);
-        }
-    };
+        Buffer::new(
+            ctx,
+            name,
+            bytes.len() as u64,
+            usage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?,
+    );
     let mut state = ResourceState::default();
     let mut barrier = |cmd, next| {
         if let Some(p) = state.plan(next, false) {
@@ -122,7 +126,7 @@ pub fn device_buffer(
             unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
         }
     };
-    let result = ctx.one_shot(&format!("upload {name}"), |cmd| {
+    ctx.one_shot(&format!("upload {name}"), |cmd| {
         barrier(cmd, AccessKind::TransferWrite);
         unsafe {
             ctx.device.cmd_copy_buffer(
@@ -137,11 +141,6 @@ pub fn device_buffer(
             )
         };
         barrier(cmd, first_use);
-    });
-    staging.destroy(ctx);
-    if let Err(e) = result {
-        buffer.destroy(ctx);
-        return Err(e);
-    }
-    Ok(buffer)
+    })?;
+    Ok(buffer.keep())
 }
