@@ -25,6 +25,7 @@ use crate::skin::beckmann::beckmann_lut;
 use crate::skin::transmittance::shrink_units;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{
     Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, Samplers, VertexInput,
@@ -157,7 +158,7 @@ impl Frame {
             height: settings.height,
         };
         let full = PixelRect::full(extent.width, extent.height);
-        let mut f = Frame {
+        let f = Frame {
             settings: settings.clone(),
             extent,
             mm_per_unit: scene.mm_per_unit,
@@ -182,13 +183,10 @@ impl Frame {
             sss_region: scissors(&[full]),
             screen_rect: scissors(&[full]),
         };
-        match f.build(ctx, scene, res, transmittance) {
-            Ok(()) => Ok(f),
-            Err(e) => {
-                f.destroy(ctx);
-                Err(e)
-            }
-        }
+        // Filled in by `build`: on an error, the guard frees what exists.
+        let mut f = Guard::new(ctx, f);
+        f.build(ctx, scene, res, transmittance)?;
+        Ok(f.keep())
     }
 
     /// Fills in the frame's objects, each step on its own so a failure leaves
