@@ -9,6 +9,7 @@ use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
 use super::context::Context;
+use super::error::Error;
 use super::guard::Guard;
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
@@ -111,12 +112,14 @@ impl Image {
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         ctx.creation_step(&format!("image '{name}'"))?;
-        let raw = unsafe { ctx.device.create_image(&info, None) }.with_context(|| {
-            format!(
-                "creating image '{name}' {}x{} {format:?}",
-                extent.width, extent.height
-            )
-        })?;
+        let raw = unsafe { ctx.device.create_image(&info, None) }
+            .map_err(Error::from)
+            .with_context(|| {
+                format!(
+                    "creating image '{name}' {}x{} {format:?}",
+                    extent.width, extent.height
+                )
+            })?;
         // Filled in step by step: on an error, the guard frees what exists.
         let mut image = Guard::new(
             ctx,
@@ -148,10 +151,12 @@ impl Image {
                 linear: false,
                 allocation_scheme: AllocationScheme::DedicatedImage(raw),
             })
+            .map_err(Error::from)
             .with_context(|| format!("allocating memory for image '{name}'"))?;
         let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
         self.allocation = Some(allocation);
         unsafe { ctx.device.bind_image_memory(raw, memory, offset) }
+            .map_err(Error::from)
             .with_context(|| format!("binding the memory of image '{name}'"))?;
         let make_view = |aspect: vk::ImageAspectFlags, base: u32, count: u32| {
             ctx.creation_step(&format!("a view of image '{name}'"))?;
@@ -171,6 +176,7 @@ impl Image {
                     None,
                 )
             }
+            .map_err(Error::from)
             .with_context(|| format!("creating a view of image '{name}'"))
         };
         for l in 0..self.levels {
@@ -267,6 +273,7 @@ impl Buffer {
                 None,
             )
         }
+        .map_err(Error::from)
         .with_context(|| format!("creating buffer '{name}' ({size} bytes)"))?;
         // On an error below, the guard frees the buffer (and memory, once bound).
         let mut buffer = Guard::new(
@@ -288,10 +295,12 @@ impl Buffer {
                 linear: true,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
+            .map_err(Error::from)
             .with_context(|| format!("allocating memory for buffer '{name}' ({size} bytes)"))?;
         let (memory, offset) = (unsafe { a.memory() }, a.offset());
         buffer.allocation = Some(a);
         unsafe { ctx.device.bind_buffer_memory(raw, memory, offset) }
+            .map_err(Error::from)
             .with_context(|| format!("binding the memory of buffer '{name}'"))?;
         ctx.name(raw, name);
         Ok(buffer.keep())

@@ -329,7 +329,8 @@ impl Pipeline {
             ctx.device
                 .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
         }
-        .map_err(|(_, e)| anyhow!("creating pipeline '{}': {e}", d.name))?[0];
+        .map_err(|(_, e)| Error::from(e))
+        .with_context(|| format!("creating pipeline '{}'", d.name))?[0];
         ctx.name(self.raw, &d.name);
         self.count_set = count_set(ctx, &self.reflection, &self.set_layouts)?;
         Ok(())
@@ -366,7 +367,8 @@ impl Pipeline {
             ctx.device
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
         }
-        .map_err(|(_, e)| anyhow!("creating compute pipeline '{name}': {e}"))?[0];
+        .map_err(|(_, e)| Error::from(e))
+        .with_context(|| format!("creating compute pipeline '{name}'"))?[0];
         ctx.name(p.raw, name);
         p.count_set = count_set(ctx, &p.reflection, &p.set_layouts)?;
         Ok(p.keep())
@@ -504,7 +506,9 @@ impl DescriptorPool {
                     .pool_sizes(&sizes),
                 None,
             )
-        }?;
+        }
+        .map_err(Error::from)
+        .context("creating the descriptor pool")?;
         ctx.name(raw, "descriptor pool");
         Ok(DescriptorPool { raw })
     }
@@ -530,6 +534,7 @@ impl DescriptorPool {
                     .set_layouts(&[layout]),
             )
         }
+        .map_err(Error::from)
         .with_context(|| format!("allocating set {set} of '{}'", pipeline.name))?[0];
         ctx.name(ds, &format!("{} set {set}", pipeline.name));
         let declared: Vec<_> = pipeline
@@ -685,7 +690,9 @@ impl Samplers {
                     .compare_op(vk::CompareOp::LESS_OR_EQUAL);
             }
             ctx.creation_step(&format!("sampler '{name}'"))?;
-            let s = unsafe { ctx.device.create_sampler(&info, None) }?;
+            let s = unsafe { ctx.device.create_sampler(&info, None) }
+                .map_err(Error::from)
+                .with_context(|| format!("creating sampler '{name}'"))?;
             ctx.name(s, name);
             Ok(s)
         };

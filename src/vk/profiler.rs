@@ -9,6 +9,7 @@ use anyhow::{Context as _, Result};
 use ash::vk;
 
 use super::context::Context;
+use super::error::Error;
 use super::guard::Guard;
 
 pub struct Profiler {
@@ -44,6 +45,7 @@ impl Profiler {
         let pool = |name: &str, info: vk::QueryPoolCreateInfo| -> Result<vk::QueryPool> {
             ctx.creation_step(&format!("query pool '{name}'"))?;
             let p = unsafe { ctx.device.create_query_pool(&info, None) }
+                .map_err(Error::from)
                 .with_context(|| format!("creating query pool '{name}'"))?;
             ctx.name(p, name);
             Ok(p)
@@ -159,6 +161,7 @@ impl Profiler {
                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
             )
         }
+        .map_err(Error::from)
         .context("reading timestamps")?;
         let mut inv = vec![0u64; n as usize];
         if let Some(s) = self.stats {
@@ -170,6 +173,7 @@ impl Profiler {
                     vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
                 )
             }
+            .map_err(Error::from)
             .context("reading pipeline statistics")?;
         }
         let mut occ = vec![0u64; n as usize];
@@ -181,6 +185,7 @@ impl Profiler {
                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
             )
         }
+        .map_err(Error::from)
         .context("reading occlusion queries")?;
         let ms = |a: u64, b: u64| {
             let d = (b & self.valid_mask).wrapping_sub(a & self.valid_mask) & self.valid_mask;

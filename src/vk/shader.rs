@@ -190,6 +190,7 @@ pub fn create_module(ctx: &super::context::Context, name: &str) -> Result<vk::Sh
         ctx.device
             .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None)
     }
+    .map_err(super::error::Error::from)
     .with_context(|| format!("creating shader module {name}"))?;
     ctx.name(m, name);
     Ok(m)
