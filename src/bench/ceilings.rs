@@ -15,6 +15,7 @@ use crate::render::targets::LDR_FORMAT;
 use crate::report::Stats;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::memory::Image;
 use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, Samplers};
 use crate::vk::profiler::Profiler;
@@ -69,34 +70,32 @@ pub fn measure(
         })
         .collect();
     let r32: Vec<f32> = (0..n).map(|i| 10.0 + (i % 89) as f32 * 0.01).collect();
-    let mut src_rgba = upload::texture(
+    // Guarded: freed when this returns, after the wait-idle below.
+    let src_rgba = Guard::new(
         ctx,
-        "probe rgba16f",
-        extent,
-        vk::Format::R16G16B16A16_SFLOAT,
-        bytemuck::cast_slice(&rgba),
-    )?;
-    let mut src_r32 = match upload::texture(
+        upload::texture(
+            ctx,
+            "probe rgba16f",
+            extent,
+            vk::Format::R16G16B16A16_SFLOAT,
+            bytemuck::cast_slice(&rgba),
+        )?,
+    );
+    let src_r32 = Guard::new(
         ctx,
-        "probe r32f",
-        extent,
-        vk::Format::R32_SFLOAT,
-        bytemuck::cast_slice(&r32),
-    ) {
-        Ok(t) => t,
-        Err(e) => {
-            src_rgba.destroy(ctx);
-            return Err(e);
-        }
-    };
-    let mut res = Resources::default();
+        upload::texture(
+            ctx,
+            "probe r32f",
+            extent,
+            vk::Format::R32_SFLOAT,
+            bytemuck::cast_slice(&r32),
+        )?,
+    );
+    let mut res = Guard::<Resources>::null(ctx);
     let result = probe_all(ctx, &mut res, extent, reps, [&src_rgba, &src_r32]);
     unsafe {
         let _ = ctx.device.device_wait_idle();
     }
-    res.destroy(ctx);
-    src_rgba.destroy(ctx);
-    src_r32.destroy(ctx);
     result
 }
 
