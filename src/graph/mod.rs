@@ -15,6 +15,7 @@
 //! ([`Resources::create`]) and write the descriptor sets that need their views.
 
 pub mod draw;
+pub mod mesh;
 mod pass;
 mod resources;
 pub mod work;

@@ -661,3 +661,170 @@ pub fn record_passes(
         ctx.end_label(cmd);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::work::Format;
+    use crate::graph::ImageDesc;
+
+    fn image(res: &mut Resources, name: &str, w: u32, h: u32, format: vk::Format) -> ImageId {
+        res.declare(ImageDesc::new(
+            name,
+            vk::Extent2D {
+                width: w,
+                height: h,
+            },
+            format,
+        ))
+    }
+
+    // The load op is the one fact: access kinds (so barriers and layouts)
+    // follow from it.
+    #[test]
+    fn accesses_follow_from_the_load_ops() {
+        let mut res = Resources::default();
+        let c = image(&mut res, "c", 8, 8, vk::Format::R16G16B16A16_SFLOAT);
+        let ds = image(&mut res, "ds", 8, 8, vk::Format::D24_UNORM_S8_UINT);
+        type A = AccessKind;
+        for (target, access) in [
+            (ColorTarget::new(c, Load::Keep), A::ColorAttachmentLoadWrite),
+            (ColorTarget::new(c, Load::DontCare), A::ColorAttachmentWrite),
+            (
+                ColorTarget::new(c, Load::Clear([0.0; 4])),
+                A::ColorAttachmentWrite,
+            ),
+            (
+                ColorTarget::new(c, Load::Clear([0.0; 4])).persistent(),
+                A::ColorAttachmentLoadWrite,
+            ),
+        ] {
+            let p = Pass::new("p", PassRole::Sss).color(target);
+            assert_eq!(p.images, vec![(c, access)], "{target:?}");
+        }
+        let p = Pass::new("p", PassRole::Sss).depth_stencil(DepthStencil::cleared(ds, 1.0));
+        assert_eq!(p.images, vec![(ds, A::DepthStencilWrite)]);
+        let p = Pass::new("p", PassRole::Sss).depth_stencil(DepthStencil::test_only(ds));
+        assert_eq!(p.images, vec![(ds, A::DepthStencilReadOnly)]);
+    }
+
+    // Colour writes, clears, depth/stencil use and extent come from the
+    // attachments; images keep their declaration order.
+    #[test]
+    fn raster_work_is_filled_from_the_declaration() {
+        let mut res = Resources::default();
+        let src = image(&mut res, "src", 64, 32, vk::Format::R32_SFLOAT);
+        let a = image(&mut res, "a", 64, 32, vk::Format::R16G16B16A16_SFLOAT);
+        let b = image(&mut res, "b", 64, 32, vk::Format::R8G8B8A8_SRGB);
+        let ds = image(&mut res, "ds", 64, 32, vk::Format::D32_SFLOAT_S8_UINT);
+        let p = Pass::new("p", PassRole::Sss)
+            .sampled(src)
+            .color(ColorTarget::new(a, Load::Clear([1.0; 4])))
+            .depth_stencil(
+                DepthStencil::cleared(ds, 1.0)
+                    .depth_write(false)
+                    .stencil_test(Some(1)),
+            )
+            .color(ColorTarget::new(b, Load::Keep).blended())
+            .draws(None, 7);
+        assert_eq!(
+            p.images.iter().map(|i| i.0).collect::<Vec<_>>(),
+            vec![src, a, ds, b]
+        );
+        let Some(Work::Raster {
+            shader,
+            color,
+            depth_stencil,
+            width,
+            height,
+            triangles,
+            msaa,
+            clears,
+        }) = p.declared_work(&res)
+        else {
+            panic!("a raster pass")
+        };
+        assert!(shader.is_none());
+        assert_eq!(
+            color,
+            vec![
+                ColorWrite {
+                    format: Format::Rgba16Float,
+                    blend: false
+                },
+                ColorWrite {
+                    format: Format::Rgba8Srgb,
+                    blend: true
+                }
+            ]
+        );
+        assert_eq!(
+            depth_stencil,
+            Some(DepthStencilUse {
+                format: Format::D32FloatS8Uint,
+                depth_test: true,
+                depth_write: false,
+                stencil_test: true,
+                stencil_write: false,
+            })
+        );
+        assert_eq!((width, height, triangles, msaa), (64, 32, 7, 1));
+        assert_eq!(clears, vec![Format::Rgba16Float, Format::D32FloatS8Uint]);
+        // A render area overrides the attachments' extent.
+        let q = Pass::new("q", PassRole::Sss)
+            .color(ColorTarget::new(a, Load::DontCare))
+            .render_area(vk::Extent2D {
+                width: 16,
+                height: 16,
+            })
+            .draws(None, 1);
+        assert!(matches!(
+            q.declared_work(&res),
+            Some(Work::Raster { width: 16, height: 16, ref clears, .. }) if clears.is_empty()
+        ));
+    }
+
+    #[test]
+    fn targets_rendered_alone_stack_and_dispatches_count_invocations() {
+        let mut res = Resources::default();
+        let a = image(&mut res, "a", 64, 3, vk::Format::R32G32B32A32_SFLOAT);
+        let b = image(&mut res, "b", 64, 5, vk::Format::R32G32B32A32_SFLOAT);
+        let p = Pass::new("p", PassRole::Sss)
+            .each_target_alone()
+            .color(ColorTarget::new(a, Load::DontCare))
+            .color(ColorTarget::new(b, Load::DontCare))
+            .draws(None, 2);
+        assert!(matches!(
+            p.declared_work(&res),
+            Some(Work::Raster { width: 64, height: 8, ref color, .. }) if color.len() == 1
+        ));
+        let c = Pass::new("c", PassRole::Sss).dispatch(ShaderWork::default(), [3, 2, 1], 64);
+        assert!(matches!(
+            c.declared_work(&res),
+            Some(Work::Compute {
+                invocations: 384,
+                ..
+            })
+        ));
+        assert!(Pass::new("n", PassRole::Readback)
+            .declared_work(&res)
+            .is_none());
+    }
+
+    #[test]
+    #[should_panic(expected = "use color() or depth_stencil()")]
+    fn attachments_cannot_be_declared_without_their_load_op() {
+        let mut res = Resources::default();
+        let a = image(&mut res, "a", 4, 4, vk::Format::R16G16B16A16_SFLOAT);
+        let _ = Pass::new("p", PassRole::Sss).image(a, AccessKind::ColorAttachmentWrite);
+    }
+
+    #[test]
+    #[should_panic(expected = "never written")]
+    fn a_test_only_depth_is_not_written() {
+        let mut res = Resources::default();
+        let ds = image(&mut res, "ds", 4, 4, vk::Format::D24_UNORM_S8_UINT);
+        let _ = Pass::new("p", PassRole::Sss)
+            .depth_stencil(DepthStencil::test_only(ds).depth_write(true));
+    }
+}

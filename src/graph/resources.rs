@@ -471,6 +471,15 @@ mod tests {
         );
     }
 
+    // Every declared image has a work format: the map is checked where an
+    // image is declared, so nothing downstream handles a missing one.
+    #[test]
+    #[should_panic(expected = "the work vocabulary cannot name")]
+    fn images_of_unnamed_formats_are_refused_when_declared() {
+        let mut r = Resources::default();
+        r.declare(desc("odd", vk::Format::B8G8R8A8_UNORM, 1));
+    }
+
     #[test]
     fn image_uses_name_format_size_and_kind() {
         let mut r = Resources::default();
@@ -484,5 +493,6 @@ mod tests {
         assert_eq!((uses[0].width, uses[0].height), (32, 16));
         assert_eq!(uses[1].kind, ImageUseKind::Sampled);
         assert_eq!(uses[1].format, Format::Rgba16Float);
+        assert_eq!(r.texel_format(rt), Format::Rgba16Float);
     }
 }

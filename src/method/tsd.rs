@@ -50,6 +50,7 @@ use super::{
     SssMethod,
 };
 use crate::graph::draw::fullscreen;
+use crate::graph::mesh::GpuMesh;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{
     ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
@@ -60,12 +61,10 @@ use crate::skin::tsd_ref::{
     projected_px, reference_distance, refreshes, tsd_gaussians, Atlas, TsdGaussian, BACKFACE_BIAS,
     CULL_COS, EDGE_GUARD_TEXELS, NO_CLIP,
 };
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
-use crate::vk::upload::device_buffer;
 
 const UV_VERT: &str = "tsd_uv.vert";
 const MASK_SHADER: &str = "tsd_mask.frag";
@@ -395,9 +394,8 @@ pub struct Tsd {
     pub d_ref_units: f32,
     pipelines: Pipelines,
     pool: DescriptorPool,
-    vertices: Buffer,
-    indices: Buffer,
-    index_count: u32,
+    /// The head with each tangent's w carrying its atlas island.
+    mesh: GpuMesh,
     character_ubo: Buffer,
     atlas_ubo: Buffer,
     sets: SharedSets,
@@ -456,9 +454,7 @@ impl Tsd {
             d_ref_units: 0.0,
             pipelines: Pipelines::default(),
             pool: DescriptorPool::default(),
-            vertices: Buffer::default(),
-            indices: Buffer::default(),
-            index_count: head.mesh.indices.len() as u32,
+            mesh: GpuMesh::default(),
             character_ubo: Buffer::default(),
             atlas_ubo: Buffer::default(),
             sets: SharedSets::default(),
@@ -584,20 +580,7 @@ impl Tsd {
                 }
             })
             .collect();
-        self.vertices = device_buffer(
-            s.ctx,
-            "tsd head vertices",
-            bytemuck::cast_slice(&vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
-        self.indices = device_buffer(
-            s.ctx,
-            "tsd head indices",
-            bytemuck::cast_slice(&mesh.indices),
-            vk::BufferUsageFlags::INDEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
+        self.mesh = GpuMesh::upload(s.ctx, "tsd head", &vertices, &mesh.indices)?;
         Ok(())
     }
 
@@ -607,18 +590,11 @@ impl Tsd {
 
     /// Triangles of one draw of the head.
     fn triangles(&self) -> u64 {
-        self.index_count as u64 / 3
+        self.mesh.triangles()
     }
 
     fn draw_head(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        unsafe {
-            ctx.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
-            ctx.device
-                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
-            ctx.device
-                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
-        }
+        self.mesh.bind_and_draw(ctx, cmd);
     }
 
     /// The mask as the texture-space passes after the mask pass test it:
@@ -1213,8 +1189,7 @@ impl SssMethod for Tsd {
             p.destroy(ctx);
         }
         self.pool.destroy(ctx);
-        self.vertices.destroy(ctx);
-        self.indices.destroy(ctx);
+        self.mesh.destroy(ctx);
         self.character_ubo.destroy(ctx);
         self.atlas_ubo.destroy(ctx);
     }

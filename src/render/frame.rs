@@ -459,7 +459,7 @@ impl Frame {
             .filter(|o| o.skin || !skin_only)
             .map(|o| {
                 let copies = if o.skin { self.instances.len() } else { 1 };
-                o.index_count as u64 / 3 * copies as u64
+                o.mesh.triangles() * copies as u64
             })
             .sum()
     }
