@@ -14,11 +14,13 @@
 //! to derive the usages ([`Resources::allow`]), then create the images
 //! ([`Resources::create`]) and write the descriptor sets that need their views.
 
+mod attach;
 pub mod draw;
 pub mod mesh;
 mod pass;
 mod resources;
 pub mod work;
 
-pub use pass::{record_passes, ColorTarget, DepthStencil, Load, Pass, PassContext, PassSample};
+pub use attach::{ColorTarget, DepthStencil, Load};
+pub use pass::{record_passes, Pass, PassContext, PassSample};
 pub use resources::{BufferId, ImageDesc, ImageId, Resources};
