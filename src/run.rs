@@ -167,7 +167,7 @@ pub fn run(
         .passes()
         .iter()
         .map(|p| PassDecl {
-            work: p.work.clone(),
+            work: p.declared_work(&renderer.resources),
             images: renderer.resources.image_uses(&p.images),
         })
         .collect();

@@ -51,7 +51,8 @@ fn declared_fetches_are_what_the_shaders_fetch() {
             assert_eq!(counts.len(), passes.len());
             for (c, p) in counts.iter().zip(&passes) {
                 let at = format!("{label}: pass '{}'", p.name);
-                let shader = match &p.work {
+                let work = p.declared_work(&r.resources);
+                let shader = match &work {
                     Some(Work::Raster {
                         shader: Some(sh), ..
                     }) => sh,

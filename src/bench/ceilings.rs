@@ -8,12 +8,11 @@ use ash::vk;
 use serde::Serialize;
 
 use super::floor::Ceilings;
-use crate::graph::draw::{begin_rendering, Load};
-use crate::graph::work::{ColorWrite, Fetch, Filter, Format, PassRole, ShaderWork, Work};
-use crate::graph::{record_passes, work_format, ImageDesc, ImageId, Pass, PassContext, Resources};
+use crate::graph::draw::fullscreen;
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
+use crate::graph::{record_passes, ColorTarget, ImageDesc, Load, Pass, PassContext, Resources};
 use crate::render::targets::LDR_FORMAT;
 use crate::report::Stats;
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Image;
@@ -39,8 +38,8 @@ struct Probe<'p> {
     /// The source's set, and what a fetch of it is (the uploaded sources are
     /// not frame images: their barriers were made by the upload).
     src: Option<(vk::DescriptorSet, (Format, Filter))>,
-    target: ImageId,
-    access: AccessKind,
+    /// The target as the probe's pass declares it (load op, blending).
+    target: ColorTarget,
 }
 
 /// One probe's measurement.
@@ -115,11 +114,11 @@ fn probe_all(
     ));
     // The tone map writes 32 bpp: ROPs fill those at their own rate.
     let id_ldr = res.declare(ImageDesc::new("probe target rgba8", extent, LDR_FORMAT));
-    res.allow(&[
-        (id_target, AccessKind::ColorAttachmentWrite),
-        (id_target, AccessKind::ColorAttachmentLoadWrite),
-        (id_ldr, AccessKind::ColorAttachmentWrite),
-    ]);
+    // Fills overwrite their target; the blend reads it (a read-modify-write).
+    let overwrite = ColorTarget::new(id_target, Load::DontCare);
+    let overwrite_ldr = ColorTarget::new(id_ldr, Load::DontCare);
+    let blended = ColorTarget::new(id_target, Load::Keep).blended();
+    res.allow(&[overwrite, blended, overwrite_ldr].map(|c| (c.image, c.access())));
     res.create(ctx)?;
     let mut owned = Owned {
         ctx,
@@ -159,14 +158,12 @@ fn probe_all(
     let fetch_probe = |s, format| Probe {
         pipeline: fetch,
         src: Some((s, format)),
-        target: id_target,
-        access: AccessKind::ColorAttachmentWrite,
+        target: overwrite,
     };
-    let fill_probe = |pipeline, target, access| Probe {
+    let fill_probe = |pipeline, target| Probe {
         pipeline,
         src: None,
         target,
-        access,
     };
     let probes: Vec<(&str, Probe)> = vec![
         (
@@ -197,25 +194,16 @@ fn probe_all(
                 (Format::R32Float, Filter::Point),
             ),
         ),
-        (
-            "fill rgba16f",
-            fill_probe(fill, id_target, AccessKind::ColorAttachmentWrite),
-        ),
-        (
-            "fill rgba8",
-            fill_probe(fill_ldr, id_ldr, AccessKind::ColorAttachmentWrite),
-        ),
-        (
-            "blend rgba16f",
-            fill_probe(fill_blend, id_target, AccessKind::ColorAttachmentLoadWrite),
-        ),
+        ("fill rgba16f", fill_probe(fill, overwrite)),
+        ("fill rgba8", fill_probe(fill_ldr, overwrite_ldr)),
+        ("blend rgba16f", fill_probe(fill_blend, blended)),
     ];
     let texel = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
     let mut passes = Vec::new();
     // One warm-up round, then `reps` measured rounds.
     for round in 0..=reps {
         for (name, probe) in &probes {
-            passes.push(probe.pass(res, &format!("{name} #{round}"), texel));
+            passes.push(probe.pass(&format!("{name} #{round}"), texel));
         }
     }
     let profiler = Profiler::new(ctx, passes.len() as u32)?;
@@ -295,14 +283,8 @@ impl Drop for Owned<'_> {
 }
 
 impl<'p> Probe<'p> {
-    fn pass(&self, res: &Resources, name: &str, texel: [f32; 2]) -> Pass<'p> {
+    fn pass(&self, name: &str, texel: [f32; 2]) -> Pass<'p> {
         let (pipeline, set) = (self.pipeline, self.src.map(|(s, _)| s));
-        let target = self.target;
-        let load = if self.access == AccessKind::ColorAttachmentLoadWrite {
-            Load::Keep
-        } else {
-            Load::Discard
-        };
         let fetches = match self.src {
             Some((_, (format, filter))) => vec![Fetch {
                 texture: "srcTex".into(),
@@ -314,56 +296,38 @@ impl<'p> Probe<'p> {
             }],
             None => Vec::new(),
         };
-        let e = res.extent(target);
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: if set.is_some() {
-                    "probe_fetch.frag"
-                } else {
-                    "probe_fill.frag"
-                }
-                .into(),
-                fetches,
-                ..Default::default()
-            }),
-            color: vec![ColorWrite {
-                format: work_format(res.format(target)).expect("probe formats"),
-                blend: load == Load::Keep,
-            }],
-            depth_stencil: None,
-            width: e.width,
-            height: e.height,
-            triangles: 1,
-            msaa: 1,
-            clears: vec![],
+        let work = ShaderWork {
+            shader: if set.is_some() {
+                "probe_fetch.frag"
+            } else {
+                "probe_fill.frag"
+            }
+            .into(),
+            fetches,
+            ..Default::default()
         };
         Pass::new(name, PassRole::Probe)
-            .image(target, self.access)
-            .work(work)
+            .color(self.target)
+            .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
-                let (c, cmd) = (pc.ctx, pc.cmd);
-                begin_rendering(pc, &[(target, load)], None);
-                pipeline.bind(c, cmd, set.as_slice());
-                unsafe {
-                    if pipeline.has_blend_constants {
-                        c.device.cmd_set_blend_constants(cmd, &[0.5; 4]);
+                fullscreen(pc, pipeline, set.as_slice(), |c, cmd| {
+                    unsafe {
+                        if pipeline.has_blend_constants {
+                            c.device.cmd_set_blend_constants(cmd, &[0.5; 4]);
+                        }
                     }
-                }
-                if set.is_some() {
-                    pipeline.push(
-                        c,
-                        cmd,
-                        &ProbePush {
-                            texel,
-                            taps: PROBE_TAPS,
-                            pad: 0,
-                        },
-                    );
-                }
-                unsafe {
-                    c.device.cmd_draw(cmd, 3, 1, 0, 0);
-                    c.device.cmd_end_rendering(cmd);
-                }
+                    if set.is_some() {
+                        pipeline.push(
+                            c,
+                            cmd,
+                            &ProbePush {
+                                texel,
+                                taps: PROBE_TAPS,
+                                pad: 0,
+                            },
+                        );
+                    }
+                })
             })
     }
 }

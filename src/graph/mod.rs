@@ -5,16 +5,22 @@
 //! usage flags every image is created with are derived from the accesses the
 //! passes declare, every barrier from the previous and the next access (the one
 //! table in `vk::barrier`), batched into one call per pass, and each pass is
-//! wrapped in a debug label, timestamps and its queries.
+//! wrapped in a debug label, timestamps and its queries. A pass declares its
+//! attachments with their load ops once ([`ColorTarget`], [`DepthStencil`]):
+//! their access kinds, the dynamic rendering around the record closure and the
+//! pass's declared work all follow from that declaration.
 //!
 //! Set-up is therefore in three steps: declare images, build the pass lists once
 //! to derive the usages ([`Resources::allow`]), then create the images
 //! ([`Resources::create`]) and write the descriptor sets that need their views.
 
+mod attach;
 pub mod draw;
+pub mod mesh;
 mod pass;
 mod resources;
 pub mod work;
 
+pub use attach::{ColorTarget, DepthStencil, Load};
 pub use pass::{record_passes, Pass, PassContext, PassSample};
-pub use resources::{work_format, BufferId, ImageDesc, ImageId, Resources};
+pub use resources::{BufferId, ImageDesc, ImageId, Resources};

@@ -47,6 +47,8 @@ impl ImageDesc {
 
 struct Slot {
     desc: ImageDesc,
+    /// The format in the work vocabulary (every declared image has one).
+    texel: Format,
     usage: vk::ImageUsageFlags,
     image: Option<Image>,
 }
@@ -77,7 +79,17 @@ pub struct Resources {
 impl Resources {
     /// Declares an image; returns the id of level 0 (level `l` is
     /// [`Resources::level`]). It is created by [`Resources::create`].
+    ///
+    /// Panics when the format has no name in the work vocabulary: formats are
+    /// chosen by dermis's code, so one missing from [`Format`] is a programmer
+    /// error caught where it is made, and [`Resources::texel_format`] is total.
     pub fn declare(&mut self, desc: ImageDesc) -> ImageId {
+        let texel = work_format(desc.format).unwrap_or_else(|| {
+            panic!(
+                "image '{}' is declared with {:?}, which the work vocabulary cannot name",
+                desc.name, desc.format
+            )
+        });
         let slot = self.slots.len();
         let first = ImageId(self.images.len());
         for level in 0..desc.levels.max(1) {
@@ -95,6 +107,7 @@ impl Resources {
         }
         self.slots.push(Slot {
             desc,
+            texel,
             usage: vk::ImageUsageFlags::empty(),
             image: None,
         });
@@ -226,6 +239,11 @@ impl Resources {
         self.slot(id).desc.format
     }
 
+    /// The format of `id` as pass declarations and reports name it.
+    pub fn texel_format(&self, id: ImageId) -> Format {
+        self.slot(id).texel
+    }
+
     /// The size of the level `id` names.
     pub fn extent(&self, id: ImageId) -> vk::Extent2D {
         let d = &self.slot(id).desc;
@@ -308,7 +326,7 @@ impl Resources {
                 let e = self.extent(id);
                 Some(ImageUse {
                     image: self.name(id).to_string(),
-                    format: work_format(self.format(id))?,
+                    format: self.texel_format(id),
                     width: e.width,
                     height: e.height,
                     kind,
@@ -381,8 +399,9 @@ impl Resources {
     }
 }
 
-/// The work-declaration format of a Vulkan format dermis uses.
-pub fn work_format(f: vk::Format) -> Option<Format> {
+/// The work-declaration format of a Vulkan format dermis uses (checked once,
+/// when an image is declared).
+fn work_format(f: vk::Format) -> Option<Format> {
     Some(match f {
         vk::Format::R8G8B8A8_UNORM => Format::Rgba8Unorm,
         vk::Format::R8G8B8A8_SRGB => Format::Rgba8Srgb,
@@ -452,6 +471,15 @@ mod tests {
         );
     }
 
+    // Every declared image has a work format: the map is checked where an
+    // image is declared, so nothing downstream handles a missing one.
+    #[test]
+    #[should_panic(expected = "the work vocabulary cannot name")]
+    fn images_of_unnamed_formats_are_refused_when_declared() {
+        let mut r = Resources::default();
+        r.declare(desc("odd", vk::Format::B8G8R8A8_UNORM, 1));
+    }
+
     #[test]
     fn image_uses_name_format_size_and_kind() {
         let mut r = Resources::default();
@@ -465,5 +493,6 @@ mod tests {
         assert_eq!((uses[0].width, uses[0].height), (32, 16));
         assert_eq!(uses[1].kind, ImageUseKind::Sampled);
         assert_eq!(uses[1].format, Format::Rgba16Float);
+        assert_eq!(r.texel_format(rt), Format::Rgba16Float);
     }
 }

@@ -68,6 +68,11 @@ impl Format {
         }
     }
 
+    /// Whether a depth format also has a stencil aspect.
+    pub fn has_stencil(self) -> bool {
+        matches!(self, Format::D24UnormS8Uint | Format::D32FloatS8Uint)
+    }
+
     pub fn is_depth(self) -> bool {
         matches!(
             self,
@@ -276,6 +281,7 @@ mod tests {
         assert_eq!(serde_json::from_str::<Work>(&json).unwrap(), w);
         assert_eq!(Format::Rgba16Float.bytes_per_texel(), 8);
         assert!(Format::D24UnormS8Uint.is_depth() && !Format::R32Float.is_depth());
+        assert!(Format::D32FloatS8Uint.has_stencil() && !Format::D32Float.has_stencil());
     }
 
     #[test]

@@ -9,18 +9,16 @@ use anyhow::Result;
 use ash::vk;
 
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
-use super::screen::{color_write, declare_intermediate, fetch, masked_work, seed_copy, source_set};
+use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, source_set, Masked};
 use super::ssg::ScreenPush;
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
-    SssMethod, STENCIL_SKIN,
+    SssMethod,
 };
-use crate::graph::draw::fullscreen_stencil_draw;
-use crate::graph::work::{Fetch, Filter, PassRole};
-use crate::graph::{ImageId, Pass, PassContext};
+use crate::graph::work::{Fetch, Filter};
+use crate::graph::{ImageId, Pass};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::pipeline::{GraphicsDesc, Pipeline};
 
@@ -90,47 +88,36 @@ impl SssMethod for Jittered {
             wide: [k.wide[0], k.mid_radius_mm, k.wide_radius_mm, 0.0],
             ..Default::default()
         };
-        let (t, src, diffuse, region) = (f.targets, self.src, self.diffuse, f.region);
-        let ds = t.depth_stencil;
+        let (t, src, diffuse, pipeline) = (f.targets, self.src, self.diffuse, &self.pipeline);
         // Centre colour and depth and two depth texels per stretch axis by
         // texel fetch, then both rings bilinear.
-        let work = masked_work(
-            f,
-            SHADER,
-            &[RING],
-            vec![
-                fetch(f.res, src, "colorTex", Filter::Point, 1.0),
-                fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
-                // Rings rotated per pixel: neighbours share no texels.
-                Fetch {
-                    coherent: false,
-                    ..fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
-                },
-            ],
-            vec![color_write(f.res, diffuse, false)],
-            true,
-            false,
-        );
+        let fetches = vec![
+            fetch(f.res, src, "colorTex", Filter::Point, 1.0),
+            fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
+            // Rings rotated per pixel: neighbours share no texels.
+            Fetch {
+                coherent: false,
+                ..fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
+            },
+        ];
         vec![
             seed_copy("ss-jittered seed copy", f, diffuse, f.region, &[src]),
-            Pass::new("ss-jittered", PassRole::Sss)
-                .image(src, AccessKind::FragmentSampledRead)
-                .image(t.linear_depth, AccessKind::FragmentSampledRead)
-                .image(ds, AccessKind::DepthStencilReadOnly)
-                .image(diffuse, AccessKind::ColorAttachmentLoadWrite)
-                .work(work)
-                .record(move |pc: &PassContext| {
-                    fullscreen_stencil_draw(
-                        pc,
-                        &self.pipeline,
-                        self.set,
-                        &[diffuse],
-                        ds,
-                        region,
-                        STENCIL_SKIN,
-                        |c, cmd| self.pipeline.push(c, cmd, &push),
-                    )
-                }),
+            masked_pass(
+                f,
+                Masked {
+                    name: "ss-jittered".into(),
+                    shader: SHADER,
+                    loop_trips: vec![RING],
+                    pipeline,
+                    set: self.set,
+                    reads: vec![src, t.linear_depth],
+                    fetches,
+                    targets: vec![(diffuse, false)],
+                    stencil: true,
+                    depth_test: false,
+                },
+                move |c, cmd| pipeline.push(c, cmd, &push),
+            ),
         ]
     }
 

@@ -159,7 +159,12 @@ pub struct FrameView<'a, 'r> {
 
 /// An SSS method as the frame sees it.
 pub trait SssMethod {
-    /// The method's passes, in order.
+    /// Advances the method's per-frame state, once before each frame's passes
+    /// are built (bevy's `Node::update`), so that building and recording the
+    /// passes has no side effects: [`SssMethod::passes`] only reads it.
+    fn begin_frame(&mut self) {}
+    /// The method's passes, in order (as many times as asked: reports, usage
+    /// derivation and recording all build them).
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>>;
     /// The image holding the diffuse light after SSS: what the composite reads.
     fn output(&self) -> ImageId;

@@ -13,18 +13,15 @@ use anyhow::Result;
 use ash::vk;
 
 use super::region::ReachScale;
-use super::screen::{
-    color_write, declare_intermediate, fetch, fetch_at_most, masked_work, seed_copy,
-};
+use super::screen::{declare_intermediate, fetch, fetch_at_most, masked_pass, seed_copy, Masked};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
-    SssMethod, STENCIL_SKIN,
+    SssMethod,
 };
-use crate::graph::draw::{fullscreen_draw, fullscreen_stencil_draw};
-use crate::graph::work::{Filter, PassRole, ShaderWork, Work};
-use crate::graph::{ImageId, Pass, PassContext};
+use crate::graph::draw::fullscreen;
+use crate::graph::work::{Filter, PassRole, ShaderWork};
+use crate::graph::{ColorTarget, ImageId, Load, Pass, PassContext};
 use crate::skin::poisson::{poisson_disk_32, PoissonParams};
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
@@ -171,47 +168,28 @@ impl SssMethod for Poisson {
         )];
         let chains = self.chains(f);
         for l in 1..self.levels as usize {
-            let targets = [chains[0][l], chains[1][l], chains[2][l]];
-            let e = f.res.extent(targets[0]);
             let mut fetches = Vec::new();
             let mut pass = Pass::new(format!("poisson mip {l}"), PassRole::Sss);
             for (c, texture) in chains.iter().zip(["srcColor", "srcDepth", "srcNormal"]) {
                 fetches.push(fetch(f.res, c[l - 1], texture, Filter::Point, 4.0));
                 pass = pass
-                    .image(c[l - 1], AccessKind::FragmentSampledRead)
-                    .image(c[l], AccessKind::ColorAttachmentWrite);
+                    .sampled(c[l - 1])
+                    .color(ColorTarget::new(c[l], Load::DontCare));
             }
-            let work = Work::Raster {
-                shader: Some(ShaderWork {
-                    shader: MIP_SHADER.into(),
-                    fetches,
-                    alu: alu_estimate(MIP_SHADER, &[]),
-                    ..Default::default()
-                }),
-                color: targets
-                    .iter()
-                    .map(|&i| color_write(f.res, i, false))
-                    .collect(),
-                depth_stencil: None,
-                width: e.width,
-                height: e.height,
-                triangles: 1,
-                msaa: 1,
-                clears: vec![],
+            let work = ShaderWork {
+                shader: MIP_SHADER.into(),
+                fetches,
+                alu: alu_estimate(MIP_SHADER, &[]),
+                ..Default::default()
             };
             let set = self.mip_sets.get(l - 1).copied().unwrap_or_default();
-            passes.push(pass.work(work).record(move |pc: &PassContext| {
-                fullscreen_draw(pc, &self.mip_pipeline, set, &targets, |_, _| {})
+            passes.push(pass.draws(Some(work), 1).record(move |pc: &PassContext| {
+                fullscreen(pc, &self.mip_pipeline, &[set], |_, _| {})
             }));
         }
         // Every level of the three chains is read; the disk's size (8, 16 or
         // 32 taps) depends on each pixel's radius: the declared count is the most.
-        let mut pass = Pass::new("poisson", PassRole::Sss);
-        for c in &chains {
-            for &level in c {
-                pass = pass.image(level, AccessKind::FragmentSampledRead);
-            }
-        }
+        let reads: Vec<ImageId> = chains.iter().flatten().copied().collect();
         let taps = MAX_TAPS as f64;
         let mut fetches = vec![];
         for (c, texture) in chains
@@ -227,33 +205,23 @@ impl SssMethod for Poisson {
             // Whole levels (`textureLod` at an integer level): bilinear.
             fetches.push(fetch_at_most(f.res, c[0], texture, Filter::Bilinear, taps));
         }
-        let work = masked_work(
+        let (push, pipeline) = (self.push, &self.pipeline);
+        passes.push(masked_pass(
             f,
-            SHADER,
-            &[MAX_TAPS],
-            fetches,
-            vec![color_write(f.res, self.out, false)],
-            true,
-            false,
-        );
-        let (ds, out, push, region) = (t.depth_stencil, self.out, self.push, f.region);
-        passes.push(
-            pass.image(ds, AccessKind::DepthStencilReadOnly)
-                .image(out, AccessKind::ColorAttachmentLoadWrite)
-                .work(work)
-                .record(move |pc: &PassContext| {
-                    fullscreen_stencil_draw(
-                        pc,
-                        &self.pipeline,
-                        self.set,
-                        &[out],
-                        ds,
-                        region,
-                        STENCIL_SKIN,
-                        |c, cmd| self.pipeline.push(c, cmd, &push),
-                    )
-                }),
-        );
+            Masked {
+                name: "poisson".into(),
+                shader: SHADER,
+                loop_trips: vec![MAX_TAPS],
+                pipeline,
+                set: self.set,
+                reads,
+                fetches,
+                targets: vec![(self.out, false)],
+                stencil: true,
+                depth_test: false,
+            },
+            move |c, cmd| pipeline.push(c, cmd, &push),
+        ));
         passes
     }
 

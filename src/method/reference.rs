@@ -28,11 +28,10 @@ use super::screen::fetch;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::draw::{begin_rendering, DepthTarget, Load};
-use crate::graph::work::{
-    ColorWrite, DepthStencilUse, Fetch, Filter, Format, PassRole, ShaderWork, Work,
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
+use crate::graph::{
+    BufferId, ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext,
 };
-use crate::graph::{BufferId, ImageDesc, ImageId, Pass, PassContext};
 use crate::reference::narrow::{radius, supersampling};
 use crate::reference::sampling::{
     build_grid, cutoff_mm, sample_surface_within, Grid, SurfaceSample,
@@ -578,40 +577,25 @@ impl Reference {
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
             storage_write_bytes: 0.0,
         };
-        let texels: u64 = self
-            .chunks
-            .iter()
-            .map(|c| c.count.div_ceil(RADIANCE_WIDTH) as u64 * RADIANCE_WIDTH as u64)
-            .sum();
         let draws: u64 = self
             .chunks
             .iter()
             .map(|c| c.count.div_ceil(self.draw_samples) as u64)
             .sum();
+        // Each chunk's radiance target is rendered alone (its rows stacked in
+        // the work's area), every texel of it overwritten.
         let mut pass = Pass::new("reference irradiance", PassRole::Sss)
-            .image(f.targets.shadow, AccessKind::FragmentSampledRead)
-            .work(Work::Raster {
-                shader: Some(shader),
-                color: vec![crate::graph::work::ColorWrite {
-                    format: Format::Rgba32Float,
-                    blend: false,
-                }],
-                depth_stencil: None,
-                width: RADIANCE_WIDTH,
-                height: (texels / RADIANCE_WIDTH as u64) as u32,
-                triangles: draws,
-                msaa: 1,
-                clears: vec![],
-            });
+            .sampled(f.targets.shadow)
+            .each_target_alone();
         for c in &self.chunks {
             pass = pass
                 .buffer(c.buffer_ids[0], AccessKind::FragmentStorageRead)
-                .image(c.radiance, AccessKind::ColorAttachmentWrite);
+                .color(ColorTarget::new(c.radiance, Load::DontCare));
         }
-        pass.record(move |pc: &PassContext| {
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            for c in &self.chunks {
-                begin_rendering(pc, &[(c.radiance, Load::Discard)], None);
+        pass.draws(Some(shader), draws)
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let c = &self.chunks[pc.target];
                 let p = &self.irradiance;
                 p.bind(ctx, cmd, &[]);
                 p.bind_sets(ctx, cmd, 1, &[self.material_set]);
@@ -632,9 +616,7 @@ impl Reference {
                     p.push(ctx, cmd, &[n, RADIANCE_WIDTH, first_row]);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
                 }
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
-            }
-        })
+            })
     }
 }
 
@@ -643,7 +625,6 @@ impl Reference {
     /// area, normal (the narrow part's input).
     fn surface_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let sf = &self.surf;
-        let e = f.res.extent(sf.radiance);
         let shadow = fetch(
             f.res,
             f.targets.shadow,
@@ -655,91 +636,53 @@ impl Reference {
             exact: true,
             ..material_fetch("albedoTex")
         };
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: SURFACE_SHADER.into(),
-                fetches: vec![shadow, material_fetch("normalTex"), albedo],
-                alu: alu_estimate(SURFACE_SHADER, &[3, 3]),
-                ..Default::default()
-            }),
-            color: vec![
-                ColorWrite {
-                    format: Format::Rgba32Float,
-                    blend: false
-                };
-                3
-            ],
-            depth_stencil: Some(DepthStencilUse {
-                format: Format::D32Float,
-                depth_test: true,
-                depth_write: true,
-                stencil_test: false,
-                stencil_write: false,
-            }),
-            width: e.width,
-            height: e.height,
-            triangles: sf.index_count as u64 / 3 * self.instances.len() as u64,
-            msaa: 1,
-            // The three subsample targets and the depth start cleared.
-            clears: vec![
-                Format::Rgba32Float,
-                Format::Rgba32Float,
-                Format::Rgba32Float,
-                Format::D32Float,
-            ],
+        let work = ShaderWork {
+            shader: SURFACE_SHADER.into(),
+            fetches: vec![shadow, material_fetch("normalTex"), albedo],
+            alu: alu_estimate(SURFACE_SHADER, &[3, 3]),
+            ..Default::default()
         };
-        let targets = [sf.radiance, sf.position, sf.normal];
-        let depth = sf.depth;
-        let mut pass = Pass::new("reference surface", PassRole::Sss)
-            .image(f.targets.shadow, AccessKind::FragmentSampledRead)
-            .work(work);
-        for &t in &targets {
-            pass = pass.image(t, AccessKind::ColorAttachmentWrite);
-        }
-        pass = pass.image(depth, AccessKind::DepthStencilWrite);
-        pass.record(move |pc: &PassContext| {
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            let colors: Vec<(ImageId, Load)> = targets
-                .iter()
-                .map(|&t| (t, Load::Clear([0.0; 4])))
-                .collect();
-            begin_rendering(
-                pc,
-                &colors,
-                Some(DepthTarget {
-                    image: depth,
-                    clear_depth: Some(1.0),
-                    stencil: false,
-                }),
-            );
-            let p = &self.surface_pipeline;
-            p.bind(ctx, cmd, &[self.frame_set, self.surf_material]);
-            unsafe {
-                ctx.device
-                    .cmd_bind_vertex_buffers(cmd, 0, &[self.surf.vertices.raw], &[0]);
-                ctx.device.cmd_bind_index_buffer(
-                    cmd,
-                    self.surf.indices.raw,
-                    0,
-                    vk::IndexType::UINT32,
-                );
-            }
-            for m in &self.instances {
-                p.push(
-                    ctx,
-                    cmd,
-                    &SurfacePush {
-                        model: m.to_cols_array_2d(),
-                        mm_per_subsample_per_depth: self.surf.mm_per_subsample_per_depth,
-                    },
-                );
+        // The three subsample targets and the depth start cleared.
+        let clear = |t| ColorTarget::new(t, Load::Clear([0.0; 4]));
+        Pass::new("reference surface", PassRole::Sss)
+            .sampled(f.targets.shadow)
+            .color(clear(sf.radiance))
+            .color(clear(sf.position))
+            .color(clear(sf.normal))
+            .depth_stencil(DepthStencil::cleared(sf.depth, 1.0))
+            .draws(
+                Some(work),
+                sf.index_count as u64 / 3 * self.instances.len() as u64,
+            )
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.surface_pipeline;
+                p.bind(ctx, cmd, &[self.frame_set, self.surf_material]);
                 unsafe {
                     ctx.device
-                        .cmd_draw_indexed(cmd, self.surf.index_count, 1, 0, 0, 0)
-                };
-            }
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-        })
+                        .cmd_bind_vertex_buffers(cmd, 0, &[self.surf.vertices.raw], &[0]);
+                    ctx.device.cmd_bind_index_buffer(
+                        cmd,
+                        self.surf.indices.raw,
+                        0,
+                        vk::IndexType::UINT32,
+                    );
+                }
+                for m in &self.instances {
+                    p.push(
+                        ctx,
+                        cmd,
+                        &SurfacePush {
+                            model: m.to_cols_array_2d(),
+                            mm_per_subsample_per_depth: self.surf.mm_per_subsample_per_depth,
+                        },
+                    );
+                    unsafe {
+                        ctx.device
+                            .cmd_draw_indexed(cmd, self.surf.index_count, 1, 0, 0, 0)
+                    };
+                }
+            })
     }
 
     /// Zeroes the wide Gaussians' accumulators before the gather adds to them.
@@ -776,29 +719,22 @@ impl Reference {
     fn resolve_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let t = f.targets;
         let extent = f.extent;
-        let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
-        let work = Work::Compute {
-            shader: ShaderWork {
-                shader: RESOLVE_SHADER.into(),
-                fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
-                alu: alu_estimate(RESOLVE_SHADER, &[3]),
-                storage_read_bytes: 64.0,
-                storage_write_bytes: 16.0,
-            },
-            invocations: (groups.0 * groups.1 * GROUP * GROUP) as u64,
+        let work = ShaderWork {
+            shader: RESOLVE_SHADER.into(),
+            fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
+            alu: alu_estimate(RESOLVE_SHADER, &[3]),
+            storage_read_bytes: 64.0,
+            storage_write_bytes: 16.0,
         };
         let set = self.resolve_set;
         let mut pass = Pass::new("reference resolve", PassRole::Sss)
             .image(t.diffuse, AccessKind::ComputeSampledRead)
-            .image(self.out, AccessKind::ComputeStorageReadWrite)
-            .work(work);
+            .image(self.out, AccessKind::ComputeStorageReadWrite);
         for a in self.accum {
             pass = pass.image(a, AccessKind::ComputeStorageRead);
         }
-        pass.record(move |pc: &PassContext| {
-            self.resolve.bind(pc.ctx, pc.cmd, &[set]);
-            unsafe { pc.ctx.device.cmd_dispatch(pc.cmd, groups.0, groups.1, 1) };
-        })
+        pass.dispatch(work, screen_groups(extent), GROUP * GROUP)
+            .record(move |pc: &PassContext| self.resolve.bind(pc.ctx, pc.cmd, &[set]))
     }
 
     /// The narrow part, written into the output for every pixel.
@@ -806,28 +742,24 @@ impl Reference {
         let t = f.targets;
         let sf = &self.surf;
         let extent = f.extent;
-        let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
         let side = (2 * sf.max_radius + 1) as f64;
         let window = side * side;
         let bound = |image, texture: &str, count| Fetch {
             exact: false,
             ..fetch(f.res, image, texture, Filter::Point, count)
         };
-        let work = Work::Compute {
-            shader: ShaderWork {
-                shader: NARROW_SHADER.into(),
-                fetches: vec![
-                    fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
-                    bound(t.linear_depth, "depthTex", 1.0),
-                    bound(sf.normal, "surfNormal", 1.0 + window),
-                    bound(sf.position, "surfPosition", window),
-                    bound(sf.radiance, "surfRadiance", window + 1.0),
-                ],
-                alu: alu_estimate(NARROW_SHADER, &[side as u32, side as u32, 3, 3]),
-                storage_write_bytes: 16.0,
-                ..Default::default()
-            },
-            invocations: (groups.0 * groups.1 * GROUP * GROUP) as u64,
+        let work = ShaderWork {
+            shader: NARROW_SHADER.into(),
+            fetches: vec![
+                fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
+                bound(t.linear_depth, "depthTex", 1.0),
+                bound(sf.normal, "surfNormal", 1.0 + window),
+                bound(sf.position, "surfPosition", window),
+                bound(sf.radiance, "surfRadiance", window + 1.0),
+            ],
+            alu: alu_estimate(NARROW_SHADER, &[side as u32, side as u32, 3, 3]),
+            storage_write_bytes: 16.0,
+            ..Default::default()
         };
         let set = self.narrow_set;
         Pass::new("reference narrow", PassRole::Sss)
@@ -837,12 +769,18 @@ impl Reference {
             .image(sf.position, AccessKind::ComputeSampledRead)
             .image(sf.normal, AccessKind::ComputeSampledRead)
             .image(self.out, AccessKind::ComputeStorageWrite)
-            .work(work)
-            .record(move |pc: &PassContext| {
-                self.narrow.bind(pc.ctx, pc.cmd, &[set]);
-                unsafe { pc.ctx.device.cmd_dispatch(pc.cmd, groups.0, groups.1, 1) };
-            })
+            .dispatch(work, screen_groups(extent), GROUP * GROUP)
+            .record(move |pc: &PassContext| self.narrow.bind(pc.ctx, pc.cmd, &[set]))
     }
+}
+
+/// The workgroups of a dispatch over every pixel of `extent`.
+fn screen_groups(extent: vk::Extent2D) -> [u32; 3] {
+    [
+        extent.width.div_ceil(GROUP),
+        extent.height.div_ceil(GROUP),
+        1,
+    ]
 }
 
 /// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
@@ -866,9 +804,7 @@ impl SssMethod for Reference {
             self.narrow_pass(f),
             self.clear_pass(f),
         ];
-        let extent = f.extent;
-        let groups = (extent.width.div_ceil(GROUP), extent.height.div_ceil(GROUP));
-        let invocations = (groups.0 * groups.1 * GROUP * GROUP) as u64;
+        let groups = screen_groups(f.extent);
         let one = self.chunks.len() == 1;
         for (ci, c) in self.chunks.iter().enumerate() {
             for k in 0..SLABS {
@@ -885,30 +821,27 @@ impl SssMethod for Reference {
                     )
                 };
                 let candidates = self.max_candidates as f64;
-                let work = Work::Compute {
-                    shader: ShaderWork {
-                        shader: GATHER_SHADER.into(),
-                        fetches: vec![
-                            fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
-                            Fetch {
-                                exact: false,
-                                ..fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0)
-                            },
-                            Fetch {
-                                exact: false,
-                                ..fetch(f.res, self.surf.normal, "surfNormal", Filter::Point, 1.0)
-                            },
-                            Fetch {
-                                exact: false,
-                                ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
-                            },
-                        ],
-                        alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3), 3]),
-                        // Positions and normals of the candidates, cell ranges, the output.
-                        storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
-                        storage_write_bytes: 48.0,
-                    },
-                    invocations,
+                let work = ShaderWork {
+                    shader: GATHER_SHADER.into(),
+                    fetches: vec![
+                        fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
+                        Fetch {
+                            exact: false,
+                            ..fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0)
+                        },
+                        Fetch {
+                            exact: false,
+                            ..fetch(f.res, self.surf.normal, "surfNormal", Filter::Point, 1.0)
+                        },
+                        Fetch {
+                            exact: false,
+                            ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
+                        },
+                    ],
+                    alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3), 3]),
+                    // Positions and normals of the candidates, cell ranges, the output.
+                    storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
+                    storage_write_bytes: 48.0,
                 };
                 let push = GatherPush {
                     dy: k % 3 - 1,
@@ -929,11 +862,10 @@ impl SssMethod for Reference {
                         .buffer(c.buffer_ids[1], AccessKind::ComputeStorageRead)
                         .buffer(c.buffer_ids[2], AccessKind::ComputeStorageRead)
                         .buffer(self.cells_id, AccessKind::ComputeStorageRead)
-                        .work(work)
+                        .dispatch(work, groups, GROUP * GROUP)
                         .record(move |pc: &PassContext| {
                             self.gather.bind(pc.ctx, pc.cmd, &[set]);
                             self.gather.push(pc.ctx, pc.cmd, &push);
-                            unsafe { pc.ctx.device.cmd_dispatch(pc.cmd, groups.0, groups.1, 1) };
                         }),
                 );
             }

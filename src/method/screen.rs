@@ -1,6 +1,6 @@
 //! What the screen-space methods share: their intermediates, the seed copy that
 //! fills them, the descriptor set of a blur that reads colour and depth, and the
-//! work declaration of a stencil-masked full-screen pass.
+//! stencil-masked full-screen pass (declared once, here).
 //!
 //! Why seed copies: the SSS passes shade only skin pixels, but their taps read
 //! neighbours. Copying the diffuse target into an intermediate first makes its
@@ -11,10 +11,14 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::{FrameView, MethodBind};
-use crate::graph::work::{ColorWrite, DepthStencilUse, Fetch, Filter, PassRole, ShaderWork, Work};
-use crate::graph::{work_format, ImageDesc, ImageId, Pass, PassContext, Resources};
+use super::{FrameView, MethodBind, STENCIL_SKIN};
+use crate::graph::draw::fullscreen_in;
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
+use crate::graph::{
+    ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+};
 use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
 use crate::vk::pipeline::{Bind, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
 
@@ -29,8 +33,7 @@ pub fn declare_intermediate(res: &mut Resources, diffuse: ImageId, name: &str) -
 pub fn fetch(res: &Resources, image: ImageId, texture: &str, filter: Filter, count: f64) -> Fetch {
     Fetch {
         texture: texture.into(),
-        format: work_format(res.format(image))
-            .unwrap_or_else(|| panic!("image '{}' has a format work cannot name", res.name(image))),
+        format: res.texel_format(image),
         filter,
         count,
         exact: true,
@@ -52,49 +55,60 @@ pub fn fetch_at_most(
     }
 }
 
-/// A colour-write declaration for `image`.
-pub fn color_write(res: &Resources, image: ImageId, blend: bool) -> ColorWrite {
-    ColorWrite {
-        format: work_format(res.format(image)).expect("colour targets have work formats"),
-        blend,
-    }
+/// A full-screen pass tested against the frame's depth/stencil: the one
+/// declaration of every stencil-masked SSS pass (separable, ssg, ss-jittered,
+/// poisson).
+pub struct Masked<'a> {
+    pub name: String,
+    /// The fragment shader, with its loop trip counts for the ALU estimate.
+    pub shader: &'static str,
+    pub loop_trips: Vec<u32>,
+    pub pipeline: &'a Pipeline,
+    pub set: vk::DescriptorSet,
+    /// The images the shader samples, and what it fetches from them.
+    pub reads: Vec<ImageId>,
+    pub fetches: Vec<Fetch>,
+    /// The colour targets (loaded: pixels outside the mask keep their
+    /// contents), each with whether it is blended.
+    pub targets: Vec<(ImageId, bool)>,
+    /// Stencil-tested on the skin bit / depth-tested (against the depth the
+    /// pipeline's triangle is drawn at).
+    pub stencil: bool,
+    pub depth_test: bool,
 }
 
-/// The work of a full-screen pass tested against the frame's depth/stencil
-/// (stencil on the skin bit when `stencil`, depth when `depth_test`): `shader`
-/// runs per shaded fragment with `fetches` and its ALU at `loop_trips`, one
-/// triangle per region rectangle.
-pub fn masked_work(
-    f: &FrameView,
-    shader: &str,
-    loop_trips: &[u32],
-    fetches: Vec<Fetch>,
-    color: Vec<ColorWrite>,
-    stencil: bool,
-    depth_test: bool,
-) -> Work {
+/// The pass of `m`: the pipeline's full-screen triangle drawn once per
+/// rectangle of the frame's SSS region, over the frame's depth/stencil (read
+/// only); `state` sets push constants and other dynamic state after the bind.
+pub fn masked_pass<'a>(
+    f: &FrameView<'a, '_>,
+    m: Masked<'a>,
+    state: impl Fn(&Context, vk::CommandBuffer) + 'a,
+) -> Pass<'a> {
     let ds = f.targets.depth_stencil;
-    Work::Raster {
-        shader: Some(ShaderWork {
-            shader: shader.into(),
-            fetches,
-            alu: alu_estimate(shader, loop_trips),
-            ..Default::default()
-        }),
-        color,
-        depth_stencil: Some(DepthStencilUse {
-            format: work_format(f.res.format(ds)).expect("depth formats have work formats"),
-            depth_test,
-            depth_write: false,
-            stencil_test: stencil,
-            stencil_write: false,
-        }),
-        width: f.extent.width,
-        height: f.extent.height,
-        triangles: f.region.len() as u64,
-        msaa: 1,
-        clears: vec![],
+    let region = f.region;
+    let work = ShaderWork {
+        shader: m.shader.into(),
+        fetches: m.fetches,
+        alu: alu_estimate(m.shader, &m.loop_trips),
+        ..Default::default()
+    };
+    let mut pass = Pass::new(m.name, PassRole::Sss);
+    for r in m.reads {
+        pass = pass.sampled(r);
     }
+    pass = pass.depth_stencil(
+        DepthStencil::test_only(ds)
+            .depth_test(m.depth_test)
+            .stencil_test(m.stencil.then_some(STENCIL_SKIN)),
+    );
+    for (t, blend) in m.targets {
+        let target = ColorTarget::new(t, Load::Keep);
+        pass = pass.color(if blend { target.blended() } else { target });
+    }
+    let (pipeline, set) = (m.pipeline, m.set);
+    pass.draws(Some(work), region.len() as u64)
+        .record(move |pc: &PassContext| fullscreen_in(pc, pipeline, &[set], Some(region), &state))
 }
 
 /// A pass that copies `src` (the diffuse target) into each of `dsts` within
@@ -122,7 +136,7 @@ pub fn seed_copy<'a>(
         .map(|r| r.extent.width as u64 * r.extent.height as u64)
         .sum::<u64>()
         * dsts.len() as u64;
-    let bytes_per_texel = work_format(f.res.format(src)).map_or(0, |w| w.bytes_per_texel());
+    let bytes_per_texel = f.res.texel_format(src).bytes_per_texel();
     let mut pass = Pass::new(name, PassRole::Sss)
         .image(src, AccessKind::TransferRead)
         .work(Work::Copy {

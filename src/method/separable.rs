@@ -9,16 +9,14 @@ use anyhow::{bail, Result};
 use ash::vk;
 
 use super::region::{px_per_mm, ReachScale, BILINEAR_MARGIN_PX};
-use super::screen::{color_write, declare_intermediate, fetch, masked_work, seed_copy};
+use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, Masked};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
-    OptKind, OptSpec, Opts, SssMethod, STENCIL_SKIN,
+    OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::draw::fullscreen_stencil_draw;
-use crate::graph::work::{Filter, PassRole};
-use crate::graph::{ImageId, Pass, PassContext};
+use crate::graph::work::Filter;
+use crate::graph::{ImageId, Pass};
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
@@ -235,34 +233,23 @@ impl SssMethod for Separable {
                     taps,
                 ));
             }
-            let work = masked_work(
+            let (push, pipeline) = (self.push[pass], &self.pipeline);
+            masked_pass(
                 f,
-                SHADER,
-                &[n as u32 - 1],
-                fetches,
-                vec![color_write(f.res, dst, false)],
-                true,
-                false,
-            );
-            let (set, push, region) = (self.sets[pass], self.push[pass], f.region);
-            Pass::new(name, PassRole::Sss)
-                .image(src, AccessKind::FragmentSampledRead)
-                .image(t.linear_depth, AccessKind::FragmentSampledRead)
-                .image(t.depth_stencil, AccessKind::DepthStencilReadOnly)
-                .image(dst, AccessKind::ColorAttachmentLoadWrite)
-                .work(work)
-                .record(move |pc: &PassContext| {
-                    fullscreen_stencil_draw(
-                        pc,
-                        &self.pipeline,
-                        set,
-                        &[dst],
-                        t.depth_stencil,
-                        region,
-                        STENCIL_SKIN,
-                        |c, cmd| self.pipeline.push(c, cmd, &push),
-                    );
-                })
+                Masked {
+                    name: name.into(),
+                    shader: SHADER,
+                    loop_trips: vec![n as u32 - 1],
+                    pipeline,
+                    set: self.sets[pass],
+                    reads: vec![src, t.linear_depth],
+                    fetches,
+                    targets: vec![(dst, false)],
+                    stencil: true,
+                    depth_test: false,
+                },
+                move |c, cmd| pipeline.push(c, cmd, &push),
+            )
         };
         vec![
             seed_copy("sss seed copy", f, self.diffuse, f.region, &[self.tmp]),

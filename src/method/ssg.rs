@@ -14,17 +14,15 @@ use ash::vk;
 
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{
-    color_write, declare_intermediate, fetch, fetch_at_most, masked_work, seed_copy, source_set,
+    declare_intermediate, fetch, fetch_at_most, masked_pass, seed_copy, source_set, Masked,
 };
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
-    OptKind, OptSpec, Opts, SssMethod, STENCIL_SKIN,
+    OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::draw::fullscreen_stencil_draw;
-use crate::graph::work::{Fetch, Filter, PassRole};
-use crate::graph::{ImageId, Pass, PassContext};
+use crate::graph::work::{Fetch, Filter};
+use crate::graph::{ImageId, Pass};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::pipeline::{Blend, GraphicsDesc, Pipeline};
@@ -266,7 +264,6 @@ impl SssMethod for Ssg {
         )];
         let extent = f.extent;
         let stencil = self.config.mask == MaskMode::Stencil;
-        let region = f.region;
         for (g, &quad_depth) in self.gaussians.iter().zip(&self.quad_depths) {
             let base = ScreenPush {
                 texel: [1.0 / extent.width as f32, 1.0 / extent.height as f32],
@@ -287,72 +284,44 @@ impl SssMethod for Ssg {
                 ..base
             };
             let blend = [g.blend[0], g.blend[1], g.blend[2], 1.0];
-            let ds = t.depth_stencil;
-            let h_work = masked_work(
+            let horizontal = &self.horizontal;
+            passes.push(masked_pass(
                 f,
-                "ssg_horizontal.frag",
-                &[TAPS],
-                self.fetches(f, rt1),
-                vec![color_write(f.res, rt2, false)],
-                stencil,
-                true,
-            );
-            passes.push(
-                Pass::new(format!("ssg g{} horizontal", g.index), PassRole::Sss)
-                    .image(rt1, AccessKind::FragmentSampledRead)
-                    .image(t.linear_depth, AccessKind::FragmentSampledRead)
-                    .image(ds, AccessKind::DepthStencilReadOnly)
-                    .image(rt2, AccessKind::ColorAttachmentLoadWrite)
-                    .work(h_work)
-                    .record(move |pc: &PassContext| {
-                        fullscreen_stencil_draw(
-                            pc,
-                            &self.horizontal,
-                            self.set_rt1,
-                            &[rt2],
-                            ds,
-                            region,
-                            STENCIL_SKIN,
-                            |c, cmd| self.horizontal.push(c, cmd, &h),
-                        )
-                    }),
-            );
-            let v_work = masked_work(
+                Masked {
+                    name: format!("ssg g{} horizontal", g.index),
+                    shader: "ssg_horizontal.frag",
+                    loop_trips: vec![TAPS],
+                    pipeline: horizontal,
+                    set: self.set_rt1,
+                    reads: vec![rt1, t.linear_depth],
+                    fetches: self.fetches(f, rt1),
+                    targets: vec![(rt2, false)],
+                    stencil,
+                    depth_test: true,
+                },
+                move |c, cmd| horizontal.push(c, cmd, &h),
+            ));
+            // RTF (the diffuse target) blends with the constant w'_i.
+            let vertical = &self.vertical;
+            passes.push(masked_pass(
                 f,
-                "ssg_vertical.frag",
-                &[TAPS],
-                self.fetches(f, rt2),
-                vec![
-                    color_write(f.res, rt1, false),
-                    color_write(f.res, diffuse, true),
-                ],
-                stencil,
-                true,
-            );
-            passes.push(
-                Pass::new(format!("ssg g{} vertical", g.index), PassRole::Sss)
-                    .image(rt2, AccessKind::FragmentSampledRead)
-                    .image(t.linear_depth, AccessKind::FragmentSampledRead)
-                    .image(ds, AccessKind::DepthStencilReadOnly)
-                    .image(rt1, AccessKind::ColorAttachmentLoadWrite)
-                    .image(diffuse, AccessKind::ColorAttachmentLoadWrite)
-                    .work(v_work)
-                    .record(move |pc: &PassContext| {
-                        fullscreen_stencil_draw(
-                            pc,
-                            &self.vertical,
-                            self.set_rt2,
-                            &[rt1, diffuse],
-                            ds,
-                            region,
-                            STENCIL_SKIN,
-                            |c, cmd| {
-                                self.vertical.push(c, cmd, &v);
-                                unsafe { c.device.cmd_set_blend_constants(cmd, &blend) };
-                            },
-                        )
-                    }),
-            );
+                Masked {
+                    name: format!("ssg g{} vertical", g.index),
+                    shader: "ssg_vertical.frag",
+                    loop_trips: vec![TAPS],
+                    pipeline: vertical,
+                    set: self.set_rt2,
+                    reads: vec![rt2, t.linear_depth],
+                    fetches: self.fetches(f, rt2),
+                    targets: vec![(rt1, false), (diffuse, true)],
+                    stencil,
+                    depth_test: true,
+                },
+                move |c, cmd| {
+                    vertical.push(c, cmd, &v);
+                    unsafe { c.device.cmd_set_blend_constants(cmd, &blend) };
+                },
+            ));
         }
         passes
     }

@@ -38,34 +38,34 @@
 //!   staggered: its map is at most `refresh - 1` frames old.
 
 use std::any::Any;
-use std::cell::{Cell, RefCell};
 
 use anyhow::{bail, Result};
 use ash::vk;
 use glam::{Mat4, Vec4};
 
 use super::region::ReachScale;
-use super::screen::{color_write, fetch};
+use super::screen::fetch;
 use super::{
     EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts,
     SssMethod,
 };
-use crate::graph::draw::{begin_rendering, DepthTarget, Load};
-use crate::graph::work::{DepthStencilUse, Fetch, Filter, Format, PassRole, ShaderWork, Work};
-use crate::graph::{work_format, ImageDesc, ImageId, Pass, PassContext, Resources};
+use crate::graph::draw::fullscreen;
+use crate::graph::mesh::GpuMesh;
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
+use crate::graph::{
+    ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+};
 use crate::scene::mesh::Vertex;
 use crate::skin::tsd_ref::{
     self, atlas, box_outside, clip_planes, depth_scale, map_size, nearest_corner_distance,
     projected_px, reference_distance, refreshes, tsd_gaussians, Atlas, TsdGaussian, BACKFACE_BIAS,
     CULL_COS, EDGE_GUARD_TEXELS, NO_CLIP,
 };
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline, VertexInput};
 use crate::vk::shader_stats::alu_estimate;
-use crate::vk::upload::device_buffer;
 
 const UV_VERT: &str = "tsd_uv.vert";
 const MASK_SHADER: &str = "tsd_mask.frag";
@@ -409,20 +409,19 @@ pub struct Tsd {
     pub d_ref_units: f32,
     pipelines: Pipelines,
     pool: DescriptorPool,
-    vertices: Buffer,
-    indices: Buffer,
-    index_count: u32,
+    /// The head with each tangent's w carrying its atlas island.
+    mesh: GpuMesh,
     character_ubo: Buffer,
     atlas_ubo: Buffer,
     sets: SharedSets,
     diffuse: ImageId,
     shadow: ImageId,
     mask_format: vk::Format,
-    /// Frames recorded so far, and per character whether this frame updates
-    /// its map and whether it has one.
-    frame: Cell<u64>,
-    updating: RefCell<Vec<bool>>,
-    has_map: RefCell<Vec<bool>>,
+    /// Frames begun so far, and per character whether this frame updates its
+    /// map and whether it has one (set by `begin_frame`, read by `passes`).
+    frame: u64,
+    updating: Vec<bool>,
+    has_map: Vec<bool>,
 }
 
 impl Tsd {
@@ -470,18 +469,16 @@ impl Tsd {
             d_ref_units: 0.0,
             pipelines: Pipelines::default(),
             pool: DescriptorPool::default(),
-            vertices: Buffer::default(),
-            indices: Buffer::default(),
-            index_count: head.mesh.indices.len() as u32,
+            mesh: GpuMesh::default(),
             character_ubo: Buffer::default(),
             atlas_ubo: Buffer::default(),
             sets: SharedSets::default(),
             diffuse: s.targets.diffuse,
             shadow: s.targets.shadow,
             mask_format: s.depth_stencil_format,
-            frame: Cell::new(0),
-            updating: RefCell::new(vec![true; s.instances.len()]),
-            has_map: RefCell::new(vec![false; s.instances.len()]),
+            frame: 0,
+            updating: vec![true; s.instances.len()],
+            has_map: vec![false; s.instances.len()],
         };
         // Filled in by `build`: on an error, the guard frees what exists.
         let mut t = Guard::new(s.ctx, t);
@@ -595,72 +592,37 @@ impl Tsd {
                 }
             })
             .collect();
-        self.vertices = device_buffer(
-            s.ctx,
-            "tsd head vertices",
-            bytemuck::cast_slice(&vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
-        self.indices = device_buffer(
-            s.ctx,
-            "tsd head indices",
-            bytemuck::cast_slice(&mesh.indices),
-            vk::BufferUsageFlags::INDEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
+        self.mesh = GpuMesh::upload(s.ctx, "tsd head", &vertices, &mesh.indices)?;
         Ok(())
     }
 
-    /// Which characters this frame updates (called when the frame's first
-    /// pass records): all, unless the z pre-passes cull a character as outside
-    /// the frustum, or as far and not due for its refresh (after it has a map).
-    fn begin_frame(&self) {
-        let f = self.frame.get();
-        let mut up = self.updating.borrow_mut();
-        let mut has = self.has_map.borrow_mut();
-        for (k, c) in self.characters.iter().enumerate() {
-            up[k] = !c.outside && (!c.far || !has[k] || refreshes(f, k, self.config.refresh));
-            has[k] |= up[k];
-        }
-        self.frame.set(f + 1);
-    }
-
     fn updates(&self, k: usize) -> bool {
-        self.updating.borrow()[k]
+        self.updating[k]
     }
 
     /// Triangles of one draw of the head.
     fn triangles(&self) -> u64 {
-        self.index_count as u64 / 3
+        self.mesh.triangles()
     }
 
     fn draw_head(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        unsafe {
-            ctx.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
-            ctx.device
-                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
-            ctx.device
-                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
-        }
+        self.mesh.bind_and_draw(ctx, cmd);
     }
 
-    fn mask_use(&self, depth_test: bool) -> Option<DepthStencilUse> {
-        self.maps.mask.map(|_| DepthStencilUse {
-            format: work_format(self.mask_format).expect("depth formats have work formats"),
-            depth_test: depth_test && self.config.z_prepass,
-            depth_write: false,
-            stencil_test: self.config.cull == Cull::Stencil,
-            stencil_write: false,
-        })
+    /// The mask as the texture-space passes after the mask pass test it:
+    /// depth EQUAL 0 with the z pre-passes, the cull bit with the stencil cull.
+    fn mask_test(&self, mask: ImageId) -> DepthStencil {
+        let cfg = self.config;
+        DepthStencil::test_only(mask)
+            .depth_test(cfg.z_prepass)
+            .stencil_test((cfg.cull == Cull::Stencil).then_some(1))
     }
 
     /// The mask pass of character `k`: depth 1 and stencil 0 everywhere, then
     /// (when it is updated) the z pre-passes' draws (depth 0 on the unwrapped
     /// mesh, clipped; depth 1 where it faces away) and the cull mask's
     /// (stencil 1 where it faces the eye within 105 degrees).
-    fn mask_pass<'a>(&'a self, k: usize, first: bool) -> Pass<'a> {
+    fn mask_pass<'a>(&'a self, k: usize) -> Pass<'a> {
         let cfg = self.config;
         let mask = self
             .maps
@@ -668,72 +630,60 @@ impl Tsd {
             .expect("masked configurations declare a mask");
         let c = &self.characters[k];
         let draws = 2 * cfg.z_prepass as u64 + (cfg.cull == Cull::Stencil) as u64;
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: MASK_SHADER.into(),
-                fetches: Vec::new(),
-                alu: alu_estimate(MASK_SHADER, &[]),
-                ..Default::default()
-            }),
-            color: Vec::new(),
-            depth_stencil: Some(DepthStencilUse {
-                format: work_format(self.mask_format).expect("depth formats have work formats"),
-                depth_test: cfg.z_prepass,
-                depth_write: cfg.z_prepass,
-                stencil_test: false,
-                stencil_write: cfg.cull == Cull::Stencil,
-            }),
-            width: c.size,
-            height: c.size,
-            triangles: self.triangles() * draws,
-            msaa: 1,
-            // Depth 1 and stencil 0 everywhere first.
-            clears: vec![work_format(self.mask_format).expect("depth formats have work formats")],
+        let work = ShaderWork {
+            shader: MASK_SHADER.into(),
+            fetches: Vec::new(),
+            alu: alu_estimate(MASK_SHADER, &[]),
+            ..Default::default()
         };
-        let size = c.size;
+        let up = self.updates(k);
         Pass::new(format!("tsd mask c{k}"), PassRole::Sss)
-            .image(mask, AccessKind::DepthStencilWrite)
-            .work(work)
+            .depth_stencil(
+                DepthStencil::cleared(mask, 1.0)
+                    .depth_test(cfg.z_prepass)
+                    .depth_write(cfg.z_prepass)
+                    .stencil_write(cfg.cull == Cull::Stencil),
+            )
+            .render_area(square(c.size))
+            .draws(Some(work), self.triangles() * draws)
             .record(move |pc: &PassContext| {
-                if first {
-                    self.begin_frame();
+                if !up {
+                    return;
                 }
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
-                begin_area(pc, &[], Some((mask, AttachmentUse::Clear)), size);
-                if self.updates(k) {
-                    let p = &self.pipelines;
-                    let c = &self.characters[k];
-                    if cfg.z_prepass {
-                        p.mask_depth.bind(ctx, cmd, &[self.sets.frame[0]]);
-                        p.mask_depth.bind_sets(ctx, cmd, 2, &[c.uv_sets[0]]);
-                        p.mask_depth.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
-                        self.draw_head(ctx, cmd);
-                        p.mask_backface.bind(ctx, cmd, &[self.sets.frame[1]]);
-                        p.mask_backface.bind_sets(ctx, cmd, 2, &[c.uv_sets[1]]);
-                        p.mask_backface
-                            .push(ctx, cmd, &uv_push(1.0, -BACKFACE_BIAS, 0.0));
-                        self.draw_head(ctx, cmd);
-                    }
-                    if cfg.cull == Cull::Stencil {
-                        p.mask_cull.bind(ctx, cmd, &[self.sets.frame[2]]);
-                        p.mask_cull.bind_sets(ctx, cmd, 2, &[c.uv_sets[2]]);
-                        unsafe {
-                            ctx.device.cmd_set_stencil_reference(
-                                cmd,
-                                vk::StencilFaceFlags::FRONT_AND_BACK,
-                                1,
-                            )
-                        };
-                        p.mask_cull.push(ctx, cmd, &uv_push(0.0, CULL_COS, 1.0));
-                        self.draw_head(ctx, cmd);
-                    }
+                let p = &self.pipelines;
+                let c = &self.characters[k];
+                if cfg.z_prepass {
+                    p.mask_depth.bind(ctx, cmd, &[self.sets.frame[0]]);
+                    p.mask_depth.bind_sets(ctx, cmd, 2, &[c.uv_sets[0]]);
+                    p.mask_depth.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
+                    self.draw_head(ctx, cmd);
+                    p.mask_backface.bind(ctx, cmd, &[self.sets.frame[1]]);
+                    p.mask_backface.bind_sets(ctx, cmd, 2, &[c.uv_sets[1]]);
+                    p.mask_backface
+                        .push(ctx, cmd, &uv_push(1.0, -BACKFACE_BIAS, 0.0));
+                    self.draw_head(ctx, cmd);
                 }
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
+                if cfg.cull == Cull::Stencil {
+                    p.mask_cull.bind(ctx, cmd, &[self.sets.frame[2]]);
+                    p.mask_cull.bind_sets(ctx, cmd, 2, &[c.uv_sets[2]]);
+                    // Set after the bind: the pre-pass pipelines before it
+                    // take no dynamic stencil reference.
+                    unsafe {
+                        ctx.device.cmd_set_stencil_reference(
+                            cmd,
+                            vk::StencilFaceFlags::FRONT_AND_BACK,
+                            1,
+                        )
+                    };
+                    p.mask_cull.push(ctx, cmd, &uv_push(0.0, CULL_COS, 1.0));
+                    self.draw_head(ctx, cmd);
+                }
             })
     }
 
     /// The irradiance pass of character `k` (MRT: irradiance, stretch u, stretch v).
-    fn irradiance_pass<'a>(&'a self, k: usize, first: bool, f: &FrameView<'a, '_>) -> Pass<'a> {
+    fn irradiance_pass<'a>(&'a self, k: usize, f: &FrameView<'a, '_>) -> Pass<'a> {
         let cfg = self.config;
         let m = self.maps;
         let c = &self.characters[k];
@@ -748,68 +698,36 @@ impl Tsd {
             material_fetch("albedoTex", !culls),
             shadow(Filter::Point, 1.0, false),
         ];
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: IRRADIANCE_SHADER.into(),
-                fetches,
-                alu: alu_estimate(IRRADIANCE_SHADER, &PCF_TRIPS),
-                ..Default::default()
-            }),
-            color: vec![
-                color_write(f.res, m.irradiance, false),
-                color_write(f.res, m.stretch_u, false),
-                color_write(f.res, m.stretch_v, false),
-            ],
-            depth_stencil: self.mask_use(true),
-            width: c.size,
-            height: c.size,
-            triangles: self.triangles(),
-            msaa: 1,
-            // An updated character's maps start cleared (coverage 0 off the mesh).
-            clears: [m.irradiance, m.stretch_u, m.stretch_v]
-                .iter()
-                .filter_map(|&i| work_format(f.res.format(i)))
-                .collect(),
+        let work = ShaderWork {
+            shader: IRRADIANCE_SHADER.into(),
+            fetches,
+            alu: alu_estimate(IRRADIANCE_SHADER, &PCF_TRIPS),
+            ..Default::default()
+        };
+        // An updated character's maps start cleared (coverage 0 off the mesh).
+        let load = if self.updates(k) {
+            Load::Clear([0.0; 4])
+        } else {
+            Load::DontCare
         };
         let mut pass = Pass::new(format!("tsd irradiance c{k}"), PassRole::Sss)
-            .image(f.targets.shadow, AccessKind::FragmentSampledRead)
-            .image(m.irradiance, AccessKind::ColorAttachmentWrite)
-            .image(m.stretch_u, AccessKind::ColorAttachmentWrite)
-            .image(m.stretch_v, AccessKind::ColorAttachmentWrite)
-            .work(work);
+            .sampled(f.targets.shadow)
+            .color(ColorTarget::new(m.irradiance, load))
+            .color(ColorTarget::new(m.stretch_u, load))
+            .color(ColorTarget::new(m.stretch_v, load));
         if let Some(mask) = m.mask {
-            pass = pass.image(mask, AccessKind::DepthStencilReadOnly);
+            pass = pass.depth_stencil(self.mask_test(mask));
         }
-        let size = c.size;
-        pass.record(move |pc: &PassContext| {
-            if first {
-                self.begin_frame();
-            }
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            let load = if self.updates(k) {
-                AttachmentUse::Clear
-            } else {
-                AttachmentUse::DontCare
-            };
-            let colors = [
-                (m.irradiance, load),
-                (m.stretch_u, load),
-                (m.stretch_v, load),
-            ];
-            begin_area(
-                pc,
-                &colors,
-                m.mask.map(|z| (z, AttachmentUse::ReadOnly)),
-                size,
-            );
-            let p = &self.pipelines.irradiance;
-            p.bind(ctx, cmd, &[self.sets.frame[3], self.sets.material]);
-            p.bind_sets(ctx, cmd, 2, &[self.characters[k].uv_sets[3]]);
-            set_stencil_ref(ctx, cmd, p);
-            p.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
-            self.draw_head(ctx, cmd);
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-        })
+        pass.render_area(square(c.size))
+            .draws(Some(work), self.triangles())
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.pipelines.irradiance;
+                p.bind(ctx, cmd, &[self.sets.frame[3], self.sets.material]);
+                p.bind_sets(ctx, cmd, 2, &[self.characters[k].uv_sets[3]]);
+                p.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
+                self.draw_head(ctx, cmd);
+            })
     }
 
     /// Gaussian `g`'s pass along u (`v == false`: source -> temp) or v (temp ->
@@ -839,53 +757,42 @@ impl Tsd {
                 ..fetch(f.res, src, "srcTex", Filter::Bilinear, 6.0)
             },
         ];
-        let mut color = vec![color_write(f.res, dst, false)];
-        if v {
-            color.push(color_write(f.res, c.map, true));
-        }
-        // The first Gaussian's passes start their targets (cleared when only
-        // masked texels are written); later ones keep the zeros outside the mask.
-        // The first Gaussian clears its masked target, and along v the
-        // character's map (see the recording below).
-        let masked = cfg.masked();
-        let mut clears = Vec::new();
-        if g == 0 && masked {
-            clears.extend(work_format(f.res.format(dst)));
-        }
-        if g == 0 && v {
-            clears.extend(work_format(f.res.format(c.map)));
-        }
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: shader.into(),
-                fetches,
-                alu: alu_estimate(shader, &BLUR_TRIPS),
-                ..Default::default()
-            }),
-            color,
-            depth_stencil: self.mask_use(true),
-            width: c.size,
-            height: c.size,
-            triangles: 1,
-            msaa: 1,
-            clears,
+        let work = ShaderWork {
+            shader: shader.into(),
+            fetches,
+            alu: alu_estimate(shader, &BLUR_TRIPS),
+            ..Default::default()
         };
-        let dst_access = if g == 0 || !masked {
-            AccessKind::ColorAttachmentWrite
+        // Masked, only texels inside the mask are written: the first Gaussian
+        // clears its target (when the character is updated) and later ones keep
+        // the zeros outside the mask. Unmasked, every texel is overwritten.
+        let up = self.updates(k);
+        let masked = cfg.masked();
+        let start = if g == 0 && masked && up {
+            Load::Clear([0.0; 4])
+        } else if g == 0 || !masked {
+            Load::DontCare
         } else {
-            AccessKind::ColorAttachmentLoadWrite
+            Load::Keep
         };
         let axis = if v { "v" } else { "u" };
         let mut pass = Pass::new(format!("tsd g{} {axis} c{k}", gauss.index), PassRole::Sss)
-            .image(src, AccessKind::FragmentSampledRead)
-            .image(stretch, AccessKind::FragmentSampledRead)
-            .image(dst, dst_access)
-            .work(work);
+            .sampled(src)
+            .sampled(stretch)
+            .color(ColorTarget::new(dst, start));
         if v {
-            pass = pass.image(c.map, AccessKind::ColorAttachmentLoadWrite);
+            // A character not updated keeps its map. An updated one starts
+            // from zeros: the first Gaussian blends with w' = 1, but a NaN in
+            // memory nobody wrote would survive a factor of 0.
+            let load = if g == 0 && up {
+                Load::Clear([0.0; 4])
+            } else {
+                Load::Keep
+            };
+            pass = pass.color(ColorTarget::new(c.map, load).blended().persistent());
         }
         if let Some(mask) = m.mask {
-            pass = pass.image(mask, AccessKind::DepthStencilReadOnly);
+            pass = pass.depth_stencil(self.mask_test(mask));
         }
         let set = self.sets.blur[if v {
             2
@@ -901,109 +808,55 @@ impl Tsd {
             uv_max: uv_max(c.size, cfg.size),
             alpha_test: (cfg.cull == Cull::Alpha) as i32,
         };
-        let (size, map, blend) = (c.size, c.map, gauss.blend);
-        pass.record(move |pc: &PassContext| {
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            let up = self.updates(k);
-            let start = if g == 0 && masked && up {
-                AttachmentUse::Clear
-            } else if dst_access == AccessKind::ColorAttachmentWrite {
-                AttachmentUse::DontCare
-            } else {
-                AttachmentUse::Load
-            };
-            let mut colors = vec![(dst, start)];
-            if v {
-                // A character not updated keeps its map. An updated one starts
-                // from zeros: the first Gaussian blends with w' = 1, but a
-                // NaN in memory nobody wrote would survive a factor of 0.
-                let load = if g == 0 && up {
-                    AttachmentUse::Clear
-                } else {
-                    AttachmentUse::Load
-                };
-                colors.push((map, load));
-            }
-            begin_area(
-                pc,
-                &colors,
-                m.mask.map(|z| (z, AttachmentUse::ReadOnly)),
-                size,
-            );
-            let p = if v {
-                &self.pipelines.blur_v
-            } else {
-                &self.pipelines.blur_u
-            };
-            p.bind(ctx, cmd, &[set]);
-            set_stencil_ref(ctx, cmd, p);
-            p.push(ctx, cmd, &push);
-            unsafe {
-                if v {
-                    ctx.device
-                        .cmd_set_blend_constants(cmd, &[blend[0], blend[1], blend[2], 1.0]);
-                }
-                ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
-                ctx.device.cmd_end_rendering(cmd);
-            }
-        })
+        let blend = gauss.blend;
+        let p = if v {
+            &self.pipelines.blur_v
+        } else {
+            &self.pipelines.blur_u
+        };
+        pass.render_area(square(c.size))
+            .draws(Some(work), 1)
+            .record(move |pc: &PassContext| {
+                fullscreen(pc, p, &[set], |ctx, cmd| {
+                    p.push(ctx, cmd, &push);
+                    if v {
+                        unsafe {
+                            ctx.device
+                                .cmd_set_blend_constants(cmd, &[blend[0], blend[1], blend[2], 1.0])
+                        };
+                    }
+                })
+            })
     }
 
     /// Every head drawn with the frame's vertex shader, its map's diffuse
     /// written where the geometry pass's depth matches.
     fn final_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
-        let t = f.targets;
-        let ds = t.depth_stencil;
+        let ds = f.targets.depth_stencil;
         let first_map = self.characters[0].map;
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: FINAL_SHADER.into(),
-                fetches: vec![fetch(f.res, first_map, "mapTex", Filter::Bilinear, 1.0)],
-                alu: alu_estimate(FINAL_SHADER, &[]),
-                ..Default::default()
-            }),
-            color: vec![color_write(f.res, self.diffuse, false)],
-            depth_stencil: Some(DepthStencilUse {
-                format: work_format(f.res.format(ds)).expect("depth formats have work formats"),
-                depth_test: true,
-                depth_write: false,
-                stencil_test: false,
-                stencil_write: false,
-            }),
-            width: f.extent.width,
-            height: f.extent.height,
-            triangles: self.triangles() * self.characters.len() as u64,
-            msaa: 1,
-            clears: Vec::new(),
+        let work = ShaderWork {
+            shader: FINAL_SHADER.into(),
+            fetches: vec![fetch(f.res, first_map, "mapTex", Filter::Bilinear, 1.0)],
+            alu: alu_estimate(FINAL_SHADER, &[]),
+            ..Default::default()
         };
         let mut pass = Pass::new("tsd final", PassRole::Sss)
-            .image(self.diffuse, AccessKind::ColorAttachmentLoadWrite)
-            .image(ds, AccessKind::DepthStencilReadOnly)
-            .work(work);
+            .color(ColorTarget::new(self.diffuse, Load::Keep))
+            .depth_stencil(DepthStencil::test_only(ds).depth_test(true));
         for c in &self.characters {
-            pass = pass.image(c.map, AccessKind::FragmentSampledRead);
+            pass = pass.sampled(c.map);
         }
-        let diffuse = self.diffuse;
-        pass.record(move |pc: &PassContext| {
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            begin_rendering(
-                pc,
-                &[(diffuse, Load::Keep)],
-                Some(DepthTarget {
-                    image: ds,
-                    clear_depth: None,
-                    stencil: true,
-                }),
-            );
-            let p = &self.pipelines.final_pass;
-            p.bind(ctx, cmd, &[self.sets.frame[4]]);
-            for c in &self.characters {
-                p.bind_sets(ctx, cmd, 1, &[c.final_set]);
-                p.push(ctx, cmd, &c.model.to_cols_array_2d());
-                self.draw_head(ctx, cmd);
-            }
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-        })
+        pass.draws(Some(work), self.triangles() * self.characters.len() as u64)
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.pipelines.final_pass;
+                p.bind(ctx, cmd, &[self.sets.frame[4]]);
+                for c in &self.characters {
+                    p.bind_sets(ctx, cmd, 1, &[c.final_set]);
+                    p.push(ctx, cmd, &c.model.to_cols_array_2d());
+                    self.draw_head(ctx, cmd);
+                }
+            })
     }
 }
 
@@ -1040,15 +893,6 @@ fn material_fetch(texture: &str, exact: bool) -> Fetch {
     }
 }
 
-fn set_stencil_ref(ctx: &Context, cmd: vk::CommandBuffer, p: &Pipeline) {
-    if p.has_stencil {
-        unsafe {
-            ctx.device
-                .cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, 1)
-        };
-    }
-}
-
 fn declare_maps(res: &mut Resources, cfg: &Config, mask_format: vk::Format) -> Maps {
     let e = square(cfg.size);
     Maps {
@@ -1060,89 +904,6 @@ fn declare_maps(res: &mut Resources, cfg: &Config, mask_format: vk::Format) -> M
         mask: cfg
             .masked()
             .then(|| res.declare(ImageDesc::new("tsd mask", e, mask_format))),
-    }
-}
-
-/// How a texture-space pass starts an attachment.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum AttachmentUse {
-    Clear,
-    DontCare,
-    Load,
-    /// Depth/stencil tested only.
-    ReadOnly,
-}
-
-/// Dynamic rendering over the `size`^2 corner of the maps (the depth-sized
-/// map, eq. 3.2: render area, viewport and scissor), colours cleared to 0 and
-/// depth/stencil to (1, 0) where asked.
-fn begin_area(
-    pc: &PassContext,
-    colors: &[(ImageId, AttachmentUse)],
-    depth: Option<(ImageId, AttachmentUse)>,
-    size: u32,
-) {
-    let op = |u: AttachmentUse| match u {
-        AttachmentUse::Clear => vk::AttachmentLoadOp::CLEAR,
-        AttachmentUse::DontCare => vk::AttachmentLoadOp::DONT_CARE,
-        AttachmentUse::Load | AttachmentUse::ReadOnly => vk::AttachmentLoadOp::LOAD,
-    };
-    let color_att: Vec<vk::RenderingAttachmentInfo> = colors
-        .iter()
-        .map(|&(id, u)| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(pc.view(id))
-                .image_layout(pc.layout(id))
-                .load_op(op(u))
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue { float32: [0.0; 4] },
-                })
-        })
-        .collect();
-    let ds_att = depth.map(|(id, u)| {
-        vk::RenderingAttachmentInfo::default()
-            .image_view(pc.view(id))
-            .image_layout(pc.layout(id))
-            .load_op(op(u))
-            .store_op(if u == AttachmentUse::ReadOnly {
-                vk::AttachmentStoreOp::NONE
-            } else {
-                vk::AttachmentStoreOp::STORE
-            })
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 1.0,
-                    stencil: 0,
-                },
-            })
-    });
-    let area = vk::Rect2D {
-        offset: vk::Offset2D::default(),
-        extent: square(size),
-    };
-    let mut info = vk::RenderingInfo::default()
-        .render_area(area)
-        .layer_count(1)
-        .color_attachments(&color_att);
-    if let Some(att) = &ds_att {
-        info = info.depth_attachment(att).stencil_attachment(att);
-    }
-    unsafe {
-        pc.ctx.device.cmd_begin_rendering(pc.cmd, &info);
-        pc.ctx.device.cmd_set_viewport(
-            pc.cmd,
-            0,
-            &[vk::Viewport {
-                x: 0.0,
-                y: 0.0,
-                width: size as f32,
-                height: size as f32,
-                min_depth: 0.0,
-                max_depth: 1.0,
-            }],
-        );
-        pc.ctx.device.cmd_set_scissor(pc.cmd, 0, &[area]);
     }
 }
 
@@ -1277,11 +1038,10 @@ impl SssMethod for Tsd {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
         let mut passes = Vec::new();
         for k in 0..self.characters.len() {
-            let first = k == 0;
             if self.config.masked() {
-                passes.push(self.mask_pass(k, first));
+                passes.push(self.mask_pass(k));
             }
-            passes.push(self.irradiance_pass(k, first && !self.config.masked(), f));
+            passes.push(self.irradiance_pass(k, f));
             for g in 0..self.gaussians.len() {
                 passes.push(self.blur_pass(k, g, false, f));
                 passes.push(self.blur_pass(k, g, true, f));
@@ -1289,6 +1049,20 @@ impl SssMethod for Tsd {
         }
         passes.push(self.final_pass(f));
         passes
+    }
+
+    /// Which characters this frame updates: all, unless the z pre-passes cull
+    /// a character as outside the frustum, or as far and not due for its
+    /// refresh (after it has a map).
+    fn begin_frame(&mut self) {
+        let f = self.frame;
+        for (k, c) in self.characters.iter().enumerate() {
+            let up =
+                !c.outside && (!c.far || !self.has_map[k] || refreshes(f, k, self.config.refresh));
+            self.updating[k] = up;
+            self.has_map[k] |= up;
+        }
+        self.frame = f + 1;
     }
 
     fn output(&self) -> ImageId {
@@ -1419,8 +1193,7 @@ impl SssMethod for Tsd {
     fn destroy(&mut self, ctx: &Context) {
         self.pipelines.destroy(ctx);
         self.pool.destroy(ctx);
-        self.vertices.destroy(ctx);
-        self.indices.destroy(ctx);
+        self.mesh.destroy(ctx);
         self.character_ubo.destroy(ctx);
         self.atlas_ubo.destroy(ctx);
     }

@@ -10,11 +10,9 @@ use glam::Mat4;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
 use super::targets::{LDR_FORMAT, SHADOW_FORMAT};
-use crate::graph::draw::{begin_rendering, fullscreen_draw, DepthTarget, Load};
-use crate::graph::work::{
-    ColorWrite, DepthStencilUse, Fetch, Filter, Format, PassRole, ShaderWork, Work,
-};
-use crate::graph::{work_format, ImageId, Pass, PassContext, Resources};
+use crate::graph::draw::fullscreen;
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
+use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
 use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
 use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
 use crate::scene::camera::Camera;
@@ -23,7 +21,6 @@ use crate::scene::light::LightFrame;
 use crate::scene::Scene;
 use crate::skin::beckmann::beckmann_lut;
 use crate::skin::transmittance::shrink_units;
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::{Buffer, Image};
@@ -446,7 +443,7 @@ impl Frame {
 
     /// The frame's passes in order, the method's in the middle.
     pub fn passes<'a>(&'a self, method: &'a dyn SssMethod, res: &Resources) -> Vec<Pass<'a>> {
-        let mut passes = vec![self.shadow_pass(res), self.geometry_pass(res)];
+        let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
         passes.extend(method.passes(&self.view(res)));
         passes.push(self.composite_pass(res, method.output()));
         passes.push(self.tonemap_pass(res));
@@ -460,43 +457,17 @@ impl Frame {
             .filter(|o| o.skin || !skin_only)
             .map(|o| {
                 let copies = if o.skin { self.instances.len() } else { 1 };
-                o.index_count as u64 / 3 * copies as u64
+                o.mesh.triangles() * copies as u64
             })
             .sum()
     }
 
-    fn shadow_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let shadow = self.targets.shadow;
-        let e = res.extent(shadow);
+    fn shadow_pass<'a>(&'a self) -> Pass<'a> {
         Pass::new("shadow map", PassRole::Shadow)
-            .image(shadow, AccessKind::DepthStencilWrite)
-            .work(Work::Raster {
-                shader: None,
-                color: vec![],
-                depth_stencil: Some(DepthStencilUse {
-                    format: Format::D32Float,
-                    depth_test: true,
-                    depth_write: true,
-                    stencil_test: false,
-                    stencil_write: false,
-                }),
-                width: e.width,
-                height: e.height,
-                triangles: self.triangles(true),
-                msaa: 1,
-                clears: vec![Format::D32Float],
-            })
+            .depth_stencil(DepthStencil::cleared(self.targets.shadow, 1.0))
+            .draws(None, self.triangles(true))
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
-                begin_rendering(
-                    pc,
-                    &[],
-                    Some(DepthTarget {
-                        image: shadow,
-                        clear_depth: Some(1.0),
-                        stencil: false,
-                    }),
-                );
                 self.shadow_pipeline.bind(ctx, cmd, &[]);
                 // Heads only: the backdrop receives shadows but casts none worth a texel.
                 for obj in self.objects.iter().filter(|o| o.skin) {
@@ -509,16 +480,11 @@ impl Frame {
                         obj.bind_and_draw(ctx, cmd);
                     }
                 }
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
             })
     }
 
     fn geometry_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
         let t = self.targets;
-        let colors: Vec<ImageId> = [t.diffuse, t.specular, t.linear_depth]
-            .into_iter()
-            .chain(t.normals)
-            .collect();
         let shader = geometry_shader(&t);
         let rgba8 = |texture: &str, exact| Fetch {
             texture: texture.into(),
@@ -528,7 +494,7 @@ impl Frame {
             exact,
             coherent: true,
         };
-        let shadow_format = work_format(res.format(t.shadow)).expect("shadow format");
+        let shadow_format = res.texel_format(t.shadow);
         // Per fragment: the 3x3 PCF, the three material maps (the normal map
         // only where the tangent frame is valid), the Beckmann lobe where
         // N.L > 0, and one shadow-map texel for transmittance on skin.
@@ -561,88 +527,49 @@ impl Frame {
                 coherent: true,
             },
         ];
-        let color: Vec<ColorWrite> = colors
-            .iter()
-            .map(|&c| ColorWrite {
-                format: work_format(res.format(c)).expect("colour formats"),
-                blend: false,
-            })
-            .collect();
-        let ds_format = work_format(res.format(t.depth_stencil)).expect("depth formats");
-        // Every target is cleared when the pass begins (see the record below).
-        let clears = color.iter().map(|c| c.format).chain([ds_format]).collect();
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: shader.into(),
-                fetches,
-                alu: alu_estimate(shader, &PCF_TRIPS),
-                ..Default::default()
-            }),
-            color,
-            depth_stencil: Some(DepthStencilUse {
-                format: ds_format,
-                depth_test: true,
-                depth_write: true,
-                stencil_test: false,
-                stencil_write: true,
-            }),
-            width: self.extent.width,
-            height: self.extent.height,
-            triangles: self.triangles(false),
-            msaa: 1,
-            clears,
+        let work = ShaderWork {
+            shader: shader.into(),
+            fetches,
+            alu: alu_estimate(shader, &PCF_TRIPS),
+            ..Default::default()
         };
+        // Every target starts cleared; linear depth clears to the far plane, so
+        // no surface reads as "in front". Declared in the order the dumps number
+        // them: the three targets, depth and stencil, then the normals a method
+        // asked for (attachment order: the colours in the order given).
+        let clear = |c: ImageId, v: [f32; 4]| ColorTarget::new(c, Load::Clear(v));
         let mut pass = Pass::new("geometry", PassRole::Geometry)
-            .image(t.shadow, AccessKind::FragmentSampledRead)
-            .work(work);
-        // Declared in the order the dumps number them: the three targets, depth
-        // and stencil, then the normals a method asked for.
-        for &c in &colors[..3] {
-            pass = pass.image(c, AccessKind::ColorAttachmentWrite);
+            .sampled(t.shadow)
+            .color(clear(t.diffuse, [0.0; 4]))
+            .color(clear(t.specular, [0.0; 4]))
+            .color(clear(t.linear_depth, [self.camera.far, 0.0, 0.0, 0.0]))
+            // Every drawn pixel gets its object's skin bit (the reference is set per draw).
+            .depth_stencil(DepthStencil::cleared(t.depth_stencil, 1.0).stencil_write(true));
+        if let Some(n) = t.normals {
+            pass = pass.color(clear(n, [0.0; 4]));
         }
-        pass = pass.image(t.depth_stencil, AccessKind::DepthStencilWrite);
-        for &c in &colors[3..] {
-            pass = pass.image(c, AccessKind::ColorAttachmentWrite);
-        }
-        let far = self.camera.far;
-        pass.record(move |pc: &PassContext| {
-            let (ctx, cmd) = (pc.ctx, pc.cmd);
-            // Linear depth clears to the far plane: no surface reads as "in front".
-            let clears = [[0.0f32; 4], [0.0; 4], [far, 0.0, 0.0, 0.0], [0.0; 4]];
-            let targets: Vec<(ImageId, Load)> = colors
-                .iter()
-                .zip(clears)
-                .map(|(&c, v)| (c, Load::Clear(v)))
-                .collect();
-            begin_rendering(
-                pc,
-                &targets,
-                Some(DepthTarget {
-                    image: t.depth_stencil,
-                    clear_depth: Some(1.0),
-                    stencil: true,
-                }),
-            );
-            let p = &self.geometry_pipeline;
-            p.bind(ctx, cmd, &[self.frame_set]);
-            for obj in &self.objects {
-                p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
-                unsafe {
-                    ctx.device.cmd_set_stencil_reference(
-                        cmd,
-                        vk::StencilFaceFlags::FRONT_AND_BACK,
-                        if obj.skin { STENCIL_SKIN } else { 0 },
-                    );
+        pass.draws(Some(work), self.triangles(false))
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.geometry_pipeline;
+                p.bind(ctx, cmd, &[self.frame_set]);
+                for obj in &self.objects {
+                    p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
+                    unsafe {
+                        ctx.device.cmd_set_stencil_reference(
+                            cmd,
+                            vk::StencilFaceFlags::FRONT_AND_BACK,
+                            if obj.skin { STENCIL_SKIN } else { 0 },
+                        );
+                    }
+                    let backdrop = [self.backdrop];
+                    let models: &[Mat4] = if obj.skin { &self.instances } else { &backdrop };
+                    for m in models {
+                        p.push(ctx, cmd, &m.to_cols_array_2d());
+                        obj.bind_and_draw(ctx, cmd);
+                    }
                 }
-                let backdrop = [self.backdrop];
-                let models: &[Mat4] = if obj.skin { &self.instances } else { &backdrop };
-                for m in models {
-                    p.push(ctx, cmd, &m.to_cols_array_2d());
-                    obj.bind_and_draw(ctx, cmd);
-                }
-            }
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-        })
+            })
     }
 
     fn fullscreen_pass<'a>(&'a self, res: &Resources, p: PostPass<'a, '_>) -> Pass<'a> {
@@ -655,41 +582,30 @@ impl Frame {
             target,
             push,
         } = p;
-        let work = Work::Raster {
-            shader: Some(ShaderWork {
-                shader: shader.into(),
-                fetches: reads
-                    .iter()
-                    .map(|&(id, texture)| Fetch {
-                        texture: texture.into(),
-                        format: work_format(res.format(id)).expect("frame formats"),
-                        filter: Filter::Point,
-                        count: 1.0,
-                        exact: true,
-                        coherent: true,
-                    })
-                    .collect(),
-                alu: alu_estimate(shader, &[]),
-                ..Default::default()
-            }),
-            color: vec![ColorWrite {
-                format: work_format(res.format(target)).expect("frame formats"),
-                blend: false,
-            }],
-            depth_stencil: None,
-            width: self.extent.width,
-            height: self.extent.height,
-            triangles: 1,
-            msaa: 1,
-            clears: vec![],
+        let work = ShaderWork {
+            shader: shader.into(),
+            fetches: reads
+                .iter()
+                .map(|&(id, texture)| Fetch {
+                    texture: texture.into(),
+                    format: res.texel_format(id),
+                    filter: Filter::Point,
+                    count: 1.0,
+                    exact: true,
+                    coherent: true,
+                })
+                .collect(),
+            alu: alu_estimate(shader, &[]),
+            ..Default::default()
         };
-        let mut pass = Pass::new(name, PassRole::Post).work(work);
+        let mut pass = Pass::new(name, PassRole::Post);
         for &(r, _) in reads {
-            pass = pass.image(r, AccessKind::FragmentSampledRead);
+            pass = pass.sampled(r);
         }
-        pass.image(target, AccessKind::ColorAttachmentWrite)
+        pass.color(ColorTarget::new(target, Load::DontCare))
+            .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
-                fullscreen_draw(pc, pipeline, set, &[target], |c, cmd| {
+                fullscreen(pc, pipeline, &[set], |c, cmd| {
                     if let Some(p) = &push {
                         pipeline.push(c, cmd, p);
                     }

@@ -261,6 +261,7 @@ impl<'c> Renderer<'c> {
 
     /// Records, submits and waits for one frame; returns its per-pass samples.
     fn run_frame(&mut self, plan: Option<&mut ReadbackPlan>) -> Result<Vec<PassSample>> {
+        self.method.begin_frame();
         let mut passes = self.frame.passes(self.method.as_ref(), &self.resources);
         if let Some(plan) = plan {
             passes = plan.interleave(self.ctx, &mut self.resources, passes)?;
@@ -375,6 +376,7 @@ impl<'c> Renderer<'c> {
     /// Runs only the SSS passes on whatever the targets hold (tests) and reads
     /// back the method's output as f32 RGBA with the pass samples.
     pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
+        self.method.begin_frame();
         let passes = self.method.passes(&self.frame.view(&self.resources));
         if passes.is_empty() {
             bail!("the SSS-only run needs a method with passes");

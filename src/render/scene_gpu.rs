@@ -3,13 +3,13 @@
 use anyhow::Result;
 use ash::vk;
 
+use crate::graph::mesh::GpuMesh;
 use crate::scene::mesh::{Material, Object, Texture};
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::{Buffer, Image};
 use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
-use crate::vk::upload::{device_buffer, texture};
+use crate::vk::upload::texture;
 
 /// std140 layout of `MaterialUniforms` in geometry.frag.
 #[repr(C)]
@@ -21,9 +21,7 @@ pub struct MaterialUniforms {
 
 pub struct GpuObject {
     pub name: String,
-    pub vertices: Buffer,
-    pub indices: Buffer,
-    pub index_count: u32,
+    pub mesh: GpuMesh,
     pub skin: bool,
     textures: Vec<Image>,
     uniforms: Buffer,
@@ -88,9 +86,7 @@ impl GpuObject {
             ctx,
             GpuObject {
                 name: name.to_string(),
-                vertices: Buffer::default(),
-                indices: Buffer::default(),
-                index_count: object.mesh.indices.len() as u32,
+                mesh: GpuMesh::default(),
                 skin: object.material.skin,
                 textures: Vec::new(),
                 uniforms: Buffer::default(),
@@ -111,20 +107,7 @@ impl GpuObject {
     ) -> Result<()> {
         let name = self.name.clone();
         let mesh = &object.mesh;
-        self.vertices = device_buffer(
-            ctx,
-            &format!("{name} vertices"),
-            bytemuck::cast_slice(&mesh.vertices),
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
-        self.indices = device_buffer(
-            ctx,
-            &format!("{name} indices"),
-            bytemuck::cast_slice(&mesh.indices),
-            vk::BufferUsageFlags::INDEX_BUFFER,
-            AccessKind::VertexInputRead,
-        )?;
+        self.mesh = GpuMesh::upload(ctx, &name, &mesh.vertices, &mesh.indices)?;
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [
@@ -193,19 +176,11 @@ impl GpuObject {
     }
 
     pub fn bind_and_draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        unsafe {
-            ctx.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
-            ctx.device
-                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
-            ctx.device
-                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
-        }
+        self.mesh.bind_and_draw(ctx, cmd);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        self.vertices.destroy(ctx);
-        self.indices.destroy(ctx);
+        self.mesh.destroy(ctx);
         self.uniforms.destroy(ctx);
         for t in &mut self.textures {
             t.destroy(ctx);

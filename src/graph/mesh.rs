@@ -1,0 +1,77 @@
+//! A triangle mesh on the GPU, drawn by raster passes: the one upload and
+//! draw of vertex and index buffers (the frame's objects, tsd's unwrapped head).
+
+use anyhow::Result;
+use ash::vk;
+
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::guard::Guard;
+use crate::vk::memory::Buffer;
+use crate::vk::upload::device_buffer;
+
+/// A triangle mesh on the GPU: vertex and index buffers (u32 indices) and one
+/// way to draw it. The frame's objects and the methods that draw a mesh of
+/// their own (tsd's unwrapped head) share it.
+#[derive(Default)]
+pub struct GpuMesh {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+}
+
+impl GpuMesh {
+    /// Uploads `vertices` and `indices` into device-local buffers named after
+    /// `name`; on an error nothing is left behind.
+    pub fn upload<V: bytemuck::Pod>(
+        ctx: &Context,
+        name: &str,
+        vertices: &[V],
+        indices: &[u32],
+    ) -> Result<Self> {
+        let vertex_buffer = Guard::new(
+            ctx,
+            device_buffer(
+                ctx,
+                &format!("{name} vertices"),
+                bytemuck::cast_slice(vertices),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+                AccessKind::VertexInputRead,
+            )?,
+        );
+        let index_buffer = device_buffer(
+            ctx,
+            &format!("{name} indices"),
+            bytemuck::cast_slice(indices),
+            vk::BufferUsageFlags::INDEX_BUFFER,
+            AccessKind::VertexInputRead,
+        )?;
+        Ok(GpuMesh {
+            vertices: vertex_buffer.keep(),
+            indices: index_buffer,
+            index_count: indices.len() as u32,
+        })
+    }
+
+    /// Triangles of one draw.
+    pub fn triangles(&self) -> u64 {
+        self.index_count as u64 / 3
+    }
+
+    /// Binds the buffers and draws every triangle once.
+    pub fn bind_and_draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe {
+            ctx.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
+            ctx.device
+                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
+            ctx.device
+                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.vertices.destroy(ctx);
+        self.indices.destroy(ctx);
+    }
+}
