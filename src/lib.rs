@@ -8,14 +8,16 @@
 //! `scene`, `skin`, `reference` (pure CPU: meshes, framing, profiles, kernels,
 //! CPU references, the ground truth's sampling) -> `method` (the SSS methods,
 //! one module each behind one trait, and their registry) -> `render` (the frame
-//! around a method) -> `report`, `bench`, `run`, `budget`, `plot` (runs, statistics, floors,
-//! the console budget model, the chart writer) ->
+//! around a method) -> `report`, `bench`, `run`, `output`, `trace`, `budget`, `plot` (report.json's
+//! schema and statistics, floors, runs, the file writers, the timeline, the console budget
+//! model, the chart writer) ->
 //! `eval` (ground-truth comparisons, charts). `main.rs` parses arguments only.
 pub mod bench;
 pub mod budget;
 pub mod eval;
 pub mod graph;
 pub mod method;
+pub mod output;
 pub mod plot;
 pub mod reference;
 pub mod render;
@@ -23,4 +25,5 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod skin;
+pub mod trace;
 pub mod vk;

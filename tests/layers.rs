@@ -15,7 +15,9 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "skin", "reference"],
     &["method"],
     &["render"],
-    &["report", "bench", "run", "budget", "plot"],
+    &[
+        "report", "bench", "run", "output", "trace", "budget", "plot",
+    ],
     &["eval"],
 ];
 

@@ -22,7 +22,7 @@ use crate::scene::mesh::{Aabb, Mesh};
 
 /// Whether the SSS passes work only near skin (the default) or on the whole
 /// screen (the demos' way; kept to measure what the region saves).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RegionMode {
     Skin,
