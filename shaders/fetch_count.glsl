@@ -1,3 +1,5 @@
+#ifndef DERMIS_FETCH_COUNT_GLSL
+#define DERMIS_FETCH_COUNT_GLSL
 // The fetch-counting build (compiled with -DDERMIS_COUNT_FETCHES): every texture
 // fetch of a shader is written COUNTED(SITE(set, binding, kind), fetch), and every
 // shader starts with COUNT_INVOCATION(). The counting build adds one to
@@ -16,4 +18,5 @@ layout(std430, set = 3, binding = 0) buffer FetchCounts { uint fetchCounts[]; };
 #else
 #define COUNTED(site, e) (e)
 #define COUNT_INVOCATION()
+#endif
 #endif

@@ -14,7 +14,8 @@
 pub mod draw;
 mod pass;
 mod resources;
-pub mod work;
+/// The pass work vocabulary is pure data (`crate::work`); the graph carries it.
+pub use crate::work;
 
 pub use pass::{record_passes, Pass, PassContext, PassSample};
 pub use resources::{work_format, BufferId, ImageDesc, ImageId, Resources};

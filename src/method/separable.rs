@@ -8,7 +8,7 @@ use std::any::Any;
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::region::{px_per_mm, ReachScale, BILINEAR_MARGIN_PX};
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{color_write, declare_intermediate, fetch, masked_work, seed_copy};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
@@ -23,7 +23,7 @@ use crate::vk::context::Context;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 
-const SHADER: &str = "sss_blur.frag";
+const SHADER: &str = "separable_blur.frag";
 
 const OPTIONS: &[OptSpec] = &[
     OptSpec {
@@ -138,7 +138,7 @@ impl Config {
     }
 }
 
-/// Push constants of sss_blur.frag.
+/// Push constants of separable_blur.frag.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct SssPush {
@@ -285,17 +285,7 @@ impl SssMethod for Separable {
             .iter()
             .map(|s| s.offset_mm.abs())
             .fold(0.0, f32::max);
-        Some(
-            widest_mm
-                * scale.max_strength
-                * px_per_mm(
-                    depth,
-                    scale.height_px,
-                    scale.tan_half_fovy,
-                    scale.mm_per_unit,
-                )
-                + BILINEAR_MARGIN_PX,
-        )
+        Some(widest_mm * scale.max_strength * scale.px_per_mm(depth) + BILINEAR_MARGIN_PX)
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {

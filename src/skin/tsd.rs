@@ -28,6 +28,7 @@ use super::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 use super::ssg::{blend_weights, GaussianFit, LISTING_4_1_WEIGHTS};
 use super::texel::{bilinear4, round_f16_with, F16Rounding};
 use crate::scene::mesh::{Aabb, Mesh};
+use crate::view::{tan_half, ViewScale};
 
 /// cos(105 degrees): the thesis' cull angle (Listing 3.2). A texel whose
 /// interpolated eye-dot is below it is culled.
@@ -129,7 +130,7 @@ pub fn reference_distance(
 ) -> f32 {
     let unit = HEAD_MM / mm_per_unit;
     let view = (height_px as f32 / THESIS_HEIGHT_PX)
-        * ((0.5 * THESIS_FOVY_DEG.to_radians()).tan() / (0.5 * fovy_rad).tan());
+        * (tan_half(THESIS_FOVY_DEG.to_radians()) / tan_half(fovy_rad));
     d_ref_thesis * unit * view * (THESIS_T_MAX as f32 / t_max as f32)
 }
 
@@ -167,7 +168,8 @@ pub fn box_outside(planes: &[Vec4; 6], b: &Aabb) -> bool {
 
 /// Projected height in pixels of something `size` units tall at distance `d`.
 pub fn projected_px(size: f32, d: f32, height_px: u32, fovy_rad: f32) -> f32 {
-    height_px as f32 * size / (2.0 * d.max(1e-6) * (0.5 * fovy_rad).tan())
+    // A projected length needs no millimetres: any scale gives the same pixels.
+    ViewScale::new(height_px, fovy_rad, 1.0).projected_px(size, d)
 }
 
 /// Whether far character `k` is refreshed on `frame` (0-based): once every
