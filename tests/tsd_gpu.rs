@@ -16,10 +16,10 @@ use dermis::scene::mesh::{Material, Mesh, Object, Texture, Vertex};
 use dermis::scene::Scene;
 use dermis::skin::texel::F16Rounding;
 use dermis::skin::tsd::{
-    blur_chain, clip_planes, depth_scale, keeps, map_size, nearest_corner_distance,
-    reference_distance, texel_hits, triangle_stretch, ChainInput, KeepRule, VertexTerms,
-    BACKFACE_BIAS, CULL_COS, THESIS_D_REF,
+    clip_planes, depth_scale, map_size, nearest_corner_distance, reference_distance,
+    triangle_stretch, BACKFACE_BIAS, CULL_COS, THESIS_D_REF,
 };
+use dermis::skin::tsd_mirror::{blur_chain, keeps, texel_hits, ChainInput, KeepRule, VertexTerms};
 use glam::Vec3;
 
 // --- Scenes ---------------------------------------------------------------------------

@@ -23,3 +23,4 @@ pub mod ssg_mirror;
 pub mod texel;
 pub mod transmittance;
 pub mod tsd;
+pub mod tsd_mirror;
