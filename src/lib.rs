@@ -17,7 +17,8 @@
 //! charts). `main.rs` parses arguments only.
 //!
 //! The pure core and, above it, `eval::metrics` and `budget::model` name
-//! neither `ash`, `crate::vk` nor `crate::graph` (tests/layers.rs).
+//! neither `ash`, `crate::vk` nor `crate::graph`, nor reach them through any
+//! file they lead to (tests/layers.rs).
 pub mod bench;
 pub mod budget;
 pub mod eval;

@@ -357,6 +357,20 @@ fn impurities(text: &str, module: &[String]) -> Vec<String> {
         .collect()
 }
 
+/// The file under `src/` a crate path leads to: its longest prefix that is a
+/// module file (`crate::skin::ssg::Stretch` -> skin/ssg.rs).
+fn file_of(path: &[String]) -> Option<PathBuf> {
+    if path.first().map(String::as_str) != Some("crate") {
+        return None;
+    }
+    (2..=path.len()).rev().find_map(|k| {
+        let base = src().join(path[1..k].join("/"));
+        [base.with_extension("rs"), base.join("mod.rs")]
+            .into_iter()
+            .find(|c| c.is_file())
+    })
+}
+
 /// Whether a file (path under `src/`) must be pure.
 fn must_be_pure(rel: &Path) -> bool {
     let m = module_of(rel);
@@ -505,10 +519,25 @@ fn the_module_of_a_file() {
     assert!(
         !must_be_pure(Path::new("budget/units.rs")) && !must_be_pure(Path::new("method/mod.rs"))
     );
+    let m = |s: &str| s.split("::").map(String::from).collect::<Vec<_>>();
+    assert_eq!(
+        file_of(&m("crate::skin::ssg::Stretch")),
+        Some(src().join("skin/ssg.rs"))
+    );
+    assert_eq!(
+        file_of(&m("crate::graph::work::Format")),
+        Some(src().join("graph/mod.rs"))
+    );
+    assert_eq!(
+        file_of(&m("crate::work::Format")),
+        Some(src().join("work.rs"))
+    );
+    assert_eq!(file_of(&m("std::fmt")), None);
 }
 
 /// The pure core (the bottom layer) and the pure files above it name neither
-/// `ash`, `crate::vk` nor `crate::graph`: pure math cannot reach Vulkan.
+/// `ash`, `crate::vk` nor `crate::graph`, nor reach them through any file
+/// they lead to: pure math cannot reach Vulkan.
 #[test]
 fn pure_math_names_no_vulkan() {
     let mut files = Vec::new();
@@ -523,6 +552,36 @@ fn pure_math_names_no_vulkan() {
         checked += 1;
         for p in impurities(&code(f), &module_of(rel)) {
             bad.push(format!("{} names {p}", rel.display()));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "pure files name Vulkan:\n{}",
+        bad.join("\n")
+    );
+    // Nor through another file: every file a pure file's paths lead to is
+    // pure too (`crate::graph::work::X` leads to graph/mod.rs, which is not).
+    for f in &files {
+        let rel = f.strip_prefix(src()).unwrap();
+        if !must_be_pure(rel) {
+            continue;
+        }
+        let mut seen = BTreeSet::from([f.clone()]);
+        let mut todo = vec![(f.clone(), rel.display().to_string())];
+        while let Some((g, chain)) = todo.pop() {
+            let grel = g.strip_prefix(src()).unwrap().to_path_buf();
+            let text = code(&g);
+            let module = module_of(&grel);
+            if let Some(p) = impurities(&text, &module).first() {
+                bad.push(format!("{chain} names {p}"));
+            }
+            for path in named(&text, &module) {
+                if let Some(h) = file_of(&path).filter(|h| !seen.contains(h)) {
+                    seen.insert(h.clone());
+                    let next = format!("{chain} -> {}", h.strip_prefix(src()).unwrap().display());
+                    todo.push((h, next));
+                }
+            }
         }
     }
     assert!(
