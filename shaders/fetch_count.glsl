@@ -4,8 +4,8 @@
 // fetch of a shader is written COUNTED(SITE(set, binding, kind), fetch), and every
 // shader starts with COUNT_INVOCATION(). The counting build adds one to
 // fetchCounts[site] per fetch and fetchCounts[0] per invocation, so a test can
-// hold each pass's declared work (graph::work) against what its shader does.
-// The normal build compiles both to nothing. Kinds follow graph::work::Filter.
+// hold each pass's declared work (crate::work) against what its shader does.
+// The normal build compiles both to nothing. Kinds follow crate::work::Filter.
 #define FK_POINT 0u
 #define FK_BILINEAR 1u
 #define FK_COMPARE 2u
