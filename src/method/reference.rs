@@ -16,14 +16,14 @@
 //! binding stays within the device's storage-buffer range and every radiance
 //! image within its largest image: the default density works on any conforming
 //! device, at any head count its memory holds. The pure parts (sampling, grid,
-//! profile split, an f64 CPU gather) are in `crate::reference`.
+//! chunk plan, profile split, an f64 CPU gather) are in `crate::reference`.
 
 use std::any::Any;
 
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::region::{px_per_mm, ReachScale};
+use super::region::ReachScale;
 use super::screen::fetch;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
@@ -32,11 +32,11 @@ use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{
     BufferId, ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext,
 };
+use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
-use crate::reference::sampling::{
-    build_grid, cutoff_mm, sample_surface_within, Grid, SurfaceSample,
-};
+use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface_within, SurfaceSample};
 use crate::reference::tissue::TISSUE_TOLERANCE;
+use crate::shader_constants::{NARROW_GAUSSIANS as NARROW, PCF_TRIPS, WIDE_GAUSSIANS};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::{Context, DeviceFacts};
 use crate::vk::guard::{Destroy, Guard};
@@ -53,8 +53,6 @@ const RESOLVE_SHADER: &str = "reference_resolve.comp";
 /// The surface pass's targets: radiance, position + area, normal.
 const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const SURFACE_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
-/// Width of the radiance images: sample i of a chunk is texel (i % width, i / width).
-pub const RADIANCE_WIDTH: u32 = 2048;
 /// Workgroup side of the gather (reference_gather.comp's local size).
 const GROUP: u32 = 8;
 /// The gather's 3x3x3 cell neighbourhood runs as 9 dispatches of one row of 3
@@ -140,77 +138,6 @@ struct GatherPush {
     dz: i32,
     first: u32,
     count: u32,
-}
-
-/// The device limits the split follows.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ChunkLimits {
-    /// maxStorageBufferRange, bytes.
-    pub storage_range: u64,
-    /// maxImageDimension2D.
-    pub max_image_dimension: u32,
-}
-
-/// How the samples are split.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ChunkPlan {
-    /// (first sample, count) of each gather chunk: positions bound whole,
-    /// radiance image of `count.div_ceil(RADIANCE_WIDTH)` rows.
-    pub chunks: Vec<(u32, u32)>,
-    /// Samples per draw of the radiance pass (its 64-byte samples bound by range).
-    pub draw_samples: u32,
-}
-
-/// Splits `count` samples into chunks of whole radiance rows within `limits`.
-pub fn plan_chunks(count: u32, limits: ChunkLimits) -> Result<ChunkPlan> {
-    let sample_bytes = std::mem::size_of::<SurfaceSample>() as u64;
-    let rows_by =
-        |bytes_per_sample: u64| limits.storage_range / (bytes_per_sample * RADIANCE_WIDTH as u64);
-    // Positions are vec4 (16 bytes) read by the gather; samples 64 bytes read
-    // by the radiance pass, one range per draw.
-    let chunk_rows = rows_by(16).min(limits.max_image_dimension as u64);
-    let draw_rows = rows_by(sample_bytes);
-    if chunk_rows == 0 || draw_rows == 0 {
-        bail!(
-            "this device's storage-buffer range ({} bytes) cannot hold one row of {RADIANCE_WIDTH} reference samples",
-            limits.storage_range
-        );
-    }
-    let per_chunk = (chunk_rows * RADIANCE_WIDTH as u64).min(u32::MAX as u64) as u32;
-    let mut chunks = Vec::new();
-    let mut first = 0u32;
-    while first < count {
-        let n = (count - first).min(per_chunk);
-        chunks.push((first, n));
-        first += n;
-    }
-    Ok(ChunkPlan {
-        chunks,
-        draw_samples: (draw_rows * RADIANCE_WIDTH as u64).min(u32::MAX as u64) as u32,
-    })
-}
-
-/// The most samples one gather invocation visits in one slab: the largest sum of
-/// the counts of a row of 3 neighbouring cells (an upper bound of its radiance
-/// fetches, which are the visited samples within the cut-off).
-fn max_slab_candidates(grid: &Grid) -> u32 {
-    let [nx, ny, nz] = grid.dims.map(|d| d as i64);
-    let count = |x: i64, y: i64, z: i64| -> u32 {
-        if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {
-            return 0;
-        }
-        let i = ((z * ny + y) * nx + x) as usize;
-        grid.cell_start[i + 1] - grid.cell_start[i]
-    };
-    let mut best = 0;
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                best = best.max(count(x - 1, y, z) + count(x, y, z) + count(x + 1, y, z));
-            }
-        }
-    }
-    best
 }
 
 /// One chunk: its samples' buffers and radiance image, and its sets.
@@ -494,7 +421,6 @@ impl Reference {
         s: &mut MethodSetup,
         skin: &crate::scene::mesh::Object,
     ) -> Result<()> {
-        let mm = s.view.mm_per_unit;
         let eye = s.view.camera.eye;
         let bounds = skin.mesh.bounds();
         let nearest = s
@@ -506,7 +432,7 @@ impl Reference {
             })
             .fold(f32::INFINITY, f32::min)
             .max(s.view.camera.near);
-        let px_per_mm = px_per_mm(nearest, s.view.extent.height, s.view.tan_half_fovy(), mm);
+        let px_per_mm = s.view.scale().px_per_mm(nearest);
         let ss = supersampling(px_per_mm);
         let extent = vk::Extent2D {
             width: s.view.extent.width * ss,
@@ -529,7 +455,11 @@ impl Reference {
             normal: s.res.declare(desc("normal", SURFACE_FORMAT)),
             depth: s.res.declare(desc("depth", SURFACE_DEPTH)),
             max_radius: radius(px_per_mm, ss),
-            mm_per_subsample_per_depth: 2.0 * s.view.tan_half_fovy() * mm / extent.height as f32,
+            mm_per_subsample_per_depth: crate::view::ViewScale {
+                height_px: extent.height,
+                ..s.view.scale()
+            }
+            .mm_per_px_per_depth(),
             ..Default::default()
         };
         let mesh = &skin.mesh;
@@ -573,7 +503,7 @@ impl Reference {
                 material_fetch("normalTex"),
                 material_fetch("albedoTex"),
             ],
-            alu: alu_estimate(lit, &[3, 3]),
+            alu: alu_estimate(lit, &PCF_TRIPS),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
             storage_write_bytes: 0.0,
         };
@@ -639,7 +569,7 @@ impl Reference {
         let work = ShaderWork {
             shader: SURFACE_SHADER.into(),
             fetches: vec![shadow, material_fetch("normalTex"), albedo],
-            alu: alu_estimate(SURFACE_SHADER, &[3, 3]),
+            alu: alu_estimate(SURFACE_SHADER, &PCF_TRIPS),
             ..Default::default()
         };
         // The three subsample targets and the depth start cleared.
@@ -722,7 +652,7 @@ impl Reference {
         let work = ShaderWork {
             shader: RESOLVE_SHADER.into(),
             fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
-            alu: alu_estimate(RESOLVE_SHADER, &[3]),
+            alu: alu_estimate(RESOLVE_SHADER, &[WIDE_GAUSSIANS as u32]),
             storage_read_bytes: 64.0,
             storage_write_bytes: 16.0,
         };
@@ -757,7 +687,10 @@ impl Reference {
                 bound(sf.position, "surfPosition", window),
                 bound(sf.radiance, "surfRadiance", window + 1.0),
             ],
-            alu: alu_estimate(NARROW_SHADER, &[side as u32, side as u32, 3, 3]),
+            alu: alu_estimate(
+                NARROW_SHADER,
+                &[side as u32, side as u32, NARROW as u32, NARROW as u32],
+            ),
             storage_write_bytes: 16.0,
             ..Default::default()
         };
@@ -838,7 +771,10 @@ impl SssMethod for Reference {
                             ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
                         },
                     ],
-                    alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3), 3]),
+                    alu: alu_estimate(
+                        GATHER_SHADER,
+                        &[3, self.max_candidates.div_ceil(3), WIDE_GAUSSIANS as u32],
+                    ),
                     // Positions and normals of the candidates, cell ranges, the output.
                     storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
                     storage_write_bytes: 48.0,
@@ -1040,57 +976,5 @@ impl SssMethod for Reference {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    // lavapipe: 128 MiB of storage range, 16384-texel images. The Lee
-    // Perry-Smith bust at 32 samples per mm^2 is 10.9 M samples.
-    #[test]
-    fn chunks_stay_within_the_limits_and_cover_every_sample() {
-        let lavapipe = ChunkLimits {
-            storage_range: 134_217_728,
-            max_image_dimension: 16384,
-        };
-        let plan = plan_chunks(10_885_671, lavapipe).unwrap();
-        assert_eq!(plan.chunks.len(), 2);
-        let mut next = 0;
-        for &(first, n) in &plan.chunks {
-            assert_eq!(first, next);
-            assert!(n as u64 * 16 <= lavapipe.storage_range);
-            assert!(n.div_ceil(RADIANCE_WIDTH) <= lavapipe.max_image_dimension);
-            assert_eq!(first % RADIANCE_WIDTH, 0, "chunks start on whole rows");
-            next = first + n;
-        }
-        assert_eq!(next, 10_885_671);
-        assert!(plan.draw_samples as u64 * 64 <= lavapipe.storage_range);
-        // A small image limit splits by rows instead.
-        let small = ChunkLimits {
-            storage_range: 1 << 40,
-            max_image_dimension: 4096,
-        };
-        let plan = plan_chunks(10_885_671, small).unwrap();
-        assert_eq!(plan.chunks[0].1, 4096 * RADIANCE_WIDTH);
-        // Below one row of range: a clear error.
-        let tiny = ChunkLimits {
-            storage_range: 1024,
-            max_image_dimension: 4096,
-        };
-        assert!(plan_chunks(10, tiny).is_err());
-        assert!(plan_chunks(0, lavapipe).unwrap().chunks.is_empty());
-    }
-
-    #[test]
-    fn slab_candidates_bound_the_visited_samples() {
-        let grid = Grid {
-            origin: glam::Vec3::ZERO,
-            cell: 1.0,
-            dims: [3, 1, 1],
-            cell_start: vec![0, 5, 6, 10],
-        };
-        assert_eq!(max_slab_candidates(&grid), 10);
     }
 }
