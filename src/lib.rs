@@ -2,6 +2,8 @@
 //! measures what every pass costs on the GPU.
 //!
 //! Layers, bottom up (a module uses only the ones before it):
+//! `files` (the one door every user-supplied file is read through: regular
+//! files only, sizes and decoded image sizes bounded; pure) ->
 //! `vk` (device, barrier table, memory, shaders and their statistics, uploads,
 //! profiler) -> `graph` (declared images, passes with their role, work and
 //! accesses; barriers and usages derived, never written at call sites) ->
@@ -14,6 +16,7 @@
 pub mod bench;
 pub mod budget;
 pub mod eval;
+pub mod files;
 pub mod graph;
 pub mod method;
 pub mod plot;

@@ -113,7 +113,7 @@ fn register_system_font() -> Result<()> {
             FONT_PATHS.join(", ")
         );
     };
-    let bytes = fs::read(path).with_context(|| format!("reading font {}", path.display()))?;
+    let bytes = crate::files::read_bounded(path, "font", crate::files::MAX_FONT_FILE)?;
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
     for family in ["sans-serif", "serif", "monospace"] {
         plotters::style::register_font(family, FontStyle::Normal, bytes)

@@ -85,9 +85,40 @@ pub struct RunRecord {
 impl RunRecord {
     /// Reads a report (JSON) from a file.
     pub fn load(path: &std::path::Path) -> Result<RunRecord> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+        let text = crate::files::read_text(path, "report", crate::files::MAX_TEXT_FILE)?;
+        let r: RunRecord =
+            serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+        r.check()
+            .with_context(|| format!("report {}", path.display()))?;
+        Ok(r)
+    }
+
+    /// The ranges `render` holds its settings to, for a report whoever wrote it:
+    /// the frame's sides within 1..=`MAX_IMAGE_SIDE`, at most `MAX_HEADS` heads,
+    /// measured times finite and not negative.
+    pub fn check(&self) -> Result<()> {
+        use crate::render::settings::{MAX_HEADS, MAX_IMAGE_SIDE};
+        for (what, v) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_IMAGE_SIDE).contains(&v) {
+                bail!("{what} must be within 1..={MAX_IMAGE_SIDE} pixels (as render's --{what}), got {v}");
+            }
+        }
+        if self.heads > MAX_HEADS {
+            bail!("heads must be within 1..={MAX_HEADS}, got {}", self.heads);
+        }
+        for p in &self.passes {
+            if let Some(t) = p
+                .gpu_ms
+                .filter(|t| !(t.median.is_finite() && t.median >= 0.0))
+            {
+                bail!(
+                    "pass '{}': gpu_ms.median must be a finite number, not negative, got {}",
+                    p.name,
+                    t.median
+                );
+            }
+        }
+        Ok(())
     }
 
     /// The record of any serialisable report (a live `run::Report`).

@@ -177,10 +177,9 @@ impl Output {
     fn read(d: &Path) -> Result<Self> {
         let (width, height, diffuse) = read_exr(&d.join("diffuse.exr"))?;
         let p = d.join("frame.png");
-        let frame = image::open(&p)
-            .with_context(|| format!("reading {}", p.display()))?
-            .to_rgba8()
-            .into_raw();
+        // Its sides within the range `render` accepts for a frame's width and height.
+        let frame_bound = crate::files::ImageBound::rgba8(crate::render::settings::MAX_IMAGE_SIDE);
+        let frame = crate::files::read_rgba8(&p, "frame", &frame_bound)?.into_raw();
         Ok(Output {
             width,
             height,
@@ -218,9 +217,11 @@ fn reference_bands(b: &Path, r: &Output, mask: &[bool]) -> Result<Vec<Option<Ban
         );
     }
     let p = b.join("report.json");
-    let report: serde_json::Value = serde_json::from_slice(
-        &std::fs::read(&p).with_context(|| format!("reading {}", p.display()))?,
-    )
+    let report: serde_json::Value = serde_json::from_slice(&crate::files::read_bounded(
+        &p,
+        "report",
+        crate::files::MAX_TEXT_FILE,
+    )?)
     .with_context(|| format!("parsing {}", p.display()))?;
     let number = |k: &str| {
         report[k]
