@@ -16,6 +16,7 @@ mod common;
 
 use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};
+use dermis::scene::gltf_load::fixture::{base64, f32_bytes, glb_bytes, Container, Model};
 use dermis::scene::gltf_load::{load_head_with_warnings, TextureOverrides};
 use dermis::scene::load_gltf_scene;
 use dermis::scene::mesh::Object;
@@ -57,35 +58,6 @@ impl Rng {
 
 // ---- Generated models -----------------------------------------------------------------
 
-/// A glTF document and its one buffer, before it is written in some container.
-#[derive(Clone)]
-struct Model {
-    json: Value,
-    buffer: Vec<u8>,
-}
-
-fn f32_bytes(v: &[f32]) -> Vec<u8> {
-    v.iter().flat_map(|f| f.to_le_bytes()).collect()
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                s.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
-}
-
 /// A small PNG for the embedded texture.
 fn png(rng: &mut Rng) -> Vec<u8> {
     let (w, h) = (1 + rng.below(6) as u32, 1 + rng.below(6) as u32);
@@ -98,163 +70,15 @@ fn png(rng: &mut Rng) -> Vec<u8> {
     out.into_inner()
 }
 
-/// A valid model: a bumpy n x n grid facing +Z with normals, texture coordinates,
-/// u16 indices and an embedded PNG albedo. Views: 0 positions, 1 normals, 2 UVs,
-/// 3 indices, 4 image. Accessors: 0 POSITION, 1 NORMAL, 2 TEXCOORD_0, 3 indices.
+/// A valid model: the shared fixture's grid (`Model::grid`) of 2..=8 vertices a
+/// side with a small PNG albedo.
 fn base_model(rng: &mut Rng) -> Model {
     let n = 2 + rng.below(7);
-    let (mut pos, mut nrm, mut uv, mut idx) = (vec![], vec![], vec![], vec![]);
-    for j in 0..n {
-        for i in 0..n {
-            let (u, v) = (i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32);
-            pos.extend([u - 0.5, v - 0.5, 0.1 * (u * 3.0).sin() * (v * 3.0).cos()]);
-            nrm.extend([0.0, 0.0, 1.0]);
-            uv.extend([u, 1.0 - v]);
-        }
-    }
-    for j in 0..n - 1 {
-        for i in 0..n - 1 {
-            let a = (j * n + i) as u16;
-            let (b, c, d) = (a + 1, a + n as u16 + 1, a + n as u16);
-            idx.extend([a, b, c, a, c, d]);
-        }
-    }
-    let mut buffer = Vec::new();
-    let mut views = Vec::new();
-    let mut push = |bytes: Vec<u8>, buffer: &mut Vec<u8>| {
-        while buffer.len() % 4 != 0 {
-            buffer.push(0);
-        }
-        views.push(json!({"buffer": 0, "byteOffset": buffer.len(), "byteLength": bytes.len()}));
-        buffer.extend(bytes);
-    };
-    push(f32_bytes(&pos), &mut buffer);
-    push(f32_bytes(&nrm), &mut buffer);
-    push(f32_bytes(&uv), &mut buffer);
-    push(
-        idx.iter().flat_map(|i| i.to_le_bytes()).collect(),
-        &mut buffer,
-    );
-    push(png(rng), &mut buffer);
-    let count = n * n;
-    let json = json!({
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "name": "grid"}],
-        "meshes": [{"name": "grid", "primitives": [{
-            "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
-            "indices": 3,
-            "material": 0
-        }]}],
-        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
-        "textures": [{"source": 0}],
-        "images": [{"bufferView": 4, "mimeType": "image/png"}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3",
-             "min": [-0.5, -0.5, -0.1], "max": [0.5, 0.5, 0.1]},
-            {"bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3"},
-            {"bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2"},
-            {"bufferView": 3, "componentType": 5123, "count": idx.len(), "type": "SCALAR"}
-        ],
-        "bufferViews": views,
-        "buffers": [{"byteLength": buffer.len()}]
-    });
-    Model { json, buffer }
-}
-
-/// Appends bytes to the buffer as a new view; returns the view index.
-fn add_view(m: &mut Model, bytes: &[u8], stride: Option<usize>) -> usize {
-    while m.buffer.len() % 4 != 0 {
-        m.buffer.push(0);
-    }
-    let mut v = json!({"buffer": 0, "byteOffset": m.buffer.len(), "byteLength": bytes.len()});
-    if let Some(s) = stride {
-        v["byteStride"] = json!(s);
-    }
-    m.buffer.extend(bytes);
-    m.json["buffers"][0]["byteLength"] = json!(m.buffer.len());
-    let views = m.json["bufferViews"].as_array_mut().expect("views");
-    views.push(v);
-    views.len() - 1
-}
-
-fn add_accessor(m: &mut Model, acc: Value) -> usize {
-    let accs = m.json["accessors"].as_array_mut().expect("accessors");
-    accs.push(acc);
-    accs.len() - 1
+    Model::grid(n, png(rng))
 }
 
 fn vertex_count(m: &Model) -> usize {
     m.json["accessors"][0]["count"].as_u64().unwrap_or(0) as usize
-}
-
-#[derive(Clone, Copy, PartialEq)]
-enum Container {
-    DataUri,
-    BinFile,
-    Glb,
-}
-
-fn glb_bytes(json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
-    let mut j = serde_json::to_vec(json).expect("json");
-    while j.len() % 4 != 0 {
-        j.push(b' ');
-    }
-    let mut v = b"glTF".to_vec();
-    v.extend(2u32.to_le_bytes());
-    v.extend(0u32.to_le_bytes());
-    v.extend((j.len() as u32).to_le_bytes());
-    v.extend(b"JSON");
-    v.extend(&j);
-    if let Some(bin) = bin {
-        let mut b = bin.to_vec();
-        while b.len() % 4 != 0 {
-            b.push(0);
-        }
-        v.extend((b.len() as u32).to_le_bytes());
-        v.extend(b"BIN\0");
-        v.extend(b);
-    }
-    let n = v.len() as u32;
-    v[8..12].copy_from_slice(&n.to_le_bytes());
-    v
-}
-
-/// Writes the model; buffer 0 gets its URI from the container unless the case set one.
-fn write(m: &Model, c: Container, dir: &Path, name: &str) -> PathBuf {
-    let mut json = m.json.clone();
-    // A generic JSON mutation may have broken the buffer's shape: then write as is.
-    if let Some(b) = json
-        .pointer_mut("/buffers/0")
-        .and_then(Value::as_object_mut)
-    {
-        match c {
-            Container::DataUri if !b.contains_key("uri") => {
-                b.insert(
-                    "uri".into(),
-                    json!(format!(
-                        "data:application/octet-stream;base64,{}",
-                        base64(&m.buffer)
-                    )),
-                );
-            }
-            Container::BinFile if !b.contains_key("uri") => {
-                std::fs::write(dir.join(format!("{name}.bin")), &m.buffer).expect("write bin");
-                b.insert("uri".into(), json!(format!("{name}.bin")));
-            }
-            _ => {}
-        }
-    }
-    if c == Container::Glb {
-        let path = dir.join(format!("{name}.glb"));
-        std::fs::write(&path, glb_bytes(&json, Some(&m.buffer))).expect("write glb");
-        path
-    } else {
-        let path = dir.join(format!("{name}.gltf"));
-        std::fs::write(&path, serde_json::to_vec(&json).expect("json")).expect("write gltf");
-        path
-    }
 }
 
 // ---- Mutations --------------------------------------------------------------------------
@@ -346,9 +170,9 @@ fn mutate_accessors(m: &mut Model, rng: &mut Rng) -> String {
                     ids.dedup();
                 }
                 let ibytes: Vec<u8> = ids.iter().flat_map(|i| i.to_le_bytes()).collect();
-                let iv = add_view(m, &ibytes, None);
+                let iv = m.add_view(&ibytes, None);
                 let vals: Vec<f32> = (0..ids.len() * 4).map(|k| k as f32 * 0.01).collect();
-                let vv = add_view(m, &f32_bytes(&vals), None);
+                let vv = m.add_view(&f32_bytes(&vals), None);
                 let sc = if rng.chance(0.9) {
                     ids.len()
                 } else {
@@ -475,9 +299,8 @@ fn quantized(m: &mut Model, rng: &mut Rng) -> String {
     } else {
         None
     };
-    let v = add_view(m, &bytes, stride);
-    let a = add_accessor(
-        m,
+    let v = m.add_view(&bytes, stride);
+    let a = m.add_accessor(
         json!({"bufferView": v, "componentType": ct, "normalized": normalized, "count": n, "type": "VEC2"}),
     );
     m.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(a);
@@ -492,9 +315,8 @@ fn quantized(m: &mut Model, rng: &mut Rng) -> String {
         let idx: Vec<u8> = (0..6)
             .map(|k| [0u8, 1, 2, 0, 2, 3][k].min(n as u8 - 1))
             .collect();
-        let v = add_view(m, &idx, None);
-        let a = add_accessor(
-            m,
+        let v = m.add_view(&idx, None);
+        let a = m.add_accessor(
             json!({"bufferView": v, "componentType": 5121, "count": 6, "type": "SCALAR"}),
         );
         m.json["meshes"][0]["primitives"][0]["indices"] = json!(a);
@@ -611,9 +433,8 @@ fn mutate_mode(m: &mut Model, rng: &mut Rng) -> String {
     if k == 0 {
         prim.as_object_mut().expect("prim").remove("indices");
     } else {
-        let v = add_view(m, &bytes, None);
-        let a = add_accessor(
-            m,
+        let v = m.add_view(&bytes, None);
+        let a = m.add_accessor(
             json!({"bufferView": v, "componentType": 5123, "count": k, "type": "SCALAR"}),
         );
         m.json["meshes"][0]["primitives"][0]["indices"] = json!(a);
@@ -987,7 +808,7 @@ fn gltf_fuzz() {
         .enumerate()
     {
         let m = base_model(&mut rng);
-        let p = write(&m, c, &dir, &format!("base{k}"));
+        let p = m.write(c, &dir, &format!("base{k}"));
         fz.case("base", &p, "clean base model");
     }
     // A FIFO as a buffer: opening it would block forever.
@@ -999,7 +820,7 @@ fn gltf_fuzz() {
     {
         let mut m = base_model(&mut rng);
         m.json["buffers"][0]["uri"] = json!("fifo.bin");
-        let p = write(&m, Container::DataUri, &dir, "fifo");
+        let p = m.write(Container::DataUri, &dir, "fifo");
         fz.case("uri", &p, "FIFO buffer");
     }
 
@@ -1043,19 +864,19 @@ fn gltf_fuzz() {
         let (path, what) = match category {
             "accessor" => {
                 let w = mutate_accessors(&mut m, &mut rng);
-                (write(&m, container, &dir, &name), w)
+                (m.write(container, &dir, &name), w)
             }
             "quantized" => {
                 let w = quantized(&mut m, &mut rng);
-                (write(&m, container, &dir, &name), w)
+                (m.write(container, &dir, &name), w)
             }
             "nodes" => {
                 let w = mutate_nodes(&mut m, &mut rng);
-                (write(&m, container, &dir, &name), w)
+                (m.write(container, &dir, &name), w)
             }
             "modes" => {
                 let w = mutate_mode(&mut m, &mut rng);
-                (write(&m, container, &dir, &name), w)
+                (m.write(container, &dir, &name), w)
             }
             "uri" => {
                 let w = mutate_uri(&mut m, &mut rng, &dir, &name);
@@ -1064,7 +885,7 @@ fn gltf_fuzz() {
                 } else {
                     container
                 };
-                (write(&m, c, &dir, &name), w)
+                (m.write(c, &dir, &name), w)
             }
             "glb" => {
                 let (bytes, w) = corrupt_glb(&m, &mut rng);
@@ -1074,12 +895,12 @@ fn gltf_fuzz() {
             }
             "values" => {
                 let w = mutate_values(&mut m, &mut rng);
-                (write(&m, container, &dir, &name), w)
+                (m.write(container, &dir, &name), w)
             }
             "json" => {
                 let k = 1 + rng.below(3);
                 let w: Vec<String> = (0..k).map(|_| mutate_json(&mut m.json, &mut rng)).collect();
-                (write(&m, container, &dir, &name), w.join("; "))
+                (m.write(container, &dir, &name), w.join("; "))
             }
             _ => {
                 let (Some(bytes), Some((json, bin))) = (&lps_bytes, &lps_parts) else {
