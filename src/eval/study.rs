@@ -229,13 +229,17 @@ fn reference_bands(b: &Path, r: &Output, mask: &[bool]) -> Result<Vec<Option<Ban
             .map(|v| v as f32)
             .with_context(|| format!("{} has no number '{k}'", p.display()))
     };
+    // Held to the ranges `render` takes them in, whoever wrote the report.
+    let (fovy, mm) = (number("fovy_deg")?, number("mm_per_unit")?);
+    crate::render::settings::check_fovy(fovy).with_context(|| p.display().to_string())?;
+    crate::scene::check_mm_per_unit(mm).with_context(|| p.display().to_string())?;
     let depth: Vec<f32> = depth.iter().map(|d| d[0]).collect();
     Ok(bands(&BandInput::for_view(
         (w as usize, h as usize),
         mask,
         &depth,
-        number("fovy_deg")?,
-        number("mm_per_unit")?,
+        fovy,
+        mm,
     )))
 }
 
