@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 /// The layers, bottom up, as `src/lib.rs` documents them. A module may use
 /// modules of its own layer index or lower; `run` and `report` share a layer.
 const LAYERS: &[&[&str]] = &[
+    &["files"],
     &["vk"],
     &["graph"],
     &["scene", "skin", "reference"],
