@@ -26,6 +26,9 @@
 //! file, an image too large to decode) is left out with a warning, so a file
 //! beside a model never stops its render, and a file the rule does not match is
 //! never opened.
+//!
+//! `--sidecar-top-down` (how files from beside the scene or the command line are
+//! oriented) is named in a note as ignored when no texture came from either.
 
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
@@ -297,6 +300,7 @@ pub(super) fn material(
         ));
     }
     let mut skipped_beside = Vec::new();
+    let mut taken_beside = 0;
     for slot in Slot::ALL {
         let i = slot as usize;
         let claims = &beside.claims[i];
@@ -341,6 +345,7 @@ pub(super) fn material(
                     factor = [1.0; 4];
                 }
                 slots[i] = Some(t);
+                taken_beside += 1;
             }
             Err(e) => warn.push(format!(
                 "{} beside the scene not used as the {what} texture: {e:#}",
@@ -369,6 +374,14 @@ pub(super) fn material(
         if slot == Slot::Albedo {
             factor = [1.0; 4];
         }
+    }
+    // An option that changes nothing is named, not ignored in silence.
+    let sidecars = taken_beside + given.iter().filter(|g| g.is_some()).count();
+    if overrides.sidecar_top_down && sidecars == 0 {
+        warn.note(
+            "--sidecar-top-down is ignored: no texture came from beside the file or the command line"
+                .to_string(),
+        );
     }
     let [base_color, normal_map, specular_map] = slots;
     Ok(Material {
@@ -538,6 +551,16 @@ mod tests {
             "{:?}",
             l.warnings
         );
+        let top_down = TextureOverrides {
+            sidecar_top_down: true,
+            ..Default::default()
+        };
+        let l = crate::scene::gltf_load::load_head_with_notes(&scene, &top_down).unwrap();
+        assert!(
+            !l.notes.iter().any(|n| n.contains("--sidecar-top-down")),
+            "{:?}",
+            l.notes
+        );
         // Two files claiming one role: neither is taken.
         image::RgbaImage::new(8, 8)
             .save(dir.join("other_diffuse.png"))
@@ -551,6 +574,21 @@ mod tests {
             ),
             "{w:?}"
         );
+        // Nothing came from beside the file: --sidecar-top-down changes nothing, and says so.
+        let bare = temp_dir("bare");
+        let l = crate::scene::gltf_load::load_head_with_notes(
+            &tiny_gltf(&bare, true, true, [0.0; 3]),
+            &top_down,
+        )
+        .unwrap();
+        assert!(
+            l.notes
+                .iter()
+                .any(|n| n.contains("--sidecar-top-down is ignored")),
+            "{:?}",
+            l.notes
+        );
+        let _ = std::fs::remove_dir_all(bare);
         let _ = std::fs::remove_dir_all(dir);
     }
 }
