@@ -541,3 +541,93 @@ fn files_beside_a_model_never_stop_or_change_its_render() {
     let _ = std::fs::remove_dir_all(dir);
     ctx.finish().unwrap();
 }
+
+// The same doors from the command line: each hostile file ends in exit 1 and one
+// `error:` line naming it, within a minute (a child still running then is killed
+// and fails the test).
+#[test]
+fn the_command_line_ends_hostile_files_in_one_error_line() {
+    let dir = temp_dir("hostile-cli");
+    let (fifo, zero, bomb) = hostile_files(&dir, "input", "png");
+    let out = dir.join("out");
+    let o = out.to_str().unwrap();
+    let (f, z, b) = (
+        fifo.to_str().unwrap(),
+        zero.to_str().unwrap(),
+        bomb.to_str().unwrap(),
+    );
+    let fifo_dir = dir.join("fifo_run");
+    std::fs::create_dir_all(&fifo_dir).unwrap();
+    mkfifo(&fifo_dir.join("diffuse.exr"));
+    let fd = fifo_dir.to_str().unwrap();
+    let render = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "render", "--device", "llvmpipe", "--width", "64", "--height", "36", "--frames", "1",
+            "--warmup", "0", "--out", o,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (render(&["--scene", f]), "scene file is not a regular file"),
+        (render(&["--scene", z]), "scene file is not a regular file"),
+        (
+            ["compare", fd, fd].iter().map(|s| s.to_string()).collect(),
+            "EXR image is not a regular file",
+        ),
+        (
+            ["budget", "--device", "llvmpipe", "--profile", z, "--out", o]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+            "profile is not a regular file",
+        ),
+    ];
+    let scene = Model::triangle(true, true, [0.0; 3]).write(Container::DataUri, &dir, "tri");
+    let s = scene.to_str().unwrap();
+    let mut cases = cases;
+    cases.push((
+        render(&["--scene", s, "--albedo", f]),
+        "albedo texture is not a regular file",
+    ));
+    cases.push((
+        render(&["--scene", s, "--spec-map", b]),
+        "100000x100000 pixels",
+    ));
+    for (args, phrase) in cases {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_dermis"))
+            .args(&args)
+            .env("RUST_BACKTRACE", "0")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run dermis");
+        let start = std::time::Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if start.elapsed() > Duration::from_secs(60) {
+                let _ = child.kill();
+                panic!("{args:?}: still running after a minute");
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        };
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        let lines: Vec<&str> = err
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with("note: "))
+            .collect();
+        assert_eq!(status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(lines.len(), 1, "{args:?}: not one line: {err}");
+        assert!(
+            lines[0].starts_with("error: ") && lines[0].contains(phrase),
+            "{args:?}: '{phrase}' not in: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
