@@ -12,8 +12,9 @@
 //! the glTF files the tests and the fuzzer load.
 //!
 //! Every input ends in a loaded head or one error line naming the file and the element
-//! (the bytes are read with bounds by `gltf_source` and `gltf_accessor`; the node graph
-//! is walked without recursion). What glTF allows is loaded, what it forbids refused:
+//! (the bytes are read with bounds by `gltf_source` and `gltf_accessor`, every file
+//! through the one door, `crate::files`; the node graph is walked without recursion).
+//! What glTF allows is loaded, what it forbids refused:
 //! - TRIANGLE_STRIP and TRIANGLE_FAN become triangle lists with glTF's winding;
 //!   POINTS and LINES* are refused (drawing them as something else would be a lie).
 //! - A primitive without NORMAL gets flat normals, as the spec requires (warning).
@@ -27,8 +28,9 @@
 //!   Any other required extension is refused by name.
 //! - Non-finite positions, normals, tangents, texture coordinates or node transforms
 //!   are errors, and so are texture coordinates of 2^24 or more (no texel left to
-//!   address; the sampler's arithmetic overflows). Node transforms are composed in f64, and a model far from the origin
-//!   for its size (a scan placed at 1e7) is moved to it, so f32 keeps its shape.
+//!   address; the sampler's arithmetic overflows). Node transforms are composed in
+//!   f64, and a model far from the origin for its size (a scan placed at 1e7) is moved
+//!   to it, so f32 keeps its shape.
 //! - Far outlier vertices (one flipped exponent bit) load with a warning; the framing
 //!   (`head_measure`, the scene's bounds) leaves them out.
 

@@ -460,26 +460,15 @@ mod tests {
 
     #[test]
     fn glb_chunks_are_bounds_checked() {
-        let glb = |json: &[u8], bin: Option<&[u8]>, declared: Option<u32>| -> Vec<u8> {
-            let mut v = b"glTF".to_vec();
-            v.extend(2u32.to_le_bytes());
-            v.extend(0u32.to_le_bytes());
-            v.extend((json.len() as u32).to_le_bytes());
-            v.extend(b"JSON");
-            v.extend(json);
-            if let Some(bin) = bin {
-                v.extend(declared.unwrap_or(bin.len() as u32).to_le_bytes());
-                v.extend(b"BIN\0");
-                v.extend(bin);
-            }
-            let n = v.len() as u32;
-            v[8..12].copy_from_slice(&n.to_le_bytes());
-            v
-        };
-        let ok = glb(b"{}", Some(&[1, 2, 3, 4]), None);
+        // The shared fixture's GLB writer (it pads the JSON chunk to 4 bytes).
+        use super::super::gltf_load::fixture::glb_bytes;
+        let ok = glb_bytes(&serde_json::json!({}), Some(&[1, 2, 3, 4]));
         let (j, b) = split_glb(&ok).unwrap();
-        assert_eq!((j, b), (&b"{}"[..], Some(&[1u8, 2, 3, 4][..])));
-        let bad = glb(b"{}", Some(&[1, 2, 3, 4]), Some(u32::MAX));
+        assert_eq!((j, b), (&b"{}  "[..], Some(&[1u8, 2, 3, 4][..])));
+        // The BIN chunk's length field (after the 12-byte header and the 12-byte
+        // JSON chunk) declaring more than follows.
+        let mut bad = ok.clone();
+        bad[24..28].copy_from_slice(&u32::MAX.to_le_bytes());
         let e = format!("{:#}", split_glb(&bad).unwrap_err());
         assert!(
             e.contains("declares 4294967295 bytes but only 4 follow"),
