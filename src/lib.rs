@@ -3,8 +3,9 @@
 //!
 //! Layers, bottom up (a module uses only the ones before it; tests/layers.rs
 //! checks it on every path the code names):
-//! the pure core, `shader_constants`, `work`, `view`, `scene`, `skin`,
-//! `reference` (no Vulkan: the numbers shared with the shaders, the
+//! the pure core, `files`, `shader_constants`, `work`, `view`, `scene`, `skin`,
+//! `reference` (no Vulkan: the one door every user-supplied file is read
+//! through, regular files only and sizes bounded; the numbers shared with the shaders, the
 //! vocabulary of a pass's work, the view's scale and the SSS region, meshes and
 //! framing, profiles, kernels and the CPU mirrors of the passes, the ground
 //! truth's sampling and chunk plan) -> `vk` (device, barrier table, memory,
@@ -23,6 +24,7 @@
 pub mod bench;
 pub mod budget;
 pub mod eval;
+pub mod files;
 pub mod graph;
 pub mod method;
 pub mod output;

@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 /// sit above it.
 const LAYERS: &[&[&str]] = &[
     &[
+        "files",
         "shader_constants",
         "work",
         "view",

@@ -176,10 +176,9 @@ impl Output {
     fn read(d: &Path) -> Result<Self> {
         let (width, height, diffuse) = read_exr(&d.join("diffuse.exr"))?;
         let p = d.join("frame.png");
-        let frame = image::open(&p)
-            .with_context(|| format!("reading {}", p.display()))?
-            .to_rgba8()
-            .into_raw();
+        // Its sides within the range `render` accepts for a frame's width and height.
+        let frame_bound = crate::files::ImageBound::rgba8(crate::render::settings::MAX_IMAGE_SIDE);
+        let frame = crate::files::read_rgba8(&p, "frame", &frame_bound)?.into_raw();
         Ok(Output {
             width,
             height,

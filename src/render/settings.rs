@@ -25,6 +25,15 @@ pub const MAX_AMBIENT: f32 = 100.0;
 /// few pixels high in a 4K frame, and f32 still separates near and far planes.
 pub const MAX_DISTANCE_HEADS: f32 = 1000.0;
 
+/// The vertical field of view's range, (0.5, 170) degrees: `--fovy`, and the
+/// `fovy_deg` of a report `compare` reads.
+pub fn check_fovy(fovy_deg: f32) -> Result<()> {
+    if !fovy_deg.is_finite() || fovy_deg <= 0.5 || fovy_deg >= 170.0 {
+        bail!("vertical field of view must be within 0.5..170 degrees, got {fovy_deg}");
+    }
+    Ok(())
+}
+
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
     pub width: u32,
@@ -148,12 +157,7 @@ impl RenderSettings {
                 self.distance_heads
             );
         }
-        if !self.fovy_deg.is_finite() || self.fovy_deg <= 0.5 || self.fovy_deg >= 170.0 {
-            bail!(
-                "vertical field of view must be within 0.5..170 degrees, got {}",
-                self.fovy_deg
-            );
-        }
+        check_fovy(self.fovy_deg)?;
         self.light.validate()?;
         if !self.ambient.is_finite() || !(0.0..=MAX_AMBIENT).contains(&self.ambient) {
             bail!(
