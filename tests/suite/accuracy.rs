@@ -7,7 +7,7 @@
 //! - uniform light (white skin, ambient only): the ground truth must return its
 //!   input (what light goes in comes out), thin parts apart.
 
-mod common;
+use crate::common;
 
 use dermis::method::reference::Reference;
 use dermis::render::{RenderSettings, Renderer};
