@@ -28,6 +28,7 @@ P=$STORE/perf
 B=${B:-.bin/dermis}
 A=.assets/lee-perry-smith/LeePerrySmith.glb
 mkdir -p "$P" "$OUT"
+. "$(dirname "$0")/methods.sh"
 DRY=${DRY:-0}
 if [ "$DRY" = 1 ]; then
   EXTRA=(--device llvmpipe --warmup 1 --frames 2)
@@ -72,13 +73,13 @@ smoke() {
   { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader || true; "$B" devices; } > "$P/gpu.txt" 2>&1
   # The same renderer under the Khronos validation layer (synchronization
   # validation on; any message is an error) on a real GPU: the default scene
-  # with every method, and the head with the reference.
+  # with every method of the registry, and the head with ssg.
   if [ "$DRY" != 1 ] && ls .vvl/*.deb > /dev/null 2>&1; then
     mkdir -p /tmp/vvl && for f in .vvl/*.deb; do dpkg -x "$f" /tmp/vvl; done
     export VK_LAYER_PATH=/tmp/vvl/usr/share/vulkan/explicit_layer.d
     export LD_LIBRARY_PATH=/tmp/vvl/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   fi
-  for m in separable ssg ss-jittered poisson reference none; do
+  for m in $(dermis_methods "$B"); do
     run "validate $m" "$P/validate/$m/report.json" render --validate "${EXTRA[@]}" --method "$m" \
       --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/$m"
   done
@@ -172,7 +173,8 @@ images() {
     local -n args=$case
     run "img $case reference" "$I/$case/reference/frame.png" render "${EXTRA[@]}" "${args[@]}" --width $W --height $H --method reference --out "$I/$case/reference"
   done
-  for m in none separable ssg ss-jittered poisson; do
+  # Every method but the ground truth (rendered above) beside it.
+  for m in $(dermis_methods "$B" 'not m["ground_truth"]'); do
     run "img head $m" "$I/head/$m/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --method "$m" --out "$I/head/$m"
   done
   run "img head separable nofollow" "$I/head/separable-nofollow/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --no-follow-surface --out "$I/head/separable-nofollow"

@@ -476,10 +476,11 @@ mod tests {
     use super::*;
 
     /// The leaf keys of a JSON value, nested keys joined by `_` and array
-    /// elements named r, g, b (a gain).
+    /// elements named r, g, b (a gain); the bands' columns go by their keys
+    /// under `bands` (`bands.interior.flip` is `interior_flip`).
     fn leaves(v: &serde_json::Value, at: &str, out: &mut Vec<String>) {
         let join = |k: &str| {
-            if at.is_empty() {
+            if at.is_empty() || at == "bands" {
                 k.to_string()
             } else {
                 format!("{at}_{k}")

@@ -346,11 +346,13 @@ pub fn listing_text() -> String {
         };
         let _ = writeln!(s, "{}{tags}: {}", m.name, m.summary);
         for o in &m.options {
-            let flag = match o.kind {
-                "value" => format!("--{} VALUE", o.flag),
-                _ => format!("--{}", o.flag),
+            // A switch turns on by default what its `--no-` flag turns off.
+            let (flag, default) = match o.kind {
+                "value" => (format!("--{} VALUE", o.flag), o.default),
+                _ => (format!("--{}", o.flag), "on"),
             };
-            let _ = writeln!(s, "    {flag:<28} default {:<8} {}", o.default, o.help);
+            let default = if default.is_empty() { "-" } else { default };
+            let _ = writeln!(s, "    {flag:<28} default {default:<8} {}", o.help);
         }
     }
     s

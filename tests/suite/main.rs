@@ -25,6 +25,7 @@ mod common;
 
 mod accuracy;
 mod budget_cli;
+mod harness;
 mod reference;
 mod region;
 mod scenes;
