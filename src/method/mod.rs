@@ -6,8 +6,9 @@
 //! [`METHODS`], and its test. The frame (`render`) knows nothing of any method:
 //! it declares the targets the method says it [`Needs`], builds it from one
 //! [`MethodSetup`], records the passes it returns and composites whatever image
-//! it names as its output. The CLI, `eval`, the bench matrix and the tests
-//! iterate [`METHODS`].
+//! it names as its output. The CLI, `eval` (its sweep and the dolly chart's
+//! lines), the bench matrix and the tests iterate [`METHODS`]; the scripts in
+//! `tools/` read it through `dermis methods --json` ([`listing`]).
 
 pub mod jittered;
 pub mod none;

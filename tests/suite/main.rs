@@ -1,6 +1,6 @@
 //! dermis's integration tests: one binary, one module per area (the catalogue
 //! is docs/tests.md). One binary because each integration binary links the
-//! whole crate: sixteen of them took most of a clean run's time on two cores.
+//! whole crate and its dependencies (there were sixteen).
 //!
 //! Every test here runs on lavapipe (or DERMIS_TEST_DEVICE) with the Khronos
 //! validation layer and synchronization validation on, any message failing
