@@ -40,13 +40,6 @@ const QUARTER_BOUND_MIB: f64 = 1.0;
 /// Most growth over all the frames (and over the renders), in MiB.
 const TOTAL_BOUND_MIB: f64 = 24.0;
 
-fn env_usize(key: &str, default: usize) -> usize {
-    std::env::var(key)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
 /// The soak's length: (frames a method, renders in a row). The short soak
 /// unless DERMIS_SOAK=1 asks for the long one; DERMIS_SOAK_FRAMES and
 /// DERMIS_SOAK_RENDERS override either.
@@ -54,8 +47,8 @@ fn length() -> (usize, usize) {
     let long = std::env::var("DERMIS_SOAK").is_ok_and(|v| v == "1");
     let (frames, renders) = if long { (120, 8) } else { (40, 4) };
     (
-        env_usize("DERMIS_SOAK_FRAMES", frames),
-        env_usize("DERMIS_SOAK_RENDERS", renders),
+        common::env_usize("DERMIS_SOAK_FRAMES", frames),
+        common::env_usize("DERMIS_SOAK_RENDERS", renders),
     )
 }
 
