@@ -195,38 +195,3 @@ pub fn pass_table(profile: &str, f: &FrameInput) -> Result<String> {
     );
     Ok(s)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Prints docs/budget.md's tables:
-    /// `cargo test --release --lib budget::porting -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn print_porting_tables() {
-        let frames = porting_frames().unwrap();
-        assert!(
-            !frames.is_empty(),
-            "run tools/budget_frames.sh porting first"
-        );
-        println!(
-            "### xbox360\n\n{}",
-            summary_table("xbox360", &frames, 2.0).unwrap()
-        );
-        for p in ["xbox360", "switch-handheld", "switch-docked", "steam-deck"] {
-            println!(
-                "### {p} (compact)\n\n{}",
-                compact_table(p, &frames, 2.0).unwrap()
-            );
-        }
-        for (config, method, f) in &frames {
-            if config == "h1 mid" && method != "none" {
-                println!(
-                    "#### xbox360, {config}, {method}\n\n{}",
-                    pass_table("xbox360", f).unwrap()
-                );
-            }
-        }
-    }
-}

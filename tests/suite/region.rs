@@ -1,11 +1,11 @@
-//! The SSS region (render/region.rs) on lavapipe with validation: limiting the
+//! The SSS region (method/region.rs) on lavapipe with validation: limiting the
 //! seed copies and the stencil-tested draws to the skin's widened bounds must
 //! change no pixel of any method's output, on one head, on many heads (several
 //! rectangles), on a head cut by the screen edge and on a camera inside the
 //! head's box (the whole-screen fallback), while the region really is smaller
 //! than the screen where it can be.
 
-mod common;
+use crate::common;
 
 use dermis::graph::work::PassRole;
 use dermis::method::region::{PixelRect, RegionMode};
@@ -115,6 +115,13 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
             },
         );
         let (ds, df) = (&fs.diffuse, &ff.diffuse);
+        let _diff = common::DiffOnFailure::new(
+            format!("region-{name}"),
+            base.width as usize,
+            base.height as usize,
+            ds,
+            df,
+        );
         assert_eq!(ff.region_pixels, pixels);
         if expect_smaller {
             assert!(

@@ -3,7 +3,7 @@
 //! Thresholds come from measurements printed by the tests and recorded in
 //! docs/accuracy.md.
 
-mod common;
+use crate::common;
 
 use dermis::method::{MethodEntry, MethodOptions};
 use dermis::render::{RenderSettings, Renderer};

@@ -2,7 +2,7 @@
 //! the default scene, the Lee Perry-Smith head, many heads, and a scene with no
 //! skin, checked for finite, non-constant output and sane reports.
 
-mod common;
+use crate::common;
 
 use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};
