@@ -1,7 +1,7 @@
 //! dermis: a hand-written Vulkan (ash) renderer for real-time human skin that
 //! measures what every pass costs on the GPU.
 //!
-//! Layers, bottom up (a module uses only the ones before it; tests/layers.rs
+//! Layers, bottom up (a module uses only the ones before it; tests/suite/layers.rs
 //! checks it on every path the code names):
 //! the pure core, `files`, `shader_constants`, `work`, `view`, `scene`, `skin`,
 //! `reference` (no Vulkan: the one door every user-supplied file is read
@@ -20,7 +20,7 @@
 //!
 //! The pure core and, above it, `eval::metrics` and `budget::model` name
 //! neither `ash`, `crate::vk` nor `crate::graph`, nor reach them through any
-//! file they lead to (tests/layers.rs).
+//! file they lead to (tests/suite/layers.rs).
 pub mod bench;
 pub mod budget;
 pub mod eval;

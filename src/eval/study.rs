@@ -10,8 +10,8 @@ use serde::Serialize;
 use super::bands::{bands, Band, BandErrors, BandInput};
 use super::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
 use super::{chart, pareto, sweep};
-use crate::output::{read_exr, write_json, write_rgba8_png};
 use crate::method::lookup;
+use crate::output::{read_exr, write_json, write_rgba8_png};
 use crate::render::RenderSettings;
 use crate::vk::context::Context;
 

@@ -1,5 +1,5 @@
 //! The one glTF fixture builder, shared by the loader's unit tests,
-//! `tests/cli.rs` and the fuzzer (`tests/gltf_fuzz.rs`): a document and its
+//! `tests/suite/cli.rs` and the fuzzer (`tests/suite/gltf_fuzz.rs`): a document and its
 //! one buffer, built up view by view and accessor by accessor, then written as
 //! a .gltf with a data: URI, a .gltf beside a .bin, or a GLB.
 //!

@@ -3,7 +3,7 @@
 //! the pure files above it name neither `ash`, `crate::vk` nor `crate::graph`,
 //! no two sibling files import each other in a cycle, `render/mod.rs` stays
 //! small and long functions say why. (That no code compares a pass label is
-//! checked in tests/work_gpu.rs, on the labels the frames really have.)
+//! checked in tests/suite/work.rs, on the labels the frames really have.)
 //!
 //! The checks read paths, not text: comments and string literals are dropped,
 //! grouped imports (`use crate::{a, b::{c, d}}`) are expanded, and `super::`

@@ -7,12 +7,12 @@
 //!
 //! Quick run (the default: 3000 random cases plus the fixed ones, up to 40 loaded cases
 //! per category rendered; well under a minute in the debug profile):
-//!     cargo test --test gltf_fuzz -- --nocapture
+//!     cargo test --test suite gltf_fuzz -- --nocapture
 //! Long run (the number of random cases, and another seed):
-//!     DERMIS_FUZZ_ITERS=50000 DERMIS_FUZZ_SEED=7 cargo test --release --test gltf_fuzz -- --nocapture
+//!     DERMIS_FUZZ_ITERS=50000 DERMIS_FUZZ_SEED=7 cargo test --release --test suite gltf_fuzz -- --nocapture
 //! DERMIS_FUZZ_RENDER=0 skips the rendering part (no Vulkan needed).
 
-mod common;
+use crate::common;
 
 use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};

@@ -1,9 +1,9 @@
 //! Hostile but fair input on the GPU (issue 11), lavapipe with validation on:
 //! a texture larger than the device allows, a far outlier vertex, a flat object,
 //! and the extremes of every documented range, each rendered for real. (The CLI
-//! sweep of every flag is in tests/cli.rs; the glTF fuzzer in tests/gltf_fuzz.rs.)
+//! sweep of every flag is in tests/suite/cli.rs; the glTF fuzzer in tests/suite/gltf_fuzz.rs.)
 
-mod common;
+use crate::common;
 
 use dermis::render::{Capture, RenderSettings};
 use dermis::run::{run, RunOptions};

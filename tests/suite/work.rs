@@ -4,7 +4,7 @@
 //! held to what its pass declares: exact counts exactly, upper bounds as bounds,
 //! and no fetch that is not declared.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 
