@@ -302,6 +302,9 @@ impl From<Preset> for PresetArg {
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum Shot {
+    /// The default: a portrait, the head alone in frame with a little room
+    /// (`render::settings::PORTRAIT_CLOSE_UPS` close-up distances).
+    Portrait,
     /// The head fills the screen height.
     Close,
     /// Twice the close-up distance.
@@ -365,7 +368,7 @@ struct Common {
           default_value_t = LayoutArg::from(defaults().layout))]
     layout: LayoutArg,
     /// Camera shot (ignored when --distance is given).
-    #[arg(long, value_enum, default_value_t = Shot::Mid)]
+    #[arg(long, value_enum, default_value_t = Shot::Portrait)]
     shot: Shot,
     /// Camera distance from the head centre in head heights.
     #[arg(long)]
@@ -444,6 +447,7 @@ impl Common {
     fn settings(&self) -> Result<RenderSettings> {
         let close = Camera::close_up_distance_heads(self.fovy);
         let distance = self.distance.unwrap_or(match self.shot {
+            Shot::Portrait => dermis::render::settings::PORTRAIT_CLOSE_UPS * close,
             Shot::Close => close,
             Shot::Mid => 2.0 * close,
             Shot::Far => 5.0 * close,

@@ -89,7 +89,7 @@ fn setup(method: &str) -> (Scene, RenderSettings) {
         width: 64,
         height: 36,
         shadow_size: 256,
-        ..Default::default()
+        ..RenderSettings::study()
     }
     .with(common::m(method), &[]);
     if method == "reference" {

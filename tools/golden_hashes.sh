@@ -8,17 +8,21 @@
 # --dump, and writes one line per file (sha256 of frame.png, diffuse.exr and
 # every pass dump) and one line per pass of report.json (fragment invocations,
 # samples passed). Times are left out: they are the only thing allowed to move.
-# PROCEDURAL_SCENE_ARGS name the procedural scene (default: none, the embedded
-# default; after the default head changed: --scene builtin:egg). GRID="--layout grid"
+# PROCEDURAL_SCENE_ARGS name the procedural scene and its shot (default: --shot mid, the
+# embedded default at the study view's distance; after the default head changed: --scene builtin:egg). GRID="--layout grid"
 # keeps the 3-head case on the grid layout once the crowd became the default.
 set -euo pipefail
 out=$1; shift
 proc=("$@")
+[ ${#proc[@]} -eq 0 ] && proc=(--shot mid)
 B=${B:-target/release/dermis}
 HEAD=${HEAD:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-common=(--device llvmpipe --validate --width 256 --height 144)
+# The study view (RenderSettings::study()): the default view before issue 15
+# made the default a portrait. Named here so the hashes keep meaning one view.
+study=(--light-azimuth 60 --light-elevation 30 --ambient 0.08)
+common=(--device llvmpipe --validate --width 256 --height 144 "${study[@]}")
 configs=(
   "none|--method none"
   "separable 9|--method separable --samples 9"
@@ -62,7 +66,7 @@ PY
   # allowed to move) are dropped; every modelled figure, count and resolve is kept.
   d=$tmp/budget
   rm -rf "$d"
-  "$B" budget --device llvmpipe --validate --width 256 --height 144 "${sargs[@]}" \
+  "$B" budget "${common[@]}" "${sargs[@]}" \
     --profile xbox360,nvidia-h200 --compare-methods --warmup 0 --frames 1 --out "$d" >/dev/null
   python3 - "$d" "$scene" >> "$out" <<'PY'
 import json, sys, pathlib, hashlib

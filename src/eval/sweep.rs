@@ -101,7 +101,7 @@ pub fn dolly_scenes(head: PathBuf) -> Vec<SceneSpec> {
 
 /// The embedded scene at its default view.
 pub fn procedural_scene() -> SceneSpec {
-    let d = RenderSettings::default();
+    let d = RenderSettings::study();
     SceneSpec {
         name: "procedural".into(),
         gltf: None,
@@ -576,7 +576,7 @@ mod tests {
                 .iter()
                 .find(|c| c.setting.label == format!("{n} samples"))
                 .unwrap();
-            let s = RenderSettings::default().with(c.method, c.setting.options);
+            let s = RenderSettings::study().with(c.method, c.setting.options);
             assert_eq!(s.method.opts(&s.options).raw("samples"), n);
         }
     }

@@ -72,7 +72,7 @@ fn card_settings(scene: &Scene, px_per_mm: f32) -> RenderSettings {
         fovy_deg: fovy,
         distance_heads: d / scene.head_height_units(),
         ambient: 0.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     s.light.azimuth_deg = 0.0;
     s.light.elevation_deg = 0.0;
@@ -353,7 +353,7 @@ fn white_ambient(scene: &mut Scene) -> RenderSettings {
         height: 120,
         shadow_size: 256,
         ambient: 1.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
     .with(common::m("reference"), &[("density", "16")]);
     s.light.intensity = 0.0;

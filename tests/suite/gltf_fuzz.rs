@@ -166,7 +166,7 @@ fn render_small(
         width: 64,
         height: 36,
         shadow_size: 256,
-        ..Default::default()
+        ..RenderSettings::study()
     };
     let opts = RunOptions {
         warmup: 0,

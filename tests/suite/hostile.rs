@@ -18,7 +18,7 @@ fn small() -> RenderSettings {
         width: 64,
         height: 36,
         shadow_size: 256,
-        ..Default::default()
+        ..RenderSettings::study()
     }
 }
 

@@ -16,7 +16,7 @@ fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
         height,
         shadow_size: 256,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
     .with(common::m("reference"), &[("density", &density.to_string())])
 }

@@ -169,7 +169,7 @@ fn the_region_changes_no_pixel_on_the_egg_scene() {
         width: 192,
         height: 108,
         shadow_size: 256,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     region_changes_nothing(&egg_scene(), base.clone(), true);
     // Close and wide: taps reach far past the silhouette, where only the
@@ -194,7 +194,7 @@ fn the_region_changes_no_pixel_on_many_heads_and_cut_heads() {
         width: 192,
         height: 108,
         shadow_size: 256,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     // Three heads at the thesis' far distance: several rectangles.
     region_changes_nothing(
@@ -225,7 +225,7 @@ fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
         height: 64,
         shadow_size: 256,
         distance_heads: 0.3,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     let ctx = common::ctx();
     let r = Renderer::new(&ctx, &scene, &s).expect("renderer");
@@ -242,7 +242,7 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
         heads: 4,
         layout: Layout::Grid,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     let r = Renderer::new(&ctx, &egg_scene(), &s).expect("renderer");
     let region = &r.frame.region_px;
@@ -285,7 +285,7 @@ fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
         height: 432,
         shadow_size: 256,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     base.options.set("follow-surface", "false");
     // Taps reach ~90 px (50 mm at 1.8 px/mm), far more than the up to 31 px a

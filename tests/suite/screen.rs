@@ -52,7 +52,7 @@ fn settings(method: &str) -> RenderSettings {
         shadow_size: 64,
         method: lookup(method).unwrap(),
         distance_heads: 1.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
 }
 
@@ -282,7 +282,7 @@ fn gaussian_lod_by_counts_on_a_dolly() {
                 height: 80,
                 shadow_size: 128,
                 distance_heads: distance,
-                ..RenderSettings::default()
+                ..RenderSettings::study()
             }
             .with(
                 lookup("ssg").unwrap(),

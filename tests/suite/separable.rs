@@ -53,7 +53,7 @@ fn renderer_settings() -> RenderSettings {
         width: W as u32,
         height: H as u32,
         shadow_size: 64,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
 }
 

@@ -137,7 +137,7 @@ fn settings(method: &str, opts: &[(&str, &str)], w: u32, h: u32, distance: f32) 
         height: h,
         shadow_size: 256,
         distance_heads: distance,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
     .with(common::m(method), opts)
 }

@@ -66,7 +66,7 @@ fn main() -> Result<()> {
                 height: 720,
                 shadow_size: 256,
                 distance_heads: 4.0,
-                ..RenderSettings::default()
+                ..RenderSettings::study()
             }
             .with(lookup(m)?, opts);
             s.heads = heads;
