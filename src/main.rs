@@ -300,6 +300,16 @@ impl From<Preset> for PresetArg {
     }
 }
 
+/// The views the shot, key light and ambient default to.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum View {
+    /// The default picture: `RenderSettings::default()`, the portrait.
+    Portrait,
+    /// `RenderSettings::study()` at the mid shot: the tests' view and every
+    /// recorded run's before issue 15.
+    Study,
+}
+
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum Shot {
     /// The default: a portrait, the head alone in frame with a little room
@@ -367,25 +377,35 @@ struct Common {
     #[arg(long, value_enum, ignore_case = true,
           default_value_t = LayoutArg::from(defaults().layout))]
     layout: LayoutArg,
-    /// Camera shot (ignored when --distance is given).
-    #[arg(long, value_enum, default_value_t = Shot::Portrait)]
-    shot: Shot,
+    /// The view the shot, key light and ambient default to: portrait (the
+    /// default picture, `RenderSettings::default()`) or study (the fixed view of
+    /// the tests and of every run recorded before issue 15,
+    /// `RenderSettings::study()` at the mid shot). --shot, --light-azimuth,
+    /// --light-elevation and --ambient override it.
+    #[arg(long, value_enum, default_value_t = View::Portrait)]
+    view: View,
+    /// Camera shot (ignored when --distance is given) [default: portrait, or mid
+    /// with --view study].
+    #[arg(long, value_enum)]
+    shot: Option<Shot>,
     /// Camera distance from the head centre in head heights.
     #[arg(long)]
     distance: Option<f32>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = defaults().fovy_deg)]
     fovy: f32,
-    /// Key light azimuth in degrees (0 = from the camera side, positive toward the viewer's right).
-    #[arg(long, default_value_t = defaults().light.azimuth_deg, allow_negative_numbers = true)]
-    light_azimuth: f32,
-    /// Key light elevation in degrees above the horizon.
-    #[arg(long, default_value_t = defaults().light.elevation_deg, allow_negative_numbers = true)]
-    light_elevation: f32,
+    /// Key light azimuth in degrees (0 = from the camera side, positive toward the
+    /// viewer's right) [default: the --view's].
+    #[arg(long, allow_negative_numbers = true)]
+    light_azimuth: Option<f32>,
+    /// Key light elevation in degrees above the horizon [default: the --view's].
+    #[arg(long, allow_negative_numbers = true)]
+    light_elevation: Option<f32>,
     #[arg(long, default_value_t = defaults().light.intensity)]
     light_intensity: f32,
-    #[arg(long, default_value_t = defaults().ambient)]
-    ambient: f32,
+    /// Constant ambient irradiance [default: the --view's].
+    #[arg(long)]
+    ambient: Option<f32>,
     #[arg(long, default_value_t = defaults().exposure)]
     exposure: f32,
     #[arg(long, default_value_t = defaults().shadow_size)]
@@ -446,12 +466,18 @@ impl Args for MethodArgs {
 impl Common {
     fn settings(&self) -> Result<RenderSettings> {
         let close = Camera::close_up_distance_heads(self.fovy);
-        let distance = self.distance.unwrap_or(match self.shot {
-            Shot::Portrait => dermis::render::settings::PORTRAIT_CLOSE_UPS * close,
-            Shot::Close => close,
-            Shot::Mid => 2.0 * close,
-            Shot::Far => 5.0 * close,
-        });
+        let (base, base_shot) = match self.view {
+            View::Portrait => (defaults(), Shot::Portrait),
+            View::Study => (RenderSettings::study(), Shot::Mid),
+        };
+        let distance = self
+            .distance
+            .unwrap_or(match self.shot.unwrap_or(base_shot) {
+                Shot::Portrait => dermis::render::settings::PORTRAIT_CLOSE_UPS * close,
+                Shot::Close => close,
+                Shot::Mid => 2.0 * close,
+                Shot::Far => 5.0 * close,
+            });
         let mut s = RenderSettings {
             width: self.width,
             height: self.height,
@@ -465,12 +491,12 @@ impl Common {
             layout: self.layout.into(),
             distance_heads: distance,
             fovy_deg: self.fovy,
-            ..defaults()
+            ..base.clone()
         };
-        s.light.azimuth_deg = self.light_azimuth;
-        s.light.elevation_deg = self.light_elevation;
+        s.light.azimuth_deg = self.light_azimuth.unwrap_or(base.light.azimuth_deg);
+        s.light.elevation_deg = self.light_elevation.unwrap_or(base.light.elevation_deg);
         s.light.intensity = self.light_intensity;
-        s.ambient = self.ambient;
+        s.ambient = self.ambient.unwrap_or(base.ambient);
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
         // Checked again against the device limits once a device is open.

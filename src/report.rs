@@ -435,6 +435,6 @@ mod tests {
         // Old and new files both: the defaults were exercised.
         assert!(with_layout > 0 && with_layout < files.len());
         let e = load(Path::new("/nonexistent/report.json")).unwrap_err();
-        assert!(format!("{e:#}").contains("reading /nonexistent/report.json"));
+        assert!(format!("{e:#}").contains("report not found: /nonexistent/report.json"));
     }
 }

@@ -8,21 +8,19 @@
 # --dump, and writes one line per file (sha256 of frame.png, diffuse.exr and
 # every pass dump) and one line per pass of report.json (fragment invocations,
 # samples passed). Times are left out: they are the only thing allowed to move.
-# PROCEDURAL_SCENE_ARGS name the procedural scene and its shot (default: --shot mid, the
-# embedded default at the study view's distance; after the default head changed: --scene builtin:egg). GRID="--layout grid"
+# PROCEDURAL_SCENE_ARGS name the procedural scene (default: none, the embedded
+# default; after the default head changed: --scene builtin:egg). GRID="--layout grid"
 # keeps the 3-head case on the grid layout once the crowd became the default.
 set -euo pipefail
 out=$1; shift
 proc=("$@")
-[ ${#proc[@]} -eq 0 ] && proc=(--shot mid)
 B=${B:-target/release/dermis}
 HEAD=${HEAD:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-# The study view (RenderSettings::study()): the default view before issue 15
-# made the default a portrait. Named here so the hashes keep meaning one view.
-study=(--light-azimuth 60 --light-elevation 30 --ambient 0.08)
-common=(--device llvmpipe --validate --width 256 --height 144 "${study[@]}")
+# The study view (RenderSettings::study() at the mid shot): the default view
+# before issue 15 made the default a portrait, so the hashes keep meaning one view.
+common=(--device llvmpipe --validate --width 256 --height 144 --view study)
 configs=(
   "none|--method none"
   "separable 9|--method separable --samples 9"

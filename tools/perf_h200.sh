@@ -51,7 +51,7 @@ for part in "$@"; do
       for m in $(dermis_methods "$B"); do
         [ -e "$STORE/validate/$m/report.json" ] && continue
         echo "+ dermis render --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method $m --width 1280 --height 720" >> "$STORE/validate/commands.txt"
-        if "$B" render --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method "$m" \
+        if "$B" render --view study --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method "$m" \
           --width 1280 --height 720 --out "$STORE/validate/$m" >> "$STORE/validate/log.txt" 2>&1; then
           echo "    ok" >> "$STORE/validate/commands.txt"
         else

@@ -1,5 +1,5 @@
 //! Frames to price besides a live run's: the stored frames of
-//! `docs/budget/frames/` (dermis's frames of the published scenes and of the
+//! `profiles/frames/` (dermis's frames of the published scenes and of the
 //! benchmark configurations, rendered on lavapipe by `tools/budget_frames.sh`),
 //! the pairing of a benchmark report with the stored frame of its
 //! configuration, the transformations that turn a dermis frame into the
@@ -20,9 +20,9 @@ use crate::graph::work::{
 };
 use crate::report::Report;
 
-/// `docs/budget/frames/` beside Cargo.toml.
+/// `profiles/frames/` beside Cargo.toml.
 pub fn frames_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/budget/frames")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/frames")
 }
 
 /// `docs/perf/` beside Cargo.toml.

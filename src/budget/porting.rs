@@ -1,7 +1,7 @@
 //! The porting answer (docs/budget.md): dermis's frames of the Lee Perry-Smith
 //! head at 1280x720, 1/3/5 characters at the close, mid and far shots, every
 //! real-time method (stored by `tools/budget_frames.sh porting` in
-//! `docs/budget/frames/porting/`), priced on the console and handheld profiles
+//! `profiles/frames/porting/`), priced on the console and handheld profiles
 //! and summarised as Markdown tables: per configuration the frame, the skin
 //! SSS time and how much of it is eDRAM resolves, whether it fits a skin
 //! budget; per pass of one configuration the tiles, resolves and ms.

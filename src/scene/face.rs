@@ -19,6 +19,10 @@
 //! - two ears: height fields over an ear-shaped outline, the outer and the inner side
 //!   over the same points joined by a rounded rim, so the pinna is 2-4 mm thick like
 //!   real cartilage; their front edge is pushed into the side of the skull.
+//!
+//! Over 800 lines because the skull, the features, the ears and the backdrop are
+//! built from one set of measurements (740 lines of code) and their tests (360)
+//! check those measurements against each other.
 
 use super::mesh::{Material, Mesh, Object, Vertex};
 use super::procedural::MM_PER_UNIT;

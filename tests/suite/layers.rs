@@ -752,3 +752,30 @@ fn the_renderer_stays_small_and_long_functions_say_why() {
         }
     }
 }
+
+/// No source file over 800 lines without a reason at its top ("Over 800
+/// lines because ..." in its leading `//!` doc): in src/, tests/ and tools/.
+#[test]
+fn long_files_say_why() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for d in ["src", "tests", "tools"] {
+        rust_files(&root.join(d), &mut files);
+    }
+    let mut unexplained = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let n = text.lines().count();
+        let reason = text
+            .lines()
+            .take_while(|l| l.starts_with("//!"))
+            .any(|l| l.contains("Over 800 lines because"));
+        if n > 800 && !reason {
+            unexplained.push(format!("{} ({n} lines)", f.display()));
+        }
+    }
+    assert!(
+        unexplained.is_empty(),
+        "files over 800 lines with no reason at their top (\"Over 800 lines because ...\"): {unexplained:?}"
+    );
+}

@@ -4,6 +4,9 @@
 //! against a CPU visibility prediction (by counts of the fetch-counting build),
 //! the depth-sized viewport, the z pre-passes' zero invocations, far
 //! characters keeping their maps, and each optimisation's change to the image.
+//!
+//! Over 800 lines because every test of the area shares one synthetic unwrapped
+//! mesh and its CPU mirrors; split, each file would rebuild the fixture.
 
 use crate::common;
 
