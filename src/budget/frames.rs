@@ -47,7 +47,7 @@ pub fn load_frame(path: &Path) -> Result<FrameInput> {
 /// negative, and no raster pass with more fragments, samples or rasterised
 /// pixels than its triangles can cover (each covers at most its render area).
 pub fn check_frame(f: &FrameInput) -> Result<()> {
-    let max = crate::render::settings::MAX_IMAGE_SIDE;
+    let max = crate::scene::MAX_IMAGE_SIDE;
     let side = |what: &str, v: u32| -> Result<()> {
         if !(1..=max).contains(&v) {
             bail!("{what} must be within 1..={max} pixels (as render's --width/--height), got {v}");

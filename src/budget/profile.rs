@@ -475,7 +475,7 @@ impl Profile {
             }
         };
         // The frame sizes `render` accepts (`--width`/`--height`), whoever wrote the file.
-        let side = crate::render::settings::MAX_IMAGE_SIDE;
+        let side = crate::scene::MAX_IMAGE_SIDE;
         for (n, v) in [
             ("target.width_px", self.target.width_px),
             ("target.height_px", self.target.height_px),

@@ -9,11 +9,9 @@ use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
 
-/// Largest frame side and shadow map dermis accepts (a device may allow
-/// less: its maxImageDimension2D is checked once it is open).
-pub const MAX_IMAGE_SIDE: u32 = 16384;
-/// Most characters a scene may hold.
-pub const MAX_HEADS: u32 = 1024;
+/// The ranges every reader of a frame holds it to (pure: the budget's readers
+/// use them too), re-exported where the settings are checked.
+pub use crate::scene::{MAX_HEADS, MAX_IMAGE_SIDE};
 /// Exposure (a factor on linear light before the tone curve): 2^-10..=2^10
 /// around the default 2. Past it the frame is black or white whatever the
 /// scene (the issue's `--exposure 1e30` was a black frame).

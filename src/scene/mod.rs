@@ -137,6 +137,14 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
 /// file or a typo.
 pub const MM_PER_UNIT_RANGE: std::ops::RangeInclusive<f32> = 1e-12..=1e12;
 
+/// Largest frame side and shadow map dermis accepts (a device may allow
+/// less: its maxImageDimension2D is checked once it is open). Here, in the pure
+/// core, because every reader of a frame (render's settings, the budget's
+/// profiles and stored frames, reports) holds it to the same range.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most characters a scene may hold.
+pub const MAX_HEADS: u32 = 1024;
+
 /// Checks a scene scale (given with `--mm-per-unit` or derived from the head).
 pub fn check_mm_per_unit(mm: f32) -> Result<()> {
     if !mm.is_finite() || !MM_PER_UNIT_RANGE.contains(&mm) {
