@@ -1,3 +1,5 @@
+#ifndef DERMIS_DRIVER_WORKAROUNDS_GLSL
+#define DERMIS_DRIVER_WORKAROUNDS_GLSL
 // Driver workarounds shared by the shaders (fragment stage).
 //
 // lavapipe in Mesa 22.3 (Debian 12's) compiles a fresh copy of a fragment shader,
@@ -9,3 +11,4 @@
 // but the driver cannot know that. See docs/reliability.md and
 // tools/examples/lavapipe_inline_leak.rs (the minimal program).
 #define NOT_UNIFORM_ZERO min(gl_FragCoord.x, 0.0)
+#endif

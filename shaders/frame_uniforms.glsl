@@ -1,3 +1,5 @@
+#ifndef DERMIS_FRAME_UNIFORMS_GLSL
+#define DERMIS_FRAME_UNIFORMS_GLSL
 // Per-frame constants shared by the shadow and geometry passes (std140).
 layout(set = 0, binding = 0) uniform FrameUniforms {
     mat4 viewProj;
@@ -10,3 +12,4 @@ layout(set = 0, binding = 0) uniform FrameUniforms {
     vec4 params;        // x: mm per unit, y: shadow depth range (units), z: normal shrink (units), w: transmittance on
     vec4 shadowParams;  // x: 1 / shadow map size, y: receiver depth bias (shadow depth units), z: T(s) exponent scale
 } frame;
+#endif

@@ -1,3 +1,5 @@
+#ifndef DERMIS_GEOMETRY_BODY_GLSL
+#define DERMIS_GEOMETRY_BODY_GLSL
 // The geometry pass body, shared by geometry.frag and geometry_normals.frag.
 #include "lighting.glsl"
 #include "driver_workarounds.glsl"
@@ -52,3 +54,4 @@ void main() {
     outNormal = vec4(normalize(mat3(frame.view) * N), 0.0);
 #endif
 }
+#endif

@@ -1,3 +1,5 @@
+#ifndef DERMIS_LIGHTING_GLSL
+#define DERMIS_LIGHTING_GLSL
 // The shading model shared by the geometry pass and the ground-truth reference
 // (reference_irradiance.comp): resources, shadow lookup, Lambert diffuse with
 // normal mapping, transmittance, Kelemen/Szirmay-Kalos specular. One place, so
@@ -6,6 +8,7 @@
 // depend on derivatives (the reference runs it over surface samples, not pixels).
 #include "frame_uniforms.glsl"
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
 layout(set = 0, binding = 1) uniform texture2D shadowMap;
 layout(set = 0, binding = 2) uniform samplerShadow shadowCompare;  // LESS_OR_EQUAL, bilinear: 2x2 PCF
 layout(set = 0, binding = 3) uniform sampler nearestClamp;
@@ -25,12 +28,12 @@ layout(set = 1, binding = 3) uniform MaterialUniforms {
 // the plane integral of the profile (src/skin/transmittance.rs says why).
 vec3 transmittanceProfile(float s) {
     float s2 = s * s * frame.shadowParams.z;
-    return vec3(0.233, 0.455, 0.649) * exp(-s2 / 0.0064) +
-           vec3(0.1, 0.336, 0.344) * exp(-s2 / 0.0484) +
-           vec3(0.118, 0.198, 0.0) * exp(-s2 / 0.187) +
-           vec3(0.113, 0.007, 0.007) * exp(-s2 / 0.567) +
-           vec3(0.358, 0.004, 0.0) * exp(-s2 / 1.99) +
-           vec3(0.078, 0.0, 0.0) * exp(-s2 / 7.41);
+    return SIX_GAUSSIAN_WEIGHT_0 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_0) +
+           SIX_GAUSSIAN_WEIGHT_1 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_1) +
+           SIX_GAUSSIAN_WEIGHT_2 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_2) +
+           SIX_GAUSSIAN_WEIGHT_3 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_3) +
+           SIX_GAUSSIAN_WEIGHT_4 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_4) +
+           SIX_GAUSSIAN_WEIGHT_5 * exp(-s2 / SIX_GAUSSIAN_VARIANCE_5);
 }
 
 vec3 shadowCoord(vec3 worldPos) {
@@ -39,7 +42,7 @@ vec3 shadowCoord(vec3 worldPos) {
 }
 
 
-// 3x3 PCF over 2x2 filtered comparisons.
+// 3x3 PCF over 2x2 filtered comparisons (PCF_RADIUS, PCF_TRIPS in src/shader_constants.rs).
 float shadowPcf(vec3 worldPos, vec3 n) {
     vec3 c = shadowCoord(worldPos);
     float texel = frame.shadowParams.x;
@@ -47,12 +50,12 @@ float shadowPcf(vec3 worldPos, vec3 n) {
     // receiver: clamp so such points compare like points on the far plane.
     float ref = min(c.z - frame.shadowParams.y, 1.0);
     float sum = 0.0;
-    for (int y = -1; y <= 1; y++)
-        for (int x = -1; x <= 1; x++) {
+    for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++)
+        for (int x = -PCF_RADIUS; x <= PCF_RADIUS; x++) {
             vec2 uv = c.xy + vec2(x, y) * texel;
             sum += COUNTED(SITE(0, 1, FK_COMPARE), textureLod(sampler2DShadow(shadowMap, shadowCompare), vec3(uv, ref), 0.0));
         }
-    return sum / 9.0;
+    return sum / PCF_TAPS;
 }
 
 float fresnelSchlick(float vDotH, float f0) {
@@ -94,3 +97,4 @@ vec3 diffuseLight(vec3 albedo, vec3 N, float shadow) {
     vec3 L = normalize(frame.lightDir.xyz);
     return albedo * (frame.lightColor.rgb * max(dot(N, L), 0.0) * shadow + frame.ambient.rgb);
 }
+#endif

@@ -32,6 +32,9 @@ void main() {
     float d = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthChain, p, 0)).r;
     vec3 n = COUNTED(SITE(0, 2, FK_POINT), texelFetch(normalChain, p, 0)).xyz;
     vec2 uv = (vec2(p) + 0.5) / pc.size;
+    // Pixels per mm times the radius, in this shader's own order of products
+    // (mm_per_unit first, unlike view_scale.glsl): its images are hashed bit
+    // for bit, and skin::screen_mirror rounds the same way.
     float rPx = pc.radiusMm / (pc.mmPerUnit * 2.0 * d * pc.tanHalfFovy) * pc.size.y * colorM.a;
     int count = rPx >= 16.0 ? 32 : (rPx >= 8.0 ? 16 : 8);
     vec3 falloff = pc.falloff[count == 32 ? 2 : (count == 16 ? 1 : 0)].rgb;

@@ -2,14 +2,15 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_GOOGLE_include_directive : require
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
 // Ground truth, the wide part: for every skin pixel and each of the profile's
 // Gaussians 4-6, accumulates sum_j L_d(x_j) G_i(|x_j - x_o|) dA_j (rgb) and
 // sum_j G_i(|x_j - x_o|) dA_j (alpha) over all surface samples within the cut-off
 // that light reaches through tissue (true 3D distances, visible or not;
 // src/reference/tissue.rs). reference_resolve.comp divides one by the other
 // (each Gaussian conserves the light it gathers; src/reference/narrow.rs says
-// why) and adds them to the narrow part. Keep in step with NARROW_GAUSSIANS in
-// src/reference/sampling.rs.
+// why) and adds them to the narrow part. The split comes from NARROW_GAUSSIANS
+// (src/shader_constants.rs).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;  // L_d(x_o) (no transmittance), alpha = strength
 layout(set = 0, binding = 1) uniform texture2D depthTex;    // linear view depth
@@ -38,16 +39,12 @@ layout(set = 0, binding = 10, rgba32f) uniform image2D accum6;
 layout(push_constant) uniform Push { int dy; int dz; uint first; uint count; } pc;
 
 // Variances (mm^2) of the six-Gaussian profile's Gaussians 4-6 (thesis Table 4.2).
-const float V[3] = float[](0.567, 1.99, 7.41);
+const float V[WIDE_GAUSSIANS] = WIDE_VARIANCES_MM2;
 const float TWO_PI = 6.28318530718;
 
-bool throughTissue(vec3 xo, vec3 no, vec3 xi, vec3 ni) {
-    vec3 d = xi - xo;
-    // Points closer than 1 um are one point (src/reference/tissue.rs, SAME_POINT_MM).
-    if (length(d) * params.view.z < 1e-3) return true;
-    float lim = params.tissue.x * length(d);
-    return dot(d, no) <= lim && -dot(d, ni) <= lim;
-}
+#define TISSUE_MM_PER_UNIT params.view.z
+#define TISSUE_TOLERANCE_VALUE params.tissue.x
+#include "tissue.glsl"
 
 void main() {
     COUNT_INVOCATION();
@@ -67,7 +64,7 @@ void main() {
     ivec3 dims = ivec3(params.gridDims.xyz);
     int s = int(params.tissue.y);
     vec3 no = COUNTED(SITE(0, 8, FK_POINT), texelFetch(surfNormal, p * s + s / 2, 0)).xyz;
-    vec4 acc[3] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
+    vec4 acc[WIDE_GAUSSIANS] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
     int dz = pc.dz;
     int dy = pc.dy;
     for (int dx = -1; dx <= 1; dx++) {
@@ -82,7 +79,7 @@ void main() {
             float r2 = dot(dv, dv);
             if (r2 > cutoff2 || !throughTissue(xo, no, pa.xyz, normals[k].xyz)) continue;
             vec3 radiance = COUNTED(SITE(0, 4, FK_POINT), texelFetch(radianceTex, ivec2(k % params.gridDims.w, k / params.gridDims.w), 0)).rgb;
-            for (int g = 0; g < 3; g++) {
+            for (int g = 0; g < WIDE_GAUSSIANS; g++) {
                 float e = pa.w * exp(-r2 / (2.0 * V[g])) / (TWO_PI * V[g]);
                 acc[g] += vec4(e * radiance, e);
             }

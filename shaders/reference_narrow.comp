@@ -7,6 +7,8 @@
 // src/reference/cpu.rs mirrors this). Writes every pixel: skin gets the narrow
 // part (the gather passes add the wide part), other pixels the diffuse light.
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
+#include "view_scale.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;   // alpha = SSS strength
 layout(set = 0, binding = 1) uniform texture2D depthTex;     // linear view depth
@@ -20,17 +22,14 @@ layout(set = 0, binding = 6) uniform NarrowParams {
     uvec4 surface;  // x: subsamples per pixel per axis, y: largest window radius
 } params;
 
-const float V[3] = float[](0.0064, 0.0484, 0.187);
-const vec3 W[3] = vec3[](vec3(0.233, 0.455, 0.649), vec3(0.1, 0.336, 0.344), vec3(0.118, 0.198, 0.0));
-const float SIGMA3 = 0.43243496;  // sqrt(0.187)
+// Variances (mm^2) and RGB weights of the profile's narrow Gaussians (thesis Table 4.2).
+const float V[NARROW_GAUSSIANS] = NARROW_VARIANCES_MM2;
+const vec3 W[NARROW_GAUSSIANS] = NARROW_WEIGHTS;
+const float SIGMA3 = NARROW_LAST_SIGMA_MM;  // the widest narrow Gaussian's sigma
 
-bool throughTissue(vec3 xo, vec3 no, vec3 xi, vec3 ni) {
-    vec3 d = xi - xo;
-    // Points closer than 1 um are one point (src/reference/tissue.rs, SAME_POINT_MM).
-    if (length(d) * params.view.z < 1e-3) return true;
-    float lim = params.view.w * length(d);
-    return dot(d, no) <= lim && -dot(d, ni) <= lim;
-}
+#define TISSUE_MM_PER_UNIT params.view.z
+#define TISSUE_TOLERANCE_VALUE params.view.w
+#include "tissue.glsl"
 
 void main() {
     COUNT_INVOCATION();
@@ -51,10 +50,10 @@ void main() {
     ivec2 ssize = textureSize(surfPosition, 0);
     vec3 no = COUNTED(SITE(0, 5, FK_POINT), texelFetch(surfNormal, c, 0)).xyz;
     float mm = params.view.z;
-    float pxPerMm = float(size.y) / (2.0 * z * params.view.x * mm);
+    float pxPerMm = PX_PER_MM(float(size.y), z, params.view.x, mm);
     int r = int(min(max(ceil(4.0 * SIGMA3 * pxPerMm * float(s)), 1.0), float(params.surface.y)));
-    vec3 sum[3] = vec3[](vec3(0.0), vec3(0.0), vec3(0.0));
-    float norm[3] = float[](0.0, 0.0, 0.0);
+    vec3 sum[NARROW_GAUSSIANS] = vec3[](vec3(0.0), vec3(0.0), vec3(0.0));
+    float norm[NARROW_GAUSSIANS] = float[](0.0, 0.0, 0.0);
     for (int qy = c.y - r; qy <= c.y + r; qy++) {
         for (int qx = c.x - r; qx <= c.x + r; qx++) {
             ivec2 q = ivec2(qx, qy);
@@ -66,7 +65,7 @@ void main() {
             vec3 dv = (pa.xyz - xo) * mm;
             float r2 = dot(dv, dv);
             vec3 L = COUNTED(SITE(0, 3, FK_POINT), texelFetch(surfRadiance, q, 0)).rgb;
-            for (int g = 0; g < 3; g++) {
+            for (int g = 0; g < NARROW_GAUSSIANS; g++) {
                 float e = exp(-r2 / (2.0 * V[g])) * pa.w;
                 norm[g] += e;
                 sum[g] += e * L;
@@ -75,7 +74,7 @@ void main() {
     }
     vec3 Lc = COUNTED(SITE(0, 3, FK_POINT), texelFetch(surfRadiance, c, 0)).rgb;
     vec3 acc = vec3(0.0);
-    for (int g = 0; g < 3; g++) {
+    for (int g = 0; g < NARROW_GAUSSIANS; g++) {
         acc += W[g] * (norm[g] > 0.0 ? sum[g] / norm[g] : Lc);
     }
     imageStore(outImage, p, vec4(acc, d0.a));

@@ -5,13 +5,14 @@
 // as its accumulated radiance over its accumulated weight (reference_gather.comp),
 // times its RGB weight (thesis Table 4.2).
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;  // alpha = SSS strength
 layout(set = 0, binding = 1, rgba32f) uniform image2D outImage;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D accum4;
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D accum5;
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D accum6;
-const vec3 W[3] = vec3[](vec3(0.113, 0.007, 0.007), vec3(0.358, 0.004, 0.0), vec3(0.078, 0.0, 0.0));
+const vec3 W[WIDE_GAUSSIANS] = WIDE_WEIGHTS;
 void main() {
     COUNT_INVOCATION();
     ivec2 size = textureSize(diffuseTex, 0);
@@ -19,9 +20,9 @@ void main() {
     if (p.x >= size.x || p.y >= size.y) return;
     vec4 d0 = COUNTED(SITE(0, 0, FK_POINT), texelFetch(diffuseTex, p, 0));
     if (d0.a <= 0.0) return;
-    vec4 acc[3] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
+    vec4 acc[WIDE_GAUSSIANS] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
     vec3 m = imageLoad(outImage, p).rgb;
-    for (int g = 0; g < 3; g++) {
+    for (int g = 0; g < WIDE_GAUSSIANS; g++) {
         if (acc[g].a > 0.0) m += W[g] * (acc[g].rgb / acc[g].a);
     }
     imageStore(outImage, p, vec4(m, d0.a));

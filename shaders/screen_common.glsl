@@ -1,3 +1,5 @@
+#ifndef DERMIS_SCREEN_COMMON_GLSL
+#define DERMIS_SCREEN_COMMON_GLSL
 #include "fetch_count.glsl"
 // Shared by the chapter-4 screen-space passes (ssg, ss-jittered): sources,
 // push constants and the stretch factors of thesis eq. 4.1-4.4.
@@ -36,3 +38,4 @@ float stretch(ivec2 p, ivec2 axis, float depth, float strength) {
     float g = depthGradient(p, axis);
     return pc.alpha / (depth + pc.beta * min(abs(g), pc.gamma)) * strength;
 }
+#endif

@@ -1,3 +1,6 @@
+#ifndef DERMIS_SSG_BLUR_GLSL
+#define DERMIS_SSG_BLUR_GLSL
+#include "shader_constants.glsl"
 // One 1D Gaussian of the sum-of-Gaussians chain (Listing 4.1): 7 taps spaced by
 // one standard deviation, scaled per pixel by the stretch factors.
 layout(early_fragment_tests) in;
@@ -12,10 +15,12 @@ vec4 ssgBlur() {
     float stepPx = stretch(p, axis, depth, colorM.a) * pc.stdMm / 3.0;
     vec2 uv = (vec2(p) + 0.5) * pc.texel;
     vec2 stepUv = pc.dir * stepPx * pc.texel;
-    const float w[7] = float[](0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006);
+    const float w[7] = float[](LISTING_4_1_WEIGHT_0, LISTING_4_1_WEIGHT_1, LISTING_4_1_WEIGHT_2,
+        LISTING_4_1_WEIGHT_3, LISTING_4_1_WEIGHT_4, LISTING_4_1_WEIGHT_5, LISTING_4_1_WEIGHT_6);
     vec3 acc = vec3(0.0);
     for (int k = -3; k <= 3; k++) {
         acc += w[k + 3] * COUNTED(SITE(0, 0, FK_BILINEAR), texture(sampler2D(colorTex, linearClamp), uv + float(k) * stepUv)).rgb;
     }
     return vec4(acc, colorM.a);
 }
+#endif

@@ -1,3 +1,5 @@
+#ifndef DERMIS_TSD_BLUR_GLSL
+#define DERMIS_TSD_BLUR_GLSL
 // Texture-space diffusion: one separable Gaussian pass (Listing 4.1's 7 taps,
 // one standard deviation apart, as seed 004's convolveU/convolveV), the step
 // scaled by the stretch map. The maps hold premultiplied coverage (rgb * a, a):
@@ -8,6 +10,7 @@
 #extension GL_EXT_samplerless_texture_functions : require
 layout(early_fragment_tests) in;
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
 layout(set = 0, binding = 0) uniform texture2D srcTex;
 layout(set = 0, binding = 1) uniform texture2D stretchTex;   // texels per mm along this pass's axis
 layout(set = 0, binding = 2) uniform sampler linearClamp;
@@ -30,7 +33,8 @@ vec4 tsdBlur() {
     vec2 stepUv = pc.dir * (st * pc.stdMm * pc.invSize);
     vec2 lo = vec2(0.5 * pc.invSize);
     vec2 hi = vec2(pc.uvMax);
-    const float w[4] = float[](0.382, 0.242, 0.061, 0.006);
+    // Listing 4.1's centre and one side (the weights are symmetric).
+    const float w[4] = float[](LISTING_4_1_WEIGHT_3, LISTING_4_1_WEIGHT_4, LISTING_4_1_WEIGHT_5, LISTING_4_1_WEIGHT_6);
     vec4 acc = w[0] * c;
     for (int k = 1; k <= 3; k++) {
         vec2 o = float(k) * stepUv;
@@ -39,3 +43,4 @@ vec4 tsdBlur() {
     }
     return acc;
 }
+#endif

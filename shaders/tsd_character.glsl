@@ -1,3 +1,6 @@
+#ifndef DERMIS_TSD_CHARACTER_GLSL
+#define DERMIS_TSD_CHARACTER_GLSL
+#include "shader_constants.glsl"
 // Texture-space diffusion (method/tsd.rs): what every UV-space draw of one
 // character reads. Set 2 (sets 0 and 1 are lighting.glsl's frame and material).
 layout(set = 2, binding = 0) uniform CharacterUniforms {
@@ -8,9 +11,10 @@ layout(set = 2, binding = 0) uniform CharacterUniforms {
 } ch;
 // The atlas: per UV island, atlas = uv * x + yz (skin::tsd_ref::Atlas). A
 // vertex's island is encoded in its tangent's w: sign(w) (1 + island).
-layout(set = 2, binding = 1) uniform AtlasUniforms { vec4 islands[256]; } atlas;
+layout(set = 2, binding = 1) uniform AtlasUniforms { vec4 islands[TSD_MAX_ISLANDS]; } atlas;
 layout(push_constant) uniform TsdPush {
     float z;          // depth the draw writes or tests (0: kept, 1: culled)
     float threshold;  // tsd_mask.frag: the eye-dot threshold
     float keepAbove;  // tsd_mask.frag: 1 keeps texels at or above it, 0 those below
 } pc;
+#endif

@@ -7,6 +7,7 @@
 // divided by its coverage. Specular is the frame's own target.
 layout(early_fragment_tests) in;
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
 layout(set = 1, binding = 0) uniform texture2D mapTex;
 layout(set = 1, binding = 1) uniform sampler linearClamp;
 layout(set = 1, binding = 2) uniform CharacterUniforms {
@@ -15,7 +16,7 @@ layout(set = 1, binding = 2) uniform CharacterUniforms {
     vec4 params;      // x: s (eq. 3.1), y: SSS strength
     vec4 mapInfo;     // x: 1 / T_max, y: largest tap coordinate (see tsd_blur.glsl)
 } ch;
-layout(set = 1, binding = 3) uniform AtlasUniforms { vec4 islands[256]; } atlas;
+layout(set = 1, binding = 3) uniform AtlasUniforms { vec4 islands[TSD_MAX_ISLANDS]; } atlas;
 // geometry.vert's outputs (all declared: an unread one is a validation warning).
 layout(location = 0) in vec3 vWorldPos;
 layout(location = 1) in vec3 vNormal;

@@ -1,26 +1,40 @@
 //! dermis: a hand-written Vulkan (ash) renderer for real-time human skin that
 //! measures what every pass costs on the GPU.
 //!
-//! Layers, bottom up (a module uses only the ones before it):
-//! `vk` (device, barrier table, memory, shaders and their statistics, uploads,
-//! profiler) -> `graph` (declared images, passes with their role, work and
-//! accesses; barriers and usages derived, never written at call sites) ->
-//! `scene`, `skin`, `reference` (pure CPU: meshes, framing, profiles, kernels,
-//! CPU references, the ground truth's sampling) -> `method` (the SSS methods,
-//! one module each behind one trait, and their registry) -> `render` (the frame
-//! around a method) -> `report`, `bench`, `run`, `budget`, `plot` (runs, statistics, floors,
-//! the console budget model, the chart writer) ->
-//! `eval` (ground-truth comparisons, charts). `main.rs` parses arguments only.
+//! Layers, bottom up (a module uses only the ones before it; tests/layers.rs
+//! checks it on every path the code names):
+//! the pure core, `shader_constants`, `work`, `view`, `scene`, `skin`,
+//! `reference` (no Vulkan: the numbers shared with the shaders, the
+//! vocabulary of a pass's work, the view's scale and the SSS region, meshes and
+//! framing, profiles, kernels and the CPU mirrors of the passes, the ground
+//! truth's sampling and chunk plan) -> `vk` (device, barrier table, memory,
+//! shaders and their statistics, uploads, profiler) -> `graph` (declared images,
+//! passes with their role, work and accesses; barriers and usages derived, never
+//! written at call sites) -> `method` (the SSS methods, one module each behind
+//! one trait, and their registry) -> `render` (the frame around a method) ->
+//! `report`, `bench`, `run`, `output`, `trace`, `budget`, `plot` (report.json's
+//! schema and statistics, floors, runs, the file writers, the timeline, the
+//! console budget model, the chart writer) -> `eval` (ground-truth comparisons,
+//! charts). `main.rs` parses arguments only.
+//!
+//! The pure core and, above it, `eval::metrics` and `budget::model` name
+//! neither `ash`, `crate::vk` nor `crate::graph`, nor reach them through any
+//! file they lead to (tests/layers.rs).
 pub mod bench;
 pub mod budget;
 pub mod eval;
 pub mod graph;
 pub mod method;
+pub mod output;
 pub mod plot;
 pub mod reference;
 pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod shader_constants;
 pub mod skin;
+pub mod trace;
+pub mod view;
 pub mod vk;
+pub mod work;

@@ -45,6 +45,10 @@ enum Command {
         /// Also write every pass output as linear EXR under DIR/passes/.
         #[arg(long)]
         dump: bool,
+        /// Also write the measured frames' per-pass timeline (GPU timestamps, barriers
+        /// as their own slices) as Chrome trace-event JSON, for Perfetto or chrome://tracing.
+        #[arg(long, value_name = "FILE.json")]
+        trace: Option<PathBuf>,
         #[arg(long, default_value_t = 3)]
         warmup: usize,
         #[arg(long, default_value_t = 10)]
@@ -57,6 +61,10 @@ enum Command {
         /// Report path (JSON).
         #[arg(long, default_value = "out/bench.json")]
         report: PathBuf,
+        /// Also write the measured frames' per-pass timeline (GPU timestamps, barriers
+        /// as their own slices) as Chrome trace-event JSON, for Perfetto or chrome://tracing.
+        #[arg(long, value_name = "FILE.json")]
+        trace: Option<PathBuf>,
         #[arg(long, default_value_t = 20)]
         warmup: usize,
         #[arg(long, default_value_t = 100)]
@@ -378,13 +386,22 @@ fn main_result() -> Result<()> {
             common,
             out,
             dump,
+            trace,
             warmup,
             frames,
         } => {
             dermis::run::check_frame_counts(warmup, frames)?;
             let settings = common.settings()?;
             warn_foreign(&settings);
-            render(&common, settings, &out, dump, warmup, frames)?;
+            render(
+                &common,
+                settings,
+                &out,
+                dump,
+                trace.as_deref(),
+                warmup,
+                frames,
+            )?;
         }
         Command::Reference { common, out } => {
             let settings = RenderSettings {
@@ -392,7 +409,7 @@ fn main_result() -> Result<()> {
                 ..common.settings()?
             };
             warn_foreign(&settings);
-            render(&common, settings, &out, false, 0, 1)?;
+            render(&common, settings, &out, false, None, 0, 1)?;
         }
         Command::Compare { a, b, none, out } => {
             let out = out.unwrap_or_else(|| a.clone());
@@ -410,9 +427,10 @@ fn main_result() -> Result<()> {
         Command::Bench {
             common,
             report,
+            trace,
             warmup,
             frames,
-        } => bench(&common, &report, warmup, frames)?,
+        } => bench(&common, &report, trace.as_deref(), warmup, frames)?,
         Command::Budget {
             common,
             profiles,
@@ -479,7 +497,7 @@ fn eval(common: &Common, out: &Path, scenes: &str, warmup: usize, frames: usize)
     dermis::run::check_frame_counts(warmup, frames)?;
     let base = common.settings()?;
     let specs = study::scene_set(scenes, common.scene.as_deref(), &base)?;
-    dermis::run::prepare_out_dir(out)?;
+    dermis::output::prepare_out_dir(out)?;
     let ctx = common.context()?;
     let opts = sweep::EvalOptions {
         base,
@@ -500,9 +518,18 @@ fn eval(common: &Common, out: &Path, scenes: &str, warmup: usize, frames: usize)
 }
 
 /// `dermis bench`: many frames and the device ceilings, the report only.
-fn bench(common: &Common, report: &Path, warmup: usize, frames: usize) -> Result<()> {
+fn bench(
+    common: &Common,
+    report: &Path,
+    trace: Option<&Path>,
+    warmup: usize,
+    frames: usize,
+) -> Result<()> {
     dermis::run::check_frame_counts(warmup, frames)?;
-    dermis::run::prepare_report_path(report)?;
+    dermis::output::prepare_file(report)?;
+    if let Some(t) = trace {
+        dermis::output::prepare_file(t)?;
+    }
     let settings = common.settings()?;
     warn_foreign(&settings);
     let scene = common.scene()?;
@@ -517,13 +544,20 @@ fn bench(common: &Common, report: &Path, warmup: usize, frames: usize) -> Result
         progress: true,
     };
     let r = bench_run(&ctx, &scene, &settings, &opts, report);
-    let r = ctx.finish_with(r)?;
+    let out = ctx.finish_with(r)?;
+    if let Some(t) = trace {
+        dermis::trace::write(t, &out.report, &out.frames)?;
+    }
+    let r = out.report;
     println!("{}", header(&r));
     print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
     if let Some(c) = &r.ceilings {
         println!("{}", c.summary());
     }
     println!("wrote {}", report.display());
+    if let Some(t) = trace {
+        println!("wrote {} (open it in ui.perfetto.dev)", t.display());
+    }
     Ok(())
 }
 
@@ -532,10 +566,14 @@ fn render(
     settings: RenderSettings,
     out: &std::path::Path,
     dump: bool,
+    trace: Option<&Path>,
     warmup: usize,
     frames: usize,
 ) -> Result<()> {
-    dermis::run::prepare_render_dir(out, dump)?;
+    dermis::output::prepare_render_dir(out, dump)?;
+    if let Some(t) = trace {
+        dermis::output::prepare_file(t)?;
+    }
     let scene = common.scene()?;
     let ctx = common.context()?;
     let opts = RunOptions {
@@ -548,7 +586,11 @@ fn render(
         progress: true,
     };
     let r = render_to_dir(&ctx, &scene, &settings, out, &opts);
-    let r = ctx.finish_with(r)?.report;
+    let output = ctx.finish_with(r)?;
+    if let Some(t) = trace {
+        dermis::trace::write(t, &output.report, &output.frames)?;
+    }
+    let r = output.report;
     println!("{}", header(&r));
     print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
     println!(
@@ -557,6 +599,9 @@ fn render(
         out.join("diffuse.exr").display(),
         out.join("report.json").display()
     );
+    if let Some(t) = trace {
+        println!("wrote {} (open it in ui.perfetto.dev)", t.display());
+    }
     Ok(())
 }
 

@@ -15,6 +15,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::output::{write_bytes, write_image};
+
 /// Marker colours, one per series in order of first appearance (Okabe-Ito:
 /// distinguishable with the common colour-vision deficiencies).
 pub const COLOURS: [RGBColor; 7] = [
@@ -51,10 +53,12 @@ pub fn write_png_svg(
     }
     let image = image::RgbImage::from_raw(size.0, size.1, rgb)
         .ok_or_else(|| anyhow!("chart buffer does not match {}x{}", size.0, size.1))?;
-    create_parent(png_path)?;
-    image
-        .save_with_format(png_path, image::ImageFormat::Png)
-        .with_context(|| format!("writing chart PNG {}", png_path.display()))?;
+    write_image(
+        png_path,
+        &image::DynamicImage::ImageRgb8(image),
+        image::ImageFormat::Png,
+    )
+    .context("writing the chart's PNG")?;
 
     let mut svg = String::new();
     {
@@ -64,21 +68,12 @@ pub fn write_png_svg(
             .map_err(plot_err)
             .context("finishing the SVG chart")?;
     }
-    create_parent(svg_path)?;
-    fs::write(svg_path, svg).with_context(|| format!("writing chart SVG {}", svg_path.display()))
+    write_bytes(svg_path, svg.as_bytes()).context("writing the chart's SVG")
 }
 
 /// plotters' errors borrow nothing but are not always `Send + Sync`: keep the text.
 pub fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow!("plotting: {e}")
-}
-
-fn create_parent(path: &Path) -> Result<()> {
-    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        Some(parent) => fs::create_dir_all(parent)
-            .with_context(|| format!("creating folder {}", parent.display())),
-        None => Ok(()),
-    }
 }
 
 /// Where to look for a sans-serif TrueType font, in order, after `DERMIS_FONT`.

@@ -1,12 +1,133 @@
-//! Per-pass statistics over measured frames, the printed table and the JSON report.
+//! report.json's schema, in one place: the types `run` writes for `render`
+//! and `bench` ([`Report`] and what it holds), read back typed by `budget`
+//! and `compare` through one loader ([`load`]); and the statistics over
+//! measured frames and the printed table that fill and show them.
+//!
+//! Reports older than a field read it as `None` where no value would be true
+//! of those runs (`role` and `work`, absent before passes declared them; the
+//! SSS region, absent before regions, when the SSS passes covered the screen;
+//! `layout`), and as empty where nothing was there (the method's options and
+//! details, floors, ceilings, probes). Every report under docs/ loads (a test
+//! reads them all).
 
-use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use serde::{Deserialize, Serialize};
 
 use crate::graph::work::{ImageUse, PassRole, Work};
 use crate::graph::PassSample;
+use crate::method::region::RegionMode;
+use crate::scene::layout::Layout;
+use crate::skin::transmittance::TransmittanceProfile;
+
+/// The JSON report of `render` and `bench`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Report {
+    pub dermis_version: String,
+    pub command: String,
+    pub device: String,
+    pub device_type: String,
+    pub driver: String,
+    pub vulkan_api: String,
+    pub validation: bool,
+    pub width: u32,
+    pub height: u32,
+    pub method: String,
+    /// Every option of the method, given or default.
+    #[serde(default)]
+    pub method_options: BTreeMap<String, String>,
+    /// What the method reports of itself (kernel, fit, stretch, samples...).
+    #[serde(default)]
+    pub method_details: serde_json::Value,
+    pub transmittance: bool,
+    pub transmittance_profile: TransmittanceProfile,
+    /// `None`: a report from before SSS regions (the SSS passes covered the screen).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sss_region: Option<RegionMode>,
+    /// Pixels inside the region the SSS passes worked in (the screen without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sss_region_pixels: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sss_region_rects: Option<u64>,
+    pub scene: String,
+    pub mm_per_unit: f32,
+    pub heads: u32,
+    /// `None`: a report from before layouts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layout: Option<Layout>,
+    pub distance_heads: f32,
+    pub fovy_deg: f32,
+    pub light: LightReport,
+    pub warmup_frames: usize,
+    pub measured_frames: usize,
+    pub passes: Vec<PassReport>,
+    pub frame: Option<FrameReport>,
+    /// Sum of the SSS passes (every pass of role `sss`) per frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sss_total_ms: Option<Stats>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ceilings: Option<Ceilings>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probes: Option<Vec<ProbeResult>>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LightReport {
+    pub azimuth_deg: f32,
+    pub elevation_deg: f32,
+    pub intensity: f32,
+}
+
+/// Reads a report (report.json of `render`, the `--report` of `bench`): the
+/// one loader every reader of reports goes through.
+pub fn load(path: &Path) -> Result<Report> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_slice(&bytes).with_context(|| format!("parsing {}", path.display()))
+}
+
+/// Rates measured by the ceiling probes, in giga-operations per second
+/// (`bench::ceilings` measures them, `bench::floor` prices passes with them).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ceilings {
+    pub bilinear_rgba16f_gtaps: f64,
+    pub point_rgba16f_gtaps: f64,
+    pub bilinear_r32f_gtaps: f64,
+    pub point_r32f_gtaps: f64,
+    pub fill_rgba16f_gpix: f64,
+    /// `None`: a report from before this probe (docs/perf/h100-run1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fill_rgba8_gpix: Option<f64>,
+    /// RGBA16F with constant-factor blending (read-modify-write); `None` as above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blend_rgba16f_gpix: Option<f64>,
+}
+
+impl Ceilings {
+    /// One line of the measured rates, for the bench printout.
+    pub fn summary(&self) -> String {
+        let rate = |v: Option<f64>| v.map_or("not measured".into(), |v| format!("{v:.2}"));
+        format!(
+            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}",
+            self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, rate(self.fill_rgba8_gpix), rate(self.blend_rgba16f_gpix)
+        )
+    }
+}
+
+/// One ceiling probe's measurement.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ProbeResult {
+    pub name: String,
+    pub taps_per_fragment: i32,
+    pub fragments: u64,
+    pub gpu_ms: Stats,
+    /// Giga-taps (or giga-pixels for the fill probe) per second at the median.
+    pub rate_g_per_s: f64,
+}
 
 /// Median, minimum and 95th percentile of a set of times (ms).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     pub median: f64,
     pub min: f64,
@@ -49,10 +170,12 @@ pub struct PassDecl {
     pub images: Vec<ImageUse>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PassReport {
     pub name: String,
-    pub role: PassRole,
+    /// `None`: a report from before passes declared their role and work.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub role: Option<PassRole>,
     pub gpu_ms: Stats,
     /// Time of the barriers before the pass, kept out of `gpu_ms`.
     pub barrier_ms: Stats,
@@ -61,17 +184,19 @@ pub struct PassReport {
     /// Samples that passed depth and stencil tests (occlusion query), last measured frame.
     pub samples_passed: u64,
     /// Lower bound from the measured device ceilings (bench only).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floor_ms: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floor_ratio: Option<f64>,
     /// The pass's declared work per unit (see `graph::work`).
+    #[serde(default)]
     pub work: Option<Work>,
     /// The images it touches and how.
+    #[serde(default)]
     pub images: Vec<ImageUse>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FrameReport {
     /// Sum of pass and barrier times per frame.
     pub gpu_ms: Stats,
@@ -95,7 +220,7 @@ pub fn aggregate(
             let decl = decls.get(i).cloned().unwrap_or_default();
             PassReport {
                 name: s.name.clone(),
-                role: s.role,
+                role: Some(s.role),
                 work: decl.work,
                 images: decl.images,
                 gpu_ms: Stats::of(&gpu).expect("non-empty"),
@@ -212,9 +337,68 @@ mod tests {
         assert_eq!(p[0].gpu_ms.median, 2.0);
         assert_eq!(p[1].gpu_ms.min, 2.0);
         assert_eq!(p[0].fragment_invocations, Some(5));
-        assert_eq!(p[1].role, PassRole::Post);
+        assert_eq!(p[1].role, Some(PassRole::Post));
         assert_eq!(frame.unwrap().gpu_ms.median, 5.5);
         let t = table(&p, None);
         assert!(t.contains("median ms") && t.lines().count() == 3);
+    }
+
+    /// Every JSON file under `dir` (recursively) that looks like a report.
+    fn reports_under(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                reports_under(&p, out);
+            } else if p.extension().is_some_and(|x| x == "json") {
+                let v: serde_json::Value =
+                    serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+                if v.get("passes").is_some() && v.get("device").is_some() {
+                    out.push(p);
+                }
+            }
+        }
+    }
+
+    // The one loader reads every report the project has kept, from the
+    // oldest (no roles, no regions, no layouts, fewer probes) to today's;
+    // one of today's shape written back is its file exactly (the schema's
+    // names and defaults agree with the writer).
+    #[test]
+    fn every_kept_report_loads_and_round_trips() {
+        let mut files = Vec::new();
+        reports_under(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("docs"),
+            &mut files,
+        );
+        assert!(files.len() > 300, "{} reports", files.len());
+        let mut with_layout = 0;
+        for f in &files {
+            let r = load(f).unwrap_or_else(|e| panic!("{e:#}"));
+            assert!(!r.passes.is_empty(), "{}", f.display());
+            let again: Report = serde_json::from_str(&serde_json::to_string(&r).unwrap()).unwrap();
+            assert_eq!(
+                serde_json::to_value(&again).unwrap(),
+                serde_json::to_value(&r).unwrap(),
+                "{}",
+                f.display()
+            );
+            // A report of today's shape writes back to its file (the same
+            // field names and defaults as the writer; both texts read by the
+            // same parser, so a float compares as the same text would).
+            if r.layout.is_some() {
+                with_layout += 1;
+                let text = |s: &str| serde_json::from_str::<serde_json::Value>(s).unwrap();
+                let back = text(&serde_json::to_string(&r).unwrap());
+                assert!(
+                    back == text(&std::fs::read_to_string(f).unwrap()),
+                    "{}",
+                    f.display()
+                );
+            }
+        }
+        // Old and new files both: the defaults were exercised.
+        assert!(with_layout > 0 && with_layout < files.len());
+        let e = load(Path::new("/nonexistent/report.json")).unwrap_err();
+        assert!(format!("{e:#}").contains("reading /nonexistent/report.json"));
     }
 }

@@ -1,77 +1,35 @@
 //! A whole run: render or bench a scene, aggregate the samples, attach floors,
-//! and produce the report. The CLI and the tests both go through here.
+//! and produce the report. The CLI and the tests both go through here; the
+//! report's types are `report`'s, the files are written by `output`.
 
 use std::path::Path;
 
 use anyhow::{Context as _, Result};
-use serde::Serialize;
 
-use crate::bench::ceilings::{self, ProbeResult};
-use crate::bench::floor::{floor_ms, Ceilings};
+use crate::bench::ceilings;
+use crate::bench::floor::floor_ms;
 use crate::graph::work::PassRole;
-use crate::method::region::RegionMode;
-use crate::render::readback::DumpedImage;
+use crate::graph::PassSample;
+use crate::output::{
+    prepare_file, prepare_render_dir, slug, write_depth_exr, write_diffuse_exr, write_exr,
+    write_json, write_png,
+};
 use crate::render::{Capture, RenderSettings, Renderer};
-use crate::report::{aggregate, FrameReport, PassDecl, PassReport, Stats};
-use crate::scene::layout::Layout;
+use crate::report::{aggregate, LightReport, PassDecl, Stats};
 use crate::scene::Scene;
-use crate::skin::transmittance::TransmittanceProfile;
 use crate::vk::context::Context;
 
-#[derive(Clone, Debug, Serialize)]
-pub struct LightReport {
-    pub azimuth_deg: f32,
-    pub elevation_deg: f32,
-    pub intensity: f32,
-}
-
-/// The JSON report of `render` and `bench`.
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    pub dermis_version: &'static str,
-    pub command: String,
-    pub device: String,
-    pub device_type: String,
-    pub driver: String,
-    pub vulkan_api: String,
-    pub validation: bool,
-    pub width: u32,
-    pub height: u32,
-    pub method: &'static str,
-    /// Every option of the method, given or default.
-    pub method_options: std::collections::BTreeMap<&'static str, String>,
-    /// What the method reports of itself (kernel, fit, stretch, samples...).
-    pub method_details: serde_json::Value,
-    pub transmittance: bool,
-    pub transmittance_profile: TransmittanceProfile,
-    pub sss_region: RegionMode,
-    /// Pixels inside the region the SSS passes worked in (the screen without one).
-    pub sss_region_pixels: u64,
-    pub sss_region_rects: usize,
-    pub scene: String,
-    pub mm_per_unit: f32,
-    pub heads: u32,
-    pub layout: Layout,
-    pub distance_heads: f32,
-    pub fovy_deg: f32,
-    pub light: LightReport,
-    pub warmup_frames: usize,
-    pub measured_frames: usize,
-    pub passes: Vec<PassReport>,
-    pub frame: Option<FrameReport>,
-    /// Sum of the SSS passes (every pass of role `sss`) per frame.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sss_total_ms: Option<Stats>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ceilings: Option<Ceilings>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub probes: Option<Vec<ProbeResult>>,
-}
+/// What `run` returns: the report's schema lives in `report`; named here too
+/// because a run is where reports come from.
+pub use crate::report::Report;
 
 /// What a run produced.
 pub struct RunOutput {
     pub report: Report,
     pub capture: Option<Capture>,
+    /// Every measured frame's pass samples, in order (what the report's
+    /// statistics were taken over; `trace` lays them out as a timeline).
+    pub frames: Vec<Vec<PassSample>>,
 }
 
 #[derive(Clone, Debug)]
@@ -188,7 +146,7 @@ pub fn run(
     let mm_per_unit = renderer.frame.mm_per_unit;
     let region = &renderer.frame.region_px;
     let (sss_region_pixels, sss_region_rects) =
-        (region.iter().map(|r| r.area()).sum(), region.len());
+        (region.iter().map(|r| r.area()).sum(), region.len() as u64);
     let method_details = renderer.method.details();
     drop(renderer);
 
@@ -210,7 +168,7 @@ pub fn run(
     let f = &ctx.facts;
     let m = settings.method;
     let report = Report {
-        dermis_version: env!("CARGO_PKG_VERSION"),
+        dermis_version: env!("CARGO_PKG_VERSION").to_string(),
         command: opts.command.clone(),
         device: f.name.clone(),
         device_type: f.device_type.clone(),
@@ -219,18 +177,23 @@ pub fn run(
         validation: ctx.validation,
         width: settings.width,
         height: settings.height,
-        method: m.name,
-        method_options: m.opts(&settings.options).resolved(),
+        method: m.name.to_string(),
+        method_options: m
+            .opts(&settings.options)
+            .resolved()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect(),
         method_details,
         transmittance: settings.transmittance,
         transmittance_profile: settings.transmittance_profile,
-        sss_region: settings.sss_region,
-        sss_region_pixels,
-        sss_region_rects,
+        sss_region: Some(settings.sss_region),
+        sss_region_pixels: Some(sss_region_pixels),
+        sss_region_rects: Some(sss_region_rects),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,
-        layout: settings.layout,
+        layout: Some(settings.layout),
         distance_heads: settings.distance_heads,
         fovy_deg: settings.fovy_deg,
         light: LightReport {
@@ -250,65 +213,11 @@ pub fn run(
         ceilings,
         probes,
     };
-    Ok(RunOutput { report, capture })
-}
-
-/// Makes sure `dir` exists and can be written, before any GPU work: a bad
-/// `--out` is reported at once, not after the render.
-pub fn prepare_out_dir(dir: &Path) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        anyhow::bail!("--out {} exists and is not a directory", dir.display());
-    }
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let probe = dir.join(".dermis-write-test");
-    std::fs::write(&probe, b"").with_context(|| format!("{} is not writable", dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
-}
-
-/// The files `render_to_dir` writes into its folder.
-pub const RENDER_OUTPUTS: [&str; 3] = ["frame.png", "diffuse.exr", "report.json"];
-
-/// `prepare_out_dir`, and the files a render writes there (with `dump`, the
-/// passes/ folder) can be written: each is checked before any GPU work, so a
-/// bad `--out` never costs a render.
-pub fn prepare_render_dir(dir: &Path, dump: bool) -> Result<()> {
-    prepare_out_dir(dir)?;
-    for name in RENDER_OUTPUTS {
-        check_writable_file(&dir.join(name))?;
-    }
-    let passes = dir.join("passes");
-    if dump && passes.exists() && !passes.is_dir() {
-        anyhow::bail!("--out: {} exists and is not a directory", passes.display());
-    }
-    Ok(())
-}
-
-/// The report path of `bench`: its folder exists (or is made) and is
-/// writable, and the path itself is not a folder. Checked before any GPU work.
-pub fn prepare_report_path(path: &Path) -> Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        prepare_out_dir(parent)?;
-    }
-    check_writable_file(path)
-}
-
-/// A file that is about to be (over)written: not a folder, and writable if
-/// it exists (it is opened for appending, which changes nothing).
-fn check_writable_file(path: &Path) -> Result<()> {
-    if path.is_dir() {
-        anyhow::bail!(
-            "{} is a directory, not a file dermis can write",
-            path.display()
-        );
-    }
-    if path.exists() {
-        std::fs::OpenOptions::new()
-            .append(true)
-            .open(path)
-            .with_context(|| format!("{} is not writable", path.display()))?;
-    }
-    Ok(())
+    Ok(RunOutput {
+        report,
+        capture,
+        frames,
+    })
 }
 
 /// The one-line header of a run's table.
@@ -344,7 +253,7 @@ pub fn render_to_dir(
             )?;
         }
     }
-    write_report(&out.join("report.json"), &output.report)?;
+    write_json(&out.join("report.json"), &output.report)?;
     Ok(output)
 }
 
@@ -355,206 +264,16 @@ pub fn bench_run(
     settings: &RenderSettings,
     opts: &RunOptions,
     path: &Path,
-) -> Result<Report> {
-    prepare_report_path(path)?;
+) -> Result<RunOutput> {
+    prepare_file(path)?;
     let output = run(ctx, scene, settings, opts)?;
-    write_report(path, &output.report)?;
-    Ok(output.report)
-}
-
-/// Writes a report as pretty JSON, creating its folder.
-pub fn write_report(path: &Path, report: &Report) -> Result<()> {
-    write_json(path, report)
-}
-
-/// `value` as pretty JSON at `path`, its folder made first.
-pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .with_context(|| format!("creating {}", parent.display()))?;
-    }
-    std::fs::write(path, serde_json::to_string_pretty(value)?)
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Where the first non-finite (NaN or infinite) texel of `rgba` is, and how
-/// many there are.
-pub fn first_nonfinite(rgba: &[[f32; 4]], width: u32) -> Option<(usize, u32, u32)> {
-    let count = rgba
-        .iter()
-        .filter(|p| !p.iter().all(|c| c.is_finite()))
-        .count();
-    let at = rgba.iter().position(|p| !p.iter().all(|c| c.is_finite()))?;
-    let w = width.max(1) as usize;
-    Some((count, (at % w) as u32, (at / w) as u32))
-}
-
-/// Writes the tone-mapped frame as an sRGB PNG. Refuses a frame whose HDR
-/// composite held NaN or infinite values (they would be black pixels).
-pub fn write_png(path: &Path, c: &Capture) -> Result<()> {
-    if c.hdr_nonfinite > 0 {
-        anyhow::bail!(
-            "not writing {}: {} pixel(s) of the frame before tone mapping are NaN or infinite (a renderer defect: please report it)",
-            path.display(),
-            c.hdr_nonfinite
-        );
-    }
-    let mut rgba = c.ldr.clone();
-    for px in rgba.chunks_exact_mut(4) {
-        px[3] = 255;
-    }
-    let img = image::RgbaImage::from_raw(c.width, c.height, rgba).context("frame size mismatch")?;
-    img.save(path)
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Writes one pass output as a linear float EXR. Refuses an image holding NaN
-/// or infinite values: no output of dermis ever does.
-pub fn write_exr(path: &Path, d: &DumpedImage) -> Result<()> {
-    if let Some((n, x, y)) = first_nonfinite(&d.rgba, d.width) {
-        anyhow::bail!(
-            "not writing {}: {n} texel(s) of '{}' after '{}' are NaN or infinite, the first at ({x}, {y}) (a renderer defect: please report it)",
-            path.display(),
-            d.image,
-            d.pass
-        );
-    }
-    let data: Vec<f32> = d.rgba.iter().flatten().copied().collect();
-    let img =
-        image::Rgba32FImage::from_raw(d.width, d.height, data).context("dump size mismatch")?;
-    image::DynamicImage::ImageRgba32F(img)
-        .save(path)
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Writes the diffuse light after SSS (linear, alpha = SSS strength) as EXR.
-pub fn write_diffuse_exr(path: &Path, c: &Capture) -> Result<()> {
-    write_exr(
-        path,
-        &DumpedImage {
-            pass: "final".into(),
-            image: "diffuse".into(),
-            width: c.width,
-            height: c.height,
-            rgba: c.diffuse.clone(),
-        },
-    )
-}
-
-/// Writes the linear view depth (scene units, in R, G and B) as EXR: with
-/// report.json's fovy_deg and mm_per_unit, what `compare` finds the accuracy
-/// bands from.
-pub fn write_depth_exr(path: &Path, c: &Capture) -> Result<()> {
-    write_exr(
-        path,
-        &DumpedImage {
-            pass: "final".into(),
-            image: "linear depth".into(),
-            width: c.width,
-            height: c.height,
-            rgba: c.depth.iter().map(|&d| [d, d, d, 1.0]).collect(),
-        },
-    )
-}
-
-/// Reads an RGBA EXR written by dermis.
-pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
-    let img = image::open(path)
-        .with_context(|| format!("reading {}", path.display()))?
-        .to_rgba32f();
-    let (w, h) = img.dimensions();
-    Ok((w, h, img.pixels().map(|p| p.0).collect()))
-}
-
-/// A file-name-safe version of a pass or image name.
-pub fn slug(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect::<String>()
-        .split('_')
-        .filter(|p| !p.is_empty())
-        .collect::<Vec<_>>()
-        .join("_")
+    write_json(path, &output.report)?;
+    Ok(output)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("dermis-run-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    }
-
-    // Issue 11: NaN texture coordinates gave NaN pixels in diffuse.exr. The
-    // writers refuse non-finite images with a clear error, and write nothing.
-    #[test]
-    fn writers_refuse_nan_and_inf() {
-        let d = tmp("nan");
-        let mut img = DumpedImage {
-            pass: "final".into(),
-            image: "diffuse".into(),
-            width: 3,
-            height: 2,
-            rgba: vec![[0.5; 4]; 6],
-        };
-        write_exr(&d.join("ok.exr"), &img).unwrap();
-        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-            img.rgba[4][1] = bad;
-            let p = d.join("bad.exr");
-            let e = write_exr(&p, &img).unwrap_err().to_string();
-            assert!(e.contains("1 texel(s)") && e.contains("(1, 1)"), "{e}");
-            assert!(!p.exists());
-        }
-        let mut c = Capture {
-            ldr: vec![0; 6 * 4],
-            width: 3,
-            height: 2,
-            dumps: Vec::new(),
-            samples: Vec::new(),
-            diffuse: vec![[0.0; 4]; 6],
-            depth: vec![1.0; 6],
-            hdr_nonfinite: 0,
-        };
-        write_png(&d.join("ok.png"), &c).unwrap();
-        c.hdr_nonfinite = 2;
-        let e = write_png(&d.join("bad.png"), &c).unwrap_err().to_string();
-        assert!(e.contains("2 pixel(s)"), "{e}");
-        assert!(!d.join("bad.png").exists());
-        let _ = std::fs::remove_dir_all(d);
-    }
-
-    // Issue 11: `--out` problems were found only after the render.
-    #[test]
-    fn output_paths_are_checked_before_any_work() {
-        let d = tmp("out");
-        let file = d.join("a-file");
-        std::fs::write(&file, b"x").unwrap();
-        let e = prepare_render_dir(&file, false).unwrap_err().to_string();
-        assert!(e.contains("not a directory"), "{e}");
-        let e = prepare_render_dir(&file.join("below"), false).unwrap_err();
-        assert!(format!("{e:#}").contains("creating"), "{e:#}");
-        // An output name taken by a folder.
-        let out = d.join("out");
-        std::fs::create_dir_all(out.join("frame.png")).unwrap();
-        let e = prepare_render_dir(&out, false).unwrap_err().to_string();
-        assert!(e.contains("frame.png is a directory"), "{e}");
-        prepare_render_dir(&d.join("fresh"), true).unwrap();
-        // bench --report: a folder, or below a file.
-        let e = prepare_report_path(&out).unwrap_err().to_string();
-        assert!(e.contains("is a directory"), "{e}");
-        assert!(prepare_report_path(&file.join("r.json")).is_err());
-        prepare_report_path(&d.join("new/r.json")).unwrap();
-        let _ = std::fs::remove_dir_all(d);
-    }
 
     // Issue 11: huge --frames/--warmup aborted on a 100 GB allocation.
     #[test]
@@ -570,11 +289,5 @@ mod tests {
             let e = check_frame_counts(w, m).unwrap_err().to_string();
             assert!(e.contains("must be within"), "{e}");
         }
-    }
-
-    #[test]
-    fn slugs_are_file_safe() {
-        assert_eq!(slug("sss horizontal -> diffuse"), "sss_horizontal_diffuse");
-        assert_eq!(slug("Shadow Map"), "shadow_map");
     }
 }

@@ -195,7 +195,7 @@ fn a_bench_report_reads_back_as_a_frame() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let rec = dermis::budget::record::RunRecord::load(&report).unwrap();
+    let rec = dermis::report::load(&report).unwrap();
     let f = dermis::budget::record::frame_from_record(&rec, None, "bench").unwrap();
     assert_eq!(f.passes.len(), rec.passes.len());
     assert!(f.passes.iter().all(|p| p.measured_ms.is_some()));

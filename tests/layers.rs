@@ -1,23 +1,54 @@
 //! The shape of the code, checked by reading it (no GPU): the layers of
-//! `src/lib.rs` hold (a module uses only the ones below it), no two sibling
-//! files import each other in a cycle, `render/mod.rs` stays small and long
-//! functions say why. (That no code compares a pass label is checked in
-//! tests/work_gpu.rs, on the labels the frames really have.)
+//! `src/lib.rs` hold (a module uses only the ones below it), the pure core and
+//! the pure files above it name neither `ash`, `crate::vk` nor `crate::graph`,
+//! no two sibling files import each other in a cycle, `render/mod.rs` stays
+//! small and long functions say why. (That no code compares a pass label is
+//! checked in tests/work_gpu.rs, on the labels the frames really have.)
+//!
+//! The checks read paths, not text: comments and string literals are dropped,
+//! grouped imports (`use crate::{a, b::{c, d}}`) are expanded, and `super::`
+//! and `self::` are resolved against the file's own module, so every way of
+//! naming a module is seen. The reader is tested on small sources below.
+//!
+//! Why a rule checked here and not a workspace crate for the device-free core:
+//! the pure modules share the crate's error and serde conventions and are
+//! named by about a hundred `crate::` paths across the tree; a crate split
+//! would rewrite every one of them while six branches edit the same files.
+//! The rule below states the same boundary and fails on the first path that
+//! crosses it; a crate can follow once the tree is quiet.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, bottom up, as `src/lib.rs` documents them. A module may use
 /// modules of its own layer index or lower; `run` and `report` share a layer.
+/// The bottom layer is the pure core: it cannot name `vk` or `graph`, which
+/// sit above it.
 const LAYERS: &[&[&str]] = &[
+    &[
+        "shader_constants",
+        "work",
+        "view",
+        "scene",
+        "skin",
+        "reference",
+    ],
     &["vk"],
     &["graph"],
-    &["scene", "skin", "reference"],
     &["method"],
     &["render"],
-    &["report", "bench", "run", "budget", "plot"],
+    &[
+        "report", "bench", "run", "output", "trace", "budget", "plot",
+    ],
     &["eval"],
 ];
+
+/// Files above the pure core that must stay pure too (paths under `src/`).
+const PURE_FILES: &[&str] = &["eval/metrics.rs", "budget/model.rs"];
+
+/// What no pure file may name: the Vulkan bindings, and the crate's device
+/// and graph layers.
+const FORBIDDEN: &[&[&str]] = &[&["ash"], &["crate", "vk"], &["crate", "graph"]];
 
 fn src() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
@@ -37,8 +68,12 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 /// The file without its trailing `#[cfg(test)]` module (tests may reach anywhere).
 fn code(path: &Path) -> String {
     let s = std::fs::read_to_string(path).unwrap();
+    without_tests(&s).to_string()
+}
+
+fn without_tests(s: &str) -> &str {
     match s.find("#[cfg(test)]") {
-        Some(i) => s[..i].to_string(),
+        Some(i) => &s[..i],
         None => s,
     }
 }
@@ -47,22 +82,522 @@ fn layer(module: &str) -> Option<usize> {
     LAYERS.iter().position(|l| l.contains(&module))
 }
 
-/// Top-level modules named by `crate::NAME` in `text`.
-fn crate_refs(text: &str) -> BTreeSet<String> {
-    let mut out = BTreeSet::new();
-    let mut rest = text;
-    while let Some(i) = rest.find("crate::") {
-        let tail = &rest[i + 7..];
-        let name: String = tail
-            .chars()
-            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-            .collect();
-        if !name.is_empty() {
-            out.insert(name);
+/// The module path of a file under `src/`: `skin/ssg.rs` is `[skin, ssg]`,
+/// `skin/mod.rs` is `[skin]`, `lib.rs` is `[]`.
+fn module_of(rel: &Path) -> Vec<String> {
+    let mut m: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let last = m.pop().unwrap_or_default();
+    let stem = last.trim_end_matches(".rs");
+    if !["mod", "lib", "main"].contains(&stem) {
+        m.push(stem.to_string());
+    }
+    m
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Ident(String),
+    Path, // `::`
+    Open,
+    Close,
+    Comma,
+    Other,
+}
+
+/// Identifiers and the punctuation paths are made of; comments, string and
+/// character literals dropped (a path named in a comment names nothing).
+fn tokens(text: &str) -> Vec<Tok> {
+    let c: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < c.len() {
+        let ch = c[i];
+        let next = c.get(i + 1).copied();
+        if ch == '/' && next == Some('/') {
+            while i < c.len() && c[i] != '\n' {
+                i += 1;
+            }
+        } else if ch == '/' && next == Some('*') {
+            // Block comments nest in Rust.
+            let mut depth = 0;
+            while i < c.len() {
+                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+                    depth += 1;
+                    i += 2;
+                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        } else if ch == '"' || (ch == 'r' && (next == Some('"') || next == Some('#'))) {
+            i = skip_string(&c, i);
+            out.push(Tok::Other);
+        } else if ch == '\'' {
+            // A char literal ('x', '\n', '\u{..}') or a lifetime ('a).
+            let close = if c.get(i + 1) == Some(&'\\') {
+                c[i + 2..]
+                    .iter()
+                    .position(|&x| x == '\'')
+                    .map(|k| i + 2 + k)
+            } else if c.get(i + 2) == Some(&'\'') {
+                Some(i + 2)
+            } else {
+                None
+            };
+            match close {
+                Some(k) => i = k + 1,
+                None => i += 1,
+            }
+            out.push(Tok::Other);
+        } else if ch.is_alphabetic() || ch == '_' {
+            let s = i;
+            while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_') {
+                i += 1;
+            }
+            out.push(Tok::Ident(c[s..i].iter().collect()));
+        } else if ch.is_ascii_digit() {
+            while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_' || c[i] == '.') {
+                i += 1;
+            }
+            out.push(Tok::Other);
+        } else if ch.is_whitespace() {
+            i += 1;
+        } else {
+            out.push(match ch {
+                ':' if next == Some(':') => {
+                    i += 1;
+                    Tok::Path
+                }
+                '{' => Tok::Open,
+                '}' => Tok::Close,
+                ',' => Tok::Comma,
+                _ => Tok::Other,
+            });
+            i += 1;
         }
-        rest = tail;
     }
     out
+}
+
+/// Index after the string literal starting at `i` (plain, byte or raw).
+fn skip_string(c: &[char], mut i: usize) -> usize {
+    if c[i] == 'r' {
+        let mut hashes = 0;
+        i += 1;
+        while c.get(i) == Some(&'#') {
+            hashes += 1;
+            i += 1;
+        }
+        if c.get(i) != Some(&'"') {
+            return i; // `r#ident`, not a string
+        }
+        i += 1;
+        while i < c.len() {
+            if c[i] == '"' && (0..hashes).all(|h| c.get(i + 1 + h) == Some(&'#')) {
+                return i + 1 + hashes;
+            }
+            i += 1;
+        }
+        return i;
+    }
+    i += 1;
+    while i < c.len() {
+        match c[i] {
+            '\\' => i += 2,
+            '"' => return i + 1,
+            _ => i += 1,
+        }
+    }
+    i
+}
+
+/// Every path in `text`, grouped imports expanded: `use a::{b, c::{d, e}}`
+/// gives `a::b`, `a::c::d`, `a::c::e`; `self` inside a group names its
+/// parent; a glob ends the path at its parent.
+fn paths(text: &str) -> Vec<Vec<String>> {
+    let t = tokens(text);
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < t.len() {
+        let after_keyword = i > 0 && matches!(&t[i - 1], Tok::Ident(k) if is_keyword(k));
+        let starts = match &t[i] {
+            Tok::Ident(k) => !is_keyword(k) && (i == 0 || t[i - 1] != Tok::Path),
+            // A leading `::` (`use ::ash::vk`) starts an absolute path.
+            Tok::Path => {
+                matches!(t.get(i + 1), Some(Tok::Ident(_)))
+                    && (i == 0 || after_keyword || !matches!(t[i - 1], Tok::Ident(_) | Tok::Close))
+            }
+            _ => false,
+        };
+        if starts {
+            let from = if t[i] == Tok::Path { i + 1 } else { i };
+            i = tree(&t, from, Vec::new(), &mut out);
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Rust keywords that may stand before a path but never begin one
+/// (`crate`, `self`, `super` and `Self` do begin paths).
+fn is_keyword(w: &str) -> bool {
+    [
+        "as", "async", "await", "break", "const", "continue", "dyn", "else", "enum", "extern",
+        "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub",
+        "ref", "return", "static", "struct", "trait", "type", "unsafe", "use", "where", "while",
+    ]
+    .contains(&w)
+}
+
+/// Reads one path tree at `i` under `prefix`, pushing each leaf path; returns
+/// the index after it.
+fn tree(t: &[Tok], mut i: usize, mut prefix: Vec<String>, out: &mut Vec<Vec<String>>) -> usize {
+    loop {
+        match t.get(i) {
+            Some(Tok::Ident(name)) => {
+                if name != "self" || prefix.is_empty() {
+                    prefix.push(name.clone());
+                }
+                i += 1;
+            }
+            Some(Tok::Open) if !prefix.is_empty() => {
+                // A group: subtrees separated by commas, up to the closing brace.
+                i += 1;
+                loop {
+                    match t.get(i) {
+                        Some(Tok::Close) => {
+                            i += 1;
+                            break;
+                        }
+                        Some(Tok::Comma) => i += 1,
+                        // `b as c`: the new name is no path.
+                        Some(Tok::Ident(k)) if k == "as" => i += 2,
+                        Some(Tok::Ident(_)) | Some(Tok::Open) => {
+                            i = tree(t, i, prefix.clone(), out);
+                        }
+                        None => break,
+                        _ => i += 1, // `*`, `as` renames are idents, handled above
+                    }
+                }
+                return i;
+            }
+            _ => {
+                out.push(prefix);
+                return i;
+            }
+        }
+        if t.get(i) == Some(&Tok::Path) {
+            i += 1;
+        } else {
+            // `a::b as c`: the rename names nothing more.
+            out.push(prefix);
+            return i;
+        }
+    }
+}
+
+/// A path made absolute: `crate::...` as written; `super::`/`self::` against
+/// `module` (the file's module path), each `super` one level up; other paths
+/// (`ash::vk`, `std::..`, local names) as written.
+fn resolve(path: &[String], module: &[String]) -> Vec<String> {
+    let mut p = path;
+    let mut base: Vec<String> = module.to_vec();
+    let mut relative = false;
+    while let Some(first) = p.first() {
+        match first.as_str() {
+            "super" => {
+                base.pop();
+                relative = true;
+            }
+            "self" => relative = true,
+            _ => break,
+        }
+        p = &p[1..];
+    }
+    if !relative {
+        return path.to_vec();
+    }
+    let mut out = vec!["crate".to_string()];
+    out.extend(base);
+    out.extend(p.iter().cloned());
+    out
+}
+
+/// Every path `text` names, absolute (see [`resolve`]), in a file of module `module`.
+fn named(text: &str, module: &[String]) -> Vec<Vec<String>> {
+    paths(text).iter().map(|p| resolve(p, module)).collect()
+}
+
+/// Top-level crate modules `text` names (`crate::NAME...`).
+fn crate_modules(text: &str, module: &[String]) -> BTreeSet<String> {
+    named(text, module)
+        .into_iter()
+        .filter(|p| p.len() >= 2 && p[0] == "crate")
+        .map(|p| p[1].clone())
+        .collect()
+}
+
+/// The forbidden paths a pure file names, as written out (`crate::vk::x`).
+fn impurities(text: &str, module: &[String]) -> Vec<String> {
+    named(text, module)
+        .into_iter()
+        .filter(|p| {
+            FORBIDDEN
+                .iter()
+                .any(|f| p.len() >= f.len() && p[..f.len()].iter().zip(*f).all(|(a, b)| a == b))
+        })
+        .map(|p| p.join("::"))
+        .collect()
+}
+
+/// The file under `src/` a crate path leads to: its longest prefix that is a
+/// module file (`crate::skin::ssg::Stretch` -> skin/ssg.rs).
+fn file_of(path: &[String]) -> Option<PathBuf> {
+    if path.first().map(String::as_str) != Some("crate") {
+        return None;
+    }
+    (2..=path.len()).rev().find_map(|k| {
+        let base = src().join(path[1..k].join("/"));
+        [base.with_extension("rs"), base.join("mod.rs")]
+            .into_iter()
+            .find(|c| c.is_file())
+    })
+}
+
+/// Whether a file (path under `src/`) must be pure.
+fn must_be_pure(rel: &Path) -> bool {
+    let m = module_of(rel);
+    let top = m.first().map(String::as_str).unwrap_or("");
+    layer(top) == Some(0) || PURE_FILES.iter().any(|f| rel == Path::new(f))
+}
+
+#[test]
+fn the_reader_sees_grouped_nested_and_relative_paths() {
+    let m = |s: &str| s.split("::").map(String::from).collect::<Vec<_>>();
+    let skin_ssg = m("skin::ssg");
+    // A grouped import naming vk is caught, however deep the group.
+    let grouped = "use crate::{scene::mesh::Mesh, vk::context::Context};";
+    assert_eq!(
+        impurities(grouped, &skin_ssg),
+        vec!["crate::vk::context::Context"]
+    );
+    let nested = "use crate::{a::{b, c::{d, e}}, graph::{self, Pass}};";
+    assert_eq!(
+        named(nested, &skin_ssg),
+        vec![
+            m("crate::a::b"),
+            m("crate::a::c::d"),
+            m("crate::a::c::e"),
+            m("crate::graph"),
+            m("crate::graph::Pass")
+        ]
+    );
+    assert_eq!(
+        impurities(nested, &skin_ssg),
+        vec!["crate::graph", "crate::graph::Pass"]
+    );
+    // super::super:: climbs out of the module, to the crate root here.
+    let up = "fn f() -> super::super::vk::memory::Buffer { todo!() }";
+    assert_eq!(impurities(up, &skin_ssg), vec!["crate::vk::memory::Buffer"]);
+    assert_eq!(
+        crate_modules("use super::profile::X;", &skin_ssg),
+        BTreeSet::from(["skin".to_string()])
+    );
+    // ash by any spelling.
+    for s in [
+        "use ash::vk;",
+        "let f = ash::vk::Format::UNDEFINED;",
+        "use ::ash::{vk, Device};",
+        "use {ash::vk};",
+    ] {
+        assert!(!impurities(s, &skin_ssg).is_empty(), "{s}");
+    }
+    // Words in comments and strings name nothing; a clean file is clean.
+    let clean = "//! Not `crate::vk`.\n/* use crate::graph; /* nested */ */\nuse crate::scene::mesh::{Aabb, Mesh};\nconst S: &str = \"crate::vk::x\"; const R: &str = r#\"ash::vk\"#; fn g<'a>(c: char) -> bool { c == '\"' || c == '{' }";
+    assert!(
+        impurities(clean, &skin_ssg).is_empty(),
+        "{:?}",
+        impurities(clean, &skin_ssg)
+    );
+    assert_eq!(
+        crate_modules(clean, &skin_ssg),
+        BTreeSet::from(["scene".to_string()])
+    );
+    // A path after a method call or a type's own path is not a new path.
+    assert!(impurities("let x = a.vk::<u8>(); let y = Foo::vk;", &skin_ssg).is_empty());
+}
+
+/// tools/build.rs compiles src/shader_constants.rs on its own (`#[path]`), so
+/// it may name nothing of the crate and import nothing but std.
+#[test]
+fn the_shader_constants_stand_alone() {
+    let text = code(&src().join("shader_constants.rs"));
+    let module = module_of(Path::new("shader_constants.rs"));
+    let foreign: Vec<String> = named(&text, &module)
+        .into_iter()
+        .filter(|p| p.len() >= 2 && p[0] == "crate")
+        .map(|p| p.join("::"))
+        .collect();
+    assert!(foreign.is_empty(), "{foreign:?}");
+    let t = tokens(&text);
+    for (i, tok) in t.iter().enumerate() {
+        if *tok == Tok::Ident("use".into()) {
+            assert_eq!(
+                t.get(i + 1),
+                Some(&Tok::Ident("std".into())),
+                "shader_constants.rs imports beyond std"
+            );
+        }
+    }
+}
+
+/// Every shader is named after what owns it: a method module (`separable_*`,
+/// `poisson_*`, ... as in `src/method/`), a pass of the frame around the
+/// methods, the bench's probes, or an include shared across owners.
+#[test]
+fn shaders_are_named_after_their_owner() {
+    let methods: Vec<String> = std::fs::read_dir(src().join("method"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "rs"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .filter(|m| !["mod", "options", "region", "screen", "none"].contains(&m.as_str()))
+        .collect();
+    // The frame's own passes and the bench's probes.
+    let frame = [
+        "fullscreen",
+        "shadow",
+        "geometry",
+        "composite",
+        "tonemap",
+        "probe",
+    ];
+    // Includes whose facts several owners share.
+    let shared = [
+        "shader_constants",
+        "view_scale",
+        "tissue",
+        "lighting",
+        "frame_uniforms",
+        "fetch_count",
+        "driver_workarounds",
+        "screen_common",
+    ];
+    let dir = src().parent().unwrap().join("shaders");
+    let mut seen = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        let stem = name.split('.').next().unwrap();
+        let owned = |p: &str| stem == p || stem.starts_with(&format!("{p}_"));
+        assert!(
+            methods.iter().any(|m| owned(m))
+                || frame.iter().any(|p| owned(p))
+                || shared.contains(&stem),
+            "shaders/{name} is named after no method, frame pass or shared include"
+        );
+        seen += 1;
+    }
+    assert!(
+        seen > 30 && methods.contains(&"separable".to_string()),
+        "{seen} {methods:?}"
+    );
+}
+
+#[test]
+fn the_module_of_a_file() {
+    assert_eq!(module_of(Path::new("skin/ssg.rs")), ["skin", "ssg"]);
+    assert_eq!(module_of(Path::new("skin/mod.rs")), ["skin"]);
+    assert!(module_of(Path::new("lib.rs")).is_empty());
+    assert!(must_be_pure(Path::new("skin/ssg.rs")) && must_be_pure(Path::new("budget/model.rs")));
+    assert!(
+        !must_be_pure(Path::new("budget/units.rs")) && !must_be_pure(Path::new("method/mod.rs"))
+    );
+    let m = |s: &str| s.split("::").map(String::from).collect::<Vec<_>>();
+    assert_eq!(
+        file_of(&m("crate::skin::ssg::Stretch")),
+        Some(src().join("skin/ssg.rs"))
+    );
+    assert_eq!(
+        file_of(&m("crate::graph::work::Format")),
+        Some(src().join("graph/mod.rs"))
+    );
+    assert_eq!(
+        file_of(&m("crate::work::Format")),
+        Some(src().join("work.rs"))
+    );
+    assert_eq!(file_of(&m("std::fmt")), None);
+}
+
+/// The pure core (the bottom layer) and the pure files above it name neither
+/// `ash`, `crate::vk` nor `crate::graph`, nor reach them through any file
+/// they lead to: pure math cannot reach Vulkan.
+#[test]
+fn pure_math_names_no_vulkan() {
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    let mut checked = 0;
+    let mut bad = Vec::new();
+    for f in &files {
+        let rel = f.strip_prefix(src()).unwrap();
+        if !must_be_pure(rel) {
+            continue;
+        }
+        checked += 1;
+        for p in impurities(&code(f), &module_of(rel)) {
+            bad.push(format!("{} names {p}", rel.display()));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "pure files name Vulkan:\n{}",
+        bad.join("\n")
+    );
+    // Nor through another file: every file a pure file's paths lead to is
+    // pure too (`crate::graph::work::X` leads to graph/mod.rs, which is not).
+    for f in &files {
+        let rel = f.strip_prefix(src()).unwrap();
+        if !must_be_pure(rel) {
+            continue;
+        }
+        let mut seen = BTreeSet::from([f.clone()]);
+        let mut todo = vec![(f.clone(), rel.display().to_string())];
+        while let Some((g, chain)) = todo.pop() {
+            let grel = g.strip_prefix(src()).unwrap().to_path_buf();
+            let text = code(&g);
+            let module = module_of(&grel);
+            if let Some(p) = impurities(&text, &module).first() {
+                bad.push(format!("{chain} names {p}"));
+            }
+            for path in named(&text, &module) {
+                if let Some(h) = file_of(&path).filter(|h| !seen.contains(h)) {
+                    seen.insert(h.clone());
+                    let next = format!("{chain} -> {}", h.strip_prefix(src()).unwrap().display());
+                    todo.push((h, next));
+                }
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "pure files reach Vulkan:\n{}",
+        bad.join("\n")
+    );
+    for f in PURE_FILES {
+        assert!(
+            src().join(f).is_file(),
+            "PURE_FILES names {f}, which is gone"
+        );
+    }
+    assert!(checked > 30, "{checked}");
 }
 
 #[test]
@@ -84,7 +619,7 @@ fn layers_hold_and_modules_form_no_cycle() {
             continue;
         }
         let from = layer(&top).unwrap_or_else(|| panic!("module '{top}' is in no layer of LAYERS"));
-        for to in crate_refs(&code(f)) {
+        for to in crate_modules(&code(f), &module_of(rel)) {
             if to == top {
                 continue;
             }
@@ -127,14 +662,18 @@ fn sibling_files_form_no_cycle() {
             .collect();
         let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         for (p, name) in siblings.iter().zip(&names) {
-            let text = code(p);
-            for other in &names {
-                if other != name
-                    && (text.contains(&format!("super::{other}::"))
-                        || text.contains(&format!("super::{other}::{{"))
-                        || text.contains(&format!("use super::{other};")))
-                {
-                    edges.entry(name.clone()).or_default().insert(other.clone());
+            let rel = p.strip_prefix(src()).unwrap();
+            let module = module_of(rel);
+            // The folder's own module path: a sibling is one more segment.
+            let mut folder = vec!["crate".to_string()];
+            folder.extend(module[..module.len() - 1].iter().cloned());
+            for path in named(&code(p), &module) {
+                let n = folder.len();
+                if path.len() > n && path[..n] == folder[..] {
+                    let other = &path[n];
+                    if other != name && names.contains(other) {
+                        edges.entry(name.clone()).or_default().insert(other.clone());
+                    }
                 }
             }
         }

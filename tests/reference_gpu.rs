@@ -6,7 +6,7 @@ mod common;
 
 use dermis::eval::metrics::relative_rmse;
 use dermis::method::reference::Reference;
-use dermis::reference::cpu::{gather_f64, GatherView, SurfaceImages};
+use dermis::reference::mirror::{gather_f64, GatherView, SurfaceImages};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 

@@ -1,5 +1,5 @@
 //! The chapter-4 screen-space methods on the GPU (lavapipe, validation on):
-//! `ssg` and `ss-jittered` against their CPU references, stencil versus branch
+//! `ssg` and `ss-jittered` against their CPU mirrors, stencil versus branch
 //! masking, and the depth-based Gaussian LOD proven by counts on a camera dolly.
 
 mod common;
@@ -11,9 +11,10 @@ use dermis::method::ssg::{MaskMode, Ssg};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::skin::jittered::hable_kernel;
-use dermis::skin::screen_ref::{jittered, ScreenInput};
+use dermis::skin::mirror::MirrorInput;
+use dermis::skin::screen_mirror::jittered;
 use dermis::skin::ssg::{GaussianFit, Stretch};
-use dermis::skin::ssg_ref::{ssg_with_rounding, SsgInput};
+use dermis::skin::ssg_mirror::{ssg_with_rounding, SsgInput};
 use dermis::skin::texel::{round_f16, F16Rounding};
 
 const W: usize = 96;
@@ -121,11 +122,13 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
             .collect();
         let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
         let input = SsgInput {
-            width: W,
-            height: H,
-            diffuse: &diffuse,
-            linear_depth: &depth,
-            skin: &skin,
+            frame: MirrorInput {
+                width: W,
+                height: H,
+                diffuse: &diffuse,
+                linear_depth: &depth,
+                skin: &skin,
+            },
             ndc_depth: &ndc,
         };
         // Vulkan lets a device round f32 -> f16 stores to nearest-even or toward
@@ -155,7 +158,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         println!("  matched {mode:?}; LOD distances {lod_distances:?}");
         assert!(
             ulps <= 2.0 && mean < 0.1,
-            "ssg differs from the CPU reference ({mode:?}): worst {ulps} ulps, mean {mean}"
+            "ssg differs from the CPU mirror ({mode:?}): worst {ulps} ulps, mean {mean}"
         );
         for i in 0..W * H {
             if !skin[i] {
@@ -251,7 +254,7 @@ fn jittered_matches_cpu_reference() {
     let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
     let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
     let cpu = jittered(
-        &ScreenInput {
+        &MirrorInput {
             width: W,
             height: H,
             diffuse: &diffuse,
@@ -359,7 +362,7 @@ fn gaussian_lod_by_counts_on_a_dolly() {
 #[test]
 fn poisson_matches_cpu_reference() {
     use dermis::skin::poisson::PoissonParams;
-    use dermis::skin::screen_ref::poisson_with_rounding;
+    use dermis::skin::screen_mirror::poisson_with_rounding;
     let ctx = common::ctx();
     let scene = egg_scene();
     let (diffuse, depth, skin) = synthetic();
@@ -383,7 +386,7 @@ fn poisson_matches_cpu_reference() {
         .collect();
     r.upload_normals(&n16).unwrap();
     let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
-    let input = ScreenInput {
+    let input = MirrorInput {
         width: W,
         height: H,
         diffuse: &diffuse,
@@ -413,7 +416,7 @@ fn poisson_matches_cpu_reference() {
     // ~1e-6 relative: 2 half ulps bound it.
     assert!(
         ulps <= 2.0,
-        "poisson differs from the CPU reference ({mode:?}) by {ulps} ulps"
+        "poisson differs from the CPU mirror ({mode:?}) by {ulps} ulps"
     );
     assert_eq!(
         samples(&passes, "poisson"),

@@ -1,12 +1,13 @@
-//! The separable SSS passes on the GPU against the CPU reference
-//! (`skin::separable_ref`), and stencil masking proven by counts.
+//! The separable SSS passes on the GPU against the CPU mirror
+//! (`skin::separable_mirror`), and stencil masking proven by counts.
 
 mod common;
 
 use dermis::method::separable::Separable;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
-use dermis::skin::separable_ref::{separable_sss, SssInput, SssView};
+use dermis::skin::mirror::MirrorInput;
+use dermis::skin::separable_mirror::{separable_sss, SssView};
 use dermis::skin::texel::round_f16;
 
 const W: usize = 96;
@@ -85,7 +86,7 @@ fn gpu_matches_cpu_reference() {
             follow_tolerance_mm: kernel.params.width_mm,
         };
         let cpu = separable_sss(
-            &SssInput {
+            &MirrorInput {
                 width: W,
                 height: H,
                 diffuse: &diffuse,

@@ -1,5 +1,5 @@
 //! Texture-space diffusion (`tsd`, `tsd-opt`) on lavapipe with validation:
-//! the stretch map and the convolution chain against their CPU references on
+//! the stretch map and the convolution chain against their CPU mirrors on
 //! a small synthetic unwrapped mesh, the seams, the optimisations' texels
 //! against a CPU visibility prediction (by counts of the fetch-counting build),
 //! the depth-sized viewport, the z pre-passes' zero invocations, far
@@ -15,11 +15,11 @@ use dermis::render::{Capture, RenderSettings, Renderer};
 use dermis::scene::mesh::{Material, Mesh, Object, Texture, Vertex};
 use dermis::scene::Scene;
 use dermis::skin::texel::F16Rounding;
-use dermis::skin::tsd_ref::{
-    blur_chain, clip_planes, depth_scale, keeps, map_size, nearest_corner_distance,
-    reference_distance, texel_hits, triangle_stretch, ChainInput, KeepRule, VertexTerms,
-    BACKFACE_BIAS, CULL_COS, THESIS_D_REF,
+use dermis::skin::tsd::{
+    clip_planes, depth_scale, map_size, nearest_corner_distance, reference_distance,
+    triangle_stretch, BACKFACE_BIAS, CULL_COS, THESIS_D_REF,
 };
+use dermis::skin::tsd_mirror::{blur_chain, keeps, texel_hits, ChainInput, KeepRule, VertexTerms};
 use glam::Vec3;
 
 // --- Scenes ---------------------------------------------------------------------------
@@ -563,7 +563,7 @@ fn far_characters_keep_their_maps_between_refreshes() {
                 .iter()
                 .find(|p| p.name == format!("tsd g1 u c{k}"))
                 .unwrap();
-            let due = dermis::skin::tsd_ref::refreshes(frame, k, 3);
+            let due = dermis::skin::tsd::refreshes(frame, k, 3);
             assert_eq!(p.samples_passed > 0, due, "frame {frame} character {k}");
         }
     }

@@ -6,10 +6,21 @@
 //! the StorageBuffer storage class (SPIR-V 1.3+) and cannot parse the SPIR-V 1.4+
 //! entry-point interfaces; SPIR-V 1.0 spells SSBOs as Uniform + BufferBlock. A missing compiler stops
 //! the build with the name of the Debian package that provides it.
+//!
+//! Before compiling, it writes `shader_constants.glsl` (the numbers shaders
+//! share with Rust, from src/shader_constants.rs, compiled into this script)
+//! into OUT_DIR, which is on the include path. After compiling, naga (an
+//! independent SPIR-V front end) parses and validates every module, so a
+//! glslang quirk stops the build instead of reaching a driver.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// The constants shared with the crate: the same file, compiled here too.
+#[path = "../src/shader_constants.rs"]
+#[allow(dead_code)]
+mod shader_constants;
 
 /// Suffix of a shader's fetch-counting build in the table.
 const COUNT_SUFFIX: &str = "#count";
@@ -19,6 +30,10 @@ fn main() {
     let dir = Path::new("shaders");
     // Headers (*.glsl) are compiled only through the shaders that include them.
     println!("cargo:rerun-if-changed=shaders");
+    println!("cargo:rerun-if-changed=src/shader_constants.rs");
+    std::fs::write(out.join("shader_constants.glsl"), shader_constants::glsl())
+        .expect("writing shader_constants.glsl");
+    let include_out = format!("-I{}", out.display());
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
         .expect("shaders/ directory is missing")
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -44,7 +59,7 @@ fn main() {
         for (suffix, defines) in variants {
             let spv = out.join(format!("{name}{}.spv", suffix.replace('#', "_")));
             let status = Command::new(&compiler)
-                .args(["-V", "--target-env", "vulkan1.0", "-Ishaders"])
+                .args(["-V", "--target-env", "vulkan1.0", "-Ishaders", &include_out])
                 .args(defines.iter())
                 .arg("-o")
                 .arg(&spv)
@@ -62,6 +77,7 @@ fn main() {
                 ),
                 Ok(_) => {}
             }
+            validate(&spv, &format!("{name}{suffix}"));
             writeln!(
                 table,
                 "    ({:?}, include_bytes!({:?})),",
@@ -73,4 +89,17 @@ fn main() {
     }
     table.push_str("];\n");
     std::fs::write(out.join("shaders.rs"), table).expect("writing shaders.rs");
+}
+
+/// Parses and validates one SPIR-V module with naga; a failure stops the build.
+fn validate(spv: &Path, name: &str) {
+    let bytes = std::fs::read(spv).unwrap_or_else(|e| panic!("reading {}: {e}", spv.display()));
+    let module = naga::front::spv::parse_u8_slice(&bytes, &naga::front::spv::Options::default())
+        .unwrap_or_else(|e| panic!("naga cannot parse shaders/{name}: {e:?}"));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("naga rejects shaders/{name}: {e:?}"));
 }

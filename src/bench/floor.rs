@@ -2,32 +2,10 @@
 //! at the device's measured ceilings. Fetch units and ROPs work concurrently, so
 //! the floor is the larger of the two, not their sum. Pure arithmetic.
 
-use serde::Serialize;
-
 use crate::graph::work::{ColorWrite, Fetch, Filter, Format, Work};
 
-/// Rates measured by the ceiling probes, in giga-operations per second.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Ceilings {
-    pub bilinear_rgba16f_gtaps: f64,
-    pub point_rgba16f_gtaps: f64,
-    pub bilinear_r32f_gtaps: f64,
-    pub point_r32f_gtaps: f64,
-    pub fill_rgba16f_gpix: f64,
-    pub fill_rgba8_gpix: f64,
-    /// RGBA16F with constant-factor blending (read-modify-write).
-    pub blend_rgba16f_gpix: f64,
-}
-
-impl Ceilings {
-    /// One line of the measured rates, for the bench printout.
-    pub fn summary(&self) -> String {
-        format!(
-            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {:.2}, blended rgba16f {:.2}",
-            self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, self.fill_rgba8_gpix, self.blend_rgba16f_gpix
-        )
-    }
-}
+// report.json's type: the schema lives in `report`.
+pub use crate::report::Ceilings;
 
 /// Fetch rate of a declared fetch, if a probe measured that kind.
 fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
@@ -44,8 +22,8 @@ fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
 fn fill_rate(c: &Ceilings, w: &ColorWrite) -> Option<f64> {
     Some(match (w.format, w.blend) {
         (Format::Rgba16Float, false) => c.fill_rgba16f_gpix,
-        (Format::Rgba16Float, true) => c.blend_rgba16f_gpix,
-        (Format::Rgba8Srgb | Format::Rgba8Unorm, false) => c.fill_rgba8_gpix,
+        (Format::Rgba16Float, true) => c.blend_rgba16f_gpix?,
+        (Format::Rgba8Srgb | Format::Rgba8Unorm, false) => c.fill_rgba8_gpix?,
         _ => return None,
     })
 }
@@ -94,8 +72,8 @@ mod tests {
             bilinear_r32f_gtaps: 31.0,
             point_r32f_gtaps: 31.0,
             fill_rgba16f_gpix: 7.0,
-            fill_rgba8_gpix: 14.0,
-            blend_rgba16f_gpix: 3.5,
+            fill_rgba8_gpix: Some(14.0),
+            blend_rgba16f_gpix: Some(3.5),
         }
     }
 

@@ -13,11 +13,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use crate::budget::input::{FrameInput, PassInput};
-use crate::budget::record::{FragmentCounting, RunRecord};
+use crate::budget::record::{counting, FragmentCounting};
 use crate::graph::work::{
     ColorWrite, DepthStencilUse, Fetch, Filter, Format, ImageUse, ImageUseKind, PassRole,
     ShaderWork, Work,
 };
+use crate::report::Report;
 
 /// `docs/budget/frames/` beside Cargo.toml.
 pub fn frames_dir() -> PathBuf {
@@ -121,7 +122,7 @@ pub fn scale_taps(f: &FrameInput, factor: f64) -> FrameInput {
 /// images and counted fetches, with the report's own counts and times (its
 /// driver's fragment counts, its samples passed, its SSS region's pixels and
 /// rectangles for the region-limited draws and copies).
-pub fn paired_frame(rep: &RunRecord, stored: &FrameInput) -> Result<FrameInput> {
+pub fn paired_frame(rep: &Report, stored: &FrameInput) -> Result<FrameInput> {
     let names = |v: Vec<&str>| v.join(", ");
     if rep.passes.len() != stored.passes.len()
         || rep
@@ -141,11 +142,11 @@ pub fn paired_frame(rep: &RunRecord, stored: &FrameInput) -> Result<FrameInput> 
     let rects = rep.sss_region_rects.unwrap_or(1);
     // The stored run's region, from its region-limited draws.
     let stored_region = stored.passes.iter().find_map(|p| p.rasterized_pixels);
-    let nvidia = rep.counting() == FragmentCounting::AfterEarlyTests;
+    let nvidia = counting(rep) == FragmentCounting::AfterEarlyTests;
     let mut g = stored.clone();
     for (q, r) in g.passes.iter_mut().zip(&rep.passes) {
         q.samples_passed = r.samples_passed;
-        q.measured_ms = r.gpu_ms.map(|t| t.median);
+        q.measured_ms = Some(r.gpu_ms.median);
         let shades = matches!(
             q.work,
             Work::Raster {
@@ -396,7 +397,7 @@ mod tests {
     #[test]
     fn an_old_report_pairs_with_its_stored_frame() {
         let name = "separable_1920x1080_near_1h";
-        let rep = RunRecord::load(&perf_dir().join(format!("h100/{name}.json"))).unwrap();
+        let rep = crate::report::load(&perf_dir().join(format!("h100/{name}.json"))).unwrap();
         let f = paired_frame(&rep, &stored("h100", name)).unwrap();
         let h = &f.passes[3];
         assert_eq!(h.fragments, 1_145_416);

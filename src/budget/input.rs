@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::graph::work::{ImageUse, PassRole, Work};
+use crate::work::{ImageUse, PassRole, Work};
 
 /// One pass of a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -135,7 +135,7 @@ impl FrameInput {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::work::{Format, ImageUseKind};
+    use crate::work::{Format, ImageUseKind};
 
     fn raster(w: u32, h: u32) -> Work {
         Work::Raster {

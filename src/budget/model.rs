@@ -11,7 +11,7 @@ use crate::budget::params::{ModelParams, ParamSet};
 use crate::budget::profile::{Profile, RateSource};
 use crate::budget::transfers::price_units;
 use crate::budget::units::{Bound, EdramUse, PassUnits, Substitution, UnitTimes};
-use crate::graph::work::PassRole;
+use crate::work::PassRole;
 
 /// The combining rule, written out for reports.
 pub const COMBINING_RULE: &str = "t = fixed + k_rect rects + k_fill T_clear + max(k_tex (T_tex + \
@@ -207,7 +207,7 @@ pub fn price_frame(
 mod tests {
     use super::*;
     use crate::budget::input::PassInput;
-    use crate::graph::work::{
+    use crate::work::{
         ColorWrite, Fetch, Filter, Format, ImageUse, ImageUseKind, ShaderWork, Work,
     };
 
@@ -367,7 +367,7 @@ mod tests {
                     blend: false,
                 },
             ];
-            *depth_stencil = Some(crate::graph::work::DepthStencilUse {
+            *depth_stencil = Some(crate::work::DepthStencilUse {
                 format: Format::D24UnormS8Uint,
                 depth_test: true,
                 depth_write: true,

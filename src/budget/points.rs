@@ -21,7 +21,8 @@ use crate::budget::frames::{
     skinless, with_counted_fetches, without_seed_copies,
 };
 use crate::budget::input::FrameInput;
-use crate::budget::record::{frame_from_record, RunRecord};
+use crate::budget::record::frame_from_record;
+use crate::report;
 
 /// Directories of new-format bench reports under `docs/perf/`: (directory,
 /// profile of the GPU that ran them, a word its device name must contain).
@@ -255,7 +256,7 @@ pub fn benchmark() -> Result<(Vec<Point>, Vec<String>)> {
     let h100 = "docs/perf/h100 (NVIDIA H100, medians of 100 frames)";
     for path in json_files(&perf_dir().join("h100"))? {
         let name = path.file_stem().unwrap_or_default().to_string_lossy();
-        let rep = RunRecord::load(&path)?;
+        let rep = report::load(&path)?;
         let stored = frames_dir().join("h100").join(format!("{name}.json"));
         match load_frame(&stored).and_then(|f| paired_frame(&rep, &f)) {
             Ok(f) => v.extend(pass_points(&f, "H100", "nvidia-h100", &name, h100)),
@@ -267,7 +268,7 @@ pub fn benchmark() -> Result<(Vec<Point>, Vec<String>)> {
         let source = format!("docs/perf/{dir}");
         for path in json_files(&perf_dir().join(dir))? {
             let name = path.file_stem().unwrap_or_default().to_string_lossy();
-            let frame = RunRecord::load(&path)
+            let frame = report::load(&path)
                 .and_then(|r| {
                     if !r.device.contains(device) {
                         anyhow::bail!("run on {}, not an {device}", r.device);

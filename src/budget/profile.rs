@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::graph::work::Format;
+use crate::work::Format;
 
 /// A number of a profile.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,6 +1,6 @@
-//! A run's report as the model reads it ([`RunRecord`]: the JSON of `dermis
-//! render`/`bench`/`budget`, live or from a file) and the [`FrameInput`] built
-//! from it: each pass's role, declared work and images, its counts and its
+//! A run's report as the model reads it (`report::Report`, the schema of
+//! `dermis render`/`bench`, live or loaded by `report::load`) and the
+//! [`FrameInput`] built from it: each pass's role, declared work and images, its counts and its
 //! measured time, with two rules stated here and written into the frame's
 //! provenance:
 //!
@@ -22,11 +22,12 @@
 //!   bound (Poisson's 32 taps, the geometry pass's branches) is replaced by
 //!   the average the frame really took.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::budget::input::{FrameInput, PassInput};
-use crate::graph::work::{Filter, ImageUse, PassRole, ShaderWork, Work};
+use crate::graph::work::{Filter, ShaderWork, Work};
+use crate::report::{PassReport, Report};
 
 /// The fragments rule (module docs), for reports.
 pub const FRAGMENTS_RULE: &str = "fragments shaded = the pipeline-statistics invocation count on \
@@ -35,70 +36,9 @@ before them) the samples that passed the depth test for a pass that writes depth
 early-Z GPU shades), and for other passes with a shader the invocations the fetch-counting \
 build counted in main (the samples passed when there was no counting run)";
 
-/// The GPU time statistics of a pass as reports write them.
-#[derive(Clone, Copy, Debug, Deserialize)]
-pub struct TimeRecord {
-    pub median: f64,
-}
-
-/// One pass of a report.
-#[derive(Clone, Debug, Deserialize)]
-pub struct PassRecord {
-    pub name: String,
-    /// Absent in reports from before passes declared their role and work.
-    #[serde(default)]
-    pub role: Option<PassRole>,
-    #[serde(default)]
-    pub work: Option<Work>,
-    #[serde(default)]
-    pub images: Vec<ImageUse>,
-    #[serde(default)]
-    pub gpu_ms: Option<TimeRecord>,
-    #[serde(default)]
-    pub fragment_invocations: Option<u64>,
-    #[serde(default)]
-    pub samples_passed: u64,
-}
-
-/// A run's report, as much of it as the model reads.
-#[derive(Clone, Debug, Deserialize)]
-pub struct RunRecord {
-    #[serde(default)]
-    pub command: String,
-    pub device: String,
-    #[serde(default)]
-    pub driver: String,
-    pub width: u32,
-    pub height: u32,
-    pub method: String,
-    #[serde(default)]
-    pub scene: String,
-    #[serde(default)]
-    pub heads: u32,
-    #[serde(default)]
-    pub sss_region_pixels: Option<u64>,
-    #[serde(default)]
-    pub sss_region_rects: Option<u64>,
-    pub passes: Vec<PassRecord>,
-}
-
-impl RunRecord {
-    /// Reads a report (JSON) from a file.
-    pub fn load(path: &std::path::Path) -> Result<RunRecord> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
-    }
-
-    /// The record of any serialisable report (a live `run::Report`).
-    pub fn of<T: Serialize>(report: &T) -> Result<RunRecord> {
-        serde_json::from_value(serde_json::to_value(report)?).context("reading the run's report")
-    }
-
-    /// How this record's driver counts fragment invocations.
-    pub fn counting(&self) -> FragmentCounting {
-        FragmentCounting::of(&self.device, &self.driver)
-    }
+/// How the driver of the run `r` counts fragment invocations.
+pub fn counting(r: &Report) -> FragmentCounting {
+    FragmentCounting::of(&r.device, &r.driver)
 }
 
 /// When a driver's pipeline statistics count fragment-shader invocations.
@@ -170,7 +110,7 @@ pub fn apply_counts(s: &mut ShaderWork, c: &CountedPass) -> bool {
 
 /// Shaded fragments of one pass (module docs).
 fn fragments(
-    p: &PassRecord,
+    p: &PassReport,
     work: &Work,
     counting: FragmentCounting,
     counted: Option<&CountedPass>,
@@ -201,7 +141,7 @@ fn fragments(
 /// test without writing depth (the stencil-masked SSS passes): the SSS
 /// region's pixels when it draws one triangle per rectangle of the region,
 /// else its whole render area. `None` for passes that reject nothing early.
-fn rasterized(rec: &RunRecord, work: &Work) -> Option<u64> {
+fn rasterized(rec: &Report, work: &Work) -> Option<u64> {
     let Work::Raster {
         depth_stencil: Some(ds),
         width,
@@ -225,7 +165,7 @@ fn rasterized(rec: &RunRecord, work: &Work) -> Option<u64> {
 /// The frame of a run: every pass with its declaration and counts, fetch
 /// counts from `counted` (one per pass, in order) when given.
 pub fn frame_from_record(
-    rec: &RunRecord,
+    rec: &Report,
     counted: Option<&[CountedPass]>,
     label: &str,
 ) -> Result<FrameInput> {
@@ -238,7 +178,7 @@ pub fn frame_from_record(
             );
         }
     }
-    let counting = rec.counting();
+    let counting = counting(rec);
     let mut passes = Vec::new();
     let mut any_counted = false;
     for (i, p) in rec.passes.iter().enumerate() {
@@ -254,7 +194,7 @@ pub fn frame_from_record(
         q.samples_passed = p.samples_passed;
         q.rasterized_pixels = rasterized(rec, &q.work);
         q.images = p.images.clone();
-        q.measured_ms = p.gpu_ms.map(|t| t.median);
+        q.measured_ms = Some(p.gpu_ms.median);
         if let Some(c) = c {
             let shader = match &mut q.work {
                 Work::Raster {
@@ -297,7 +237,8 @@ pub fn frame_from_record(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::work::{DepthStencilUse, Fetch, Format};
+    use crate::graph::work::{DepthStencilUse, Fetch, Format, PassRole};
+    use crate::report::Stats;
 
     fn shader(taps: f64) -> ShaderWork {
         let f = |texture: &str, filter, count| Fetch {
@@ -339,7 +280,7 @@ mod tests {
         assert_eq!(t.fetches[1].count, 32.0);
     }
 
-    fn record(device: &str) -> RunRecord {
+    fn record(device: &str) -> Report {
         let ds = |write| DepthStencilUse {
             format: Format::D32FloatS8Uint,
             depth_test: true,
@@ -357,31 +298,40 @@ mod tests {
             msaa: 1,
             clears: vec![],
         };
-        let pass = |name: &str, role, work| PassRecord {
+        let stats = Stats {
+            median: 0.5,
+            min: 0.5,
+            p95: 0.5,
+        };
+        let pass = |name: &str, role, work| PassReport {
             name: name.into(),
             role: Some(role),
-            work: Some(work),
-            images: vec![],
-            gpu_ms: Some(TimeRecord { median: 0.5 }),
+            gpu_ms: stats,
+            barrier_ms: stats,
             fragment_invocations: Some(4000),
             samples_passed: 3000,
+            floor_ms: None,
+            floor_ratio: None,
+            work: Some(work),
+            images: vec![],
         };
-        RunRecord {
-            command: String::new(),
-            device: device.into(),
-            driver: String::new(),
-            width: 100,
-            height: 50,
-            method: "poisson".into(),
-            scene: String::new(),
-            heads: 1,
-            sss_region_pixels: Some(2000),
-            sss_region_rects: Some(3),
-            passes: vec![
-                pass("geometry", PassRole::Geometry, raster(true, 5000)),
-                pass("poisson", PassRole::Sss, raster(false, 3)),
-            ],
-        }
+        // What every report holds (an old one's fields default), then the passes.
+        let mut r: Report = serde_json::from_value(serde_json::json!({
+            "dermis_version": "0", "command": "", "device": device, "device_type": "",
+            "driver": "", "vulkan_api": "", "validation": false, "width": 100,
+            "height": 50, "method": "poisson", "transmittance": true,
+            "transmittance_profile": "thesis", "scene": "", "mm_per_unit": 1.0,
+            "heads": 1, "distance_heads": 1.0, "fovy_deg": 20.0,
+            "light": { "azimuth_deg": 0.0, "elevation_deg": 0.0, "intensity": 1.0 },
+            "warmup_frames": 0, "measured_frames": 1, "passes": [], "frame": null,
+            "sss_region_pixels": 2000, "sss_region_rects": 3,
+        }))
+        .unwrap();
+        r.passes = vec![
+            pass("geometry", PassRole::Geometry, raster(true, 5000)),
+            pass("poisson", PassRole::Sss, raster(false, 3)),
+        ];
+        r
     }
 
     #[test]

@@ -16,16 +16,15 @@ use crate::budget::input::{FrameInput, RESCALE_RULE};
 use crate::budget::model::{price_frame, FrameBudget, Rescale, COMBINING_RULE};
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
-use crate::budget::record::{
-    frame_from_record, CountedPass, PassRecord, RunRecord, FRAGMENTS_RULE,
-};
+use crate::budget::record::{frame_from_record, CountedPass, FRAGMENTS_RULE};
 use crate::budget::table::budget_table;
 use crate::graph::work::Work;
 use crate::method::METHODS;
+use crate::output::{prepare_out_dir, write_json};
 use crate::render::counting::{decode_site, PassCounts};
 use crate::render::{RenderSettings, Renderer};
-use crate::run::write_json;
-use crate::run::{prepare_out_dir, run, RunOptions};
+use crate::report::PassReport;
+use crate::run::{run, RunOptions};
 use crate::scene::Scene;
 use crate::vk::context::{Context, ContextDesc};
 use crate::vk::shader::reflect;
@@ -91,7 +90,7 @@ pub struct ProfileSummary {
 /// Turns one pass's counter sites into texture variables, by reflecting the
 /// shader its work names (site = 1 + (set * 16 + binding) * 4 + filter kind,
 /// shaders/fetch_count.glsl).
-fn counted_pass(p: &PassRecord, c: &PassCounts) -> Result<CountedPass> {
+fn counted_pass(p: &PassReport, c: &PassCounts) -> Result<CountedPass> {
     let shader = match &p.work {
         Some(Work::Raster {
             shader: Some(s), ..
@@ -146,11 +145,10 @@ pub fn method_frame(
         progress: false,
     };
     let report = run(ctx, scene, settings, &run_opts)?.report;
-    let record = RunRecord::of(&report)?;
     let counted = match counting {
         Some(c) => {
             let counts = Renderer::new(c, scene, settings)?.count_fetches()?;
-            let passes: Vec<CountedPass> = record
+            let passes: Vec<CountedPass> = report
                 .passes
                 .iter()
                 .zip(&counts)
@@ -169,7 +167,7 @@ pub fn method_frame(
         report.heads,
         report.distance_heads
     );
-    frame_from_record(&record, counted.as_deref(), &label)
+    frame_from_record(&report, counted.as_deref(), &label)
 }
 
 /// Runs, counts, prices, prints and writes (module docs).

@@ -17,7 +17,7 @@ use crate::budget::edram;
 use crate::budget::input::{FrameInput, PassInput};
 use crate::budget::profile::{Profile, TargetFormat};
 use crate::budget::units::{pass_units, priced_format, PassUnits, Transfer};
-use crate::graph::work::{ImageUse, ImageUseKind, Work};
+use crate::work::{ImageUse, ImageUseKind, Work};
 
 const G: f64 = 1e9;
 const MS: f64 = 1e3;

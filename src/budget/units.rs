@@ -23,7 +23,7 @@ use crate::budget::edram;
 use crate::budget::input::PassInput;
 use crate::budget::params::ModelParams;
 use crate::budget::profile::{kebab, FormatCaps, FormatClass, Profile, Quantity, TargetFormat};
-use crate::graph::work::{
+use crate::work::{
     ColorWrite, DepthStencilUse, Filter, Format, ImageUseKind, PassRole, ShaderWork, Work,
 };
 

@@ -69,13 +69,13 @@ impl<'a> BandInput<'a> {
         fovy_deg: f32,
         mm_per_unit: f32,
     ) -> Self {
-        let tan_half = (fovy_deg.to_radians() * 0.5).tan();
+        let scale = crate::view::ViewScale::new(height as u32, fovy_deg.to_radians(), mm_per_unit);
         BandInput {
             width,
             height,
             skin,
             depth,
-            mm_per_px_per_depth: 2.0 * tan_half * mm_per_unit / height as f32,
+            mm_per_px_per_depth: scale.mm_per_px_per_depth(),
             mm_per_unit,
         }
     }

@@ -6,10 +6,9 @@
 //! setting beats on both), and the front is exactly that set.
 
 use std::fmt::Write as _;
-use std::fs;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 /// One measured configuration: what it cost on the GPU and how far it is from
 /// the ground truth.
@@ -82,11 +81,7 @@ pub fn write_csv(path: &Path, points: &[EvalPoint]) -> Result<()> {
             p.error
         );
     }
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        fs::create_dir_all(parent)
-            .with_context(|| format!("creating folder {}", parent.display()))?;
-    }
-    fs::write(path, out).with_context(|| format!("writing CSV {}", path.display()))
+    crate::output::write_bytes(path, out.as_bytes())
 }
 
 fn csv_field(s: &str) -> String {

@@ -10,8 +10,8 @@ use serde::Serialize;
 use super::bands::{bands, Band, BandErrors, BandInput};
 use super::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
 use super::{chart, pareto, sweep};
+use crate::output::{read_exr, write_json, write_rgba8_png};
 use crate::render::RenderSettings;
-use crate::run::read_exr;
 use crate::vk::context::Context;
 
 /// The default head scan beside the project (never copied into it).
@@ -83,8 +83,7 @@ pub fn eval(
         "scenes": specs, "rows": rows, "summary": summary,
         "pareto_front": pareto::pareto_front(&interior).iter().map(|&i| &summary[i]).collect::<Vec<_>>(),
     });
-    std::fs::write(&files[1], serde_json::to_string_pretty(&report)?)
-        .with_context(|| format!("writing {}", files[1].display()))?;
+    write_json(&files[1], &report)?;
     let panels: Vec<chart::Panel> = Band::ALL
         .iter()
         .map(|&band| chart::Panel {
@@ -217,24 +216,14 @@ fn reference_bands(b: &Path, r: &Output, mask: &[bool]) -> Result<Vec<Option<Ban
             r.height
         );
     }
-    let p = b.join("report.json");
-    let report: serde_json::Value = serde_json::from_slice(
-        &std::fs::read(&p).with_context(|| format!("reading {}", p.display()))?,
-    )
-    .with_context(|| format!("parsing {}", p.display()))?;
-    let number = |k: &str| {
-        report[k]
-            .as_f64()
-            .map(|v| v as f32)
-            .with_context(|| format!("{} has no number '{k}'", p.display()))
-    };
+    let report = crate::report::load(&b.join("report.json"))?;
     let depth: Vec<f32> = depth.iter().map(|d| d[0]).collect();
     Ok(bands(&BandInput::for_view(
         (w as usize, h as usize),
         mask,
         &depth,
-        number("fovy_deg")?,
-        number("mm_per_unit")?,
+        report.fovy_deg,
+        report.mm_per_unit,
     )))
 }
 
@@ -264,13 +253,7 @@ pub fn compare(a: &Path, b: &Path, none: Option<&Path>, out: &Path) -> Result<Co
         &band_of,
     );
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let save = |name: &str, rgba: Vec<u8>| -> Result<()> {
-        let p = out.join(name);
-        image::RgbaImage::from_raw(wa, ha, rgba)
-            .context("error image size")?
-            .save(&p)
-            .with_context(|| format!("writing {}", p.display()))
-    };
+    let save = |name: &str, rgba: Vec<u8>| write_rgba8_png(&out.join(name), wa, ha, rgba);
     /// Relative diffuse error mapped onto the colour ramp: 0..10%.
     const DIFFUSE_RAMP_MAX: f32 = 0.1;
     save(
@@ -293,9 +276,7 @@ pub fn compare(a: &Path, b: &Path, none: Option<&Path>, out: &Path) -> Result<Co
         flip_mean: flip.mean,
         bands: band_errors,
     };
-    let p = out.join("compare.json");
-    std::fs::write(&p, serde_json::to_string_pretty(&c)?)
-        .with_context(|| format!("writing {}", p.display()))?;
+    write_json(&out.join("compare.json"), &c)?;
     Ok(c)
 }
 

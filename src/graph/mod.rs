@@ -19,7 +19,8 @@ pub mod draw;
 pub mod mesh;
 mod pass;
 mod resources;
-pub mod work;
+/// The pass work vocabulary is pure data (`crate::work`); the graph carries it.
+pub use crate::work;
 
 pub use attach::{ColorTarget, DepthStencil, Load};
 pub use pass::{record_passes, Pass, PassContext, PassSample};

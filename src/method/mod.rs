@@ -102,7 +102,16 @@ impl ViewInfo {
     }
 
     pub fn tan_half_fovy(&self) -> f32 {
-        (0.5 * self.camera.fovy_rad).tan()
+        crate::view::tan_half(self.camera.fovy_rad)
+    }
+
+    /// Pixels per millimetre and its kin for this view (`crate::view`).
+    pub fn scale(&self) -> crate::view::ViewScale {
+        crate::view::ViewScale {
+            height_px: self.extent.height,
+            tan_half_fovy: self.tan_half_fovy(),
+            mm_per_unit: self.mm_per_unit,
+        }
     }
 
     /// The depth-buffer value of a surface at linear view depth `d`.

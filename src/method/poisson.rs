@@ -29,7 +29,7 @@ use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
 
 const SHADER: &str = "poisson.frag";
-const MIP_SHADER: &str = "mip_down.frag";
+const MIP_SHADER: &str = "poisson_mip_down.frag";
 /// Mip levels of the chains: enough for radii of 16 x 2^4 = 256 pixels.
 pub const MAX_LEVELS: u32 = 5;
 /// The most disk samples a pixel takes (8, 16 or 32 by its radius in pixels).

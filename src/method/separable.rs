@@ -8,7 +8,7 @@ use std::any::Any;
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::region::{px_per_mm, ReachScale, BILINEAR_MARGIN_PX};
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, Masked};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
@@ -22,7 +22,7 @@ use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 
-const SHADER: &str = "sss_blur.frag";
+const SHADER: &str = "separable_blur.frag";
 
 const OPTIONS: &[OptSpec] = &[
     OptSpec {
@@ -137,7 +137,7 @@ impl Config {
     }
 }
 
-/// Push constants of sss_blur.frag.
+/// Push constants of separable_blur.frag.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct SssPush {
@@ -270,17 +270,7 @@ impl SssMethod for Separable {
             .iter()
             .map(|s| s.offset_mm.abs())
             .fold(0.0, f32::max);
-        Some(
-            widest_mm
-                * scale.max_strength
-                * px_per_mm(
-                    depth,
-                    scale.height_px,
-                    scale.tan_half_fovy,
-                    scale.mm_per_unit,
-                )
-                + BILINEAR_MARGIN_PX,
-        )
+        Some(widest_mm * scale.max_strength * scale.px_per_mm(depth) + BILINEAR_MARGIN_PX)
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {

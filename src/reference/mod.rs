@@ -1,7 +1,8 @@
-//! The ground truth's pure parts: surface sampling, the grid, the profile split,
-//! and an f64 CPU gather that checks the GPU one. The GPU passes are in
-//! `method::reference`.
-pub mod cpu;
+//! The ground truth's pure parts: surface sampling, the grid, the chunk plan,
+//! the profile split, the tissue test, and an f64 CPU mirror of the GPU passes
+//! (`mirror`). The GPU passes are in `method::reference`.
+pub mod chunks;
+pub mod mirror;
 pub mod narrow;
 pub mod sampling;
 pub mod tissue;

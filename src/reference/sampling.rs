@@ -27,7 +27,8 @@ pub struct SurfaceSample {
 /// 4.5e-3 and 2.4e-3). Taking them as w_i L_d(x_o) at the pixel instead (the
 /// earlier definition) scatters almost no green or blue: on the card it moved
 /// 6% of the exact green and blue energy across the edge.
-pub const NARROW_GAUSSIANS: usize = 3;
+/// (Shared with the ground truth's shaders through `crate::shader_constants`.)
+pub use crate::shader_constants::NARROW_GAUSSIANS;
 
 /// Cut-off radius of the gather: 4 standard deviations of the widest Gaussian
 /// (7.41 mm^2). A 2D Gaussian keeps exp(-r^2 / 2 sigma^2) of its energy beyond r:

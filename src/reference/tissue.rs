@@ -30,14 +30,18 @@
 //! points that each see the other on their tissue side (a surface that bulges
 //! between them), which skin geometry within 11 mm (the profile's reach) does
 //! not produce at folds.
+//!
+//! The GPU passes run the same test from shaders/tissue.glsl (its one copy,
+//! with [`SAME_POINT_MM`] generated from the Rust constant; the tolerance
+//! reaches it as a uniform).
 
 /// Largest offset in front of a tangent plane, as a fraction of the distance,
 /// that a path may have and still count as through tissue (see the module doc).
 pub const TISSUE_TOLERANCE: f32 = 0.25;
 
-/// Distance (mm) under which two points are one: their direction is rounding
-/// noise (a pixel's own subsample sits within f32 rounding of the pixel's point).
-pub const SAME_POINT_MM: f32 = 1e-3;
+/// Distance (mm) under which two points are one (shared with shaders/tissue.glsl
+/// through `crate::shader_constants`).
+pub use crate::shader_constants::SAME_POINT_MM;
 
 /// Whether light can diffuse from `xi` (normal `ni`) to `xo` (normal `no`)
 /// through tissue (see the module doc). Normals are unit, outward; positions

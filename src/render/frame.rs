@@ -45,8 +45,7 @@ const SHADOW_SLOPE_BIAS: f32 = 1.5;
 const WHITE_POINT: f32 = 11.2;
 const COMPOSITE_SHADER: &str = "composite.frag";
 const TONEMAP_SHADER: &str = "tonemap.frag";
-/// Loop trip counts of the 3x3 percentage-closer filter in lighting.glsl.
-const PCF_TRIPS: [u32; 2] = [3, 3];
+use crate::shader_constants::PCF_TRIPS;
 
 /// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
 #[repr(C)]

@@ -1,6 +1,6 @@
 //! The flat skin card: a uniformly lit plane with an albedo step, the
 //! closed form of its scattered exitance under the six-Gaussian profile,
-//! and a harness that runs every screen-space method's CPU reference on it.
+//! and a harness that runs every screen-space method's CPU mirror on it.
 //!
 //! # The closed form
 //!
@@ -41,8 +41,8 @@
 //!
 //! [`CardScene`] builds the card as a `width x rows` diffuse image (all
 //! skin, strength 1, flat depth) at a chosen pixel scale and runs each
-//! method's CPU reference ([`super::separable_ref`], [`super::ssg_ref`],
-//! [`super::screen_ref`]) on it, exactly the arithmetic of the shaders. The
+//! method's CPU mirror ([`super::separable_mirror`], [`super::ssg_mirror`],
+//! [`super::screen_mirror`]) on it, exactly the arithmetic of the shaders. The
 //! scene's field of view is chosen so that one millimetre spans `px_per_mm`
 //! pixels with the image's own height, which is what every method converts
 //! its millimetres with; the image needs only as many rows as the
@@ -52,12 +52,13 @@ use std::f64::consts::PI;
 
 use super::jittered::JitteredKernel;
 use super::kernel::SeparableKernel;
+use super::mirror::MirrorInput;
 use super::poisson::PoissonParams;
 use super::profile::{normal_cdf, SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
-use super::screen_ref::{jittered, poisson, ScreenInput};
-use super::separable_ref::{separable_sss, SssInput, SssView};
+use super::screen_mirror::{jittered, poisson};
+use super::separable_mirror::{separable_sss, SssView};
 use super::ssg::{lod_depth, ssg_gaussians, GaussianFit, Stretch};
-use super::ssg_ref::{ssg, SsgInput};
+use super::ssg_mirror::{ssg, SsgInput};
 
 /// `sum_i w_ic sigma_i / sqrt(2 pi)` per channel (mm): the energy moved
 /// across an edge of unit contrast under unit irradiance.
@@ -259,14 +260,14 @@ impl CardScene {
         (0..self.rows).flat_map(|_| row.iter().copied()).collect()
     }
 
-    /// Runs `method`'s CPU reference on the card; returns its output image.
+    /// Runs `method`'s CPU mirror on the card; returns its output image.
     pub fn run(&self, method: &CardMethod) -> Vec<[f32; 4]> {
         let (w, h) = (self.width, self.rows);
         let n = w * h;
         let diffuse = self.diffuse();
         let depth = vec![CARD_DEPTH_UNITS; n];
         let skin = vec![true; n];
-        let screen = ScreenInput {
+        let screen = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -275,7 +276,7 @@ impl CardScene {
         };
         match *method {
             CardMethod::Separable(kernel) => {
-                let input = SssInput {
+                let input = MirrorInput {
                     width: w,
                     height: h,
                     diffuse: &diffuse,
@@ -307,11 +308,13 @@ impl CardScene {
                     })
                     .collect();
                 let input = SsgInput {
-                    width: w,
-                    height: h,
-                    diffuse: &diffuse,
-                    linear_depth: &depth,
-                    skin: &skin,
+                    frame: MirrorInput {
+                        width: w,
+                        height: h,
+                        diffuse: &diffuse,
+                        linear_depth: &depth,
+                        skin: &skin,
+                    },
                     ndc_depth: &ndc,
                 };
                 ssg(&input, fit, stretch, &quads)

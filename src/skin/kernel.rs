@@ -233,8 +233,9 @@ pub struct SeparableKernel {
 }
 
 impl SeparableKernel {
-    /// Upper bound on taps (the shader's fixed-size uniform array).
-    pub const MAX_SAMPLES: usize = 63;
+    /// Upper bound on taps (the shader's fixed-size uniform array, sized from
+    /// the same constant).
+    pub const MAX_SAMPLES: usize = crate::shader_constants::SEPARABLE_MAX_SAMPLES;
 
     /// Builds the kernel with `n_samples` taps (odd, 3..=63).
     pub fn build(params: SssParams, n_samples: usize) -> Result<Self> {

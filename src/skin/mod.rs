@@ -4,19 +4,23 @@
 //! checked against it: the diffusion profile and its exact line integrals,
 //! the separable subsurface-scattering kernel of Jimenez's thesis (eq. 6.1),
 //! the transmittance function (eq. 5.12), the Beckmann look-up texture used
-//! by the Kelemen/Szirmay-Kalos specular, and a CPU reference of the two
-//! screen-space SSS passes.
+//! by the Kelemen/Szirmay-Kalos specular, each method's pure parts (`ssg`,
+//! `jittered`, `poisson`, `tsd`), and the CPU mirrors of the GPU passes
+//! (`*_mirror`: the pass repeated operation by operation, so a test can hold
+//! the GPU to it per pixel; "reference" names only the ground truth).
 
 pub mod beckmann;
 pub mod card;
 pub mod jittered;
 pub mod kernel;
+pub mod mirror;
 pub mod poisson;
 pub mod profile;
-pub mod screen_ref;
-pub mod separable_ref;
+pub mod screen_mirror;
+pub mod separable_mirror;
 pub mod ssg;
-pub mod ssg_ref;
+pub mod ssg_mirror;
 pub mod texel;
 pub mod transmittance;
-pub mod tsd_ref;
+pub mod tsd;
+pub mod tsd_mirror;

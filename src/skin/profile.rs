@@ -10,19 +10,10 @@
 
 use std::f64::consts::PI;
 
-/// Variances (mm^2) of the six-Gaussian skin fit, Table 4.2.
-pub const SIX_GAUSSIAN_VARIANCES_MM2: [f32; 6] = [0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41];
-
-/// Weights `w_i` (rows: one Gaussian; columns: R, G, B) of the six-Gaussian
-/// skin fit, Table 4.2. Each channel sums to 1 (unit total diffuse response).
-pub const SIX_GAUSSIAN_WEIGHTS_RGB: [[f32; 3]; 6] = [
-    [0.233, 0.455, 0.649],
-    [0.1, 0.336, 0.344],
-    [0.118, 0.198, 0.0],
-    [0.113, 0.007, 0.007],
-    [0.358, 0.004, 0.0],
-    [0.078, 0.0, 0.0],
-];
+/// The six-Gaussian skin fit of Table 4.2: variances (mm^2) and RGB weights,
+/// written once for Rust and the shaders (lighting.glsl's transmittance, the
+/// ground truth's passes) in `crate::shader_constants`.
+pub use crate::shader_constants::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 
 /// Variances (mm^2) of the four-Gaussian skin fit, Table 4.2.
 pub const FOUR_GAUSSIAN_VARIANCES_MM2: [f32; 4] = [0.0064, 0.0516, 0.2719, 2.0062];

@@ -21,6 +21,7 @@ use super::profile::{
     FOUR_GAUSSIAN_VARIANCES_MM2, FOUR_GAUSSIAN_WEIGHTS_RGB, SIX_GAUSSIAN_VARIANCES_MM2,
     SIX_GAUSSIAN_WEIGHTS_RGB,
 };
+use crate::view::ViewScale;
 
 /// Which of d'Eon's skin fits (Table 4.2) to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -182,8 +183,9 @@ impl Stretch {
     /// `k` for gamma) and alpha is `31.5 / 1.183` for a 230 mm unit.
     pub fn for_view(height_px: u32, fovy_rad: f32, mm_per_unit: f32) -> Stretch {
         let k = DEMO_UNIT_MM / mm_per_unit;
-        let tan_half = (0.5 * fovy_rad).tan();
-        let focal_px = height_px as f32 / (2.0 * tan_half);
+        let scale = ViewScale::new(height_px, fovy_rad, mm_per_unit);
+        let tan_half = scale.tan_half_fovy;
+        let focal_px = scale.focal_px();
         // f / f_T, as (height/720) (tan 10 / tan(fovy/2)): exactly
         // height/720 at 20 degrees.
         let h = height_px as f32 / 720.0;
@@ -228,9 +230,9 @@ impl Stretch {
     }
 }
 
-/// The 7 tap weights of Listing 4.1 (a Gaussian of one tap-step standard
-/// deviation, taps at -3..=3 steps).
-pub const LISTING_4_1_WEIGHTS: [f32; 7] = [0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006];
+/// The 7 tap weights of Listing 4.1, shared with ssg_blur.glsl and
+/// tsd_blur.glsl through `crate::shader_constants`.
+pub use crate::shader_constants::LISTING_4_1_WEIGHTS;
 
 /// Eq. 4.6 with the thesis' 0.5 factor instead of 2: the view depth (scene
 /// units) beyond which Gaussian `i` is skipped. The thesis found 0.5 turns
@@ -352,7 +354,7 @@ mod tests {
     #[test]
     fn alpha_is_the_projected_millimetre() {
         // One mm at depth d, projected: height / (2 d tan(fovy/2) mm_per_unit)
-        // pixels (render::region::px_per_mm), for several views.
+        // pixels (crate::view::ViewScale::px_per_mm), for several views.
         for (h, fov_deg, mm, d) in [
             (720u32, 20f32, 230f32, 1.0f32),
             (1080, 35.0, 10.0, 37.0),

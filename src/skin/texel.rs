@@ -1,4 +1,4 @@
-//! The device rules every CPU reference follows, in one place: Vulkan's
+//! The device rules every CPU mirror follows, in one place: Vulkan's
 //! bilinear filtering with CLAMP_TO_EDGE, 2x2 mip chains as the GPU's mip pass
 //! builds them, and the rounding of f32 stores into 16-bit float targets.
 //!
@@ -6,7 +6,7 @@
 //! `(x, y)` is `((x + 0.5)/width, (y + 0.5)/height)`.
 
 /// Bilinear taps along one axis, Vulkan's rule with CLAMP_TO_EDGE: the one
-/// place every CPU reference takes it from: `t = coord * size - 0.5`,
+/// place every CPU mirror takes it from: `t = coord * size - 0.5`,
 /// `i0 = floor(t)`, `frac = t - i0`, indices `i0`, `i0 + 1` clamped into `[0, size - 1]`.
 fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
     let t = coord * size as f32 - 0.5;
@@ -22,7 +22,7 @@ fn axis_taps(coord: f32, size: usize) -> (usize, usize, f32) {
     )
 }
 
-/// `a + (b - a) * s`, the lerp form used by every reference here.
+/// `a + (b - a) * s`, the lerp form used by every mirror here.
 pub fn lerp(a: f32, b: f32, s: f32) -> f32 {
     a + (b - a) * s
 }

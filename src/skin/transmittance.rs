@@ -22,7 +22,7 @@ pub fn transmittance_rgb(s_mm: f32) -> [f32; 3] {
 /// distance d gives sum_i w_i exp(-d^2 / (2 v_i)) instead (the step from eq. 5.9 to
 /// 5.10 drops the 2). That is the same function at s / sqrt(2). `Thesis` is
 /// the default, since it is the published method; `Integral` is the consistent one.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TransmittanceProfile {
     Thesis,

@@ -10,7 +10,7 @@ use spirv_reflect::types::{ReflectDescriptorType, ReflectShaderStageFlags};
 
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 
-/// SPIR-V bytes of the shader file `name` (e.g. "sss_blur.frag").
+/// SPIR-V bytes of the shader file `name` (e.g. "separable_blur.frag").
 pub fn spirv(name: &str) -> Result<&'static [u8]> {
     SHADERS
         .iter()
@@ -220,7 +220,7 @@ mod tests {
 
     #[test]
     fn reflection_finds_sss_interface() {
-        let r = reflect(&["fullscreen.vert", "sss_blur.frag"]).unwrap();
+        let r = reflect(&["fullscreen.vert", "separable_blur.frag"]).unwrap();
         let color = r.find(0, "colorTex").expect("colorTex binding");
         assert_eq!(color.descriptor_type, vk::DescriptorType::SAMPLED_IMAGE);
         let sampler = r.find(0, "linearClamp").expect("linearClamp binding");

@@ -202,7 +202,7 @@ mod tests {
     // counts is the body's size times their difference.
     #[test]
     fn loops_scale_with_their_trip_counts() {
-        let s = stats("sss_blur.frag").unwrap();
+        let s = stats("separable_blur.frag").unwrap();
         let a = s.alu(&[8]).unwrap();
         let b = s.alu(&[16]).unwrap();
         let body = (b - a) / 8.0;

@@ -16,14 +16,13 @@
 //! binding stays within the device's storage-buffer range and every radiance
 //! image within its largest image: the default density works on any conforming
 //! device, at any head count its memory holds. The pure parts (sampling, grid,
-//! profile split, an f64 CPU gather) are in `crate::reference`.
+//! chunk plan, profile split, an f64 CPU gather) are in `crate::reference`.
 //!
 //! The folder, by concern: this file holds the registry row, the option, the
 //! sample budget, the method's state and the frame's order of passes;
 //! `setup` samples the skin, builds the grid, uploads the chunks and makes the
 //! pipelines and images, `sets` writes the descriptor sets, `passes` records
-//! the per-frame passes, `chunks` splits the samples within the device's
-//! limits.
+//! the per-frame passes.
 
 use std::any::Any;
 
@@ -42,12 +41,9 @@ use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::Pipeline;
 
-mod chunks;
 mod passes;
 mod sets;
 mod setup;
-
-pub use chunks::{plan_chunks, ChunkLimits, ChunkPlan, RADIANCE_WIDTH};
 
 const IRRADIANCE_SHADER: &str = "reference_irradiance.frag";
 const SURFACE_SHADER: &str = "reference_surface.frag";

@@ -4,14 +4,14 @@
 
 use ash::vk;
 
-use super::{
-    Reference, GATHER_SHADER, GROUP, NARROW_SHADER, RADIANCE_WIDTH, RESOLVE_SHADER, SURFACE_SHADER,
-};
+use super::{Reference, GATHER_SHADER, GROUP, NARROW_SHADER, RESOLVE_SHADER, SURFACE_SHADER};
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext};
 use crate::method::screen::fetch;
 use crate::method::FrameView;
+use crate::reference::chunks::RADIANCE_WIDTH;
 use crate::reference::sampling::SurfaceSample;
+use crate::shader_constants::{NARROW_GAUSSIANS as NARROW, PCF_TRIPS, WIDE_GAUSSIANS};
 use crate::vk::barrier::AccessKind;
 use crate::vk::shader_stats::alu_estimate;
 
@@ -56,7 +56,7 @@ impl Reference {
                 material_fetch("normalTex"),
                 material_fetch("albedoTex"),
             ],
-            alu: alu_estimate(lit, &[3, 3]),
+            alu: alu_estimate(lit, &PCF_TRIPS),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
             storage_write_bytes: 0.0,
         };
@@ -120,7 +120,7 @@ impl Reference {
         let work = ShaderWork {
             shader: SURFACE_SHADER.into(),
             fetches: vec![shadow, material_fetch("normalTex"), albedo],
-            alu: alu_estimate(SURFACE_SHADER, &[3, 3]),
+            alu: alu_estimate(SURFACE_SHADER, &PCF_TRIPS),
             ..Default::default()
         };
         // The three subsample targets and the depth start cleared.
@@ -203,7 +203,7 @@ impl Reference {
         let work = ShaderWork {
             shader: RESOLVE_SHADER.into(),
             fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
-            alu: alu_estimate(RESOLVE_SHADER, &[3]),
+            alu: alu_estimate(RESOLVE_SHADER, &[WIDE_GAUSSIANS as u32]),
             storage_read_bytes: 64.0,
             storage_write_bytes: 16.0,
         };
@@ -238,7 +238,10 @@ impl Reference {
                 bound(sf.position, "surfPosition", window),
                 bound(sf.radiance, "surfRadiance", window + 1.0),
             ],
-            alu: alu_estimate(NARROW_SHADER, &[side as u32, side as u32, 3, 3]),
+            alu: alu_estimate(
+                NARROW_SHADER,
+                &[side as u32, side as u32, NARROW as u32, NARROW as u32],
+            ),
             storage_write_bytes: 16.0,
             ..Default::default()
         };
@@ -291,7 +294,10 @@ impl Reference {
                     ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
                 },
             ],
-            alu: alu_estimate(GATHER_SHADER, &[3, self.max_candidates.div_ceil(3), 3]),
+            alu: alu_estimate(
+                GATHER_SHADER,
+                &[3, self.max_candidates.div_ceil(3), WIDE_GAUSSIANS as u32],
+            ),
             // Positions and normals of the candidates, cell ranges, the output.
             storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
             storage_write_bytes: 48.0,

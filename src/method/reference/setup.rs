@@ -5,14 +5,13 @@
 use anyhow::{bail, Result};
 use ash::vk;
 
-use super::chunks::{max_slab_candidates, plan_chunks, ChunkLimits};
 use super::{
     sample_budget, Chunk, Reference, Surface, GATHER_SHADER, IRRADIANCE_SHADER, NARROW_SHADER,
-    RADIANCE_WIDTH, RESOLVE_SHADER, SURFACE_DEPTH, SURFACE_FORMAT, SURFACE_SHADER,
+    RESOLVE_SHADER, SURFACE_DEPTH, SURFACE_FORMAT, SURFACE_SHADER,
 };
 use crate::graph::ImageDesc;
-use crate::method::region::px_per_mm;
 use crate::method::MethodSetup;
+use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
 use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface_within};
 use crate::reference::tissue::TISSUE_TOLERANCE;
@@ -228,7 +227,6 @@ impl Reference {
         s: &mut MethodSetup,
         skin: &crate::scene::mesh::Object,
     ) -> Result<()> {
-        let mm = s.view.mm_per_unit;
         let eye = s.view.camera.eye;
         let bounds = skin.mesh.bounds();
         let nearest = s
@@ -240,7 +238,7 @@ impl Reference {
             })
             .fold(f32::INFINITY, f32::min)
             .max(s.view.camera.near);
-        let px_per_mm = px_per_mm(nearest, s.view.extent.height, s.view.tan_half_fovy(), mm);
+        let px_per_mm = s.view.scale().px_per_mm(nearest);
         let ss = supersampling(px_per_mm);
         let extent = vk::Extent2D {
             width: s.view.extent.width * ss,
@@ -263,7 +261,11 @@ impl Reference {
             normal: s.res.declare(desc("normal", SURFACE_FORMAT)),
             depth: s.res.declare(desc("depth", SURFACE_DEPTH)),
             max_radius: radius(px_per_mm, ss),
-            mm_per_subsample_per_depth: 2.0 * s.view.tan_half_fovy() * mm / extent.height as f32,
+            mm_per_subsample_per_depth: crate::view::ViewScale {
+                height_px: extent.height,
+                ..s.view.scale()
+            }
+            .mm_per_px_per_depth(),
             ..Default::default()
         };
         let mesh = &skin.mesh;

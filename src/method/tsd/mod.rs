@@ -18,7 +18,7 @@
 //! convolution over written texels only (Gosselin's dilation at UV seams in
 //! the variant he names: only samples that were written enter the average).
 //! The pure parts (the chain, the atlas, eq. 3.1-3.4, the visibility
-//! predictions) are in `skin::tsd_ref`.
+//! predictions) are in `skin::tsd`.
 //!
 //! `tsd-opt`'s switches, each measurable apart:
 //! - `--cull stencil|alpha|off` (section 3.2): texels facing away beyond 105
@@ -56,7 +56,7 @@ use super::{
 };
 use crate::graph::mesh::GpuMesh;
 use crate::graph::{ImageId, Pass};
-use crate::skin::tsd_ref::{self, refreshes, Atlas, TsdGaussian, EDGE_GUARD_TEXELS};
+use crate::skin::tsd::{self, refreshes, Atlas, TsdGaussian, EDGE_GUARD_TEXELS};
 use crate::vk::context::Context;
 use crate::vk::guard::Destroy;
 use crate::vk::memory::Buffer;
@@ -83,15 +83,13 @@ const MAP_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Stretch, one map per axis (each pass reads one): 32-bit float, since the
 /// maps dermis can read back and dump have no two-channel 16-bit format.
 const STRETCH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
-/// Loop trips of the 3x3 percentage-closer filter in lighting.glsl.
-const PCF_TRIPS: [u32; 2] = [3, 3];
 /// Loop trips of tsd_blur.glsl (three pairs of taps).
 const BLUR_TRIPS: [u32; 1] = [3];
 /// Bytes between characters in the uniform buffer (>= any device's
 /// minUniformBufferOffsetAlignment).
 const CHARACTER_STRIDE: u64 = 256;
 /// Islands the atlas uniform buffer holds (tsd_character.glsl).
-const MAX_ISLANDS: usize = 256;
+const MAX_ISLANDS: usize = crate::shader_constants::TSD_MAX_ISLANDS;
 /// Depth bias of the final pass: it draws the geometry pass's own triangles
 /// with the same vertex shader; a few units toward the eye absorb any
 /// difference in how a driver compiles that shader in another pipeline.
@@ -240,7 +238,7 @@ impl Config {
         size: 2048,
         cull: Cull::Off,
         depth_sized: false,
-        d_ref: tsd_ref::THESIS_D_REF,
+        d_ref: tsd::THESIS_D_REF,
         clip: false,
         z_prepass: false,
         far_px: 0.0,

@@ -6,14 +6,15 @@ use ash::vk;
 
 use super::{
     square, uv_max, Cull, Tsd, BLUR_TRIPS, BLUR_U_SHADER, BLUR_V_SHADER, FINAL_SHADER,
-    IRRADIANCE_SHADER, MASK_SHADER, PCF_TRIPS,
+    IRRADIANCE_SHADER, MASK_SHADER,
 };
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext};
 use crate::method::screen::fetch;
 use crate::method::FrameView;
-use crate::skin::tsd_ref::{BACKFACE_BIAS, CULL_COS};
+use crate::shader_constants::PCF_TRIPS;
+use crate::skin::tsd::{BACKFACE_BIAS, CULL_COS};
 use crate::vk::context::Context;
 use crate::vk::shader_stats::alu_estimate;
 

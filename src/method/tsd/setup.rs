@@ -17,7 +17,7 @@ use crate::graph::mesh::GpuMesh;
 use crate::graph::{ImageDesc, Resources};
 use crate::method::MethodSetup;
 use crate::scene::mesh::Vertex;
-use crate::skin::tsd_ref::{
+use crate::skin::tsd::{
     atlas, box_outside, clip_planes, depth_scale, map_size, nearest_corner_distance, projected_px,
     reference_distance, tsd_gaussians, CULL_COS, NO_CLIP,
 };

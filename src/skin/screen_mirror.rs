@@ -1,9 +1,9 @@
-//! CPU references of the single-pass screen-space SSS variants: the
+//! CPU mirrors of the single-pass screen-space SSS variants: the
 //! jittered 13-tap kernel (Hable et al., thesis' "SS Jittered") and the
 //! Poisson-disk kernel with depth/normal-aware weights (seed 003), plus the
 //! device rules they follow are in [`super::texel`].
 //!
-//! As in [`super::separable_ref`], every operation mirrors the shader: f32
+//! As in [`super::separable_mirror`], every operation mirrors the shader: f32
 //! arithmetic in the stated order, Vulkan bilinear filtering with
 //! CLAMP_TO_EDGE, and rounding through f16 after every write to an RGBA16F
 //! target, so GPU and CPU images can be compared per pixel.
@@ -15,37 +15,13 @@
 use std::f32::consts::PI;
 
 use super::jittered::{jitter_angle, JitteredKernel};
+use super::mirror::MirrorInput;
 use super::poisson::{count_index, mip_level, poisson_disk_32, sample_count, PoissonParams};
 use super::ssg::Stretch;
 use super::texel::{
     bilinear4, bilinear_lod1, bilinear_lod4, mip_chain1, mip_chain4_with, pixel_uv, round_f16,
     round_f16_with, F16Rounding,
 };
-
-/// Inputs of a single-pass screen-space SSS effect (slices `width*height`).
-#[derive(Clone, Copy, Debug)]
-pub struct ScreenInput<'a> {
-    pub width: usize,
-    pub height: usize,
-    /// Diffuse light RGBA (RGBA16F-exact); alpha is the per-pixel SSS
-    /// strength (0 on non-skin).
-    pub diffuse: &'a [[f32; 4]],
-    /// View depth in scene units, > 0 on skin.
-    pub linear_depth: &'a [f32],
-    /// Stencil skin bit per pixel.
-    pub skin: &'a [bool],
-}
-
-impl ScreenInput<'_> {
-    /// Panics on a size mismatch: a caller bug, not user input.
-    fn check(&self) {
-        let n = self.width * self.height;
-        assert!(self.width > 0 && self.height > 0, "empty image");
-        assert_eq!(self.diffuse.len(), n, "diffuse size");
-        assert_eq!(self.linear_depth.len(), n, "linear_depth size");
-        assert_eq!(self.skin.len(), n, "skin mask size");
-    }
-}
 
 /// Screen-space adaptation of Hable et al.'s jittered 13-tap kernel.
 ///
@@ -63,7 +39,7 @@ impl ScreenInput<'_> {
 /// * `out.rgb = center * colorM.rgb + sum_mid (mid/6) c + sum_wide (wide/6) c`,
 ///   accumulated in that order (centre, then the six mid taps, then the six
 ///   wide taps); `out.a = colorM.a`; stored as f16.
-pub fn jittered(input: &ScreenInput, kernel: &JitteredKernel, stretch: Stretch) -> Vec<[f32; 4]> {
+pub fn jittered(input: &MirrorInput, kernel: &JitteredKernel, stretch: Stretch) -> Vec<[f32; 4]> {
     input.check();
     let (w, h) = (input.width, input.height);
     let src = input.diffuse;
@@ -124,7 +100,7 @@ pub fn jittered(input: &ScreenInput, kernel: &JitteredKernel, stretch: Stretch) 
 ///   `total += w`;
 /// * `out.rgb = acc / total`, `out.a = colorM.a`, stored as f16.
 pub fn poisson(
-    input: &ScreenInput,
+    input: &MirrorInput,
     normals: &[[f32; 4]],
     params: &PoissonParams,
     fovy_rad: f32,
@@ -145,7 +121,7 @@ pub fn poisson(
 /// [`poisson`] with the device's f16 store rounding (mip levels and output).
 #[allow(clippy::too_many_arguments)]
 pub fn poisson_with_rounding(
-    input: &ScreenInput,
+    input: &MirrorInput,
     normals: &[[f32; 4]],
     params: &PoissonParams,
     fovy_rad: f32,
@@ -160,7 +136,7 @@ pub fn poisson_with_rounding(
     let depth_chain = mip_chain1(input.linear_depth, w, h, levels);
     let normal_chain = mip_chain4_with(normals, w, h, levels, Some(rounding));
     let disk = poisson_disk_32();
-    let tan_half = (0.5 * fovy_rad).tan();
+    let tan_half = crate::view::tan_half(fovy_rad);
     let mut out = input.diffuse.to_vec();
     for y in 0..h {
         for x in 0..w {
@@ -171,6 +147,8 @@ pub fn poisson_with_rounding(
             let color_m = input.diffuse[p];
             let d = input.linear_depth[p];
             let n = normal_chain[0].2[p];
+            // poisson.frag's own order of products (not ViewScale::px_per_mm's):
+            // the mirror rounds as the shader does.
             let r_px =
                 params.radius_mm / (mm_per_unit * 2.0 * d * tan_half) * h as f32 * color_m[3];
             let count = sample_count(r_px) as usize;
@@ -256,7 +234,7 @@ mod tests {
     fn jittered_leaves_non_skin_untouched_and_blurs_skin() {
         let (w, h) = (24, 20);
         let (diffuse, depth, skin) = scene(w, h, 1.0);
-        let input = ScreenInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -288,7 +266,7 @@ mod tests {
         let diffuse = vec![colour; w * h];
         let depth = vec![1.0; w * h];
         let skin = vec![true; w * h];
-        let input = ScreenInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -302,7 +280,7 @@ mod tests {
         );
         // Strength 0: every tap lands on the centre texel.
         let flat = noise_image(w * h, 0.0);
-        let input = ScreenInput {
+        let input = MirrorInput {
             diffuse: &flat,
             ..input
         };
@@ -318,7 +296,7 @@ mod tests {
         // Depth 1 with alpha 31.5: one mm of sigma spans 10.5 pixels.
         let depth = vec![1.0; w * h];
         let skin = vec![true; w * h];
-        let input = ScreenInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -349,7 +327,7 @@ mod tests {
     fn poisson_leaves_non_skin_untouched_and_blurs_skin() {
         let (w, h) = (32, 24);
         let (diffuse, depth, skin) = scene(w, h, 1.0);
-        let input = ScreenInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -391,7 +369,7 @@ mod tests {
                 round_f16([a.sin(), 0.0, a.cos(), 0.0])
             })
             .collect();
-        let input = ScreenInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -427,7 +405,7 @@ mod tests {
         }
         let skin = vec![true; w * h];
         let run = |depth: &[f32]| {
-            let input = ScreenInput {
+            let input = MirrorInput {
                 width: w,
                 height: h,
                 diffuse: &diffuse,

@@ -2,6 +2,8 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_GOOGLE_include_directive : require
 #include "fetch_count.glsl"
+#include "shader_constants.glsl"
+#include "view_scale.glsl"
 // Separable SSS, one direction per pass (thesis ch. 6 and its HLSL listing).
 // Stencil-tested on the skin bit: early tests are forced so masked pixels never
 // run this shader.
@@ -11,7 +13,7 @@ layout(set = 0, binding = 0) uniform texture2D colorTex;   // RGBA16F, alpha = S
 layout(set = 0, binding = 1) uniform texture2D depthTex;   // linear view depth, scene units
 layout(set = 0, binding = 3) uniform sampler linearClamp;
 layout(set = 0, binding = 2) uniform KernelUniforms {
-    vec4 samples[63];   // rgb weight, w: offset in millimetres; [0] is the centre
+    vec4 samples[SEPARABLE_MAX_SAMPLES];   // rgb weight, w: offset in millimetres; [0] is the centre
 } kernel;
 layout(push_constant) uniform Push {
     vec2 dir;           // (1,0) horizontal, (0,1) vertical
@@ -35,7 +37,7 @@ void main() {
 
     // Screen height in scene units at this depth; one millimetre in uv, the same
     // on-screen length in both directions.
-    float screenH = 2.0 * depthM * pc.tanHalfFovy;
+    float screenH = SCREEN_HEIGHT_UNITS(depthM, pc.tanHalfFovy);
     vec2 stepPerMm = pc.dir / (pc.mmPerUnit * screenH);
     stepPerMm.x /= pc.aspect;
     vec2 stepUv = stepPerMm * colorM.a;

@@ -1,4 +1,4 @@
-//! CPU reference of the whole screen-space sum-of-Gaussians chain
+//! CPU mirror of the whole screen-space sum-of-Gaussians chain
 //! (thesis section 4.2.1, Figure 4.6 right), operation by operation as the
 //! GPU runs it, so GPU and CPU images can be compared per pixel.
 //!
@@ -23,29 +23,23 @@
 //! their target held, including stale values from earlier Gaussians, which
 //! the next pass may sample: that is the GPU's behaviour too.
 
+use super::mirror::MirrorInput;
 use super::ssg::{ssg_gaussians, GaussianFit, Stretch, LISTING_4_1_WEIGHTS};
 use super::texel::{bilinear4, pixel_uv, round_f16_with, F16Rounding};
 
-/// Inputs of the chain (all slices row-major, `width * height`).
+/// Inputs of the chain: the frame every mirror reads, and the hardware depth
+/// buffer (D32 float) the LOD quads are tested against.
 #[derive(Clone, Copy, Debug)]
 pub struct SsgInput<'a> {
-    pub width: usize,
-    pub height: usize,
-    /// Diffuse light RGBA (RGBA16F-exact); alpha is the SSS strength.
-    pub diffuse: &'a [[f32; 4]],
-    /// View depth in scene units.
-    pub linear_depth: &'a [f32],
-    /// Stencil skin bit per pixel.
-    pub skin: &'a [bool],
-    /// The hardware depth buffer (D32 float), compared against the LOD
-    /// quad depths.
+    pub frame: MirrorInput<'a>,
+    /// The hardware depth buffer, compared against the LOD quad depths.
     pub ndc_depth: &'a [f32],
 }
 
 /// Whether a pass of a Gaussian whose quad is drawn at depth `quad_depth`
 /// shades pixel `p` (stencil skin, depth test GREATER).
 pub fn shaded(input: &SsgInput, p: usize, quad_depth: f32) -> bool {
-    input.skin[p] && quad_depth > input.ndc_depth[p]
+    input.frame.skin[p] && quad_depth > input.ndc_depth[p]
 }
 
 /// One 7-tap blur pass of `src` (Listing 4.1); `write(p, out)` receives the
@@ -60,7 +54,7 @@ fn blur_pass(
     src: &[[f32; 4]],
     mut write: impl FnMut(usize, [f32; 4]),
 ) {
-    let (w, h) = (input.width, input.height);
+    let (w, h) = (input.frame.width, input.frame.height);
     for y in 0..h {
         for x in 0..w {
             let p = y * w + x;
@@ -68,7 +62,7 @@ fn blur_pass(
                 continue;
             }
             let color_m = src[p];
-            let [sx, sy] = stretch.factors(input.linear_depth, w, h, x, y);
+            let [sx, sy] = stretch.factors(input.frame.linear_depth, w, h, x, y);
             let s = if horizontal { sx } else { sy } * color_m[3];
             let step_px = s * std_mm / 3.0;
             let [u, v] = pixel_uv(x, y, w, h);
@@ -114,11 +108,8 @@ pub fn ssg_with_rounding(
     quad_depths: &[f32],
     rounding: F16Rounding,
 ) -> Vec<[f32; 4]> {
-    let n = input.width * input.height;
-    assert!(input.width > 0 && input.height > 0, "empty image");
-    assert_eq!(input.diffuse.len(), n, "diffuse size");
-    assert_eq!(input.linear_depth.len(), n, "linear_depth size");
-    assert_eq!(input.skin.len(), n, "skin mask size");
+    input.frame.check();
+    let n = input.frame.width * input.frame.height;
     assert_eq!(input.ndc_depth.len(), n, "ndc_depth size");
     let gaussians = ssg_gaussians(fit);
     assert_eq!(
@@ -127,9 +118,9 @@ pub fn ssg_with_rounding(
         "one quad depth per Gaussian"
     );
 
-    let mut rt1 = input.diffuse.to_vec();
-    let mut rt2 = input.diffuse.to_vec();
-    let mut rtf = input.diffuse.to_vec();
+    let mut rt1 = input.frame.diffuse.to_vec();
+    let mut rt2 = input.frame.diffuse.to_vec();
+    let mut rtf = input.frame.diffuse.to_vec();
     for (g, &q) in gaussians.iter().zip(quad_depths) {
         blur_pass(
             input,
@@ -210,11 +201,13 @@ mod tests {
 
         fn input(&self) -> SsgInput<'_> {
             SsgInput {
-                width: self.w,
-                height: self.h,
-                diffuse: &self.diffuse,
-                linear_depth: &self.depth,
-                skin: &self.skin,
+                frame: MirrorInput {
+                    width: self.w,
+                    height: self.h,
+                    diffuse: &self.diffuse,
+                    linear_depth: &self.depth,
+                    skin: &self.skin,
+                },
                 ndc_depth: &self.ndc,
             }
         }

@@ -1,7 +1,8 @@
-//! The ground truth in f64 on the CPU, by brute force over every sample (no
-//! grid): an independent check of the GPU passes (the narrow part's windowed sum
-//! over the supersampled surface, the wide part's grid, cut-off, profile,
-//! position reconstruction, the tissue test) on a tiny scene.
+//! The ground truth's CPU mirror: its integral in f64 on the CPU, by brute
+//! force over every sample (no grid), an independent check of the GPU passes
+//! (the narrow part's windowed sum over the supersampled surface, the wide
+//! part's grid, cut-off, profile, position reconstruction, the tissue test) on
+//! a tiny scene.
 
 use glam::{DMat4, DVec3, Mat4};
 
@@ -9,6 +10,7 @@ use super::narrow::radius;
 use super::sampling::{cutoff_mm, SurfaceSample, NARROW_GAUSSIANS};
 use super::tissue::through_tissue;
 use crate::skin::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
+use crate::view::ViewScale;
 
 /// What the gather needs of the view.
 #[derive(Clone, Copy, Debug)]
@@ -59,6 +61,11 @@ pub fn gather_f64(
         })
         .collect();
     let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
+    let scale = ViewScale {
+        height_px: view.height as u32,
+        tan_half_fovy: view.tan_half_fovy,
+        mm_per_unit: view.mm_per_unit,
+    };
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
@@ -82,8 +89,7 @@ pub fn gather_f64(
                 surface.normal[c][2],
             ];
             // Narrow part: windowed, weight-normalised sums per Gaussian.
-            let px_per_mm = view.height as f32
-                / (2.0 * linear_depth[i] * view.tan_half_fovy * view.mm_per_unit);
+            let px_per_mm = scale.px_per_mm(linear_depth[i]);
             let r = radius(px_per_mm, surface.s) as i64;
             let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
             let mut norm = [0.0f64; NARROW_GAUSSIANS];

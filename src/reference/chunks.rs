@@ -1,11 +1,11 @@
-//! How the ground truth's samples are split: chunks of whole radiance rows,
-//! each binding within the device's storage-buffer range and each radiance
-//! image within its largest image, and the bound on the samples one gather
-//! invocation visits (pure math over the sample grid).
+//! How the ground truth splits its surface samples so that every binding and
+//! every image stays within the device's limits (pure: the limits come in as
+//! numbers; `method::reference` reads them off the device), and the bound of
+//! one gather invocation's work in one slab.
 
 use anyhow::{bail, Result};
 
-use crate::reference::sampling::{Grid, SurfaceSample};
+use super::sampling::{Grid, SurfaceSample};
 
 /// Width of the radiance images: sample i of a chunk is texel (i % width, i / width).
 pub const RADIANCE_WIDTH: u32 = 2048;
@@ -61,7 +61,7 @@ pub fn plan_chunks(count: u32, limits: ChunkLimits) -> Result<ChunkPlan> {
 /// The most samples one gather invocation visits in one slab: the largest sum of
 /// the counts of a row of 3 neighbouring cells (an upper bound of its radiance
 /// fetches, which are the visited samples within the cut-off).
-pub(super) fn max_slab_candidates(grid: &Grid) -> u32 {
+pub fn max_slab_candidates(grid: &Grid) -> u32 {
     let [nx, ny, nz] = grid.dims.map(|d| d as i64);
     let count = |x: i64, y: i64, z: i64| -> u32 {
         if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {

@@ -1,4 +1,4 @@
-//! CPU reference of the two screen-space separable SSS passes.
+//! CPU mirror of the two screen-space separable SSS passes.
 //!
 //! This mirrors the GPU shader operation by operation (f32 arithmetic,
 //! Vulkan bilinear filtering with clamp-to-edge, RGBA16F intermediate
@@ -20,23 +20,11 @@
 //!
 //! `mix(a, b, s)` and bilinear lerps are evaluated as `a + (b - a) * s`.
 //! Note: real texture units quantise the bilinear fraction (typically 8
-//! sub-texel bits), so GPU results can differ from this reference by up to
+//! sub-texel bits), so GPU results can differ from this mirror by up to
 //! ~1/512 of the difference between neighbouring texels.
 
 use super::kernel::SeparableKernel;
-
-/// Inputs of the full two-pass effect (all slices row-major, `width*height`).
-#[derive(Clone, Copy, Debug)]
-pub struct SssInput<'a> {
-    pub width: usize,
-    pub height: usize,
-    /// Diffuse irradiance RGBA; alpha is the per-pixel SSS strength.
-    pub diffuse: &'a [[f32; 4]],
-    /// View-space distance along the view axis, scene units, > 0.
-    pub linear_depth: &'a [f32],
-    /// Stencil skin bit per pixel.
-    pub skin: &'a [bool],
-}
+use super::mirror::MirrorInput;
 
 /// Camera and scale information the passes need.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,7 +41,7 @@ pub struct SssView {
 
 use super::texel::{bilinear as bilinear_uv, lerp, round_f16};
 
-/// Bilinear fetch of `C` channels at `uv` (the rule of `screen_ref`).
+/// Bilinear fetch of `C` channels at `uv` (the rule of `screen_mirror`).
 fn bilinear<const C: usize>(
     tex: &[[f32; C]],
     width: usize,
@@ -92,7 +80,7 @@ pub fn sss_pass(
     let depth_tex: Vec<[f32; 1]> = linear_depth.iter().map(|&d| [d]).collect();
     let follow = view.follow_surface && view.follow_tolerance_mm > 0.0;
     let aspect = width as f32 / height as f32;
-    let tan_half = (0.5 * view.fovy_rad).tan();
+    let scale = crate::view::ViewScale::new(height as u32, view.fovy_rad, view.mm_per_unit);
     let inv_mm_per_unit = 1.0 / view.mm_per_unit;
 
     for y in 0..height {
@@ -108,7 +96,7 @@ pub fn sss_pass(
                 (x as f32 + 0.5) / width as f32,
                 (y as f32 + 0.5) / height as f32,
             ];
-            let screen_h = 2.0 * depth_m * tan_half;
+            let screen_h = scale.screen_height_units(depth_m);
             let step_mm = inv_mm_per_unit / screen_h;
             let step = if horizontal {
                 [step_mm / aspect, 0.0]
@@ -145,7 +133,11 @@ pub fn sss_pass(
 /// it is stored as RGBA16F; the output starts as a copy of the diffuse
 /// target, the vertical pass reads the intermediate, and the result is
 /// stored as RGBA16F.
-pub fn separable_sss(input: &SssInput, kernel: &SeparableKernel, view: &SssView) -> Vec<[f32; 4]> {
+pub fn separable_sss(
+    input: &MirrorInput,
+    kernel: &SeparableKernel,
+    view: &SssView,
+) -> Vec<[f32; 4]> {
     let (w, h) = (input.width, input.height);
     let mut tmp = input.diffuse.to_vec();
     sss_pass(
@@ -216,7 +208,7 @@ mod tests {
         let diffuse = noise_image(w * h, 1.0);
         let depth = vec![1.0; w * h];
         let skin = vec![true; w * h];
-        let input = SssInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -239,7 +231,7 @@ mod tests {
         }
         // Per-pixel strength 0: all taps land on the centre texel.
         let flat = noise_image(w * h, 0.0);
-        let input = SssInput {
+        let input = MirrorInput {
             diffuse: &flat,
             ..input
         };
@@ -258,7 +250,7 @@ mod tests {
         let diffuse = vec![colour; w * h];
         let depth = vec![1.0; w * h];
         let skin = vec![true; w * h];
-        let input = SssInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -299,7 +291,7 @@ mod tests {
             assert_eq!(*px == sentinel, !skin[i], "pixel {i}");
         }
         // Full effect on f16-representable input: bit-identical.
-        let input = SssInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
@@ -342,7 +334,7 @@ mod tests {
         let (w, h) = (48, 32);
         let (diffuse, depth) = step_scene(w, h);
         let skin = vec![true; w * h];
-        let input = SssInput {
+        let input = MirrorInput {
             width: w,
             height: h,
             diffuse: &diffuse,
