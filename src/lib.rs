@@ -1,10 +1,11 @@
 //! dermis: a hand-written Vulkan (ash) renderer for real-time human skin that
 //! measures what every pass costs on the GPU.
 //!
-//! Layers, bottom up (a module uses only the ones before it; tests/layers.rs
+//! Layers, bottom up (a module uses only the ones before it; tests/suite/layers.rs
 //! checks it on every path the code names):
-//! the pure core, `shader_constants`, `work`, `view`, `scene`, `skin`,
-//! `reference` (no Vulkan: the numbers shared with the shaders, the
+//! the pure core, `files`, `shader_constants`, `work`, `view`, `scene`, `skin`,
+//! `reference` (no Vulkan: the one door every user-supplied file is read
+//! through, regular files only and sizes bounded; the numbers shared with the shaders, the
 //! vocabulary of a pass's work, the view's scale and the SSS region, meshes and
 //! framing, profiles, kernels and the CPU mirrors of the passes, the ground
 //! truth's sampling and chunk plan) -> `vk` (device, barrier table, memory,
@@ -19,10 +20,11 @@
 //!
 //! The pure core and, above it, `eval::metrics` and `budget::model` name
 //! neither `ash`, `crate::vk` nor `crate::graph`, nor reach them through any
-//! file they lead to (tests/layers.rs).
+//! file they lead to (tests/suite/layers.rs).
 pub mod bench;
 pub mod budget;
 pub mod eval;
+pub mod files;
 pub mod graph;
 pub mod method;
 pub mod output;

@@ -10,17 +10,29 @@ use clap::{Arg, ArgAction, ArgMatches, Args, Parser, Subcommand, ValueEnum};
 use dermis::budget::run::BudgetOptions;
 use dermis::budget::Rescale;
 use dermis::eval::{study, sweep};
-use dermis::method::{all_options, foreign_options, ground_truth, lookup, MethodOptions, OptKind};
+use dermis::method::region::RegionMode;
+use dermis::method::{
+    all_options, foreign_options, ground_truth, listing, listing_text, lookup, MethodOptions,
+    OptKind,
+};
 use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::gltf_load::TextureOverrides;
+use dermis::scene::layout::Layout;
 use dermis::scene::{builtin_scene, load_gltf_scene, Scene};
+use dermis::skin::kernel::{Preset, SeparableKernel};
+use dermis::skin::transmittance::TransmittanceProfile;
+use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 
 /// `--scene builtin:NAME` names a built-in scene instead of a file.
 const BUILTIN: &str = "builtin:";
-use dermis::skin::kernel::{Preset, SeparableKernel};
-use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
+
+/// The frame's defaults: every render flag's default is read from here, so the
+/// CLI and the library (tests, eval) cannot drift apart.
+fn defaults() -> RenderSettings {
+    RenderSettings::default()
+}
 
 #[derive(Parser)]
 #[command(
@@ -146,8 +158,8 @@ enum Command {
     Kernel {
         #[arg(long, default_value_t = 17)]
         samples: usize,
-        #[arg(long, default_value = "table6.1")]
-        preset: String,
+        #[arg(long, value_enum, ignore_case = true, default_value_t = PresetArg::Table61)]
+        preset: PresetArg,
         /// Override the preset's width (mm).
         #[arg(long)]
         width_mm: Option<f32>,
@@ -157,10 +169,152 @@ enum Command {
         #[arg(long)]
         validate: bool,
     },
+    /// List the SSS methods of the registry: names, aliases, summary, and each
+    /// option's flag, default and help (what `--method` and the method flags take).
+    Methods {
+        /// Print the listing as JSON (what the scripts in tools/ read).
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+// The enum-like flags. Each mirrors a library enum, converted both ways by
+// exhaustive matches (a variant added on either side fails to compile until
+// the other has it); the defaults are the library's, read back through `From`.
+
+/// `--sss-region`: where the SSS passes run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum SssRegionArg {
+    /// The skin's projected bounds widened by the kernel's reach: seed copies
+    /// and stencil-tested draws limited to them.
+    Skin,
+    /// The whole frame, as the demos run (kept to measure what the region
+    /// saves). `screen`, its old name, is still accepted: "screen" names the
+    /// screen-space methods.
+    #[value(alias = "screen")]
+    Frame,
+}
+
+impl From<SssRegionArg> for RegionMode {
+    fn from(a: SssRegionArg) -> Self {
+        match a {
+            SssRegionArg::Skin => RegionMode::Skin,
+            SssRegionArg::Frame => RegionMode::Screen,
+        }
+    }
+}
+
+impl From<RegionMode> for SssRegionArg {
+    fn from(m: RegionMode) -> Self {
+        match m {
+            RegionMode::Skin => SssRegionArg::Skin,
+            RegionMode::Screen => SssRegionArg::Frame,
+        }
+    }
+}
+
+/// `--layout`: how several characters stand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum LayoutArg {
+    /// Rows receding from a fixed camera, as a game stages a crowd.
+    Crowd,
+    /// Side by side, the camera pulled back to fit them.
+    Grid,
+}
+
+impl From<LayoutArg> for Layout {
+    fn from(a: LayoutArg) -> Self {
+        match a {
+            LayoutArg::Crowd => Layout::Crowd,
+            LayoutArg::Grid => Layout::Grid,
+        }
+    }
+}
+
+impl From<Layout> for LayoutArg {
+    fn from(l: Layout) -> Self {
+        match l {
+            Layout::Crowd => LayoutArg::Crowd,
+            Layout::Grid => LayoutArg::Grid,
+        }
+    }
+}
+
+/// `--transmittance-profile`: which T(s) the transmittance term uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TransmittanceArg {
+    /// Eq. 5.12 as published.
+    #[value(alias = "eq5.12")]
+    Thesis,
+    /// The profile integrated over a plane: exp(-s^2 / 2v) (docs/accuracy.md).
+    Integral,
+}
+
+impl From<TransmittanceArg> for TransmittanceProfile {
+    fn from(a: TransmittanceArg) -> Self {
+        match a {
+            TransmittanceArg::Thesis => TransmittanceProfile::Thesis,
+            TransmittanceArg::Integral => TransmittanceProfile::Integral,
+        }
+    }
+}
+
+impl From<TransmittanceProfile> for TransmittanceArg {
+    fn from(p: TransmittanceProfile) -> Self {
+        match p {
+            TransmittanceProfile::Thesis => TransmittanceArg::Thesis,
+            TransmittanceProfile::Integral => TransmittanceArg::Integral,
+        }
+    }
+}
+
+/// `dermis kernel --preset`: the separable kernel's named parameter sets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum PresetArg {
+    /// Table 6.1 of the thesis (width 3.22 mm).
+    #[value(name = "table6.1", alias = "table61")]
+    Table61,
+    /// The original demo's look (width 2.76 mm).
+    Demo,
+    /// Each channel's marginal of the six-Gaussian profile (Table 4.2).
+    Physical,
+}
+
+impl From<PresetArg> for Preset {
+    fn from(a: PresetArg) -> Self {
+        match a {
+            PresetArg::Table61 => Preset::Table61,
+            PresetArg::Demo => Preset::Demo,
+            PresetArg::Physical => Preset::Physical,
+        }
+    }
+}
+
+impl From<Preset> for PresetArg {
+    fn from(p: Preset) -> Self {
+        match p {
+            Preset::Table61 => PresetArg::Table61,
+            Preset::Demo => PresetArg::Demo,
+            Preset::Physical => PresetArg::Physical,
+        }
+    }
+}
+
+/// The views the shot, key light and ambient default to.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum View {
+    /// The default picture: `RenderSettings::default()`, the portrait.
+    Portrait,
+    /// `RenderSettings::study()` at the mid shot: the tests' view and every
+    /// recorded run's before issue 15.
+    Study,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum Shot {
+    /// The default: a portrait, the head alone in frame with a little room
+    /// (`render::settings::PORTRAIT_CLOSE_UPS` close-up distances).
+    Portrait,
     /// The head fills the screen height.
     Close,
     /// Twice the close-up distance.
@@ -193,58 +347,68 @@ struct Common {
     /// Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head).
     #[arg(long)]
     mm_per_unit: Option<f32>,
-    #[arg(long, default_value_t = 1280)]
+    #[arg(long, default_value_t = defaults().width)]
     width: u32,
-    #[arg(long, default_value_t = 720)]
+    #[arg(long, default_value_t = defaults().height)]
     height: u32,
-    /// SSS method (see "Methods" in --help of the options below).
-    #[arg(long, default_value = "separable")]
+    /// SSS method, by name or alias (`dermis methods` lists them with their options).
+    #[arg(long, default_value_t = defaults().method.name.to_string())]
     method: String,
     #[command(flatten)]
     method_options: MethodArgs,
-    /// Transmittance T(s): thesis (eq. 5.12 as published) or integral (the profile
-    /// integrated over a plane: exp(-s^2 / 2v), see docs/accuracy.md).
-    #[arg(long, default_value = "thesis")]
-    transmittance_profile: String,
-    /// Where the SSS passes run: skin (the skin's projected bounds widened by the
-    /// kernel's reach: seed copies and draws limited to them) | screen (everywhere).
-    #[arg(long, default_value = "skin")]
-    sss_region: String,
+    /// Transmittance T(s).
+    #[arg(long, value_enum, ignore_case = true,
+          default_value_t = TransmittanceArg::from(defaults().transmittance_profile))]
+    transmittance_profile: TransmittanceArg,
+    /// Where the SSS passes run.
+    #[arg(long, value_enum, ignore_case = true,
+          default_value_t = SssRegionArg::from(defaults().sss_region))]
+    sss_region: SssRegionArg,
     /// Side of the SSS region's screen tiles in pixels (1..=1024): smaller hugs the
     /// skin closer but draws more rectangles.
-    #[arg(long, default_value_t = dermis::method::region::TILE_PX)]
+    #[arg(long, default_value_t = defaults().sss_region_tile)]
     sss_region_tile: u32,
     #[arg(long)]
     no_transmittance: bool,
     /// Number of characters (multi-character stress).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = defaults().heads)]
     heads: u32,
-    /// How several characters stand: crowd (rows receding from a fixed camera) | grid
-    /// (side by side, the camera pulled back to fit them).
-    #[arg(long, default_value = "crowd")]
-    layout: String,
-    /// Camera shot (ignored when --distance is given).
-    #[arg(long, value_enum, default_value_t = Shot::Mid)]
-    shot: Shot,
+    /// How several characters stand.
+    #[arg(long, value_enum, ignore_case = true,
+          default_value_t = LayoutArg::from(defaults().layout))]
+    layout: LayoutArg,
+    /// The view the shot, key light and ambient default to: portrait (the
+    /// default picture, `RenderSettings::default()`) or study (the fixed view of
+    /// the tests and of every run recorded before issue 15,
+    /// `RenderSettings::study()` at the mid shot). --shot, --light-azimuth,
+    /// --light-elevation and --ambient override it.
+    #[arg(long, value_enum, default_value_t = View::Portrait)]
+    view: View,
+    /// Camera shot (ignored when --distance is given) [default: portrait, or mid
+    /// with --view study].
+    #[arg(long, value_enum)]
+    shot: Option<Shot>,
     /// Camera distance from the head centre in head heights.
     #[arg(long)]
     distance: Option<f32>,
     /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = defaults().fovy_deg)]
     fovy: f32,
-    /// Key light azimuth in degrees (0 = from the camera side, positive toward the viewer's right).
-    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
-    light_azimuth: f32,
-    /// Key light elevation in degrees above the horizon.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
-    light_elevation: f32,
-    #[arg(long, default_value_t = 2.5)]
+    /// Key light azimuth in degrees (0 = from the camera side, positive toward the
+    /// viewer's right) [default: the --view's].
+    #[arg(long, allow_negative_numbers = true)]
+    light_azimuth: Option<f32>,
+    /// Key light elevation in degrees above the horizon [default: the --view's].
+    #[arg(long, allow_negative_numbers = true)]
+    light_elevation: Option<f32>,
+    #[arg(long, default_value_t = defaults().light.intensity)]
     light_intensity: f32,
-    #[arg(long, default_value_t = 0.08)]
-    ambient: f32,
-    #[arg(long, default_value_t = 2.0)]
+    /// Constant ambient irradiance [default: the --view's].
+    #[arg(long)]
+    ambient: Option<f32>,
+    #[arg(long, default_value_t = defaults().exposure)]
     exposure: f32,
-    #[arg(long, default_value_t = 2048)]
+    #[arg(long, default_value_t = defaults().shadow_size)]
     shadow_size: u32,
 }
 
@@ -302,30 +466,37 @@ impl Args for MethodArgs {
 impl Common {
     fn settings(&self) -> Result<RenderSettings> {
         let close = Camera::close_up_distance_heads(self.fovy);
-        let distance = self.distance.unwrap_or(match self.shot {
-            Shot::Close => close,
-            Shot::Mid => 2.0 * close,
-            Shot::Far => 5.0 * close,
-        });
+        let (base, base_shot) = match self.view {
+            View::Portrait => (defaults(), Shot::Portrait),
+            View::Study => (RenderSettings::study(), Shot::Mid),
+        };
+        let distance = self
+            .distance
+            .unwrap_or(match self.shot.unwrap_or(base_shot) {
+                Shot::Portrait => dermis::render::settings::PORTRAIT_CLOSE_UPS * close,
+                Shot::Close => close,
+                Shot::Mid => 2.0 * close,
+                Shot::Far => 5.0 * close,
+            });
         let mut s = RenderSettings {
             width: self.width,
             height: self.height,
             method: lookup(&self.method)?,
             options: self.method_options.0.clone(),
             transmittance: !self.no_transmittance,
-            sss_region: self.sss_region.parse()?,
+            sss_region: self.sss_region.into(),
             sss_region_tile: self.sss_region_tile,
-            transmittance_profile: self.transmittance_profile.parse()?,
+            transmittance_profile: self.transmittance_profile.into(),
             heads: self.heads,
-            layout: self.layout.parse()?,
+            layout: self.layout.into(),
             distance_heads: distance,
             fovy_deg: self.fovy,
-            ..RenderSettings::default()
+            ..base.clone()
         };
-        s.light.azimuth_deg = self.light_azimuth;
-        s.light.elevation_deg = self.light_elevation;
+        s.light.azimuth_deg = self.light_azimuth.unwrap_or(base.light.azimuth_deg);
+        s.light.elevation_deg = self.light_elevation.unwrap_or(base.light.elevation_deg);
         s.light.intensity = self.light_intensity;
-        s.ambient = self.ambient;
+        s.ambient = self.ambient.unwrap_or(base.ambient);
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
         // Checked again against the device limits once a device is open.
@@ -463,7 +634,7 @@ fn main_result() -> Result<()> {
             preset,
             width_mm,
         } => {
-            let preset: Preset = preset.parse()?;
+            let preset = Preset::from(preset);
             let mut params = preset.params();
             if let Some(w) = width_mm {
                 params.width_mm = w;
@@ -486,6 +657,13 @@ fn main_result() -> Result<()> {
             let devices = ctx.devices();
             for (i, name, kind) in ctx.finish_with(devices)? {
                 println!("{i}: {name} ({kind})");
+            }
+        }
+        Command::Methods { json } => {
+            if json {
+                println!("{}", serde_json::to_string_pretty(&listing())?);
+            } else {
+                print!("{}", listing_text());
             }
         }
     }

@@ -298,9 +298,12 @@ pub fn write_depth_exr(path: &Path, c: &Capture) -> Result<()> {
 /// Reads an RGBA EXR written by dermis (what `compare` reads back of the
 /// writers above).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
-    let img = image::open(path)
-        .with_context(|| format!("reading {}", path.display()))?
-        .to_rgba32f();
+    // Its sides within the range `render` accepts for a frame's width and height.
+    let img = crate::files::read_rgba32f(
+        path,
+        "EXR image",
+        &crate::files::ImageBound::rgba32f(crate::render::settings::MAX_IMAGE_SIDE),
+    )?;
     let (w, h) = img.dimensions();
     Ok((w, h, img.pixels().map(|p| p.0).collect()))
 }

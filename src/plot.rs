@@ -7,11 +7,10 @@
 //! rather than shipped in the repository. The charts themselves live with what
 //! they show (`eval::chart`, `budget::chart`).
 
-use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -95,24 +94,63 @@ fn ensure_font() -> Result<()> {
         .map_err(|e| anyhow!(e))
 }
 
-fn register_system_font() -> Result<()> {
-    let mut candidates: Vec<PathBuf> = Vec::new();
-    if let Some(p) = std::env::var_os("DERMIS_FONT") {
-        candidates.push(p.into());
-    }
-    candidates.extend(FONT_PATHS.iter().map(PathBuf::from));
-    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
-        bail!(
-            "no font for chart text: set DERMIS_FONT to a .ttf file or install \
-             fonts-dejavu-core (looked in {})",
-            FONT_PATHS.join(", ")
-        );
+/// The font file's bytes: `DERMIS_FONT` when it is set (that file or an error
+/// naming it: a font the user names is never silently replaced by another),
+/// else the first of [`FONT_PATHS`] there is; read through the one door
+/// (`files`), so a FIFO or `/dev/zero` ends in an error line, not a hang.
+fn font_bytes(given: Option<PathBuf>) -> Result<(PathBuf, Vec<u8>)> {
+    let path = match given {
+        Some(p) => p,
+        None => FONT_PATHS
+            .iter()
+            .map(PathBuf::from)
+            .find(|p| p.is_file())
+            .ok_or_else(|| {
+                anyhow!(
+                    "no font for chart text: set DERMIS_FONT to a .ttf file or install \
+                     fonts-dejavu-core (looked in {})",
+                    FONT_PATHS.join(", ")
+                )
+            })?,
     };
-    let bytes = fs::read(path).with_context(|| format!("reading font {}", path.display()))?;
+    let bytes = crate::files::read_bounded(&path, "font", crate::files::MAX_FONT_FILE)
+        .context("the chart font (DERMIS_FONT or the system's)")?;
+    Ok((path, bytes))
+}
+
+fn register_system_font() -> Result<()> {
+    let (path, bytes) = font_bytes(std::env::var_os("DERMIS_FONT").map(PathBuf::from))?;
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
     for family in ["sans-serif", "serif", "monospace"] {
         plotters::style::register_font(family, FontStyle::Normal, bytes)
             .map_err(|_| anyhow!("{} is not a usable TrueType font", path.display()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Issue 15: the font is read through the one door. A FIFO or /dev/zero named
+    // by DERMIS_FONT ends in one error line naming it (before, the FIFO was
+    // skipped in silence for another font, and any size was read).
+    #[test]
+    fn a_font_the_user_names_is_read_through_the_door() {
+        let dir = std::env::temp_dir().join(format!("dermis-font-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("font.ttf");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        for p in [fifo, PathBuf::from("/dev/zero"), dir.join("absent.ttf")] {
+            let e = format!("{:#}", font_bytes(Some(p.clone())).unwrap_err());
+            assert!(!e.contains('\n') && e.contains("chart font"), "{e}");
+            assert!(e.contains(&p.display().to_string()), "{e}");
+        }
+        let f = dir.join("small.ttf");
+        std::fs::write(&f, b"0123").unwrap();
+        assert_eq!(font_bytes(Some(f.clone())).unwrap(), (f, b"0123".to_vec()));
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }

@@ -83,8 +83,44 @@ pub struct LightReport {
 /// Reads a report (report.json of `render`, the `--report` of `bench`): the
 /// one loader every reader of reports goes through.
 pub fn load(path: &Path) -> Result<Report> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    serde_json::from_slice(&bytes).with_context(|| format!("parsing {}", path.display()))
+    let text = crate::files::read_text(path, "report", crate::files::MAX_TEXT_FILE)?;
+    let r: Report =
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    r.check()
+        .with_context(|| format!("report {}", path.display()))?;
+    Ok(r)
+}
+
+impl Report {
+    /// The ranges `render` holds its settings to, for a report whoever wrote it:
+    /// the frame's sides within 1..=`MAX_IMAGE_SIDE`, at most `MAX_HEADS` heads,
+    /// the field of view and the scale as `render` takes them, measured times
+    /// finite and not negative.
+    pub fn check(&self) -> Result<()> {
+        use crate::render::settings::{check_fovy, MAX_HEADS, MAX_IMAGE_SIDE};
+        for (what, v) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_IMAGE_SIDE).contains(&v) {
+                anyhow::bail!(
+                    "{what} must be within 1..={MAX_IMAGE_SIDE} pixels (as render's --{what}), got {v}"
+                );
+            }
+        }
+        if self.heads > MAX_HEADS {
+            anyhow::bail!("heads must be within 1..={MAX_HEADS}, got {}", self.heads);
+        }
+        check_fovy(self.fovy_deg)?;
+        crate::scene::check_mm_per_unit(self.mm_per_unit)?;
+        for p in &self.passes {
+            let t = p.gpu_ms.median;
+            if !(t.is_finite() && t >= 0.0) {
+                anyhow::bail!(
+                    "pass '{}': gpu_ms.median must be a finite number, not negative, got {t}",
+                    p.name
+                );
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Rates measured by the ceiling probes, in giga-operations per second
@@ -399,6 +435,6 @@ mod tests {
         // Old and new files both: the defaults were exercised.
         assert!(with_layout > 0 && with_layout < files.len());
         let e = load(Path::new("/nonexistent/report.json")).unwrap_err();
-        assert!(format!("{e:#}").contains("reading /nonexistent/report.json"));
+        assert!(format!("{e:#}").contains("report not found: /nonexistent/report.json"));
     }
 }

@@ -5,7 +5,7 @@
 //! no shader spells these numbers again; the Rust modules that own their
 //! meaning (`skin::profile`, `skin::ssg`, `reference::tissue`...) re-export
 //! them. Because the build script compiles it alone, this file names no other
-//! module and imports only std (tests/layers.rs checks that).
+//! module and imports only std (tests/suite/layers.rs checks that).
 //!
 //! Floats are written as Rust prints them, the shortest text that reads back
 //! as the same f32: glslang then stores the same bits as it did for the

@@ -6,12 +6,12 @@
 #   tools/bench_matrix.sh BIN OUTDIR            # bench: OUTDIR/NAME.json, a `dermis bench` report each
 #   tools/bench_matrix.sh BIN OUTDIR --frames   # the frames the calibration pairs with them: OUTDIR/NAME.json,
 #                                               # `dermis budget`'s frame of the same configuration on lavapipe
-#                                               # (fetches counted), as committed in docs/budget/frames/matrix/
+#                                               # (fetches counted), as committed in profiles/frames/matrix/
 #
 # On the device machine (one H200), from the repository root, with a release build carried:
 #   tools/bench_matrix.sh .bin/dermis out/h200 && tar czf "$OUT/h200.tgz" -C out h200
-# then commit the reports as docs/perf/h200/NAME.json; `cargo test --release --lib
-# budget::calibration -- --ignored --nocapture` scores the model on them. Set up the device
+# then commit the reports as docs/perf/h200/NAME.json; `cargo run --release --example
+# budget_calibration` scores the model on them. Set up the device
 # as tools/perf_h100.sh does: .gl (Vulkan loader debs) is unpacked here when present, and the
 # NVIDIA ICD is named when the loader does not find it.
 #
@@ -58,7 +58,7 @@ run() {
   if [ "$MODE" = --frames ]; then
     local tmp
     tmp=$(mktemp -d)
-    if "$BIN" budget --device llvmpipe --profile nvidia-h200 --warmup 0 --frames 1 \
+    if "$BIN" budget --view study --device llvmpipe --profile nvidia-h200 --warmup 0 --frames 1 \
         --scene "$ASSET" "${EXTRA[@]}" "$@" --out "$tmp" > "$tmp/log.txt" 2>&1; then
       cp "$tmp"/frames/*.json "$target"
       echo "ok: $name"
@@ -67,8 +67,8 @@ run() {
     fi
     rm -rf "$tmp"
   else
-    echo "+ $BIN bench --scene $ASSET ${EXTRA[*]} $* --report $target"
-    "$BIN" bench --scene "$ASSET" "${EXTRA[@]}" "$@" --report "$target" > /dev/null \
+    echo "+ $BIN bench --view study --scene $ASSET ${EXTRA[*]} $* --report $target"
+    "$BIN" bench --view study --scene "$ASSET" "${EXTRA[@]}" "$@" --report "$target" > /dev/null \
       || echo "FAILED: $name" >&2
   fi
 }

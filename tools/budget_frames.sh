@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The frames the budget calibration prices (docs/budget/frames/), rendered on lavapipe with
+# The frames the budget calibration prices (profiles/frames/), rendered on lavapipe with
 # the fetch-counting build by `dermis budget` (counts do not depend on the device's speed):
 #
 #   published/  the scenes of the published timings, as docs/budget-calibration.md reads them
@@ -17,7 +17,7 @@ set -uo pipefail
 BIN=${1:-target/release/dermis}
 shift || true
 ASSET=${ASSET:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
-D=docs/budget/frames
+D=profiles/frames
 parts=("$@")
 [ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting)
 
@@ -30,7 +30,7 @@ frame() {
   mkdir -p "$D/$dir"
   local tmp
   tmp=$(mktemp -d)
-  if "$BIN" budget --device llvmpipe --profile nvidia-h100 --warmup 0 --frames 1 "$@" \
+  if "$BIN" budget --view study --device llvmpipe --profile nvidia-h100 --warmup 0 --frames 1 "$@" \
       --out "$tmp" > "$tmp/log.txt" 2>&1; then
     cp "$tmp"/frames/*.json "$target"
     echo "ok: $dir/$name"
@@ -105,7 +105,7 @@ porting() {
       ls "$D/porting/${name}_"*.json > /dev/null 2>&1 && continue
       local tmp
       tmp=$(mktemp -d)
-      if "$BIN" budget --device llvmpipe --profile xbox360 --compare-methods --warmup 0 --frames 1 \
+      if "$BIN" budget --view study --device llvmpipe --profile xbox360 --compare-methods --warmup 0 --frames 1 \
           --scene "$ASSET" --width 1280 --height 720 --heads "$h" --shot "$shot" \
           --out "$tmp" > "$tmp/log.txt" 2>&1; then
         for f in "$tmp"/frames/*.json; do cp "$f" "$D/porting/${name}_$(basename "$f")"; done
@@ -124,7 +124,7 @@ porting() {
       [ -e "$target" ] && continue
       local tmp
       tmp=$(mktemp -d)
-      if "$BIN" budget --device llvmpipe --profile xbox360 --warmup 0 --frames 1 --scene "$ASSET" \
+      if "$BIN" budget --view study --device llvmpipe --profile xbox360 --warmup 0 --frames 1 --scene "$ASSET" \
           --width 1280 --height 720 --heads "$h" --shot "$shot" --samples 9 --no-follow-surface \
           --out "$tmp" > "$tmp/log.txt" 2>&1; then
         cp "$tmp/frames/separable.json" "$target"

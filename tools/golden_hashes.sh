@@ -18,7 +18,9 @@ B=${B:-target/release/dermis}
 HEAD=${HEAD:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-common=(--device llvmpipe --validate --width 256 --height 144)
+# The study view (RenderSettings::study() at the mid shot): the default view
+# before issue 15 made the default a portrait, so the hashes keep meaning one view.
+common=(--device llvmpipe --validate --width 256 --height 144 --view study)
 configs=(
   "none|--method none"
   "separable 9|--method separable --samples 9"
@@ -62,7 +64,7 @@ PY
   # allowed to move) are dropped; every modelled figure, count and resolve is kept.
   d=$tmp/budget
   rm -rf "$d"
-  "$B" budget --device llvmpipe --validate --width 256 --height 144 "${sargs[@]}" \
+  "$B" budget "${common[@]}" "${sargs[@]}" \
     --profile xbox360,nvidia-h200 --compare-methods --warmup 0 --frames 1 --out "$d" >/dev/null
   python3 - "$d" "$scene" >> "$out" <<'PY'
 import json, sys, pathlib, hashlib

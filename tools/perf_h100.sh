@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every device-machine measurement of docs/perf/ and docs/accuracy.md.
 #
-#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval
+#   bash tools/perf_h100.sh [PART...]      PART: smoke issue2 issue3-720 issue3-1080 frame-ab nofollow images dolly eval
 #                                          (default: all, in that order)
 #
 # Run it on the device machine from the repository root with these carried (see
@@ -28,6 +28,7 @@ P=$STORE/perf
 B=${B:-.bin/dermis}
 A=.assets/lee-perry-smith/LeePerrySmith.glb
 mkdir -p "$P" "$OUT"
+. "$(dirname "$0")/methods.sh"
 DRY=${DRY:-0}
 if [ "$DRY" = 1 ]; then
   EXTRA=(--device llvmpipe --warmup 1 --frames 2)
@@ -61,7 +62,13 @@ run() {
   echo "=== $name: dermis $*" >> "$P/log.txt"
   # Nothing may outlive the call: the last run is cut at START + DEADLINE + 50 s.
   local left=$((DEADLINE + 50 - (SECONDS - START)))
-  if timeout $((left < 300 ? left : 300)) "$B" "$@" >> "$P/log.txt" 2>&1; then
+  # The recorded runs were made at the view now called study (the default became
+  # the portrait in issue 15): the commands that take a view keep it.
+  local sub=$1
+  shift
+  local view=()
+  case $sub in render | bench | eval | budget | reference) view=(--view study) ;; esac
+  if timeout $((left < 300 ? left : 300)) "$B" "$sub" "${view[@]}" "$@" >> "$P/log.txt" 2>&1; then
     echo "    ok in $((SECONDS - t0)) s" >> "$P/commands.txt"
   else
     echo "    FAILED (rc $?) after $((SECONDS - t0)) s" >> "$P/commands.txt"
@@ -72,13 +79,13 @@ smoke() {
   { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader || true; "$B" devices; } > "$P/gpu.txt" 2>&1
   # The same renderer under the Khronos validation layer (synchronization
   # validation on; any message is an error) on a real GPU: the default scene
-  # with every method, and the head with the reference.
+  # with every method of the registry, and the head with ssg.
   if [ "$DRY" != 1 ] && ls .vvl/*.deb > /dev/null 2>&1; then
     mkdir -p /tmp/vvl && for f in .vvl/*.deb; do dpkg -x "$f" /tmp/vvl; done
     export VK_LAYER_PATH=/tmp/vvl/usr/share/vulkan/explicit_layer.d
     export LD_LIBRARY_PATH=/tmp/vvl/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   fi
-  for m in separable ssg ss-jittered poisson reference none; do
+  for m in $(dermis_methods "$B"); do
     run "validate $m" "$P/validate/$m/report.json" render --validate "${EXTRA[@]}" --method "$m" \
       --width "$(w 1280)" --height "$(w 720)" --out "$P/validate/$m"
   done
@@ -122,22 +129,24 @@ issue3() {
     --report "$P/ssg_branch_${W}x${H}_zoom_1h.json"
 }
 
-# The same benches with the SSS passes on the whole screen (--sss-region screen):
-# what limiting the seed copies and the draws to the skin's region saves.
-screen_ab() {
+# The same benches with the SSS passes on the whole frame (--sss-region frame, once
+# spelled screen): what limiting the seed copies and the draws to the skin's region
+# saves. (The part was called screen-ab, still accepted; its reports stay in screen/,
+# where docs/perf/ recorded them.)
+frame_ab() {
   for res in "1280 720" "1920 1080"; do
     set -- $res
     for d in zoom:1.037 near:1.852 far:4.889; do
       for h in 1 3; do
         local tag="${1}x${2}_${d%%:*}_${h}h"
-        local args=(bench "${EXTRA[@]}" --scene "$A" --width "$(w "$1")" --height "$(w "$2")" --distance "${d##*:}" --heads "$h" --sss-region screen)
+        local args=(bench "${EXTRA[@]}" --scene "$A" --width "$(w "$1")" --height "$(w "$2")" --distance "${d##*:}" --heads "$h" --sss-region frame)
         run "screen ssg lod $tag" "$P/screen/ssg_lod_$tag.json" "${args[@]}" --method ssg --report "$P/screen/ssg_lod_$tag.json"
         run "screen ssg nolod $tag" "$P/screen/ssg_nolod_$tag.json" "${args[@]}" --method ssg --no-lod --report "$P/screen/ssg_nolod_$tag.json"
         run "screen separable $tag" "$P/screen/separable_$tag.json" "${args[@]}" --method separable --report "$P/screen/separable_$tag.json"
       done
     done
   done
-  run "screen sep close s17" "$P/screen/sep_1080p_close_s17.json" bench "${EXTRA[@]}" --scene "$A" --sss-region screen \
+  run "screen sep close s17" "$P/screen/sep_1080p_close_s17.json" bench "${EXTRA[@]}" --scene "$A" --sss-region frame \
     --width "$(w 1920)" --height "$(w 1080)" --shot close --samples 17 --report "$P/screen/sep_1080p_close_s17.json"
 }
 
@@ -172,7 +181,8 @@ images() {
     local -n args=$case
     run "img $case reference" "$I/$case/reference/frame.png" render "${EXTRA[@]}" "${args[@]}" --width $W --height $H --method reference --out "$I/$case/reference"
   done
-  for m in none separable ssg ss-jittered poisson; do
+  # Every method but the ground truth (rendered above) beside it.
+  for m in $(dermis_methods "$B" 'not m["ground_truth"]'); do
     run "img head $m" "$I/head/$m/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --method "$m" --out "$I/head/$m"
   done
   run "img head separable nofollow" "$I/head/separable-nofollow/frame.png" render "${EXTRA[@]}" "${head[@]}" --width $W --height $H --no-follow-surface --out "$I/head/separable-nofollow"
@@ -213,20 +223,20 @@ eval_chart() {
 }
 
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly eval)
+[ ${#parts[@]} -eq 0 ] && parts=(smoke issue2 issue3-720 issue3-1080 frame-ab nofollow images dolly eval)
 for part in "${parts[@]}"; do
   case $part in
     smoke) smoke ;;
     issue2) issue2 ;;
     issue3-720) issue3 1280 720 ;;
     issue3-1080) issue3 1920 1080 ;;
-    screen-ab) screen_ab ;;
+    frame-ab | screen-ab) frame_ab ;;
     nofollow) nofollow ;;
     images) images ;;
     dolly) dolly ;;
     recheck) recheck ;;
     eval) eval_chart ;;
-    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 screen-ab nofollow images dolly recheck eval)" >&2; exit 2 ;;
+    *) echo "unknown part '$part' (valid: smoke issue2 issue3-720 issue3-1080 frame-ab nofollow images dolly recheck eval)" >&2; exit 2 ;;
   esac
 done
 echo "done in $((SECONDS - START)) s" >> "$P/commands.txt"

@@ -2,8 +2,8 @@
 # The H200 measurements of docs/perf/h200/ (issues 9, 10 and 12), by part:
 #
 #   bash tools/perf_h200.sh PART...
-#     smoke    GPU facts; every method (tsd and tsd-opt too) under the validation layer
-#     card     the card and uniform-light tests (tests/accuracy_gpu.rs) on the GPU
+#     smoke    GPU facts; every method of the registry under the validation layer
+#     card     the card and uniform-light tests (tests/suite/accuracy.rs) on the GPU
 #     eval     the cost/error chart: thesis scene set, 1280x720 (tools/perf_h100.sh eval)
 #     dolly    the error along a camera dolly, 1280x720 (tools/perf_h100.sh dolly)
 #     matrix   the bench matrix the budget calibration pairs (tools/bench_matrix.sh)
@@ -12,8 +12,9 @@
 # Run on the device machine from the repository root with carried:
 #   .gl      Vulkan loader debs, unpacked into /  (see docs/perf/README.md)
 #   .vvl     the vulkan-validationlayers deb (smoke, card)
-#   .bin     dermis (strip -o .bin/dermis target/release/dermis), accuracy_gpu (the
-#            release test binary of tests/accuracy_gpu.rs) and DejaVuSans.ttf for the charts
+#   .bin     dermis (strip -o .bin/dermis target/release/dermis), suite (the release
+#            test binary of tests/suite/, `cargo test --release --test suite --no-run`
+#            names it) and DejaVuSans.ttf for the charts
 #   .assets  a copy of ../shared/assets
 # Each part skips runs whose output exists and starts none after DEADLINE seconds
 # (default 540) from the script's start, so a call stays inside the device's
@@ -25,6 +26,7 @@ OUT=${OUT:-out}
 STORE=${STORE:-/tmp/dermis-h200}
 B=.bin/dermis
 mkdir -p "$STORE" "$OUT"
+. "$(dirname "$0")/methods.sh"
 for f in .gl/*.deb; do dpkg -x "$f" /; done
 ldconfig
 [ -f .bin/DejaVuSans.ttf ] && export DERMIS_FONT=$PWD/.bin/DejaVuSans.ttf
@@ -46,10 +48,10 @@ for part in "$@"; do
       { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader || true; "$B" devices; } > "$STORE/gpu.txt" 2>&1
       validation_layer
       mkdir -p "$STORE/validate"
-      for m in separable ssg ss-jittered poisson reference none tsd tsd-opt; do
+      for m in $(dermis_methods "$B"); do
         [ -e "$STORE/validate/$m/report.json" ] && continue
         echo "+ dermis render --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method $m --width 1280 --height 720" >> "$STORE/validate/commands.txt"
-        if "$B" render --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method "$m" \
+        if "$B" render --view study --validate --scene .assets/lee-perry-smith/LeePerrySmith.glb --method "$m" \
           --width 1280 --height 720 --out "$STORE/validate/$m" >> "$STORE/validate/log.txt" 2>&1; then
           echo "    ok" >> "$STORE/validate/commands.txt"
         else
@@ -60,8 +62,8 @@ for part in "$@"; do
       unset VK_LAYER_PATH ;;
     card)
       validation_layer
-      DERMIS_TEST_DEVICE=nvidia DERMIS_ASSETS=$PWD/.assets timeout "$(left)" .bin/accuracy_gpu \
-        --nocapture --test-threads 1 > "$STORE/card.txt" 2>&1
+      DERMIS_TEST_DEVICE=nvidia DERMIS_ASSETS=$PWD/.assets timeout "$(left)" .bin/suite \
+        accuracy:: --nocapture --test-threads 1 > "$STORE/card.txt" 2>&1
       echo "rc $?" >> "$STORE/card.txt"
       unset VK_LAYER_PATH ;;
     eval | dolly)

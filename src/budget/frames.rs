@@ -1,5 +1,5 @@
 //! Frames to price besides a live run's: the stored frames of
-//! `docs/budget/frames/` (dermis's frames of the published scenes and of the
+//! `profiles/frames/` (dermis's frames of the published scenes and of the
 //! benchmark configurations, rendered on lavapipe by `tools/budget_frames.sh`),
 //! the pairing of a benchmark report with the stored frame of its
 //! configuration, the transformations that turn a dermis frame into the
@@ -20,9 +20,9 @@ use crate::graph::work::{
 };
 use crate::report::Report;
 
-/// `docs/budget/frames/` beside Cargo.toml.
+/// `profiles/frames/` beside Cargo.toml.
 pub fn frames_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/budget/frames")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/frames")
 }
 
 /// `docs/perf/` beside Cargo.toml.
@@ -30,11 +30,89 @@ pub fn perf_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/perf")
 }
 
-/// A stored frame (a `frames/METHOD.json` of `dermis budget`).
+/// A stored frame (a `frames/METHOD.json` of `dermis budget`), read through
+/// the one door (`files`) and checked ([`check_frame`]).
 pub fn load_frame(path: &Path) -> Result<FrameInput> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+    let text = crate::files::read_text(path, "stored frame", crate::files::MAX_TEXT_FILE)?;
+    let f: FrameInput =
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    check_frame(&f).with_context(|| format!("stored frame {}", path.display()))?;
+    Ok(f)
+}
+
+/// The ranges `render` holds a frame to, for a frame whoever wrote it: sizes
+/// (the frame's, each render area's and image's) within 1..=`MAX_IMAGE_SIDE`,
+/// 1..=64 samples a pixel (Vulkan's largest sample count), per-invocation
+/// figures (fetches, ALU, storage bytes) and measured times finite and not
+/// negative, and no raster pass with more fragments, samples or rasterised
+/// pixels than its triangles can cover (each covers at most its render area).
+pub fn check_frame(f: &FrameInput) -> Result<()> {
+    let max = crate::render::settings::MAX_IMAGE_SIDE;
+    let side = |what: &str, v: u32| -> Result<()> {
+        if !(1..=max).contains(&v) {
+            bail!("{what} must be within 1..={max} pixels (as render's --width/--height), got {v}");
+        }
+        Ok(())
+    };
+    let amount = |what: &str, v: f64| -> Result<()> {
+        if !(v.is_finite() && v >= 0.0) {
+            bail!("{what} must be a finite number, not negative, got {v}");
+        }
+        Ok(())
+    };
+    side("width", f.width)?;
+    side("height", f.height)?;
+    for (i, p) in f.passes.iter().enumerate() {
+        let at = |what: &str| format!("pass {i} ('{}'): {what}", p.name);
+        if let Some(ms) = p.measured_ms {
+            amount(&at("measured_ms"), ms)?;
+        }
+        for im in &p.images {
+            side(&at(&format!("image '{}' width", im.image)), im.width)?;
+            side(&at(&format!("image '{}' height", im.image)), im.height)?;
+        }
+        let shader = match &p.work {
+            Work::Raster { shader, .. } => shader.as_ref(),
+            Work::Compute { shader, .. } => Some(shader),
+            _ => None,
+        };
+        if let Some(s) = shader {
+            amount(&at("alu"), s.alu)?;
+            amount(&at("storage_read_bytes"), s.storage_read_bytes)?;
+            amount(&at("storage_write_bytes"), s.storage_write_bytes)?;
+            for x in &s.fetches {
+                amount(&at(&format!("fetch count of '{}'", x.texture)), x.count)?;
+            }
+        }
+        if let Work::Raster {
+            width,
+            height,
+            triangles,
+            msaa,
+            ..
+        } = &p.work
+        {
+            side(&at("render area width"), *width)?;
+            side(&at("render area height"), *height)?;
+            if !(1..=64).contains(msaa) {
+                bail!("{} must be within 1..=64, got {msaa}", at("msaa"));
+            }
+            let most = (*width as u64 * *height as u64 * *msaa as u64).saturating_mul(*triangles);
+            for (what, n) in [
+                ("fragments", p.fragments),
+                ("samples_passed", p.samples_passed),
+                ("rasterized_pixels", p.rasterized_pixels.unwrap_or(0)),
+            ] {
+                if n > most {
+                    bail!(
+                        "{} is {n}, more than its {triangles} triangles can cover in {width}x{height} at {msaa} samples ({most})",
+                        at(what)
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The `.json` files of a directory, sorted (none when it does not exist).

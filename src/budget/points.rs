@@ -5,7 +5,7 @@
 //!   Fig. 6.4 (3), Table 4.4 (the SSS cost of SS Full and SS Jittered at 1/3/5
 //!   heads), seed 001 Table 5.2 (9) and Table 9.1 (MLAA, 2). Their frames are
 //!   dermis's frames of the same scenes, rendered on lavapipe and stored in
-//!   `docs/budget/frames/published/` (`tools/budget_frames.sh`), transformed
+//!   `profiles/frames/published/` (`tools/budget_frames.sh`), transformed
 //!   into the implementation each source timed (`frames`).
 //! - **Benchmark** ([`benchmark`]): every pass of every report of
 //!   `docs/perf/h100/` (priced with the stored frame of its configuration,

@@ -1,7 +1,7 @@
 //! The porting answer (docs/budget.md): dermis's frames of the Lee Perry-Smith
 //! head at 1280x720, 1/3/5 characters at the close, mid and far shots, every
 //! real-time method (stored by `tools/budget_frames.sh porting` in
-//! `docs/budget/frames/porting/`), priced on the console and handheld profiles
+//! `profiles/frames/porting/`), priced on the console and handheld profiles
 //! and summarised as Markdown tables: per configuration the frame, the skin
 //! SSS time and how much of it is eDRAM resolves, whether it fits a skin
 //! budget; per pass of one configuration the tiles, resolves and ms.
@@ -194,39 +194,4 @@ pub fn pass_table(profile: &str, f: &FrameInput) -> Result<String> {
         b.total_ms, b.sss_ms, b.sss_transfer_ms
     );
     Ok(s)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Prints docs/budget.md's tables:
-    /// `cargo test --release --lib budget::porting -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn print_porting_tables() {
-        let frames = porting_frames().unwrap();
-        assert!(
-            !frames.is_empty(),
-            "run tools/budget_frames.sh porting first"
-        );
-        println!(
-            "### xbox360\n\n{}",
-            summary_table("xbox360", &frames, 2.0).unwrap()
-        );
-        for p in ["xbox360", "switch-handheld", "switch-docked", "steam-deck"] {
-            println!(
-                "### {p} (compact)\n\n{}",
-                compact_table(p, &frames, 2.0).unwrap()
-            );
-        }
-        for (config, method, f) in &frames {
-            if config == "h1 mid" && method != "none" {
-                println!(
-                    "#### xbox360, {config}, {method}\n\n{}",
-                    pass_table("xbox360", f).unwrap()
-                );
-            }
-        }
-    }
 }

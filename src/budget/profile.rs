@@ -426,13 +426,12 @@ impl Profile {
         } else {
             profiles_dir().join(format!("{name_or_path}.toml"))
         };
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            let known = list_profiles().map(|v| v.join(", ")).unwrap_or_default();
-            anyhow!(
-                "{}: cannot read profile ({e}); profiles: {known}",
-                path.display()
-            )
-        })?;
+        let text = crate::files::read_text(&path, "profile", crate::files::MAX_TEXT_FILE).map_err(
+            |e| {
+                let known = list_profiles().map(|v| v.join(", ")).unwrap_or_default();
+                anyhow!("{e:#}; profiles: {known}")
+            },
+        )?;
         Profile::parse(&text, &path.display().to_string())
     }
 
@@ -475,8 +474,15 @@ impl Profile {
                 Quantity::Unknown => Ok(()),
             }
         };
-        if self.target.width_px == 0 || self.target.height_px == 0 {
-            bail!("field `target.width_px`/`target.height_px` must be positive");
+        // The frame sizes `render` accepts (`--width`/`--height`), whoever wrote the file.
+        let side = crate::render::settings::MAX_IMAGE_SIDE;
+        for (n, v) in [
+            ("target.width_px", self.target.width_px),
+            ("target.height_px", self.target.height_px),
+        ] {
+            if !(1..=side).contains(&v) {
+                bail!("field `{n}` must be within 1..={side} pixels (as render's --width/--height), got {v}");
+            }
         }
         pos("target.frame_ms", self.target.frame_ms)?;
         let b = &self.budget;

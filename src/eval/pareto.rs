@@ -1,5 +1,5 @@
 //! Cost/error points of every (method, setting, scene) run, their Pareto front,
-//! and CSV export.
+//! and CSV export (eval.csv's writer).
 //!
 //! Why a front: no single SSS method wins on both GPU time and accuracy; the
 //! useful answer is which settings are worth using at all (those no other
@@ -60,26 +60,22 @@ pub fn pareto_front(points: &[EvalPoint]) -> Vec<usize> {
     front
 }
 
-/// Writes the points as CSV with the header `method,setting,scene,gpu_ms,error`,
-/// creating the parent folder if needed.
+/// Writes a header and rows of fields as CSV, creating the parent folder if
+/// needed.
 ///
-/// Text fields holding a comma, a double quote or a line break are quoted
+/// Fields holding a comma, a double quote or a line break are quoted
 /// (RFC 4180, quotes doubled), so settings such as `strength=0.48,0.41,0.28`
-/// survive a spreadsheet. Numbers use Rust's shortest round-trip form, so
-/// reading the file back gives the same f64s.
-pub fn write_csv(path: &Path, points: &[EvalPoint]) -> Result<()> {
-    let mut out = String::from("method,setting,scene,gpu_ms,error\n");
-    for p in points {
+/// survive a spreadsheet. Callers format numbers with Rust's shortest
+/// round-trip form (`to_string`), so reading the file back gives the same f64s.
+pub fn write_table<H: AsRef<str>>(path: &Path, header: &[H], rows: &[Vec<String>]) -> Result<()> {
+    let line = |fields: &mut dyn Iterator<Item = &str>| {
+        fields.map(csv_field).collect::<Vec<_>>().join(",")
+    };
+    let mut out = line(&mut header.iter().map(|h| h.as_ref()));
+    out.push('\n');
+    for r in rows {
         // Writing to a String cannot fail.
-        let _ = writeln!(
-            out,
-            "{},{},{},{},{}",
-            csv_field(&p.method),
-            csv_field(&p.setting),
-            csv_field(&p.scene),
-            p.gpu_ms,
-            p.error
-        );
+        let _ = writeln!(out, "{}", line(&mut r.iter().map(String::as_str)));
     }
     crate::output::write_bytes(path, out.as_bytes())
 }
@@ -133,7 +129,7 @@ mod tests {
         assert_eq!(pareto_front(&[pt("only", 1.0, 1.0)]), vec![0]);
     }
 
-    /// Minimal RFC 4180 reader, enough to check what `write_csv` wrote.
+    /// Minimal RFC 4180 reader, enough to check what `write_table` wrote.
     fn parse_csv(text: &str) -> Vec<Vec<String>> {
         let mut rows = Vec::new();
         let (mut row, mut field) = (Vec::new(), String::new());
@@ -169,7 +165,25 @@ mod tests {
         ];
         points[0].setting = "strength=0.48,0.41,0.28".into();
         points[1].scene = "lps \"close\"".into();
-        write_csv(&path, &points).unwrap();
+        let fields: Vec<Vec<String>> = points
+            .iter()
+            .map(|p| {
+                let n = [p.gpu_ms, p.error].map(|v| v.to_string());
+                vec![
+                    p.method.clone(),
+                    p.setting.clone(),
+                    p.scene.clone(),
+                    n[0].clone(),
+                    n[1].clone(),
+                ]
+            })
+            .collect();
+        write_table(
+            &path,
+            &["method", "setting", "scene", "gpu_ms", "error"],
+            &fields,
+        )
+        .unwrap();
         let rows = parse_csv(&std::fs::read_to_string(&path).unwrap());
         assert_eq!(rows[0], ["method", "setting", "scene", "gpu_ms", "error"]);
         assert_eq!(rows.len(), 3);
@@ -191,7 +205,7 @@ mod tests {
         // A path whose "parent" is a regular file cannot be created.
         let file = dir.join("file");
         std::fs::write(&file, "x").unwrap();
-        let err = write_csv(&file.join("points.csv"), &[pt("a", 1.0, 1.0)]).unwrap_err();
+        let err = write_table(&file.join("points.csv"), &["a"], &[]).unwrap_err();
         assert!(format!("{err:#}").contains("file"), "{err:#}");
         std::fs::remove_dir_all(&dir).unwrap();
     }

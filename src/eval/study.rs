@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::bands::{bands, Band, BandErrors, BandInput};
 use super::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
 use super::{chart, pareto, sweep};
+use crate::method::lookup;
 use crate::output::{read_exr, write_json, write_rgba8_png};
 use crate::render::RenderSettings;
 use crate::vk::context::Context;
@@ -41,17 +42,6 @@ pub fn scene_set(
     })
 }
 
-/// The curves of the dolly chart: one method at its default setting each.
-const DOLLY_LINES: [(&str, &str); 7] = [
-    ("none", "-"),
-    ("separable", "17 samples"),
-    ("separable", "physical, 17 samples"),
-    ("ssg", "6 Gaussians, LOD"),
-    ("ssg", "6 Gaussians, no LOD"),
-    ("ss-jittered", "13 taps"),
-    ("poisson", "8-32 taps"),
-];
-
 /// What `eval` wrote.
 pub struct EvalOutcome {
     pub summary: Vec<sweep::SummaryRow>,
@@ -70,9 +60,8 @@ pub fn eval(
 ) -> Result<EvalOutcome> {
     let rows = sweep::sweep(ctx, specs, &sweep::registry(), opts)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let points: Vec<pareto::EvalPoint> = rows.iter().map(|r| r.point.clone()).collect();
     let mut files = vec![out.join("eval.csv"), out.join("eval.json")];
-    pareto::write_csv(&files[0], &points)?;
+    sweep::write_csv(&files[0], &rows)?;
     let summary = sweep::summarise(&rows);
     // The ranking is made on the interior: the bands are shown beside it.
     let interior: Vec<pareto::EvalPoint> =
@@ -119,7 +108,9 @@ pub fn eval(
         let mut series: Vec<chart::Series> = Vec::new();
         for r in &rows {
             let p = &r.point;
-            if !DOLLY_LINES.contains(&(p.method.as_str(), p.setting.as_str())) {
+            // The registry names the lines (`MethodEntry::dolly`).
+            let drawn = lookup(&p.method).is_ok_and(|m| m.dolly.contains(&p.setting.as_str()));
+            if !drawn {
                 continue;
             }
             let Some(spec) = specs.iter().find(|s| s.name == p.scene) else {
@@ -176,10 +167,9 @@ impl Output {
     fn read(d: &Path) -> Result<Self> {
         let (width, height, diffuse) = read_exr(&d.join("diffuse.exr"))?;
         let p = d.join("frame.png");
-        let frame = image::open(&p)
-            .with_context(|| format!("reading {}", p.display()))?
-            .to_rgba8()
-            .into_raw();
+        // Its sides within the range `render` accepts for a frame's width and height.
+        let frame_bound = crate::files::ImageBound::rgba8(crate::render::settings::MAX_IMAGE_SIDE);
+        let frame = crate::files::read_rgba8(&p, "frame", &frame_bound)?.into_raw();
         Ok(Output {
             width,
             height,

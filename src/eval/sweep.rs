@@ -101,7 +101,7 @@ pub fn dolly_scenes(head: PathBuf) -> Vec<SceneSpec> {
 
 /// The embedded scene at its default view.
 pub fn procedural_scene() -> SceneSpec {
-    let d = RenderSettings::default();
+    let d = RenderSettings::study();
     SceneSpec {
         name: "procedural".into(),
         gltf: None,
@@ -122,6 +122,78 @@ pub struct EvalRow {
     pub rel_rmse_all_skin: f64,
     /// err/none, gain, FLIP and relative RMSE per band.
     pub bands: BandErrors,
+}
+
+impl EvalRow {
+    /// eval.csv's header: every field eval.json writes for a row, the bands
+    /// flattened (`interior_err_none`, `interior_gain_r`...). The first five are
+    /// the columns eval.csv had before the bands joined it.
+    pub fn csv_header() -> Vec<String> {
+        let mut h: Vec<String> = [
+            "method",
+            "setting",
+            "scene",
+            "gpu_ms",
+            "error",
+            "skin_pixels",
+            "frame_ms",
+            "rel_rmse_all_skin",
+        ]
+        .map(String::from)
+        .to_vec();
+        for band in Band::ALL {
+            let b = band_key(band);
+            for f in [
+                "pixels", "rel_rmse", "err_none", "gain_r", "gain_g", "gain_b", "flip",
+            ] {
+                h.push(format!("{b}_{f}"));
+            }
+        }
+        h
+    }
+
+    /// The row's fields in [`EvalRow::csv_header`]'s order; numbers in Rust's
+    /// shortest round-trip form, an absent value (no no-SSS frame) empty.
+    pub fn csv_fields(&self) -> Vec<String> {
+        let p = &self.point;
+        let mut f = vec![
+            p.method.clone(),
+            p.setting.clone(),
+            p.scene.clone(),
+            p.gpu_ms.to_string(),
+            p.error.to_string(),
+            self.skin_pixels.to_string(),
+            self.frame_ms.to_string(),
+            self.rel_rmse_all_skin.to_string(),
+        ];
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+        for band in Band::ALL {
+            let e = self.bands.get(band);
+            f.push(e.pixels.to_string());
+            f.push(e.rel_rmse.to_string());
+            f.push(opt(e.err_none));
+            for c in 0..3 {
+                f.push(opt(e.gain.map(|g| g[c])));
+            }
+            f.push(e.flip.to_string());
+        }
+        f
+    }
+}
+
+/// A band's key in eval.json (and its prefix in eval.csv).
+fn band_key(band: Band) -> &'static str {
+    match band {
+        Band::Interior => "interior",
+        Band::Silhouette => "silhouette",
+        Band::DepthStep => "depth_step",
+    }
+}
+
+/// Writes eval.csv: one line per row, every column of eval.json's rows.
+pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
+    let fields: Vec<Vec<String>> = rows.iter().map(EvalRow::csv_fields).collect();
+    super::pareto::write_table(path, &EvalRow::csv_header(), &fields)
 }
 
 pub struct EvalOptions {
@@ -400,7 +472,92 @@ pub fn summarise(rows: &[EvalRow]) -> Vec<SummaryRow> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::bands::BandError;
     use super::*;
+
+    /// The leaf keys of a JSON value, nested keys joined by `_` and array
+    /// elements named r, g, b (a gain); the bands' columns go by their keys
+    /// under `bands` (`bands.interior.flip` is `interior_flip`).
+    fn leaves(v: &serde_json::Value, at: &str, out: &mut Vec<String>) {
+        let join = |k: &str| {
+            if at.is_empty() || at == "bands" {
+                k.to_string()
+            } else {
+                format!("{at}_{k}")
+            }
+        };
+        match v {
+            serde_json::Value::Object(m) => {
+                for (k, x) in m {
+                    leaves(x, &join(k), out);
+                }
+            }
+            serde_json::Value::Array(a) => {
+                for (x, c) in a.iter().zip(["r", "g", "b"]) {
+                    leaves(x, &join(c), out);
+                }
+            }
+            _ => out.push(at.to_string()),
+        }
+    }
+
+    // eval.csv carries every column eval.json writes for a row, and a value
+    // that eval.json leaves null is an empty field.
+    #[test]
+    fn eval_csv_has_every_column_of_eval_json() {
+        let band = |x: f64| BandError {
+            pixels: 10,
+            rel_rmse: x,
+            err_none: Some(x / 2.0),
+            gain: Some([x, x * 2.0, x * 3.0]),
+            flip: 0.25,
+        };
+        let mut row = EvalRow {
+            point: EvalPoint {
+                method: "separable".into(),
+                setting: "strength=1,2,3".into(),
+                scene: "procedural".into(),
+                gpu_ms: 0.125,
+                error: 0.3,
+            },
+            skin_pixels: 1234,
+            frame_ms: 2.5,
+            rel_rmse_all_skin: 0.1,
+            bands: BandErrors {
+                interior: band(0.1),
+                silhouette: band(0.2),
+                depth_step: band(0.4),
+            },
+        };
+        let mut json_keys = Vec::new();
+        leaves(&serde_json::to_value(&row).unwrap(), "", &mut json_keys);
+        let mut header = EvalRow::csv_header();
+        assert_eq!(header.len(), json_keys.len(), "{header:?} vs {json_keys:?}");
+        json_keys.sort();
+        header.sort();
+        assert_eq!(header, json_keys);
+        // Each field holds its own value, at its header's place.
+        let fields = row.csv_fields();
+        let header = EvalRow::csv_header();
+        let at = |k: &str| &fields[header.iter().position(|h| h == k).unwrap()];
+        assert_eq!(at("depth_step_gain_b"), &(0.4f64 * 3.0).to_string());
+        assert_eq!(at("silhouette_err_none"), "0.1");
+        assert_eq!(at("skin_pixels"), "1234");
+        row.bands.interior.err_none = None;
+        row.bands.interior.gain = None;
+        let fields = row.csv_fields();
+        assert_eq!(
+            fields[header
+                .iter()
+                .position(|h| h == "interior_err_none")
+                .unwrap()],
+            ""
+        );
+        assert_eq!(
+            fields[header.iter().position(|h| h == "interior_gain_g").unwrap()],
+            ""
+        );
+    }
 
     #[test]
     fn registry_covers_every_method_but_the_ground_truth() {
@@ -419,7 +576,7 @@ mod tests {
                 .iter()
                 .find(|c| c.setting.label == format!("{n} samples"))
                 .unwrap();
-            let s = RenderSettings::default().with(c.method, c.setting.options);
+            let s = RenderSettings::study().with(c.method, c.setting.options);
             assert_eq!(s.method.opts(&s.options).raw("samples"), n);
         }
     }

@@ -36,6 +36,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         options: &[],
     }],
     ground_truth: false,
+    dolly: &["13 taps"],
     needs: |_, _| Needs::PLAIN,
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Jittered::new(s)?)),

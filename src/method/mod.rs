@@ -6,8 +6,9 @@
 //! [`METHODS`], and its test. The frame (`render`) knows nothing of any method:
 //! it declares the targets the method says it [`Needs`], builds it from one
 //! [`MethodSetup`], records the passes it returns and composites whatever image
-//! it names as its output. The CLI, `eval`, the bench matrix and the tests
-//! iterate [`METHODS`].
+//! it names as its output. The CLI, `eval` (its sweep and the dolly chart's
+//! lines), the bench matrix and the tests iterate [`METHODS`]; the scripts in
+//! `tools/` read it through `dermis methods --json` ([`listing`]).
 
 pub mod jittered;
 pub mod none;
@@ -225,6 +226,9 @@ pub struct MethodEntry {
     pub eval: &'static [EvalSetting],
     /// The ground truth the others are scored against.
     pub ground_truth: bool,
+    /// Labels of the `eval` settings drawn as lines of the dolly chart (error
+    /// against camera distance); each names one of `eval`.
+    pub dolly: &'static [&'static str],
     pub needs: fn(&Opts, vk::Extent2D) -> Needs,
     /// Parses and checks the options before any device opens.
     pub check: fn(&Opts) -> Result<()>,
@@ -269,6 +273,114 @@ pub static METHODS: &[&MethodEntry] = &[
     &reference::ENTRY,
     &none::ENTRY,
 ];
+
+/// One method as `dermis methods` lists it: the registry row as data (what the
+/// scripts in `tools/` read with `--json` instead of naming methods themselves).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MethodListing {
+    pub name: &'static str,
+    pub aliases: &'static [&'static str],
+    pub summary: &'static str,
+    pub ground_truth: bool,
+    /// The frame's default method (`--method` left out).
+    pub default: bool,
+    pub options: Vec<OptionListing>,
+    /// The settings `eval` sweeps, by label.
+    pub eval: Vec<EvalListing>,
+    /// Labels of the settings drawn on the dolly chart.
+    pub dolly: &'static [&'static str],
+}
+
+/// One option of a method as listed: the flag as typed and its default.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct OptionListing {
+    pub key: &'static str,
+    /// The long flag without its dashes (`no-KEY` for a switch that turns KEY off).
+    pub flag: String,
+    /// `value` (the flag takes one) or `switch` (the flag alone sets KEY false).
+    pub kind: &'static str,
+    pub default: &'static str,
+    pub help: &'static str,
+}
+
+/// One `eval` setting as listed.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EvalListing {
+    pub label: &'static str,
+    pub options: Vec<(&'static str, &'static str)>,
+}
+
+/// The registry as `dermis methods` prints it, in [`METHODS`]' order.
+pub fn listing() -> Vec<MethodListing> {
+    METHODS
+        .iter()
+        .map(|m| MethodListing {
+            name: m.name,
+            aliases: m.aliases,
+            summary: m.summary,
+            ground_truth: m.ground_truth,
+            default: *m == default_method(),
+            options: m
+                .options
+                .iter()
+                .map(|o| OptionListing {
+                    key: o.key,
+                    flag: o.flag(),
+                    kind: match o.kind {
+                        OptKind::Value => "value",
+                        OptKind::NoFlag => "switch",
+                    },
+                    default: o.default,
+                    help: o.help,
+                })
+                .collect(),
+            eval: m
+                .eval
+                .iter()
+                .map(|e| EvalListing {
+                    label: e.label,
+                    options: e.options.to_vec(),
+                })
+                .collect(),
+            dolly: m.dolly,
+        })
+        .collect()
+}
+
+/// The registry as text: one paragraph a method (name, aliases, summary, then
+/// each option's flag, default and help).
+pub fn listing_text() -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    for m in listing() {
+        let mut tags = Vec::new();
+        if !m.aliases.is_empty() {
+            tags.push(format!("alias {}", m.aliases.join(", ")));
+        }
+        if m.default {
+            tags.push("default".to_string());
+        }
+        if m.ground_truth {
+            tags.push("ground truth".to_string());
+        }
+        let tags = if tags.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", tags.join("; "))
+        };
+        let _ = writeln!(s, "{}{tags}: {}", m.name, m.summary);
+        for o in &m.options {
+            // A switch turns on by default what its `--no-` flag turns off.
+            let (flag, default) = match o.kind {
+                "value" => (format!("--{} VALUE", o.flag), o.default),
+                _ => (format!("--{}", o.flag), "on"),
+            };
+            let default = if default.is_empty() { "-" } else { default };
+            let _ = writeln!(s, "    {flag:<28} default {default:<8} {}", o.help);
+        }
+    }
+    s
+}
 
 /// The default method.
 pub fn default_method() -> &'static MethodEntry {
@@ -398,6 +510,42 @@ mod tests {
                 let given = MethodOptions::default().with(s.options);
                 (m.check)(&m.opts(&given))
                     .unwrap_or_else(|e| panic!("{} '{}': {e:#}", m.name, s.label));
+            }
+        }
+    }
+
+    // The dolly chart's lines are eval settings of their method, and the
+    // listing carries every registry row, option and setting.
+    #[test]
+    fn dolly_lines_are_eval_settings_and_the_listing_is_the_registry() {
+        for m in METHODS {
+            for d in m.dolly {
+                assert!(
+                    m.eval.iter().any(|e| e.label == *d),
+                    "{}: dolly line '{d}' is not one of its eval settings",
+                    m.name
+                );
+            }
+        }
+        let l = listing();
+        assert_eq!(l.len(), METHODS.len());
+        for (row, m) in l.iter().zip(METHODS) {
+            assert_eq!(row.name, m.name);
+            assert_eq!(row.options.len(), m.options.len());
+            assert_eq!(row.eval.len(), m.eval.len());
+            assert_eq!(row.default, row.name == default_method().name);
+        }
+        assert_eq!(l.iter().filter(|r| r.default).count(), 1);
+        let json = serde_json::to_value(&l).unwrap();
+        assert_eq!(
+            json[0]["options"][0]["default"],
+            METHODS[0].options[0].default
+        );
+        let text = listing_text();
+        for m in METHODS {
+            assert!(text.contains(m.name), "{text}");
+            for o in m.options {
+                assert!(text.contains(&format!("--{}", o.flag())), "{text}");
             }
         }
     }

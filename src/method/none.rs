@@ -20,6 +20,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         options: &[],
     }],
     ground_truth: false,
+    dolly: &["-"],
     needs: |_, _| Needs::PLAIN,
     check: |_| Ok(()),
     build: |s: &mut MethodSetup| {

@@ -45,6 +45,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         options: &[],
     }],
     ground_truth: false,
+    dolly: &["8-32 taps"],
     needs: |_, extent| Needs {
         normals: true,
         mip_levels: levels_for(extent),

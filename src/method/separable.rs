@@ -93,6 +93,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         },
     ],
     ground_truth: false,
+    dolly: &["17 samples", "physical, 17 samples"],
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Separable::new(s)?)),

@@ -75,6 +75,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         },
     ],
     ground_truth: false,
+    dolly: &["6 Gaussians, LOD", "6 Gaussians, no LOD"],
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Ssg::new(s)?)),

@@ -9,8 +9,9 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use serde_json::Value;
-use std::io::Read;
 use std::path::{Path, PathBuf};
+
+use crate::files::{self, MAX_IMAGE_FILE, MAX_SCENE_FILE};
 
 /// Extensions a file may list in `extensionsRequired` and still load. Quantized
 /// geometry is read like any other accessor; the specular texture is what the skin
@@ -22,10 +23,6 @@ pub const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_materials_specular",
     "KHR_texture_transform",
 ];
-
-/// External images larger than this are refused before reading (a skin texture is a
-/// few tens of MB at most; the decoder has its own allocation limit besides).
-const MAX_IMAGE_FILE: u64 = 1 << 30;
 
 /// The parsed file: document, the bytes of each buffer (exactly its declared
 /// byteLength), the raw JSON (for extensions the `gltf` crate is not built to expose),
@@ -54,13 +51,7 @@ pub fn short(s: &str) -> String {
 /// Opens a scene file: reads it (a regular file only), splits a GLB, checks required
 /// extensions, validates the JSON and loads every buffer.
 pub fn open(path: &Path) -> Result<Source> {
-    let meta =
-        std::fs::metadata(path).map_err(|_| anyhow!("scene file not found: {}", path.display()))?;
-    if !meta.is_file() {
-        bail!("scene file is not a regular file: {}", path.display());
-    }
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    let bytes = files::read_bounded(path, "scene file", MAX_SCENE_FILE)?;
     let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
         let (json, bin) = split_glb(&bytes)
             .map_err(|e| anyhow!("not a valid glTF file: {}: {e:#}", path.display()))?;
@@ -318,45 +309,12 @@ pub fn read_uri(dir: &Path, uri: &str, expected: Option<usize>, what: &str) -> R
     }
     let rel = percent_decode(uri).with_context(|| format!("{what}: URI '{}'", short(uri)))?;
     let path = dir.join(rel);
-    // Metadata first, without opening: opening a FIFO would block until a writer comes.
-    let meta = std::fs::metadata(&path)
-        .map_err(|e| anyhow!("{what}: cannot read {}: {e}", path.display()))?;
-    if !meta.is_file() {
-        bail!("{what}: {} is not a regular file", path.display());
-    }
-    let n = match expected {
-        Some(len) => {
-            if meta.len() < len as u64 {
-                bail!(
-                    "{what} declares {len} bytes but {} has only {}",
-                    path.display(),
-                    meta.len()
-                );
-            }
-            len as u64
-        }
-        None if meta.len() > MAX_IMAGE_FILE => {
-            bail!(
-                "{what}: {} is {} bytes, more than the {MAX_IMAGE_FILE} an image may have",
-                path.display(),
-                meta.len()
-            );
-        }
-        None => meta.len(),
+    // Through the one door (`files`): a regular file only, read as far as the
+    // declared length (a buffer) or its own size within the image bound.
+    let data = match expected {
+        Some(len) => files::read_prefix(&path, what, len as u64, MAX_SCENE_FILE)?,
+        None => files::read_bounded(&path, what, MAX_IMAGE_FILE)?,
     };
-    let file = std::fs::File::open(&path)
-        .map_err(|e| anyhow!("{what}: cannot open {}: {e}", path.display()))?;
-    let mut data = Vec::with_capacity(n as usize);
-    file.take(n)
-        .read_to_end(&mut data)
-        .map_err(|e| anyhow!("{what}: cannot read {}: {e}", path.display()))?;
-    if (data.len() as u64) < n {
-        bail!(
-            "{what}: {} ended after {} of {n} bytes",
-            path.display(),
-            data.len()
-        );
-    }
     Ok(data)
 }
 
@@ -502,26 +460,15 @@ mod tests {
 
     #[test]
     fn glb_chunks_are_bounds_checked() {
-        let glb = |json: &[u8], bin: Option<&[u8]>, declared: Option<u32>| -> Vec<u8> {
-            let mut v = b"glTF".to_vec();
-            v.extend(2u32.to_le_bytes());
-            v.extend(0u32.to_le_bytes());
-            v.extend((json.len() as u32).to_le_bytes());
-            v.extend(b"JSON");
-            v.extend(json);
-            if let Some(bin) = bin {
-                v.extend(declared.unwrap_or(bin.len() as u32).to_le_bytes());
-                v.extend(b"BIN\0");
-                v.extend(bin);
-            }
-            let n = v.len() as u32;
-            v[8..12].copy_from_slice(&n.to_le_bytes());
-            v
-        };
-        let ok = glb(b"{}", Some(&[1, 2, 3, 4]), None);
+        // The shared fixture's GLB writer (it pads the JSON chunk to 4 bytes).
+        use super::super::gltf_load::fixture::glb_bytes;
+        let ok = glb_bytes(&serde_json::json!({}), Some(&[1, 2, 3, 4]));
         let (j, b) = split_glb(&ok).unwrap();
-        assert_eq!((j, b), (&b"{}"[..], Some(&[1u8, 2, 3, 4][..])));
-        let bad = glb(b"{}", Some(&[1, 2, 3, 4]), Some(u32::MAX));
+        assert_eq!((j, b), (&b"{}  "[..], Some(&[1u8, 2, 3, 4][..])));
+        // The BIN chunk's length field (after the 12-byte header and the 12-byte
+        // JSON chunk) declaring more than follows.
+        let mut bad = ok.clone();
+        bad[24..28].copy_from_slice(&u32::MAX.to_le_bytes());
         let e = format!("{:#}", split_glb(&bad).unwrap_err());
         assert!(
             e.contains("declares 4294967295 bytes but only 4 follow"),

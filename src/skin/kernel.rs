@@ -48,6 +48,10 @@
 //! reproduces the 2D profile exactly (a product of two Gaussian mixtures is
 //! not a radial mixture), so the choice is which error to keep: the
 //! marginal keeps edges exact and errs only at features small in both axes.
+//!
+//! Over 800 lines because its tests (about 500 lines: the kernel against the
+//! profile's closed forms, the presets, the rank-1 study) sit beside the 380
+//! lines of code they check.
 
 use std::str::FromStr;
 

@@ -10,8 +10,7 @@ use ash::{ext, vk};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::error::{Error, VkResult};
-use super::guard::{Guard, Undo};
-use super::memory::Buffer;
+use super::undo::Undo;
 
 /// How to choose the physical device.
 #[derive(Clone, Debug, Default)]
@@ -131,40 +130,73 @@ unsafe extern "system" fn debug_callback(
 pub const FETCH_COUNTERS: u64 = 1 + 4 * 16 * 4;
 
 /// The host-visible counters of the fetch-counting build (the context holds
-/// them: every counting pipeline binds them). Derefs to the buffer.
+/// them: every counting pipeline binds them). Raw handles, not a
+/// `memory::Buffer`: the buffer type is made through a context, so holding one
+/// here would tie the two files in a cycle.
 pub struct FetchCounters {
-    buffer: Buffer,
+    pub raw: vk::Buffer,
+    allocation: gpu_allocator::vulkan::Allocation,
 }
 
 impl FetchCounters {
     fn new(ctx: &Context) -> Result<Self> {
-        let buffer = Buffer::new(
-            ctx,
-            "fetch counters",
-            FETCH_COUNTERS * 4,
-            // Zeroed by vkCmdFillBuffer before each counted pass.
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            gpu_allocator::MemoryLocation::GpuToCpu,
-        )?;
-        Ok(FetchCounters { buffer })
+        let raw = ctx
+            .create("fetch counters", |d| unsafe {
+                d.create_buffer(
+                    &vk::BufferCreateInfo::default()
+                        .size(FETCH_COUNTERS * 4)
+                        // Zeroed by vkCmdFillBuffer before each counted pass.
+                        .usage(
+                            vk::BufferUsageFlags::STORAGE_BUFFER
+                                | vk::BufferUsageFlags::TRANSFER_DST,
+                        ),
+                    None,
+                )
+            })
+            .context("creating the fetch counters")?;
+        let undo_buffer = Undo::new(|| unsafe { ctx.device.destroy_buffer(raw, None) });
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx
+            .allocator()
+            .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                name: "fetch counters",
+                requirements,
+                location: gpu_allocator::MemoryLocation::GpuToCpu,
+                linear: true,
+                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(Error::from)
+            .context("allocating the fetch counters")?;
+        // Freed on an early return until the counters own it.
+        let slot = std::cell::RefCell::new(Some(allocation));
+        let undo_allocation = Undo::new(|| {
+            if let Some(a) = slot.borrow_mut().take() {
+                let _ = ctx.allocator().free(a);
+            }
+        });
+        {
+            let held = slot.borrow();
+            let a = held.as_ref().expect("held until the counters own it");
+            unsafe { ctx.device.bind_buffer_memory(raw, a.memory(), a.offset()) }
+                .map_err(Error::from)
+                .context("binding the fetch counters' memory")?;
+        }
+        undo_allocation.disarm();
+        undo_buffer.disarm();
+        ctx.name(raw, "fetch counters");
+        let allocation = slot.into_inner().expect("held until the counters own it");
+        Ok(FetchCounters { raw, allocation })
     }
 
     /// The counters (after the fence of the submission that wrote them).
     pub fn read(&self) -> Result<Vec<u32>> {
         let bytes = self
-            .buffer
-            .read()
+            .allocation
+            .mapped_slice()
             .context("the fetch counters are not host visible")?;
         Ok(bytemuck::pod_collect_to_vec(
             &bytes[..(FETCH_COUNTERS * 4) as usize],
         ))
-    }
-}
-
-impl std::ops::Deref for FetchCounters {
-    type Target = Buffer;
-    fn deref(&self) -> &Buffer {
-        &self.buffer
     }
 }
 
@@ -537,8 +569,11 @@ impl Context {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
         }
-        if let Some(mut c) = self.fetch_counts.take() {
-            c.buffer.destroy(self);
+        if let Some(c) = self.fetch_counts.take() {
+            unsafe { self.device.destroy_buffer(c.raw, None) };
+            if let Some(a) = self.allocator.as_ref() {
+                let _ = a.lock().map(|mut a| a.free(c.allocation));
+            }
         }
         let mut problems: Vec<String> = Vec::new();
         if let Some(a) = self.allocator.take() {
@@ -619,53 +654,6 @@ impl Context {
                 .get_physical_device_format_properties(self.physical, format)
         };
         p.optimal_tiling_features.contains(features)
-    }
-
-    /// Records and submits one command buffer and waits for it.
-    pub fn one_shot(&self, label: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
-        let cmd = self.create(label, |d| unsafe {
-            d.allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(self.command_pool)
-                    .command_buffer_count(1),
-            )
-        })?[0];
-        // Freed when this returns: after the wait, or at once on an error.
-        let cmd = Guard::new(self, cmd);
-        self.name(*cmd, label);
-        unsafe {
-            self.device.begin_command_buffer(
-                *cmd,
-                &vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )
-        }
-        .map_err(Error::from)
-        .with_context(|| format!("beginning '{label}'"))?;
-        record(*cmd);
-        self.submit_and_wait(*cmd)
-            .with_context(|| format!("submitting '{label}'"))
-    }
-
-    /// Ends, submits and waits for a recorded command buffer.
-    pub fn submit_and_wait(&self, cmd: vk::CommandBuffer) -> Result<()> {
-        unsafe { self.device.end_command_buffer(cmd) }.map_err(Error::from)?;
-        let fence = unsafe {
-            self.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        }
-        .map_err(Error::from)?;
-        // Destroyed when this returns, after the wait (or its failure).
-        let fence = Guard::new(self, fence);
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-        unsafe {
-            self.device
-                .queue_submit2(self.queue, &submit, *fence)
-                .and_then(|_| self.device.wait_for_fences(&[*fence], true, u64::MAX))
-        }
-        .map_err(Error::from)
-        .context("queue submit / wait (device lost?)")
     }
 
     pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {

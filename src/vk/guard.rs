@@ -10,61 +10,20 @@
 //! set-up: every set-up submission waits on its own fence
 //! (`Context::one_shot`), so nothing a failed set-up made is still in use.
 //!
-//! [`Undo`] covers the steps before a `Context` exists (instance, device).
+//! [`super::undo::Undo`] covers the steps before a `Context` exists (instance, device).
 
 use std::ops::{Deref, DerefMut};
 
 use ash::vk;
 
 use super::context::Context;
-use super::memory::{Buffer, Image};
-use super::pipeline::{DescriptorPool, Pipeline, Samplers};
-use super::profiler::Profiler;
 
 /// Something that frees its Vulkan objects explicitly (after the GPU is done).
 /// Destroying twice, or destroying the null object (`Default`), does nothing.
+/// Owners implement it beside their own type (memory.rs, pipeline.rs,
+/// profiler.rs...), so this file names none of them and no cycle forms.
 pub trait Destroy {
     fn destroy(&mut self, ctx: &Context);
-}
-
-impl Destroy for Pipeline {
-    fn destroy(&mut self, ctx: &Context) {
-        Pipeline::destroy(self, ctx)
-    }
-}
-
-impl Destroy for Buffer {
-    fn destroy(&mut self, ctx: &Context) {
-        Buffer::destroy(self, ctx)
-    }
-}
-
-impl Destroy for Image {
-    fn destroy(&mut self, ctx: &Context) {
-        Image::destroy(self, ctx)
-    }
-}
-
-impl Destroy for DescriptorPool {
-    fn destroy(&mut self, ctx: &Context) {
-        DescriptorPool::destroy(self, ctx)
-    }
-}
-
-impl Destroy for Samplers {
-    fn destroy(&mut self, ctx: &Context) {
-        Samplers::destroy(self, ctx);
-        *self = Samplers::default();
-    }
-}
-
-impl Destroy for Profiler {
-    fn destroy(&mut self, ctx: &Context) {
-        Profiler::destroy(self, ctx);
-        self.timestamps = vk::QueryPool::null();
-        self.stats = None;
-        self.occlusion = vk::QueryPool::null();
-    }
 }
 
 impl<T: Destroy> Destroy for Vec<T> {
@@ -173,49 +132,5 @@ impl<T: Destroy> Drop for Guard<'_, T> {
         if let Some(mut v) = self.value.take() {
             v.destroy(self.ctx);
         }
-    }
-}
-
-/// Runs `undo` on drop unless [`Undo::disarm`]ed: for what is made before a
-/// `Context` exists to destroy through (the instance, the device).
-pub struct Undo<F: FnOnce()>(Option<F>);
-
-impl<F: FnOnce()> Undo<F> {
-    pub fn new(undo: F) -> Self {
-        Undo(Some(undo))
-    }
-
-    /// Set-up went through: the owner frees the object from now on.
-    pub fn disarm(mut self) {
-        self.0 = None;
-    }
-}
-
-impl<F: FnOnce()> Drop for Undo<F> {
-    fn drop(&mut self) {
-        if let Some(f) = self.0.take() {
-            f();
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn undo_runs_unless_disarmed() {
-        let ran = std::cell::Cell::new(0);
-        drop(Undo::new(|| ran.set(ran.get() + 1)));
-        assert_eq!(ran.get(), 1);
-        Undo::new(|| ran.set(ran.get() + 1)).disarm();
-        assert_eq!(ran.get(), 1);
-        let early = || -> Result<(), ()> {
-            let _u = Undo::new(|| ran.set(ran.get() + 10));
-            Err(())?;
-            Ok(())
-        };
-        assert!(early().is_err());
-        assert_eq!(ran.get(), 11);
     }
 }

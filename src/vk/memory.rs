@@ -10,7 +10,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::context::Context;
 use super::error::Error;
-use super::guard::Guard;
+use super::guard::{Destroy, Guard};
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
 /// fields one by one in a `Guard`, which destroys whatever exists when a step
@@ -349,5 +349,17 @@ impl Buffer {
         if let Some(a) = self.allocation.take() {
             let _ = ctx.allocator().free(a);
         }
+    }
+}
+
+impl Destroy for Buffer {
+    fn destroy(&mut self, ctx: &Context) {
+        Buffer::destroy(self, ctx)
+    }
+}
+
+impl Destroy for Image {
+    fn destroy(&mut self, ctx: &Context) {
+        Image::destroy(self, ctx)
     }
 }

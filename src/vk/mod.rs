@@ -11,4 +11,6 @@ pub mod pipeline;
 pub mod profiler;
 pub mod shader;
 pub mod shader_stats;
+pub mod submit;
+pub mod undo;
 pub mod upload;

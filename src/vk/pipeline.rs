@@ -6,7 +6,7 @@ use ash::vk;
 
 use super::context::Context;
 use super::error::Error;
-use super::guard::Guard;
+use super::guard::{Destroy, Guard};
 use super::shader::{create_module, reflect, Reflection};
 
 /// Vertex layout of `scene::mesh::Vertex` (position, normal, uv, tangent; 48 bytes).
@@ -720,5 +720,24 @@ impl Samplers {
                 ctx.device.destroy_sampler(s, None);
             }
         }
+    }
+}
+
+impl Destroy for Pipeline {
+    fn destroy(&mut self, ctx: &Context) {
+        Pipeline::destroy(self, ctx)
+    }
+}
+
+impl Destroy for DescriptorPool {
+    fn destroy(&mut self, ctx: &Context) {
+        DescriptorPool::destroy(self, ctx)
+    }
+}
+
+impl Destroy for Samplers {
+    fn destroy(&mut self, ctx: &Context) {
+        Samplers::destroy(self, ctx);
+        *self = Samplers::default();
     }
 }

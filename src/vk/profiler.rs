@@ -10,7 +10,7 @@ use ash::vk;
 
 use super::context::Context;
 use super::error::Error;
-use super::guard::Guard;
+use super::guard::{Destroy, Guard};
 
 pub struct Profiler {
     pub timestamps: vk::QueryPool,
@@ -209,5 +209,14 @@ impl Profiler {
             }
             ctx.device.destroy_query_pool(self.occlusion, None);
         }
+    }
+}
+
+impl Destroy for Profiler {
+    fn destroy(&mut self, ctx: &Context) {
+        Profiler::destroy(self, ctx);
+        self.timestamps = vk::QueryPool::null();
+        self.stats = None;
+        self.occlusion = vk::QueryPool::null();
     }
 }

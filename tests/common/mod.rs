@@ -55,3 +55,173 @@ pub fn counting_ctx() -> Context {
     })
     .expect("creating a validated, fetch-counting Vulkan context on lavapipe")
 }
+
+/// The `dermis` executable of this build, backtraces off (an error is one line).
+pub fn dermis() -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_dermis"));
+    c.env("RUST_BACKTRACE", "0");
+    c
+}
+
+/// An environment variable as a count, `default` when unset or not a number.
+pub fn env_usize(key: &str, default: usize) -> usize {
+    std::env::var(key)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// Uploads a diffuse (RGBA, stored as half floats), linear-depth and skin-mask
+/// input and runs the method's SSS passes alone on it (`Renderer::run_sss_only`):
+/// the output and each pass's counts.
+pub fn sss_only(
+    r: &mut dermis::render::Renderer,
+    diffuse: &[[f32; 4]],
+    depth: &[f32],
+    skin: &[bool],
+) -> (Vec<[f32; 4]>, Vec<dermis::graph::PassSample>) {
+    let f16: Vec<u16> = diffuse
+        .iter()
+        .flatten()
+        .map(|&v| half::f16::from_f32(v).to_bits())
+        .collect();
+    r.upload_sss_inputs(&f16, depth, skin)
+        .expect("uploading the SSS inputs");
+    r.run_sss_only().expect("running the SSS passes")
+}
+
+/// The samples-passed count of the pass named `name`.
+pub fn samples_passed(passes: &[dermis::graph::PassSample], name: &str) -> u64 {
+    passes
+        .iter()
+        .find(|p| p.name == name)
+        .unwrap_or_else(|| panic!("no pass {name}"))
+        .samples_passed
+}
+
+/// Where failed image comparisons write their difference images:
+/// target/test-diffs/ (beside CARGO_TARGET_TMPDIR, so a custom target folder
+/// holds them too).
+pub fn diff_dir() -> PathBuf {
+    let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    tmp.parent().unwrap_or(&tmp).join("test-diffs")
+}
+
+/// A golden-image comparison's witness: if the test panics while it is alive
+/// (an assertion on the two images failed), its drop writes
+/// `target/test-diffs/NAME.png` (the image under test, the expected one and
+/// their difference side by side) and prints the path. Declare it after the
+/// two images and before the assertions on them; it costs nothing on success.
+pub struct DiffOnFailure<'a> {
+    pub name: String,
+    pub width: usize,
+    pub height: usize,
+    pub got: &'a [[f32; 4]],
+    pub want: &'a [[f32; 4]],
+}
+
+impl<'a> DiffOnFailure<'a> {
+    pub fn new(
+        name: impl Into<String>,
+        width: usize,
+        height: usize,
+        got: &'a [[f32; 4]],
+        want: &'a [[f32; 4]],
+    ) -> Self {
+        DiffOnFailure {
+            name: name.into(),
+            width,
+            height,
+            got,
+            want,
+        }
+    }
+}
+
+impl Drop for DiffOnFailure<'_> {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            return;
+        }
+        match write_diff_image(&self.name, self.width, self.height, self.got, self.want) {
+            Ok(p) => eprintln!("{}: difference image {}", self.name, p.display()),
+            Err(e) => eprintln!("{}: writing the difference image failed: {e}", self.name),
+        }
+    }
+}
+
+/// Writes `diff_dir()/NAME.png`: three panels side by side, `got`, `want`
+/// (linear RGB, clamped to 0..1, sRGB-encoded) and |got - want| per channel
+/// scaled so the largest difference is white (that difference is printed).
+/// Returns the path.
+pub fn write_diff_image(
+    name: &str,
+    w: usize,
+    h: usize,
+    got: &[[f32; 4]],
+    want: &[[f32; 4]],
+) -> Result<PathBuf, String> {
+    if got.len() != w * h || want.len() != w * h {
+        return Err(format!(
+            "sizes differ: {} and {} pixels for {w}x{h}",
+            got.len(),
+            want.len()
+        ));
+    }
+    let diff: Vec<[f32; 3]> = got
+        .iter()
+        .zip(want)
+        .map(|(a, b)| [0, 1, 2].map(|c| (a[c] - b[c]).abs()))
+        .collect();
+    let max = diff
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, f32::max);
+    eprintln!("{name}: largest difference {max:.3e}");
+    let srgb = |v: f32| {
+        let v = if v.is_finite() {
+            v.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        (v.powf(1.0 / 2.2) * 255.0 + 0.5) as u8
+    };
+    let mut img = image::RgbImage::new(3 * w as u32, h as u32);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let d = diff[i].map(|v| if max > 0.0 { v / max } else { 0.0 });
+            for (panel, px) in [
+                [got[i][0], got[i][1], got[i][2]],
+                [want[i][0], want[i][1], want[i][2]],
+                d,
+            ]
+            .iter()
+            .enumerate()
+            {
+                img.put_pixel((panel * w + x) as u32, y as u32, image::Rgb(px.map(srgb)));
+            }
+        }
+    }
+    let dir = diff_dir();
+    std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    let path = dir.join(format!("{}.png", sanitize(name)));
+    img.save(&path)
+        .map_err(|e| format!("writing {}: {e}", path.display()))?;
+    Ok(path)
+}
+
+/// A test name as a file name: letters, digits, '-' and '_' kept, the rest '_'.
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}

@@ -73,6 +73,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     options: OPTIONS,
     eval: &[],
     ground_truth: true,
+    dolly: &[],
     needs: |_, _| Needs {
         geometry_transmittance: false,
         ..Needs::PLAIN

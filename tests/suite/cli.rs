@@ -1,6 +1,7 @@
 //! The command line: bad input gives one clear error line and a non-zero exit,
 //! never a panic or a validation error; good input writes what it promises.
 
+use dermis::scene::gltf_load::fixture::{Container, Model};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -71,65 +72,10 @@ fn fails_with_env(args: &[&str], phrase: &str, env: &[(&str, &str)]) {
     );
 }
 
-/// A minimal glTF (one triangle) with some attributes left out.
+/// A minimal glTF (one triangle, the shared fixture's) with some attributes left
+/// out, written as `dir/NAME.gltf`.
 fn tiny_gltf(dir: &Path, name: &str, normals: bool, uvs: bool) -> PathBuf {
-    let mut bin: Vec<u8> = Vec::new();
-    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
-        for c in v {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    let pos_len = bin.len();
-    for _ in 0..3 {
-        for c in [0.0f32, 0.0, 1.0] {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for _ in 0..3 {
-        for c in [0.5f32, 0.5] {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    let b64 = {
-        const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-        let mut s = String::new();
-        for ch in bin.chunks(3) {
-            let n = (ch[0] as u32) << 16
-                | (*ch.get(1).unwrap_or(&0) as u32) << 8
-                | *ch.get(2).unwrap_or(&0) as u32;
-            for i in 0..4 {
-                if i <= ch.len() {
-                    s.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
-                } else {
-                    s.push('=');
-                }
-            }
-        }
-        s
-    };
-    let mut attrs = vec![r#""POSITION": 0"#.to_string()];
-    if normals {
-        attrs.push(r#""NORMAL": 1"#.into());
-    }
-    if uvs {
-        attrs.push(r#""TEXCOORD_0": 2"#.into());
-    }
-    let json = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
-"meshes":[{{"name":"tri","primitives":[{{"attributes":{{{}}}}}]}}],
-"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}],
-"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{}}},{{"buffer":0,"byteOffset":{},"byteLength":36}},{{"buffer":0,"byteOffset":{},"byteLength":24}}],
-"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}},{{"bufferView":2,"componentType":5126,"count":3,"type":"VEC2"}}]}}"#,
-        attrs.join(","),
-        bin.len(),
-        b64,
-        pos_len,
-        pos_len,
-        pos_len + 36
-    );
-    let p = dir.join(name);
-    std::fs::write(&p, json).unwrap();
-    p
+    Model::triangle(normals, uvs, [0.0; 3]).write(Container::DataUri, dir, name)
 }
 
 #[test]
@@ -145,7 +91,7 @@ fn missing_and_corrupt_scene_files() {
     // Valid files the glTF spec allows: no normals (flat ones are computed) and
     // no texture coordinates (the head loads untextured, with a warning).
     let out = d.join("out");
-    for (name, normals, uvs) in [("nonormals.gltf", false, true), ("nouvs.gltf", true, false)] {
+    for (name, normals, uvs) in [("nonormals", false, true), ("nouvs", true, false)] {
         let f = tiny_gltf(&d, name, normals, uvs);
         run_ok(&[
             "render",
@@ -170,7 +116,7 @@ fn missing_and_corrupt_scene_files() {
 #[test]
 fn missing_and_corrupt_textures() {
     let d = tmp("tex");
-    let ok = tiny_gltf(&d, "ok.gltf", true, true);
+    let ok = tiny_gltf(&d, "ok", true, true);
     fails_with(
         &[
             "--scene",

@@ -4,7 +4,7 @@
 //! held to what its pass declares: exact counts exactly, upper bounds as bounds,
 //! and no fetch that is not declared.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 
@@ -27,14 +27,14 @@ fn declared_fetches_are_what_the_shaders_fetch() {
             .map(|e| {
                 (
                     format!("{} {}", m.name, e.label),
-                    RenderSettings::default().with(m, e.options),
+                    RenderSettings::study().with(m, e.options),
                 )
             })
             .collect();
         if m.ground_truth {
             settings.push((
                 m.name.to_string(),
-                RenderSettings::default().with(m, &[("density", "2")]),
+                RenderSettings::study().with(m, &[("density", "2")]),
             ));
         }
         for (label, s) in settings {
@@ -136,7 +136,7 @@ fn no_code_compares_a_pass_label() {
             width: 64,
             height: 40,
             shadow_size: 64,
-            ..RenderSettings::default()
+            ..RenderSettings::study()
         }
         .with(m, &[("density", "1")]);
         let r = Renderer::new(&ctx, &scene, &s).unwrap();

@@ -1,11 +1,11 @@
-//! The SSS region (render/region.rs) on lavapipe with validation: limiting the
+//! The SSS region (method/region.rs) on lavapipe with validation: limiting the
 //! seed copies and the stencil-tested draws to the skin's widened bounds must
 //! change no pixel of any method's output, on one head, on many heads (several
 //! rectangles), on a head cut by the screen edge and on a camera inside the
 //! head's box (the whole-screen fallback), while the region really is smaller
 //! than the screen where it can be.
 
-mod common;
+use crate::common;
 
 use dermis::graph::work::PassRole;
 use dermis::method::region::{PixelRect, RegionMode};
@@ -115,6 +115,13 @@ fn region_changes_nothing(scene: &Scene, base: RenderSettings, expect_smaller: b
             },
         );
         let (ds, df) = (&fs.diffuse, &ff.diffuse);
+        let _diff = common::DiffOnFailure::new(
+            format!("region-{name}"),
+            base.width as usize,
+            base.height as usize,
+            ds,
+            df,
+        );
         assert_eq!(ff.region_pixels, pixels);
         if expect_smaller {
             assert!(
@@ -162,7 +169,7 @@ fn the_region_changes_no_pixel_on_the_egg_scene() {
         width: 192,
         height: 108,
         shadow_size: 256,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     region_changes_nothing(&egg_scene(), base.clone(), true);
     // Close and wide: taps reach far past the silhouette, where only the
@@ -187,7 +194,7 @@ fn the_region_changes_no_pixel_on_many_heads_and_cut_heads() {
         width: 192,
         height: 108,
         shadow_size: 256,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     // Three heads at the thesis' far distance: several rectangles.
     region_changes_nothing(
@@ -218,7 +225,7 @@ fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
         height: 64,
         shadow_size: 256,
         distance_heads: 0.3,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     let ctx = common::ctx();
     let r = Renderer::new(&ctx, &scene, &s).expect("renderer");
@@ -235,7 +242,7 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
         heads: 4,
         layout: Layout::Grid,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     let r = Renderer::new(&ctx, &egg_scene(), &s).expect("renderer");
     let region = &r.frame.region_px;
@@ -278,7 +285,7 @@ fn the_region_changes_no_pixel_around_a_card_whose_box_is_its_silhouette() {
         height: 432,
         shadow_size: 256,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     };
     base.options.set("follow-surface", "false");
     // Taps reach ~90 px (50 mm at 1.8 px/mm), far more than the up to 31 px a

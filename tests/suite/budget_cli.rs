@@ -4,16 +4,10 @@
 //! written; a bad profile is one error line.
 
 use std::path::PathBuf;
-use std::process::Command;
 
+use crate::common::dermis;
 use dermis::method::METHODS;
 use serde_json::Value;
-
-fn dermis() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_dermis"));
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("dermis-budget-{}-{name}", std::process::id()));

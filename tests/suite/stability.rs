@@ -3,7 +3,7 @@
 //! Thresholds come from measurements printed by the tests and recorded in
 //! docs/accuracy.md.
 
-mod common;
+use crate::common;
 
 use dermis::method::{MethodEntry, MethodOptions};
 use dermis::render::{RenderSettings, Renderer};
@@ -28,7 +28,7 @@ fn small(method: &'static MethodEntry) -> RenderSettings {
         shadow_size: 128,
         method,
         options: density(4.0),
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
 }
 
@@ -185,7 +185,7 @@ fn halo_across_a_depth_discontinuity() {
             distance_heads: 1.6,
             ambient: 0.0,
             transmittance: false,
-            ..RenderSettings::default()
+            ..RenderSettings::study()
         };
         // From behind and to the side: the ball's right flank is lit, the wall (facing +Z) is not.
         s.light.azimuth_deg = 120.0;
@@ -271,7 +271,7 @@ fn thin_parts_need_transmittance() {
             options: density(8.0),
             ambient: 0.0,
             distance_heads: 2.0,
-            ..RenderSettings::default()
+            ..RenderSettings::study()
         };
         s.light.azimuth_deg = 165.0;
         s.light.elevation_deg = 5.0;

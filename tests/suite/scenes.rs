@@ -2,7 +2,7 @@
 //! the default scene, the Lee Perry-Smith head, many heads, and a scene with no
 //! skin, checked for finite, non-constant output and sane reports.
 
-mod common;
+use crate::common;
 
 use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};
@@ -26,7 +26,7 @@ fn small() -> RenderSettings {
         width: 160,
         height: 96,
         shadow_size: 256,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
 }
 
@@ -170,7 +170,7 @@ fn a_crowd_of_1_4_16_64_heads_adds_skin_with_every_step() {
             height: 180,
             shadow_size: 512,
             heads,
-            ..RenderSettings::default()
+            ..RenderSettings::study()
         };
         let out = run(&ctx, &scene, &s, &opts(false)).expect("render");
         let n = out

@@ -2,9 +2,8 @@
 //! `ssg` and `ss-jittered` against their CPU mirrors, stencil versus branch
 //! masking, and the depth-based Gaussian LOD proven by counts on a camera dolly.
 
-mod common;
+use crate::common;
 
-use dermis::graph::PassSample;
 use dermis::method::lookup;
 use dermis::method::poisson::Poisson;
 use dermis::method::ssg::{MaskMode, Ssg};
@@ -53,23 +52,8 @@ fn settings(method: &str) -> RenderSettings {
         shadow_size: 64,
         method: lookup(method).unwrap(),
         distance_heads: 1.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
-}
-
-fn run(
-    r: &mut Renderer,
-    diffuse: &[[f32; 4]],
-    depth: &[f32],
-    skin: &[bool],
-) -> (Vec<[f32; 4]>, Vec<PassSample>) {
-    let f16: Vec<u16> = diffuse
-        .iter()
-        .flatten()
-        .map(|&v| half::f16::from_f32(v).to_bits())
-        .collect();
-    r.upload_sss_inputs(&f16, depth, skin).unwrap();
-    r.run_sss_only().unwrap()
 }
 
 /// Largest error in units of the half-float ulp of the expected value.
@@ -85,13 +69,6 @@ fn worst_ulps(gpu: &[[f32; 4]], cpu: &[[f32; 4]]) -> (f32, f32) {
         }
     }
     worst
-}
-
-fn samples(s: &[PassSample], name: &str) -> u64 {
-    s.iter()
-        .find(|p| p.name == name)
-        .unwrap_or_else(|| panic!("no pass {name}"))
-        .samples_passed
 }
 
 #[test]
@@ -115,7 +92,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         let g = r.method_as::<Ssg>().unwrap();
         let (quad_depths, lod_distances) = (g.quad_depths.clone(), g.lod_distances.clone());
-        let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
+        let (gpu, passes) = common::sss_only(&mut r, &diffuse, &depth, &skin);
         let ndc: Vec<f32> = depth
             .iter()
             .map(|&d| r.ndc_depth(d).clamp(0.0, 1.0))
@@ -142,6 +119,8 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         let mut best = None;
         for mode in [F16Rounding::NearestEven, F16Rounding::TowardZero] {
             let cpu = ssg_with_rounding(&input, fit, stretch, &quad_depths, mode);
+            let _diff =
+                common::DiffOnFailure::new(format!("ssg-{fit:?}-lod-{lod}"), W, H, &gpu, &cpu);
             let (ulps, rel) = worst_ulps(&gpu, &cpu);
             let mean: f32 = gpu
                 .iter()
@@ -155,6 +134,8 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
             }
         }
         let (ulps, mean, mode) = best.unwrap();
+        let cpu = ssg_with_rounding(&input, fit, stretch, &quad_depths, mode);
+        let _diff = common::DiffOnFailure::new(format!("ssg-{fit:?}-lod-{lod}"), W, H, &gpu, &cpu);
         println!("  matched {mode:?}; LOD distances {lod_distances:?}");
         assert!(
             ulps <= 2.0 && mean < 0.1,
@@ -170,7 +151,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
         for (k, q) in quad_depths.iter().enumerate() {
             let expected = (0..W * H).filter(|&i| skin[i] && *q > ndc[i]).count() as u64;
             let name = format!("ssg g{} horizontal", k + 2);
-            assert_eq!(samples(&passes, &name), expected, "{name}");
+            assert_eq!(common::samples_passed(&passes, &name), expected, "{name}");
             if !lod {
                 assert_eq!(expected, skin.iter().filter(|&&b| b).count() as u64);
             }
@@ -179,7 +160,7 @@ fn ssg_matches_cpu_reference_with_and_without_lod() {
             // The ramp puts some LOD cuts inside the image: at least one Gaussian is partial.
             let skin_n = skin.iter().filter(|&&b| b).count() as u64;
             let counts: Vec<u64> = (0..quad_depths.len())
-                .map(|k| samples(&passes, &format!("ssg g{} horizontal", k + 2)))
+                .map(|k| common::samples_passed(&passes, &format!("ssg g{} horizontal", k + 2)))
                 .collect();
             assert!(
                 counts.iter().any(|&n| n > 0 && n < skin_n),
@@ -206,7 +187,7 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
             &[("lod", "false"), ("mask", mask_key)],
         );
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let (img, passes) = run(&mut r, &diffuse, &depth, &skin);
+        let (img, passes) = common::sss_only(&mut r, &diffuse, &depth, &skin);
         let skin_n = skin.iter().filter(|&&b| b).count() as u64;
         let screen = (W * H) as u64;
         let llvmpipe = ctx.facts.name.contains("llvmpipe");
@@ -237,6 +218,7 @@ fn ssg_branch_mask_shades_everything_but_writes_the_same_image() {
         }
         images.push(img);
     }
+    let _diff = common::DiffOnFailure::new("ssg-branch-vs-stencil", W, H, &images[1], &images[0]);
     for (a, b) in images[0].iter().zip(&images[1]) {
         for c in 0..4 {
             assert!((a[c] - b[c]).abs() <= 1e-4, "stencil {a:?} vs branch {b:?}");
@@ -251,7 +233,7 @@ fn jittered_matches_cpu_reference() {
     let (diffuse, depth, skin) = synthetic();
     let s = settings("ss-jittered");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-    let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
+    let (gpu, passes) = common::sss_only(&mut r, &diffuse, &depth, &skin);
     let stretch = Stretch::for_view(H as u32, s.fovy_deg.to_radians(), scene.mm_per_unit);
     let cpu = jittered(
         &MirrorInput {
@@ -264,13 +246,14 @@ fn jittered_matches_cpu_reference() {
         &hable_kernel(),
         stretch,
     );
+    let _diff = common::DiffOnFailure::new("ss-jittered", W, H, &gpu, &cpu);
     let (ulps, rel) = worst_ulps(&gpu, &cpu);
     println!("ss-jittered: worst {ulps:.2} half ulps ({rel:.2e} relative)");
     // One pass, one rounding: two ulps cover a flip plus the GPU's sin/cos and
     // sub-texel weight quantisation on smooth input.
     assert!(ulps <= 2.0, "ss-jittered differs by {ulps} ulps");
     assert_eq!(
-        samples(&passes, "ss-jittered"),
+        common::samples_passed(&passes, "ss-jittered"),
         skin.iter().filter(|&&b| b).count() as u64
     );
     let changed = (0..W * H)
@@ -299,7 +282,7 @@ fn gaussian_lod_by_counts_on_a_dolly() {
                 height: 80,
                 shadow_size: 128,
                 distance_heads: distance,
-                ..RenderSettings::default()
+                ..RenderSettings::study()
             }
             .with(
                 lookup("ssg").unwrap(),
@@ -324,7 +307,7 @@ fn gaussian_lod_by_counts_on_a_dolly() {
                 .map(|(_, d)| d[0])
                 .collect();
             for (k, &d_lod) in lod_distances.iter().enumerate() {
-                let n = samples(&cap.samples, &format!("ssg g{} horizontal", k + 2));
+                let n = common::samples_passed(&cap.samples, &format!("ssg g{} horizontal", k + 2));
                 if !lod {
                     assert_eq!(n, skin.len() as u64, "no-lod g{} at {distance}", k + 2);
                     continue;
@@ -385,7 +368,7 @@ fn poisson_matches_cpu_reference() {
         .map(|&v| half::f16::from_f32(v).to_bits())
         .collect();
     r.upload_normals(&n16).unwrap();
-    let (gpu, passes) = run(&mut r, &diffuse, &depth, &skin);
+    let (gpu, passes) = common::sss_only(&mut r, &diffuse, &depth, &skin);
     let input = MirrorInput {
         width: W,
         height: H,
@@ -394,8 +377,8 @@ fn poisson_matches_cpu_reference() {
         skin: &skin,
     };
     let mut best: Option<(f32, f32, F16Rounding)> = None;
-    for mode in [F16Rounding::NearestEven, F16Rounding::TowardZero] {
-        let cpu = poisson_with_rounding(
+    let cpu_of = |mode| {
+        poisson_with_rounding(
             &input,
             &normals,
             &PoissonParams::from_profile(),
@@ -403,7 +386,11 @@ fn poisson_matches_cpu_reference() {
             scene.mm_per_unit,
             levels,
             mode,
-        );
+        )
+    };
+    for mode in [F16Rounding::NearestEven, F16Rounding::TowardZero] {
+        let cpu = cpu_of(mode);
+        let _diff = common::DiffOnFailure::new("poisson", W, H, &gpu, &cpu);
         let (ulps, rel) = worst_ulps(&gpu, &cpu);
         println!("poisson rounding={mode:?}: worst {ulps:.2} half ulps ({rel:.2e} relative)");
         if best.is_none_or(|b| ulps < b.0) {
@@ -411,6 +398,8 @@ fn poisson_matches_cpu_reference() {
         }
     }
     let (ulps, _, mode) = best.unwrap();
+    let cpu = cpu_of(mode);
+    let _diff = common::DiffOnFailure::new("poisson", W, H, &gpu, &cpu);
     // One output rounding plus mip levels rounded once each on the path; exp() on
     // the GPU is not correctly rounded (a few f32 ulps), which moves weights by
     // ~1e-6 relative: 2 half ulps bound it.
@@ -419,7 +408,7 @@ fn poisson_matches_cpu_reference() {
         "poisson differs from the CPU mirror ({mode:?}) by {ulps} ulps"
     );
     assert_eq!(
-        samples(&passes, "poisson"),
+        common::samples_passed(&passes, "poisson"),
         skin.iter().filter(|&&b| b).count() as u64
     );
     for i in 0..W * H {

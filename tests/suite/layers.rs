@@ -3,7 +3,7 @@
 //! the pure files above it name neither `ash`, `crate::vk` nor `crate::graph`,
 //! no two sibling files import each other in a cycle, `render/mod.rs` stays
 //! small and long functions say why. (That no code compares a pass label is
-//! checked in tests/work_gpu.rs, on the labels the frames really have.)
+//! checked in tests/suite/work.rs, on the labels the frames really have.)
 //!
 //! The checks read paths, not text: comments and string literals are dropped,
 //! grouped imports (`use crate::{a, b::{c, d}}`) are expanded, and `super::`
@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 /// sit above it.
 const LAYERS: &[&[&str]] = &[
     &[
+        "files",
         "shader_constants",
         "work",
         "view",
@@ -750,4 +751,31 @@ fn the_renderer_stays_small_and_long_functions_say_why() {
             );
         }
     }
+}
+
+/// No source file over 800 lines without a reason at its top ("Over 800
+/// lines because ..." in its leading `//!` doc): in src/, tests/ and tools/.
+#[test]
+fn long_files_say_why() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for d in ["src", "tests", "tools"] {
+        rust_files(&root.join(d), &mut files);
+    }
+    let mut unexplained = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let n = text.lines().count();
+        let reason = text
+            .lines()
+            .take_while(|l| l.starts_with("//!"))
+            .any(|l| l.contains("Over 800 lines because"));
+        if n > 800 && !reason {
+            unexplained.push(format!("{} ({n} lines)", f.display()));
+        }
+    }
+    assert!(
+        unexplained.is_empty(),
+        "files over 800 lines with no reason at their top (\"Over 800 lines because ...\"): {unexplained:?}"
+    );
 }

@@ -4,8 +4,11 @@
 //! against a CPU visibility prediction (by counts of the fetch-counting build),
 //! the depth-sized viewport, the z pre-passes' zero invocations, far
 //! characters keeping their maps, and each optimisation's change to the image.
+//!
+//! Over 800 lines because every test of the area shares one synthetic unwrapped
+//! mesh and its CPU mirrors; split, each file would rebuild the fixture.
 
-mod common;
+use crate::common;
 
 use dermis::eval::metrics::relative_rmse;
 use dermis::method::tsd::Tsd;
@@ -137,7 +140,7 @@ fn settings(method: &str, opts: &[(&str, &str)], w: u32, h: u32, distance: f32) 
         height: h,
         shadow_size: 256,
         distance_heads: distance,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
     .with(common::m(method), opts)
 }
@@ -229,6 +232,9 @@ fn stretch_and_convolution_match_the_cpu_references() {
             .fold(0.0f32, f32::max)
             / max
     };
+    let _diff_first =
+        common::DiffOnFailure::new("tsd-first-pass", t, t, &first_u.rgba, &cpu.passes[0]);
+    let _diff_map = common::DiffOnFailure::new("tsd-map", t, t, &gpu.rgba, &cpu.map);
     let e1 = err(&first_u.rgba, &cpu.passes[0]);
     let e12 = err(&gpu.rgba, &cpu.map);
     println!("first pass {e1:.2e}, map {e12:.2e} of the brightest texel {max}");
@@ -604,7 +610,9 @@ fn optimisations_change_the_image_within_tolerance() {
         ("clip", "false"),
         ("z-prepass", "false"),
     ];
-    assert_eq!(run("tsd-opt", &none), plain, "all off is plain tsd");
+    let all_off = run("tsd-opt", &none);
+    let _diff = common::DiffOnFailure::new("tsd-opt-all-off", 160, 100, &all_off, &plain);
+    assert_eq!(all_off, plain, "all off is plain tsd");
     let only = |k: &'static str, v: &'static str| -> Vec<(&'static str, &'static str)> {
         let mut o: Vec<(&str, &str)> = none.iter().filter(|(n, _)| *n != k).copied().collect();
         o.push((k, v));
@@ -619,6 +627,7 @@ fn optimisations_change_the_image_within_tolerance() {
         ("all", Vec::new(), 0.06),
     ] {
         let img = run("tsd-opt", &opts);
+        let _diff = common::DiffOnFailure::new(format!("tsd-opt-{what}"), 160, 100, &img, &plain);
         let e = relative_rmse(&img, &plain, &mask).unwrap();
         println!("{what}: {e:.3e} relative RMSE against tsd");
         assert!(e < tol, "{what}: {e}");
@@ -696,53 +705,6 @@ fn the_budget_model_prices_every_texture_space_pass_on_every_profile() {
             b.total_ms
         );
         assert!(b.total_ms.is_finite());
-    }
-}
-
-// Table 4.4's shape, modelled: every method of the table at 1, 5 and 16
-// characters (the crowd, 1280x720, 1024 maps), the counts from lavapipe and
-// the budget model's frame time on the 8600M GS (the table's GPU) and the
-// Xbox 360. Heavy on lavapipe (~minutes): run it by name with --ignored.
-// docs/tsd.md has its output.
-#[test]
-#[ignore]
-fn table_4_4_shape_modelled() {
-    use dermis::budget::profile::Profile;
-    use dermis::budget::{price_frame, ParamSet, Rescale};
-    let Some(head) = common::lps_path() else {
-        return;
-    };
-    let scene =
-        dermis::scene::load_gltf_scene(&head, &Default::default(), None).expect("the head scan");
-    let profiles =
-        ["geforce-8600m-gs", "xbox360", "nvidia-h200"].map(|p| Profile::load(p).unwrap());
-    println!(
-        "| method | heads | {} |",
-        profiles
-            .iter()
-            .map(|p| format!("{} ms", p.profile.name))
-            .collect::<Vec<_>>()
-            .join(" | ")
-    );
-    for m in ["none", "ss-jittered", "ssg", "separable", "tsd", "tsd-opt"] {
-        for heads in [1, 5, 16] {
-            let opts: &[(&str, &str)] = if m.starts_with("tsd") {
-                &[("irradiance-size", "1024")]
-            } else {
-                &[]
-            };
-            let mut s = settings(m, opts, 1280, 720, 4.0);
-            s.heads = heads;
-            let frame = frame_input(&scene, &s, m);
-            let ms: Vec<String> = profiles
-                .iter()
-                .map(|p| {
-                    let b = price_frame(p, &frame, &ParamSet::fitted(), Rescale::AsRun);
-                    format!("{:.2}", b.total_ms)
-                })
-                .collect();
-            println!("| {m} | {heads} | {} |", ms.join(" | "));
-        }
     }
 }
 

@@ -1,7 +1,7 @@
 //! The separable SSS passes on the GPU against the CPU mirror
 //! (`skin::separable_mirror`), and stencil masking proven by counts.
 
-mod common;
+use crate::common;
 
 use dermis::method::separable::Separable;
 use dermis::render::{RenderSettings, Renderer};
@@ -53,7 +53,7 @@ fn renderer_settings() -> RenderSettings {
         width: W as u32,
         height: H as u32,
         shadow_size: 64,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
 }
 
@@ -69,13 +69,7 @@ fn gpu_matches_cpu_reference() {
             &[("follow-surface", if follow { "true" } else { "false" })],
         );
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let f16: Vec<u16> = diffuse
-            .iter()
-            .flatten()
-            .map(|&v| half::f16::from_f32(v).to_bits())
-            .collect();
-        r.upload_sss_inputs(&f16, &depth, &skin).unwrap();
-        let (gpu, samples) = r.run_sss_only().unwrap();
+        let (gpu, samples) = common::sss_only(&mut r, &diffuse, &depth, &skin);
 
         // The kernel the method built for these options.
         let kernel = r.method_as::<Separable>().unwrap().kernel.clone();
@@ -96,6 +90,8 @@ fn gpu_matches_cpu_reference() {
             &kernel,
             &view,
         );
+        let _diff =
+            common::DiffOnFailure::new(format!("separable-follow-{follow}"), W, H, &gpu, &cpu);
 
         // Bound. Storage: the intermediate and the output are RGBA16F; where the GPU's
         // unrounded value and the CPU's straddle a rounding boundary, each store can
@@ -188,13 +184,7 @@ fn no_skin_means_no_sss_work() {
     let (diffuse, depth, _) = synthetic();
     let skin = vec![false; W * H];
     let diffuse: Vec<[f32; 4]> = diffuse.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
-    let f16: Vec<u16> = diffuse
-        .iter()
-        .flatten()
-        .map(|&v| half::f16::from_f32(v).to_bits())
-        .collect();
-    r.upload_sss_inputs(&f16, &depth, &skin).unwrap();
-    let (gpu, samples) = r.run_sss_only().unwrap();
+    let (gpu, samples) = common::sss_only(&mut r, &diffuse, &depth, &skin);
     for name in ["sss horizontal", "sss vertical"] {
         let p = samples.iter().find(|p| p.name == name).unwrap();
         assert_eq!(p.samples_passed, 0, "{name}");

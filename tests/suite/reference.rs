@@ -2,7 +2,7 @@
 //! independent CPU gather in f64 (brute force over every sample) on a tiny
 //! scene, and convergence of the surface sampling.
 
-mod common;
+use crate::common;
 
 use dermis::eval::metrics::relative_rmse;
 use dermis::method::reference::Reference;
@@ -16,7 +16,7 @@ fn settings(width: u32, height: u32, density: f32) -> RenderSettings {
         height,
         shadow_size: 256,
         distance_heads: 3.0,
-        ..RenderSettings::default()
+        ..RenderSettings::study()
     }
     .with(common::m("reference"), &[("density", &density.to_string())])
 }
@@ -94,6 +94,14 @@ fn gpu_gather_matches_f64_cpu_gather() {
         },
         &run.samples,
         &run.radiance,
+    );
+    let cpu32: Vec<[f32; 4]> = cpu.iter().map(|c| c.map(|v| v as f32)).collect();
+    let _diff = common::DiffOnFailure::new(
+        "reference-gather",
+        run.view.width,
+        run.view.height,
+        &run.output,
+        &cpu32,
     );
     let mut worst = (0.0f64, 0usize);
     let mut skin = 0;

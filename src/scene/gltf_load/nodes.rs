@@ -1,0 +1,405 @@
+//! Nodes: the scene's node graph checked to be trees and walked without
+//! recursion, every primitive placed in world space in f64, and a model far
+//! from the origin for its size moved to it.
+
+use anyhow::{bail, Result};
+use glam::{DMat3, DMat4, DQuat, DVec3, Mat4};
+use std::collections::HashMap;
+use std::rc::Rc;
+
+use super::checks::{mesh_label, node_label};
+use super::primitives::{read_primitive, Part};
+use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
+use crate::scene::gltf_source::Source;
+use crate::scene::mesh::Mesh;
+use crate::scene::robust_bounds::robust_bounds_f64;
+
+/// A model whose centre lies farther from the origin than this many times its size is
+/// moved to the origin: f32 keeps 24 bits, and at 128 sizes away fewer than 16 of
+/// them would be left across the model.
+pub(super) const RECENTRE_RATIO: f64 = 128.0;
+
+/// A node's local transform in f64, refused when not finite. A TRS rotation is
+/// normalised (exporters write slightly off unit quaternions); a zero one is refused.
+pub(super) fn local_matrix(node: &gltf::Node) -> Result<DMat4> {
+    let label = || node_label(node);
+    let finite = |v: &[f32]| v.iter().all(|c| c.is_finite());
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => {
+            if !matrix.iter().all(|c| finite(c)) {
+                bail!("{} has a non-finite matrix", label());
+            }
+            Ok(DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
+        }
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            for (what, ok) in [
+                ("translation", finite(&translation)),
+                ("rotation", finite(&rotation)),
+                ("scale", finite(&scale)),
+            ] {
+                if !ok {
+                    bail!("{} has a non-finite {what}", label());
+                }
+            }
+            let q = DQuat::from_array(rotation.map(f64::from));
+            let len = q.length();
+            if len <= 1e-12 {
+                bail!("{} has a zero rotation quaternion", label());
+            }
+            Ok(DMat4::from_scale_rotation_translation(
+                DVec3::from_array(scale.map(f64::from)),
+                q / len,
+                DVec3::from_array(translation.map(f64::from)),
+            ))
+        }
+    }
+}
+
+/// Each node's parent, after checking the hierarchy is what glTF requires (3.5.3):
+/// disjoint strict trees, no node its own ancestor, no node with two parents. Checked
+/// without recursion, so a chain of any depth is fine.
+pub(super) fn parents(nodes: &[gltf::Node]) -> Result<Vec<Option<usize>>> {
+    let mut parent: Vec<Option<usize>> = vec![None; nodes.len()];
+    for node in nodes {
+        for child in node.children() {
+            let c = child.index();
+            if c == node.index() {
+                bail!(
+                    "{} is its own child: the node graph has a cycle",
+                    node_label(node)
+                );
+            }
+            if let Some(p) = parent[c] {
+                bail!(
+                    "{} is a child of both node {p} and node {}: glTF node hierarchies must be trees",
+                    node_label(&child),
+                    node.index()
+                );
+            }
+            parent[c] = Some(node.index());
+        }
+    }
+    // With at most one parent each, a cycle is a parent chain that comes back to
+    // itself. 0: not seen, 1: on the chain being walked, 2: known to end at a root.
+    let mut state = vec![0u8; nodes.len()];
+    let mut walk = Vec::new();
+    for start in 0..nodes.len() {
+        walk.clear();
+        let mut cur = Some(start);
+        while let Some(c) = cur {
+            match state[c] {
+                2 => break,
+                1 => bail!(
+                    "{} is its own ancestor: the node graph has a cycle",
+                    node_label(&nodes[c])
+                ),
+                _ => {}
+            }
+            state[c] = 1;
+            walk.push(c);
+            cur = parent[c];
+        }
+        for &w in &walk {
+            state[w] = 2;
+        }
+    }
+    Ok(parent)
+}
+
+/// Appends a primitive placed by `world`: positions in f64 (kept apart for the
+/// recentring), normals, tangents and winding through the f32 linear part.
+pub(super) fn append_part(
+    mesh: &mut Mesh,
+    world_pos: &mut Vec<DVec3>,
+    part: &Part,
+    world: &DMat4,
+    node: &gltf::Node,
+) -> Result<()> {
+    let (v, t) = (part.mesh.vertices.len(), part.mesh.triangle_count());
+    if mesh.vertices.len() + v > MAX_VERTICES || mesh.triangle_count() + t > MAX_TRIANGLES {
+        bail!(
+            "the scene has more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (after instancing, at {})",
+            node_label(node)
+        );
+    }
+    let start = world_pos.len();
+    for vert in &part.mesh.vertices {
+        let p = world.transform_point3(DVec3::from_array(vert.position.map(f64::from)));
+        if !p.is_finite() || p.abs().max_element() > f32::MAX as f64 {
+            world_pos.truncate(start);
+            bail!(
+                "{}: its transform takes vertices beyond the f32 range",
+                node_label(node)
+            );
+        }
+        world_pos.push(p);
+    }
+    let linear = Mat4::from_mat3(DMat3::from_mat4(*world).as_mat3());
+    let mut placed = part.mesh.clone();
+    placed.transform(&linear);
+    mesh.append(&placed);
+    Ok(())
+}
+
+/// What the walk over the scene collected.
+pub(super) struct Collected {
+    pub(super) mesh: Mesh,
+    pub(super) world_pos: Vec<DVec3>,
+    pub(super) material: Option<usize>,
+    pub(super) with_uvs: usize,
+    pub(super) without_uvs: Vec<String>,
+}
+
+/// Walks the default scene (or the first, or every root node when there is none)
+/// without recursion, appending every triangle primitive in world space.
+pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
+    let nodes: Vec<gltf::Node> = src.doc.nodes().collect();
+    let parent = parents(&nodes)?;
+    let roots: Vec<usize> = match src.doc.default_scene().or_else(|| src.doc.scenes().next()) {
+        Some(scene) => {
+            let roots: Vec<usize> = scene.nodes().map(|n| n.index()).collect();
+            if let Some((&r, p)) = roots.iter().find_map(|r| parent[*r].map(|p| (r, p))) {
+                bail!(
+                    "scene {} lists {} as a root, but it is a child of node {p}",
+                    scene.index(),
+                    node_label(&nodes[r])
+                );
+            }
+            roots
+        }
+        None => (0..nodes.len()).filter(|&i| parent[i].is_none()).collect(),
+    };
+    let mut out = Collected {
+        mesh: Mesh::default(),
+        world_pos: Vec::new(),
+        material: None,
+        with_uvs: 0,
+        without_uvs: Vec::new(),
+    };
+    let mut parts: HashMap<(usize, usize), Option<Rc<Part>>> = HashMap::new();
+    let mut visited = vec![false; nodes.len()];
+    let mut stack: Vec<(usize, DMat4)> =
+        roots.iter().rev().map(|&r| (r, DMat4::IDENTITY)).collect();
+    while let Some((ni, parent_world)) = stack.pop() {
+        let node = &nodes[ni];
+        if std::mem::replace(&mut visited[ni], true) {
+            bail!(
+                "{} is listed twice among the scene's roots",
+                node_label(node)
+            );
+        }
+        let world = parent_world * local_matrix(node)?;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let key = (mesh.index(), prim.index());
+                let label = format!("{} primitive {}", mesh_label(&mesh), prim.index());
+                let part = match parts.get(&key) {
+                    Some(p) => p.clone(),
+                    None => {
+                        let p = read_primitive(src, &label, &prim, warn)?.map(Rc::new);
+                        parts.insert(key, p.clone());
+                        p
+                    }
+                };
+                let Some(part) = part else { continue };
+                append_part(&mut out.mesh, &mut out.world_pos, &part, &world, node)?;
+                if part.has_uvs {
+                    out.with_uvs += 1;
+                } else if !out.without_uvs.contains(&label) {
+                    out.without_uvs.push(label);
+                }
+                if out.material.is_none() {
+                    out.material = prim.material().index();
+                }
+            }
+        }
+        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
+    }
+    Ok(out)
+}
+
+/// Converts the f64 world positions into the mesh, moving the model to the origin when
+/// it lies so far from it that f32 would lose its shape (a scan georeferenced at 1e7).
+/// The centre and size come from robust bounds, so one corrupt far vertex neither
+/// triggers nor steers the move.
+pub(super) fn place(c: &mut Collected, warn: &mut Warnings) -> Result<()> {
+    let Some(rb) = robust_bounds_f64(&c.world_pos) else {
+        bail!("no vertices");
+    };
+    let size = rb.size().max_element();
+    if size == 0.0 {
+        let p = rb.min;
+        bail!(
+            "all {} vertices lie at one point ({}, {}, {}): nothing to draw",
+            c.world_pos.len(),
+            p.x,
+            p.y,
+            p.z
+        );
+    }
+    let centre = rb.center();
+    let shift = if centre.abs().max_element() > RECENTRE_RATIO * size {
+        warn.push(format!(
+            "the model lies at ({:e}, {:e}, {:e}), far from the origin for its size ({size:e}): moved to the origin to keep f32 precision",
+            centre.x, centre.y, centre.z
+        ));
+        centre
+    } else {
+        DVec3::ZERO
+    };
+    for (v, p) in c.mesh.vertices.iter_mut().zip(&c.world_pos) {
+        let q = (*p - shift).as_vec3();
+        if !q.is_finite() {
+            bail!("vertex positions exceed the f32 range");
+        }
+        v.position = q.into();
+    }
+    if rb.ignored > 0 {
+        let far = c
+            .world_pos
+            .iter()
+            .position(|p| p.cmplt(rb.min).any() || p.cmpgt(rb.max).any())
+            .unwrap_or(0);
+        let p = c.world_pos[far];
+        warn.push(format!(
+            "{} vertices lie far outside the rest of the mesh (vertex {far} at ({:e}, {:e}, {:e})): corrupt data? Left out of the camera's and the shadow map's framing",
+            rb.ignored, p.x, p.y, p.z
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::gltf_load::tests::{attrs, bytes_f32, load_err, quad_file, temp_dir};
+    use crate::scene::gltf_load::{load_head, load_head_with_warnings};
+    use glam::Vec3;
+
+    #[test]
+    fn node_cycles_are_refused_and_deep_chains_load() {
+        let dir = temp_dir("nodes");
+        let prim = serde_json::json!({"attributes": attrs()});
+        let own_child = serde_json::json!([{"mesh": 0, "children": [0]}]);
+        let p = quad_file(
+            &dir,
+            "own.gltf",
+            prim.clone(),
+            serde_json::json!([]),
+            &[],
+            Some(own_child),
+        );
+        let e = load_err(&p);
+        assert!(
+            e.contains("node 0 is its own child: the node graph has a cycle"),
+            "{e}"
+        );
+        // A loop of two: 0 -> 1 -> 0.
+        let cycle = serde_json::json!([{"children": [1]}, {"mesh": 0, "children": [0]}]);
+        let p = quad_file(
+            &dir,
+            "cycle.gltf",
+            prim.clone(),
+            serde_json::json!([]),
+            &[],
+            Some(cycle),
+        );
+        let e = load_err(&p);
+        assert!(
+            e.contains("node 0 is its own ancestor: the node graph has a cycle"),
+            "{e}"
+        );
+        // A 17,500-deep chain overflowed the stack of the recursive walk.
+        const DEPTH: usize = 17_500;
+        let chain: Vec<serde_json::Value> = (0..DEPTH)
+            .map(|i| {
+                if i + 1 < DEPTH {
+                    serde_json::json!({"children": [i + 1], "translation": [0.0, 0.001, 0.0]})
+                } else {
+                    serde_json::json!({"mesh": 0})
+                }
+            })
+            .collect();
+        let p = quad_file(
+            &dir,
+            "deep.gltf",
+            prim,
+            serde_json::json!([]),
+            &[],
+            Some(chain.into()),
+        );
+        let obj = load_head(&p, &Default::default()).unwrap();
+        assert!((obj.mesh.bounds().min.y - 0.001 * (DEPTH - 1) as f32).abs() < 1e-2);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn far_from_origin_is_recentred_and_lost_precision_refused() {
+        let dir = temp_dir("far");
+        // A node translation of 1e8 (f32 steps of 8 there) used to collapse the quad.
+        let nodes = serde_json::json!([{"mesh": 0, "translation": [1e8, 1e8, -1e8]}]);
+        let p = quad_file(
+            &dir,
+            "node.gltf",
+            serde_json::json!({"attributes": attrs()}),
+            serde_json::json!([]),
+            &[],
+            Some(nodes),
+        );
+        let (obj, w) = load_head_with_warnings(&p, &Default::default()).unwrap();
+        let b = obj.mesh.bounds();
+        assert_eq!(b.size(), Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(b.center(), Vec3::ZERO);
+        assert!(w.iter().any(|w| w.contains("moved to the origin")), "{w:?}");
+        // Positions stored at 1e7 in the buffer: the shape is gone in the file itself.
+        let far = bytes_f32(&[
+            1e7,
+            1e7,
+            0.0,
+            1e7 + 1.0,
+            1e7,
+            0.0,
+            1e7 + 1.0,
+            1e7 + 1.0,
+            0.0,
+            1e7,
+            1e7 + 1.0,
+            0.0,
+        ]);
+        let mut a = attrs();
+        a["POSITION"] = serde_json::json!(3);
+        let p = quad_file(
+            &dir,
+            "buf.gltf",
+            serde_json::json!({"attributes": a}),
+            serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}]),
+            &far,
+            None,
+        );
+        let e = load_err(&p);
+        assert!(
+            e.contains("but span only 1e0, fewer than 16 f32 steps"),
+            "{e}"
+        );
+        // One vertex at 1e31 (a flipped exponent bit) loads, with a warning.
+        let out = bytes_f32(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1e31, 0.0]);
+        let p = quad_file(
+            &dir,
+            "outlier.gltf",
+            serde_json::json!({"attributes": a}),
+            serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}]),
+            &out,
+            None,
+        );
+        let (_, w) = load_head_with_warnings(&p, &Default::default()).unwrap();
+        assert!(
+            w.iter().any(|w| w.contains("1 vertices lie far outside")),
+            "{w:?}"
+        );
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
