@@ -1,0 +1,350 @@
+//! The ground truth's per-frame passes: the samples' radiance, the
+//! supersampled surface, the narrow part, the accumulators' clear, the wide
+//! Gaussians' gather (one pass per chunk and slab) and the resolve.
+
+use ash::vk;
+
+use super::{Reference, GATHER_SHADER, GROUP, NARROW_SHADER, RESOLVE_SHADER, SURFACE_SHADER};
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
+use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext};
+use crate::method::screen::fetch;
+use crate::method::FrameView;
+use crate::reference::chunks::RADIANCE_WIDTH;
+use crate::reference::sampling::SurfaceSample;
+use crate::shader_constants::{NARROW_GAUSSIANS as NARROW, PCF_TRIPS, WIDE_GAUSSIANS};
+use crate::vk::barrier::AccessKind;
+use crate::vk::shader_stats::alu_estimate;
+
+/// Push constants of the surface pass (geometry.vert's model, then the frag's scale).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct SurfacePush {
+    model: [[f32; 4]; 4],
+    mm_per_subsample_per_depth: f32,
+}
+
+/// Push constants of the gather: the slab, and the chunk's range of samples.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GatherPush {
+    dy: i32,
+    dz: i32,
+    first: u32,
+    count: u32,
+}
+
+impl Reference {
+    /// The radiance pass: every chunk's samples lit, one draw per range.
+    pub(super) fn irradiance_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let lit = "reference_irradiance.frag";
+        let shader = ShaderWork {
+            shader: lit.into(),
+            // The texels past the last sample of a chunk's last row return
+            // before shading: every count is a bound.
+            fetches: vec![
+                Fetch {
+                    exact: false,
+                    ..fetch(
+                        f.res,
+                        f.targets.shadow,
+                        "shadowMap",
+                        Filter::DepthCompare,
+                        9.0,
+                    )
+                },
+                // Material textures are not frame images: RGBA8 bilinear.
+                material_fetch("normalTex"),
+                material_fetch("albedoTex"),
+            ],
+            alu: alu_estimate(lit, &PCF_TRIPS),
+            storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
+            storage_write_bytes: 0.0,
+        };
+        let draws: u64 = self
+            .chunks
+            .iter()
+            .map(|c| c.count.div_ceil(self.draw_samples) as u64)
+            .sum();
+        // Each chunk's radiance target is rendered alone (its rows stacked in
+        // the work's area), every texel of it overwritten.
+        let mut pass = Pass::new("reference irradiance", PassRole::Sss)
+            .sampled(f.targets.shadow)
+            .each_target_alone();
+        for c in &self.chunks {
+            pass = pass
+                .buffer(c.buffer_ids[0], AccessKind::FragmentStorageRead)
+                .color(ColorTarget::new(c.radiance, Load::DontCare));
+        }
+        pass.draws(Some(shader), draws)
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let c = &self.chunks[pc.target];
+                let p = &self.irradiance;
+                p.bind(ctx, cmd, &[]);
+                p.bind_sets(ctx, cmd, 1, &[self.material_set]);
+                for &(set, first, n) in &c.draws {
+                    let first_row = first / RADIANCE_WIDTH;
+                    let scissor = vk::Rect2D {
+                        offset: vk::Offset2D {
+                            x: 0,
+                            y: first_row as i32,
+                        },
+                        extent: vk::Extent2D {
+                            width: RADIANCE_WIDTH,
+                            height: n.div_ceil(RADIANCE_WIDTH),
+                        },
+                    };
+                    p.bind_sets(ctx, cmd, 0, &[set]);
+                    unsafe { ctx.device.cmd_set_scissor(cmd, 0, &[scissor]) };
+                    p.push(ctx, cmd, &[n, RADIANCE_WIDTH, first_row]);
+                    unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+                }
+            })
+    }
+
+    /// The visible skin at s x the frame's resolution: radiance, position and
+    /// area, normal (the narrow part's input).
+    pub(super) fn surface_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let sf = &self.surf;
+        let shadow = fetch(
+            f.res,
+            f.targets.shadow,
+            "shadowMap",
+            Filter::DepthCompare,
+            9.0,
+        );
+        let albedo = Fetch {
+            exact: true,
+            ..material_fetch("albedoTex")
+        };
+        let work = ShaderWork {
+            shader: SURFACE_SHADER.into(),
+            fetches: vec![shadow, material_fetch("normalTex"), albedo],
+            alu: alu_estimate(SURFACE_SHADER, &PCF_TRIPS),
+            ..Default::default()
+        };
+        // The three subsample targets and the depth start cleared.
+        let clear = |t| ColorTarget::new(t, Load::Clear([0.0; 4]));
+        Pass::new("reference surface", PassRole::Sss)
+            .sampled(f.targets.shadow)
+            .color(clear(sf.radiance))
+            .color(clear(sf.position))
+            .color(clear(sf.normal))
+            .depth_stencil(DepthStencil::cleared(sf.depth, 1.0))
+            .draws(
+                Some(work),
+                sf.index_count as u64 / 3 * self.instances.len() as u64,
+            )
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.surface_pipeline;
+                p.bind(ctx, cmd, &[self.frame_set, self.surf_material]);
+                unsafe {
+                    ctx.device
+                        .cmd_bind_vertex_buffers(cmd, 0, &[self.surf.vertices.raw], &[0]);
+                    ctx.device.cmd_bind_index_buffer(
+                        cmd,
+                        self.surf.indices.raw,
+                        0,
+                        vk::IndexType::UINT32,
+                    );
+                }
+                for m in &self.instances {
+                    p.push(
+                        ctx,
+                        cmd,
+                        &SurfacePush {
+                            model: m.to_cols_array_2d(),
+                            mm_per_subsample_per_depth: self.surf.mm_per_subsample_per_depth,
+                        },
+                    );
+                    unsafe {
+                        ctx.device
+                            .cmd_draw_indexed(cmd, self.surf.index_count, 1, 0, 0, 0)
+                    };
+                }
+            })
+    }
+
+    /// Zeroes the wide Gaussians' accumulators before the gather adds to them.
+    pub(super) fn clear_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let accum = self.accum;
+        let e = f.extent;
+        let mut pass = Pass::new("reference clear", PassRole::Sss).work(Work::Clear {
+            texels: 3 * e.width as u64 * e.height as u64,
+            bytes_per_texel: 16,
+        });
+        for a in accum {
+            pass = pass.image(a, AccessKind::ClearWrite);
+        }
+        pass.record(move |pc: &PassContext| {
+            let range = vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(1)
+                .layer_count(1);
+            for a in accum {
+                unsafe {
+                    pc.ctx.device.cmd_clear_color_image(
+                        pc.cmd,
+                        pc.image(a).raw,
+                        pc.layout(a),
+                        &vk::ClearColorValue::default(),
+                        &[range],
+                    )
+                };
+            }
+        })
+    }
+
+    /// The wide Gaussians, each over its weight, added to the narrow part.
+    pub(super) fn resolve_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let t = f.targets;
+        let extent = f.extent;
+        let work = ShaderWork {
+            shader: RESOLVE_SHADER.into(),
+            fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
+            alu: alu_estimate(RESOLVE_SHADER, &[WIDE_GAUSSIANS as u32]),
+            storage_read_bytes: 64.0,
+            storage_write_bytes: 16.0,
+        };
+        let set = self.resolve_set;
+        let mut pass = Pass::new("reference resolve", PassRole::Sss)
+            .image(t.diffuse, AccessKind::ComputeSampledRead)
+            .image(self.out, AccessKind::ComputeStorageReadWrite);
+        for a in self.accum {
+            pass = pass.image(a, AccessKind::ComputeStorageRead);
+        }
+        pass.dispatch(work, screen_groups(extent), GROUP * GROUP)
+            .record(move |pc: &PassContext| self.resolve.bind(pc.ctx, pc.cmd, &[set]))
+    }
+
+    /// The narrow part, written into the output for every pixel.
+    pub(super) fn narrow_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
+        let t = f.targets;
+        let sf = &self.surf;
+        let extent = f.extent;
+        let side = (2 * sf.max_radius + 1) as f64;
+        let window = side * side;
+        let bound = |image, texture: &str, count| Fetch {
+            exact: false,
+            ..fetch(f.res, image, texture, Filter::Point, count)
+        };
+        let work = ShaderWork {
+            shader: NARROW_SHADER.into(),
+            fetches: vec![
+                fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
+                bound(t.linear_depth, "depthTex", 1.0),
+                bound(sf.normal, "surfNormal", 1.0 + window),
+                bound(sf.position, "surfPosition", window),
+                bound(sf.radiance, "surfRadiance", window + 1.0),
+            ],
+            alu: alu_estimate(
+                NARROW_SHADER,
+                &[side as u32, side as u32, NARROW as u32, NARROW as u32],
+            ),
+            storage_write_bytes: 16.0,
+            ..Default::default()
+        };
+        let set = self.narrow_set;
+        Pass::new("reference narrow", PassRole::Sss)
+            .image(t.diffuse, AccessKind::ComputeSampledRead)
+            .image(t.linear_depth, AccessKind::ComputeSampledRead)
+            .image(sf.radiance, AccessKind::ComputeSampledRead)
+            .image(sf.position, AccessKind::ComputeSampledRead)
+            .image(sf.normal, AccessKind::ComputeSampledRead)
+            .image(self.out, AccessKind::ComputeStorageWrite)
+            .dispatch(work, screen_groups(extent), GROUP * GROUP)
+            .record(move |pc: &PassContext| self.narrow.bind(pc.ctx, pc.cmd, &[set]))
+    }
+
+    /// Slab `k` (of the 9) of the wide Gaussians' gather over chunk `ci`'s
+    /// samples, added to the accumulators.
+    pub(super) fn gather_pass<'a>(&'a self, f: &FrameView<'a, '_>, ci: usize, k: i32) -> Pass<'a> {
+        let t = f.targets;
+        let groups = screen_groups(f.extent);
+        let one = self.chunks.len() == 1;
+        let c = &self.chunks[ci];
+        // Every slab adds to the narrow part.
+        let out_access = AccessKind::ComputeStorageReadWrite;
+        let name = if one {
+            format!("reference gather {}/9", k + 1)
+        } else {
+            format!(
+                "reference gather chunk {}/{} {}/9",
+                ci + 1,
+                self.chunks.len(),
+                k + 1
+            )
+        };
+        let candidates = self.max_candidates as f64;
+        let work = ShaderWork {
+            shader: GATHER_SHADER.into(),
+            fetches: vec![
+                fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
+                Fetch {
+                    exact: false,
+                    ..fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0)
+                },
+                Fetch {
+                    exact: false,
+                    ..fetch(f.res, self.surf.normal, "surfNormal", Filter::Point, 1.0)
+                },
+                Fetch {
+                    exact: false,
+                    ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
+                },
+            ],
+            alu: alu_estimate(
+                GATHER_SHADER,
+                &[3, self.max_candidates.div_ceil(3), WIDE_GAUSSIANS as u32],
+            ),
+            // Positions and normals of the candidates, cell ranges, the output.
+            storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
+            storage_write_bytes: 48.0,
+        };
+        let push = GatherPush {
+            dy: k % 3 - 1,
+            dz: k / 3 - 1,
+            first: c.first,
+            count: c.count,
+        };
+        let set = c.gather_set;
+        Pass::new(name, PassRole::Sss)
+            .image(t.diffuse, AccessKind::ComputeSampledRead)
+            .image(t.linear_depth, AccessKind::ComputeSampledRead)
+            .image(c.radiance, AccessKind::ComputeSampledRead)
+            .image(self.surf.normal, AccessKind::ComputeSampledRead)
+            .image(self.accum[0], out_access)
+            .image(self.accum[1], out_access)
+            .image(self.accum[2], out_access)
+            .buffer(c.buffer_ids[1], AccessKind::ComputeStorageRead)
+            .buffer(c.buffer_ids[2], AccessKind::ComputeStorageRead)
+            .buffer(self.cells_id, AccessKind::ComputeStorageRead)
+            .dispatch(work, groups, GROUP * GROUP)
+            .record(move |pc: &PassContext| {
+                self.gather.bind(pc.ctx, pc.cmd, &[set]);
+                self.gather.push(pc.ctx, pc.cmd, &push);
+            })
+    }
+}
+
+/// The workgroups of a dispatch over every pixel of `extent`.
+fn screen_groups(extent: vk::Extent2D) -> [u32; 3] {
+    [
+        extent.width.div_ceil(GROUP),
+        extent.height.div_ceil(GROUP),
+        1,
+    ]
+}
+
+/// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
+fn material_fetch(texture: &str) -> Fetch {
+    Fetch {
+        texture: texture.into(),
+        format: Format::Rgba8Unorm,
+        filter: Filter::Bilinear,
+        count: 1.0,
+        exact: false,
+        coherent: true,
+    }
+}
