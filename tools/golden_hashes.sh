@@ -61,7 +61,8 @@ PY
     echo "done: $scene $name" >&2
   done
   # Budget figures: every method priced on two targets. Measured times (the only thing
-  # allowed to move) are dropped; every modelled figure, count and resolve is kept.
+  # allowed to move) are dropped; every modelled figure, count and resolve is kept;
+  # the two shaders renamed in issue 15 are hashed under their old names.
   d=$tmp/budget
   rm -rf "$d"
   "$B" budget "${common[@]}" "${sargs[@]}" \
@@ -74,6 +75,11 @@ def strip(v):
         return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}
     if isinstance(v, list):
         return [strip(x) for x in v]
+    if isinstance(v, str):
+        # Shaders renamed after their method in issue 15: their old names, so the
+        # figures are compared and not the spelling of a file name.
+        return v.replace("separable_blur.frag", "sss_blur.frag").replace(
+            "poisson_mip_down.frag", "mip_down.frag")
     return v
 d = pathlib.Path(sys.argv[1])
 for f in [d / "budget.json"] + sorted((d / "frames").glob("*.json")):
