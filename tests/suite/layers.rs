@@ -469,7 +469,8 @@ fn shaders_are_named_after_their_owner() {
     let methods: Vec<String> = std::fs::read_dir(src().join("method"))
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "rs"))
+        // A method is a file or a folder with its own mod.rs (tsd/, reference/).
+        .filter(|p| p.extension().is_some_and(|x| x == "rs") || p.join("mod.rs").is_file())
         .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
         .filter(|m| !["mod", "options", "region", "screen", "none"].contains(&m.as_str()))
         .collect();

@@ -295,6 +295,16 @@ impl Config {
     }
 }
 
+/// std140 layout of `CharacterUniforms` (tsd_character.glsl, tsd_final.frag).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct CharacterUniforms {
+    model: [[f32; 4]; 4],
+    planes: [[f32; 4]; 6],
+    params: [f32; 4],
+    map_info: [f32; 4],
+}
+
 /// One character: where it stands, what the optimisations decided for it, its map.
 #[derive(Clone, Debug)]
 pub struct Character {

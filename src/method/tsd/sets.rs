@@ -5,8 +5,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::setup::CharacterUniforms;
-use super::{Cull, Tsd, CHARACTER_STRIDE, MAX_ISLANDS};
+use super::{CharacterUniforms, Cull, Tsd, CHARACTER_STRIDE, MAX_ISLANDS};
 use crate::graph::ImageId;
 use crate::method::MethodBind;
 use crate::vk::pipeline::{Bind, Pipeline};

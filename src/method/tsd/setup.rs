@@ -10,8 +10,8 @@ use glam::Vec4;
 use super::pipelines::{make_pipelines, Pipelines};
 use super::sets::SharedSets;
 use super::{
-    square, uv_max, Character, Config, Cull, Maps, Tsd, CHARACTER_STRIDE, MAP_FORMAT, MAX_ISLANDS,
-    STRETCH_FORMAT,
+    square, uv_max, Character, CharacterUniforms, Config, Cull, Maps, Tsd, CHARACTER_STRIDE,
+    MAP_FORMAT, MAX_ISLANDS, STRETCH_FORMAT,
 };
 use crate::graph::mesh::GpuMesh;
 use crate::graph::{ImageDesc, Resources};
@@ -24,16 +24,6 @@ use crate::skin::tsd::{
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::DescriptorPool;
-
-/// std140 layout of `CharacterUniforms` (tsd_character.glsl, tsd_final.frag).
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct CharacterUniforms {
-    model: [[f32; 4]; 4],
-    planes: [[f32; 4]; 6],
-    params: [f32; 4],
-    map_info: [f32; 4],
-}
 
 impl Tsd {
     pub(super) fn new(s: &mut MethodSetup, optimised: bool) -> Result<Self> {
