@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Arg, ArgAction, ArgMatches, Args, Parser, Subcommand, ValueEnum};
+use clap::{
+    Arg, ArgAction, ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum,
+};
 
 use dermis::budget::run::BudgetOptions;
 use dermis::budget::Rescale;
@@ -555,7 +557,13 @@ fn warn_foreign(s: &RenderSettings) {
 }
 
 fn main_result() -> Result<()> {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let Some((name, sub)) = matches.subcommand() {
+        for note in ignored_options(name, sub) {
+            eprintln!("note: {note}");
+        }
+    }
     match cli.command {
         Command::Render {
             common,
@@ -801,6 +809,30 @@ fn budget(common: &Common, opts: &BudgetOptions) -> Result<()> {
         opts.out.display()
     );
     Ok(())
+}
+
+/// The options a command was given on its command line and does not read,
+/// each named in a note (their values are still checked), so a command line
+/// never silently means less than it says.
+fn ignored_options(command: &str, m: &ArgMatches) -> Vec<String> {
+    let given = |id: &str| {
+        matches!(m.try_contains_id(id), Ok(true))
+            && m.value_source(id) == Some(clap::parser::ValueSource::CommandLine)
+    };
+    let mut notes = Vec::new();
+    if given("shot") && given("distance") {
+        notes.push("--shot is ignored: --distance gives the camera distance".to_string());
+    }
+    let method_ignored = match command {
+        "reference" => Some("reference renders the ground truth"),
+        "eval" => Some("eval sweeps every registered method"),
+        "budget" if given("compare_methods") => Some("--compare-methods prices every method"),
+        _ => None,
+    };
+    if let (Some(why), true) = (method_ignored, given("method")) {
+        notes.push(format!("--method is ignored: {why}"));
+    }
+    notes
 }
 
 fn main() -> ExitCode {

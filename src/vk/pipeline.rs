@@ -4,6 +4,7 @@
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 
+use super::barrier::AccessKind;
 use super::context::Context;
 use super::error::Error;
 use super::guard::{Destroy, Guard};
@@ -570,13 +571,14 @@ impl DescriptorPool {
                         vk::DescriptorImageInfo {
                             sampler: vk::Sampler::null(),
                             image_view: *view,
-                            // Storage images are accessed in GENERAL (see vk::barrier).
+                            // The layout the access table gives the kind of
+                            // access this descriptor makes (stated once there).
                             image_layout: if info.descriptor_type
                                 == vk::DescriptorType::STORAGE_IMAGE
                             {
-                                vk::ImageLayout::GENERAL
+                                AccessKind::ComputeStorageReadWrite.info().layout
                             } else {
-                                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL
+                                AccessKind::FragmentSampledRead.info().layout
                             },
                         },
                     ));

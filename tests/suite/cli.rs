@@ -175,6 +175,47 @@ fn missing_devices() {
 }
 
 #[test]
+fn ignored_options_are_named() {
+    // --shot beside --distance, and --method for the ground truth: each named
+    // in a note, the run going on as the command line says.
+    let d = tmp("ignored");
+    let o = dermis()
+        .args([
+            "reference",
+            "--validate",
+            "--device",
+            "llvmpipe",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--method",
+            "ssg",
+            "--shot",
+            "close",
+            "--distance",
+            "3",
+            "--density",
+            "1",
+            "--out",
+        ])
+        .arg(&d)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("note: --shot is ignored: --distance gives the camera distance"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("note: --method is ignored: reference renders the ground truth"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(d);
+}
+
+#[test]
 fn render_writes_png_report_and_dumps() {
     let d = tmp("good");
     let o = dermis()
