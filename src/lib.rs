@@ -27,6 +27,7 @@ pub mod eval;
 pub mod files;
 pub mod graph;
 pub mod method;
+pub mod mix;
 pub mod output;
 pub mod plot;
 pub mod reference;

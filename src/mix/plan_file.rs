@@ -1,0 +1,199 @@
+//! `plan.json`: what `dermis plan` chose for each character of a scene, with
+//! its predictions, and what `render --plan` reads back (through the files
+//! door, checked against the registry and the frame before any device opens).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{bail, Context as _, Result};
+use serde::{Deserialize, Serialize};
+
+use super::{Choice, Mix};
+use crate::files::{read_text, MAX_TEXT_FILE};
+
+/// The plan file format's version (bumped on an incompatible change).
+pub const PLAN_VERSION: u32 = 1;
+
+/// A predicted error against the ground truth, as a fraction of the error of
+/// no SSS (the eval's bands).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PredictedError {
+    pub interior: f64,
+    pub silhouette: f64,
+}
+
+/// One character's entry.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannedCharacter {
+    /// Frame index (the order of `Framing::instances`; 0 is the front character).
+    pub character: usize,
+    pub method: String,
+    #[serde(default)]
+    pub options: BTreeMap<String, String>,
+    /// The eval setting the options are, when they are one (the accuracy model's key).
+    #[serde(default)]
+    pub setting: Option<String>,
+    /// What the planner saw and predicted (absent in a hand-written plan).
+    #[serde(default)]
+    pub px_per_mm: Option<f64>,
+    #[serde(default)]
+    pub skin_pixels: Option<u64>,
+    #[serde(default)]
+    pub predicted_ms: Option<f64>,
+    #[serde(default)]
+    pub predicted_error: Option<PredictedError>,
+}
+
+/// A whole plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanFile {
+    pub version: u32,
+    /// The profile and skin budget planned for (absent in a hand-written plan).
+    #[serde(default)]
+    pub profile: Option<String>,
+    #[serde(default)]
+    pub budget_ms: Option<f64>,
+    /// The number of characters of the scene planned for.
+    pub characters: usize,
+    pub assignments: Vec<PlannedCharacter>,
+    /// Predicted skin-SSS time on the profile and skin-area-weighted error.
+    #[serde(default)]
+    pub predicted_ms: Option<f64>,
+    #[serde(default)]
+    pub predicted_error: Option<PredictedError>,
+    /// Anything the planner wants to say about its choice (the algorithm, its bound).
+    #[serde(default)]
+    pub notes: Vec<String>,
+}
+
+impl PlanFile {
+    /// Reads and checks `path` (a plan for any frame: [`PlanFile::mix`] checks
+    /// it against one).
+    pub fn load(path: &Path) -> Result<PlanFile> {
+        let text = read_text(path, "plan file", MAX_TEXT_FILE)?;
+        let plan: PlanFile = serde_json::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("plan file {}: not a plan", path.display()))?;
+        plan.check()
+            .with_context(|| format!("plan file {}", path.display()))?;
+        Ok(plan)
+    }
+
+    /// The checks that need no frame: version, each character once, every
+    /// method and option known to the registry.
+    pub fn check(&self) -> Result<()> {
+        if self.version != PLAN_VERSION {
+            bail!(
+                "version {} (this dermis reads version {PLAN_VERSION})",
+                self.version
+            );
+        }
+        let mut seen = vec![false; self.characters];
+        for a in &self.assignments {
+            if a.character >= self.characters {
+                bail!(
+                    "character {} does not exist (the plan is for {} characters: 0-{})",
+                    a.character,
+                    self.characters,
+                    self.characters.saturating_sub(1)
+                );
+            }
+            if std::mem::replace(&mut seen[a.character], true) {
+                bail!("character {} is assigned twice", a.character);
+            }
+            Choice::new(&a.method, a.options.clone())
+                .with_context(|| format!("character {}", a.character))?;
+        }
+        if let Some(missing) = seen.iter().position(|s| !s) {
+            bail!("character {missing} has no assignment");
+        }
+        if let Some(b) = self.budget_ms {
+            if !(b.is_finite() && b > 0.0) {
+                bail!("budget_ms {b} is not a positive time");
+            }
+        }
+        Ok(())
+    }
+
+    /// The mix for a frame of `characters` characters: an error unless the
+    /// plan was made for that many.
+    pub fn mix(&self, characters: usize) -> Result<Mix> {
+        if characters != self.characters {
+            bail!(
+                "the plan is for {} characters, the scene has {characters} (give --heads {})",
+                self.characters,
+                self.characters
+            );
+        }
+        let mut choices = vec![Choice::none(); characters];
+        for a in &self.assignments {
+            choices[a.character] = Choice::new(&a.method, a.options.clone())?;
+        }
+        Ok(Mix { choices })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(json: &str) -> Result<PlanFile> {
+        let p: PlanFile = serde_json::from_str(json).map_err(|e| anyhow::anyhow!("{e}"))?;
+        p.check()?;
+        Ok(p)
+    }
+
+    const GOOD: &str = r#"{"version":1,"characters":2,"assignments":[
+        {"character":1,"method":"none"},
+        {"character":0,"method":"ssg","options":{"fit":"4"},"setting":"4 Gaussians, LOD"}]}"#;
+
+    #[test]
+    fn a_plan_round_trips_into_a_mix() {
+        let p = plan(GOOD).unwrap();
+        let mix = p.mix(2).unwrap();
+        assert_eq!(mix.choices[0].label(), "ssg:fit=4");
+        assert!(mix.choices[1].is_none());
+        let again: PlanFile = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(again, p);
+        let e = p.mix(3).unwrap_err().to_string();
+        assert!(
+            e.contains("the plan is for 2 characters, the scene has 3"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn malformed_plans_are_one_line_errors() {
+        for (json, want) in [
+            (GOOD.replace("\"version\":1", "\"version\":2"), "version 2"),
+            (GOOD.replace("\"ssg\"", "\"ssgg\""), "unknown method 'ssgg'"),
+            (
+                GOOD.replace("\"fit\"", "\"samples\""),
+                "ssg has no option 'samples'",
+            ),
+            (
+                GOOD.replace("\"character\":1", "\"character\":5"),
+                "character 5 does not exist",
+            ),
+            (
+                GOOD.replace("\"character\":1", "\"character\":0"),
+                "assigned twice",
+            ),
+            (
+                GOOD.replace("\"characters\":2", "\"characters\":3"),
+                "character 2 has no assignment",
+            ),
+            (
+                GOOD.replace("\"method\":\"none\"", "\"methd\":\"none\""),
+                "unknown field",
+            ),
+            ("{\"version\":1".to_string(), "EOF"),
+        ] {
+            let e = format!("{:#}", plan(&json).unwrap_err());
+            assert!(e.contains(want), "{json}: {e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
+}
