@@ -21,6 +21,8 @@ use dermis::method::{
     all_options, foreign_options, ground_truth, listing, listing_text, lookup, MethodOptions,
     OptKind,
 };
+use dermis::mix::plan_file::PlanFile;
+use dermis::render::settings::Assignment;
 use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
 use dermis::scene::camera::Camera;
@@ -63,6 +65,10 @@ enum Command {
         /// Also write every pass output as linear EXR under DIR/passes/.
         #[arg(long)]
         dump: bool,
+        /// Also write DIR/characters.png (16-bit grey: 0 no skin, i+1 character i) from
+        /// an extra pass after the frame (the frame's images are unchanged).
+        #[arg(long)]
+        character_ids: bool,
         /// Also write the measured frames' per-pass timeline (GPU timestamps, barriers
         /// as their own slices) as Chrome trace-event JSON, for Perfetto or chrome://tracing.
         #[arg(long, value_name = "FILE.json")]
@@ -360,6 +366,16 @@ struct Common {
     /// SSS method, by name or alias (`dermis methods` lists them with their options).
     #[arg(long, default_value_t = defaults().method.name.to_string())]
     method: String,
+    /// A method per character: rules `SELECTOR=METHOD[:key=value...]`, comma-separated,
+    /// the first match wins; SELECTOR is *, N, A-B (character indices) or dA-[B] (camera
+    /// distance in head heights). E.g. 0=ssg:fit=4,1-8=separable:preset=physical,*=none.
+    /// --method and the method flags are then ignored.
+    #[arg(long, value_name = "RULES", conflicts_with = "plan")]
+    assign: Option<String>,
+    /// A method per character from a plan file (what `dermis plan` writes); --method and
+    /// the method flags are then ignored.
+    #[arg(long, value_name = "FILE.json")]
+    plan: Option<PathBuf>,
     #[command(flatten)]
     method_options: MethodArgs,
     /// Transmittance T(s).
@@ -484,9 +500,15 @@ impl Common {
                 Shot::Mid => 2.0 * close,
                 Shot::Far => 5.0 * close,
             });
+        let assignment = match (&self.assign, &self.plan) {
+            (Some(rules), _) => Some(Assignment::Rules(rules.parse()?)),
+            (None, Some(path)) => Some(Assignment::Plan(PlanFile::load(path)?)),
+            (None, None) => None,
+        };
         let mut s = RenderSettings {
             width: self.width,
             height: self.height,
+            assignment,
             method: lookup(&self.method)?,
             options: self.method_options.0.clone(),
             transmittance: !self.no_transmittance,
@@ -551,6 +573,10 @@ fn command_line() -> String {
 
 /// Says which given options the chosen method does not read.
 fn warn_foreign(s: &RenderSettings) {
+    // With --assign/--plan no --method is read (ignored_options says so).
+    if s.assignment.is_some() {
+        return;
+    }
     for f in foreign_options(s.method, &s.options) {
         eprintln!("note: {f} does not apply to --method {}", s.method.name);
     }
@@ -569,12 +595,16 @@ fn main_result() -> Result<()> {
             common,
             out,
             dump,
+            character_ids,
             trace,
             warmup,
             frames,
         } => {
             dermis::run::check_frame_counts(warmup, frames)?;
-            let settings = common.settings()?;
+            let settings = RenderSettings {
+                character_ids,
+                ..common.settings()?
+            };
             warn_foreign(&settings);
             render(
                 &common,
@@ -589,6 +619,8 @@ fn main_result() -> Result<()> {
         Command::Reference { common, out } => {
             let settings = RenderSettings {
                 method: ground_truth(),
+                // --assign/--plan are ignored here (a note says so).
+                assignment: None,
                 ..common.settings()?
             };
             warn_foreign(&settings);
@@ -685,7 +717,11 @@ fn main_result() -> Result<()> {
 /// `dermis eval`: the sweep, its summary table and the files it wrote.
 fn eval(common: &Common, out: &Path, scenes: &str, warmup: usize, frames: usize) -> Result<()> {
     dermis::run::check_frame_counts(warmup, frames)?;
-    let base = common.settings()?;
+    // --assign/--plan are ignored by eval (a note says so).
+    let base = RenderSettings {
+        assignment: None,
+        ..common.settings()?
+    };
     let specs = study::scene_set(scenes, common.scene.as_deref(), &base)?;
     dermis::output::prepare_out_dir(out)?;
     let ctx = common.context()?;
@@ -723,6 +759,7 @@ fn bench(
     let settings = common.settings()?;
     warn_foreign(&settings);
     let scene = common.scene()?;
+    dermis::render::groups::group_specs(&scene, &settings)?;
     let ctx = common.context()?;
     let opts = RunOptions {
         warmup,
@@ -765,6 +802,7 @@ fn render(
         dermis::output::prepare_file(t)?;
     }
     let scene = common.scene()?;
+    dermis::render::groups::group_specs(&scene, &settings)?;
     let ctx = common.context()?;
     let opts = RunOptions {
         warmup,
@@ -783,6 +821,7 @@ fn render(
     let r = output.report;
     println!("{}", header(&r));
     print!("{}", dermis::report::table(&r.passes, r.frame.as_ref()));
+    print!("{}", dermis::report::groups_table(&r.groups));
     println!(
         "wrote {}, {} and {}",
         out.join("frame.png").display(),
@@ -801,6 +840,7 @@ fn budget(common: &Common, opts: &BudgetOptions) -> Result<()> {
         warn_foreign(&settings);
     }
     let scene = common.scene()?;
+    dermis::render::groups::group_specs(&scene, &settings)?;
     let r = dermis::budget::run::budget(&common.context_desc(), &scene, &settings, opts)?;
     println!(
         "priced {} method(s) on {} profile(s); wrote budget.json, frames/, budget.png and budget.svg in {}",
@@ -831,6 +871,28 @@ fn ignored_options(command: &str, m: &ArgMatches) -> Vec<String> {
     };
     if let (Some(why), true) = (method_ignored, given("method")) {
         notes.push(format!("--method is ignored: {why}"));
+    }
+    let assigned = ["assign", "plan"].into_iter().find(|a| given(a));
+    let assign_ignored = match command {
+        "reference" => Some("reference renders the ground truth"),
+        "eval" => Some("eval sweeps every registered method"),
+        "budget" if given("compare_methods") => Some("--compare-methods prices every method"),
+        _ => None,
+    };
+    match (assigned, assign_ignored) {
+        (Some(a), Some(why)) => notes.push(format!("--{a} is ignored: {why}")),
+        (Some(a), None) => {
+            let why = format!("--{a} gives each character its method");
+            if given("method") {
+                notes.push(format!("--method is ignored: {why}"));
+            }
+            for (_, o) in all_options() {
+                if given(o.key) {
+                    notes.push(format!("--{} is ignored: {why}", o.flag()));
+                }
+            }
+        }
+        _ => {}
     }
     notes
 }

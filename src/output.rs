@@ -158,6 +158,76 @@ pub fn write_rgba8_png(path: &Path, width: u32, height: u32, rgba: Vec<u8>) -> R
     )
 }
 
+/// `characters.png` of `render --character-ids`: 16-bit grey, each pixel its
+/// character's frame index + 1 (0: no skin), row-major, top row first.
+pub fn write_character_ids_png(path: &Path, width: u32, height: u32, ids: &[u32]) -> Result<()> {
+    let px: Vec<u16> = ids.iter().map(|&i| i.min(u16::MAX as u32) as u16).collect();
+    let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(width, height, px)
+        .with_context(|| format!("{}: the picture is not {width}x{height}", path.display()))?;
+    write_image(
+        path,
+        &image::DynamicImage::ImageLuma16(img),
+        image::ImageFormat::Png,
+    )
+}
+
+/// Reads `characters.png` back: each pixel's character + 1 (0: no skin).
+pub fn read_character_ids_png(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
+    let bytes = crate::files::read_bounded(path, "character ids", crate::files::MAX_IMAGE_FILE)?;
+    let reader =
+        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
+    let (w, h) = reader
+        .into_dimensions()
+        .with_context(|| format!("decoding {}", path.display()))?;
+    let side = crate::render::settings::MAX_IMAGE_SIDE;
+    if w > side || h > side {
+        bail!(
+            "{}: {w}x{h} is larger than a frame ({side} a side)",
+            path.display()
+        );
+    }
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .with_context(|| format!("decoding {}", path.display()))?
+        .into_luma16();
+    Ok((w, h, img.into_raw().into_iter().map(u32::from).collect()))
+}
+
+/// The sRGB tint of a method in `groups.png` (by its place in the registry).
+pub fn method_tint(method: &str) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 8] = [
+        [66, 135, 245],  // separable: blue
+        [60, 200, 90],   // ssg: green
+        [245, 160, 40],  // ss-jittered: orange
+        [170, 90, 230],  // poisson: purple
+        [230, 60, 60],   // tsd: red
+        [240, 110, 190], // tsd-opt: pink
+        [255, 255, 255], // reference: white
+        [128, 128, 128], // none: grey
+    ];
+    let i = crate::method::METHODS
+        .iter()
+        .position(|m| m.name == method)
+        .unwrap_or(PALETTE.len() - 1);
+    PALETTE[i % PALETTE.len()]
+}
+
+/// The tone-mapped frame `ldr` (RGBA8) with each character's skin pixels
+/// (`ids`: character + 1, 0 no skin) mixed half and half with the tint of
+/// its group (`tint_of[character]`): `groups.png`.
+pub fn tint_characters(ldr: &[u8], ids: &[u32], tint_of: &[[u8; 3]]) -> Vec<u8> {
+    let mut out = ldr.to_vec();
+    for (px, &id) in out.chunks_exact_mut(4).zip(ids) {
+        px[3] = 255;
+        let Some(t) = (id as usize).checked_sub(1).and_then(|c| tint_of.get(c)) else {
+            continue;
+        };
+        for k in 0..3 {
+            px[k] = ((px[k] as u16 + t[k] as u16) / 2) as u8;
+        }
+    }
+    out
+}
+
 /// Makes sure `dir` exists and can be written, before any GPU work: a bad
 /// `--out` is reported at once, not after the render.
 pub fn prepare_out_dir(dir: &Path) -> Result<()> {
@@ -378,6 +448,7 @@ mod tests {
             diffuse: vec![[0.0; 4]; 6],
             depth: vec![1.0; 6],
             hdr_nonfinite: 0,
+            character_ids: None,
         };
         write_png(&d.join("ok.png"), &c).unwrap();
         c.hdr_nonfinite = 2;
@@ -473,5 +544,27 @@ mod tests {
     fn slugs_are_file_safe() {
         assert_eq!(slug("sss horizontal -> diffuse"), "sss_horizontal_diffuse");
         assert_eq!(slug("Shadow Map"), "shadow_map");
+    }
+
+    // characters.png round-trips 16-bit ids (past 255 characters), and the
+    // tint mixes skin pixels only.
+    #[test]
+    fn character_ids_round_trip_and_tint_skin_only() {
+        let d = std::env::temp_dir().join(format!("dermis-ids-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let ids = vec![0, 1, 256, 1024, 2, 0];
+        let p = d.join("characters.png");
+        write_character_ids_png(&p, 3, 2, &ids).unwrap();
+        let (w, h, back) = read_character_ids_png(&p).unwrap();
+        assert_eq!((w, h), (3, 2));
+        assert_eq!(back, ids);
+        let ldr = vec![100u8; 6 * 4];
+        let tint = [[200, 0, 100]; 1024];
+        let out = tint_characters(&ldr, &ids, &tint);
+        assert_eq!(&out[0..4], &[100, 100, 100, 255]);
+        assert_eq!(&out[4..8], &[150, 50, 100, 255]);
+        assert_eq!(method_tint("separable"), [66, 135, 245]);
+        assert_ne!(method_tint("ssg"), method_tint("none"));
+        let _ = std::fs::remove_dir_all(d);
     }
 }

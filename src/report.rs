@@ -71,6 +71,40 @@ pub struct Report {
     pub ceilings: Option<Ceilings>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probes: Option<Vec<ProbeResult>>,
+    /// The method groups of the frame (issue 16): one in a single-method
+    /// frame, one per distinct choice with `--assign` or `--plan`; empty in
+    /// a report from before groups.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupReport>,
+}
+
+/// One method instance of a frame: its choice, its stencil code, its
+/// characters and where its passes worked.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GroupReport {
+    pub index: usize,
+    /// The choice as `--assign` spells it (`method[:key=value...]`; the
+    /// method's name in a single-method frame).
+    pub choice: String,
+    pub method: String,
+    /// Every option of the method, given or default.
+    #[serde(default)]
+    pub options: BTreeMap<String, String>,
+    /// The stencil value of its skin pixels (`mix::stencil_code`).
+    pub stencil: u32,
+    /// Frame indices of its characters.
+    pub characters: Vec<usize>,
+    /// Its SSS region: rectangles `[x0, y0, x1, y1]` (exclusive ends) and
+    /// their pixels (empty for a group with no SSS in a mix).
+    pub region_rects: Vec<[u32; 4]>,
+    pub region_pixels: u64,
+    /// Skin pixels of its characters on screen, when the run counted them
+    /// (a captured frame).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skin_pixels: Option<u64>,
+    /// Its colour in `groups.png` (sRGB), when one was written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tint: Option<[u8; 3]>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -204,6 +238,9 @@ impl Stats {
 pub struct PassDecl {
     pub work: Option<Work>,
     pub images: Vec<ImageUse>,
+    /// The pass's method group and its characters (none for the frame's own passes).
+    pub group: Option<usize>,
+    pub characters: Vec<usize>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -230,12 +267,24 @@ pub struct PassReport {
     /// The images it touches and how.
     #[serde(default)]
     pub images: Vec<ImageUse>,
+    /// The method group the pass belongs to (`Report::groups`) and that
+    /// group's characters; `None` and empty for the frame's own passes and
+    /// in a report from before groups.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group: Option<usize>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub characters: Vec<usize>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FrameReport {
     /// Sum of pass and barrier times per frame.
     pub gpu_ms: Stats,
+    /// CPU time of building the frame's passes and recording them into the
+    /// command buffer, per measured frame (`None`: a report from before it
+    /// was measured).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_record_ms: Option<Stats>,
 }
 
 /// Aggregates frames of pass samples (every frame has the same passes in
@@ -259,6 +308,8 @@ pub fn aggregate(
                 role: Some(s.role),
                 work: decl.work,
                 images: decl.images,
+                group: decl.group,
+                characters: decl.characters,
                 gpu_ms: Stats::of(&gpu).expect("non-empty"),
                 barrier_ms: Stats::of(&bar).expect("non-empty"),
                 fragment_invocations: frames.last().and_then(|f| f[i].fragment_invocations),
@@ -274,7 +325,10 @@ pub fn aggregate(
         .collect();
     (
         passes,
-        Stats::of(&totals).map(|gpu_ms| FrameReport { gpu_ms }),
+        Stats::of(&totals).map(|gpu_ms| FrameReport {
+            gpu_ms,
+            cpu_record_ms: None,
+        }),
     )
 }
 
@@ -325,6 +379,42 @@ pub fn table(passes: &[PassReport], frame: Option<&FrameReport>) -> String {
             s,
             "{:<18} {:>10.4} {:>10.4} {:>10.4}",
             "frame (sum)", f.gpu_ms.median, f.gpu_ms.min, f.gpu_ms.p95
+        );
+        if let Some(c) = &f.cpu_record_ms {
+            let _ = writeln!(
+                s,
+                "{:<18} {:>10.4} {:>10.4} {:>10.4}",
+                "cpu recording", c.median, c.min, c.p95
+            );
+        }
+    }
+    s
+}
+
+/// The groups of a frame of several methods, one line each (nothing for a
+/// single-method frame: its one group is the whole frame).
+pub fn groups_table(groups: &[GroupReport]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    if groups.len() < 2 {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "{:<6} {:<34} {:>7} {:>10} {:>13} {:>11}",
+        "group", "choice", "stencil", "characters", "region px", "skin px"
+    );
+    for g in groups {
+        let skin = g.skin_pixels.map_or("-".to_string(), |p| p.to_string());
+        let _ = writeln!(
+            s,
+            "{:<6} {:<34} {:>7} {:>10} {:>13} {:>11}",
+            format!("#{}", g.index),
+            g.choice,
+            g.stencil,
+            g.characters.len(),
+            g.region_pixels,
+            skin
         );
     }
     s

@@ -11,11 +11,12 @@ use crate::bench::floor::floor_ms;
 use crate::graph::work::PassRole;
 use crate::graph::PassSample;
 use crate::output::{
-    prepare_file, prepare_render_dir, slug, write_depth_exr, write_diffuse_exr, write_exr,
-    write_json, write_png,
+    method_tint, prepare_file, prepare_render_dir, slug, tint_characters, write_character_ids_png,
+    write_depth_exr, write_diffuse_exr, write_exr, write_json, write_png, write_rgba8_png,
 };
+use crate::render::groups::GroupMethod;
 use crate::render::{Capture, RenderSettings, Renderer};
-use crate::report::{aggregate, LightReport, PassDecl, Stats};
+use crate::report::{aggregate, GroupReport, LightReport, PassDecl, Stats};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 
@@ -112,7 +113,7 @@ pub fn run(
         }
     };
     renderer.run_frames(opts.warmup, tick)?;
-    let frames = renderer.frames(opts.measured, tick)?;
+    let (frames, record_ms) = renderer.frames_timed(opts.measured, tick)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -127,9 +128,49 @@ pub fn run(
         .map(|p| PassDecl {
             work: p.declared_work(&renderer.resources),
             images: renderer.resources.image_uses(&p.images),
+            group: p.group,
+            characters: p
+                .group
+                .and_then(|g| renderer.groups.iter().find(|m| m.spec.index == g))
+                .map(|m| m.spec.characters.clone())
+                .unwrap_or_default(),
         })
         .collect();
-    let (mut passes, frame) = aggregate(&frames, &decls);
+    let (mut passes, mut frame) = aggregate(&frames, &decls);
+    if let Some(f) = &mut frame {
+        f.cpu_record_ms = Stats::of(&record_ms);
+    }
+    let skin = capture
+        .as_ref()
+        .and_then(|c| group_skin_pixels(c, &renderer.groups));
+    let groups: Vec<GroupReport> = renderer
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(i, g)| GroupReport {
+            index: g.spec.index,
+            choice: g.spec.label.clone(),
+            method: g.spec.entry.name.to_string(),
+            options: g
+                .spec
+                .entry
+                .opts(&g.spec.options)
+                .resolved()
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
+            stencil: g.spec.stencil(),
+            characters: g.spec.characters.clone(),
+            region_rects: g
+                .region_px
+                .iter()
+                .map(|r| [r.x0, r.y0, r.x1, r.y1])
+                .collect(),
+            region_pixels: g.region_px.iter().map(|r| r.area()).sum(),
+            skin_pixels: skin.as_ref().and_then(|s| s.get(i).copied()),
+            tint: None,
+        })
+        .collect();
     let sss_totals: Vec<f64> = frames
         .iter()
         .map(|f| {
@@ -144,10 +185,10 @@ pub fn run(
         .is_some_and(|f| f.iter().any(|s| s.role == PassRole::Sss));
     let extent = renderer.frame.extent;
     let mm_per_unit = renderer.frame.mm_per_unit;
-    let region = &renderer.frame.region_px;
+    let region = renderer.region_px();
     let (sss_region_pixels, sss_region_rects) =
         (region.iter().map(|r| r.area()).sum(), region.len() as u64);
-    let method_details = renderer.method.details();
+    let method_details = renderer.groups[0].method.details();
     drop(renderer);
 
     let (ceilings, probes) = if opts.ceilings {
@@ -166,7 +207,17 @@ pub fn run(
     };
 
     let f = &ctx.facts;
-    let m = settings.method;
+    // A frame of several methods names itself `mix`; its groups say the rest.
+    let (method, method_options) = match &groups[..] {
+        [one] => (
+            one.method.clone(),
+            one.options.clone().into_iter().collect(),
+        ),
+        _ => (
+            crate::render::groups::MIX_NAME.to_string(),
+            Default::default(),
+        ),
+    };
     let report = Report {
         dermis_version: env!("CARGO_PKG_VERSION").to_string(),
         command: opts.command.clone(),
@@ -177,13 +228,8 @@ pub fn run(
         validation: ctx.validation,
         width: settings.width,
         height: settings.height,
-        method: m.name.to_string(),
-        method_options: m
-            .opts(&settings.options)
-            .resolved()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
+        method,
+        method_options,
         method_details,
         transmittance: settings.transmittance,
         transmittance_profile: settings.transmittance_profile,
@@ -212,12 +258,38 @@ pub fn run(
         },
         ceilings,
         probes,
+        groups,
     };
     Ok(RunOutput {
         report,
         capture,
         frames,
     })
+}
+
+/// Skin pixels of each group's characters in a captured frame with
+/// character ids (`None` without them).
+fn group_skin_pixels(c: &Capture, groups: &[GroupMethod]) -> Option<Vec<u64>> {
+    let ids = c.character_ids.as_ref()?;
+    let n = groups
+        .iter()
+        .map(|g| g.spec.characters.len())
+        .sum::<usize>();
+    let mut per_character = vec![0u64; n];
+    for &id in ids {
+        if let Some(p) = (id as usize)
+            .checked_sub(1)
+            .and_then(|i| per_character.get_mut(i))
+        {
+            *p += 1;
+        }
+    }
+    Some(
+        groups
+            .iter()
+            .map(|g| g.spec.characters.iter().map(|&c| per_character[c]).sum())
+            .collect(),
+    )
 }
 
 /// The one-line header of a run's table.
@@ -238,8 +310,49 @@ pub fn render_to_dir(
     opts: &RunOptions,
 ) -> Result<RunOutput> {
     prepare_render_dir(out, opts.dump)?;
-    let output = run(ctx, scene, settings, opts)?;
+    // A frame of several methods also writes groups.png, which needs each
+    // pixel's character: the id pass comes with it (it changes no image).
+    let mixed = crate::render::groups::group_specs(scene, settings)?.len() > 1;
+    let with_ids;
+    let settings = if mixed && !settings.character_ids {
+        with_ids = RenderSettings {
+            character_ids: true,
+            ..settings.clone()
+        };
+        &with_ids
+    } else {
+        settings
+    };
+    let mut output = run(ctx, scene, settings, opts)?;
     let capture = output.capture.as_ref().context("no frame was captured")?;
+    if let Some(ids) = &capture.character_ids {
+        write_character_ids_png(
+            &out.join("characters.png"),
+            capture.width,
+            capture.height,
+            ids,
+        )?;
+        if mixed {
+            let mut tint_of = vec![
+                [0u8; 3];
+                output
+                    .report
+                    .groups
+                    .iter()
+                    .map(|g| g.characters.len())
+                    .sum()
+            ];
+            for g in &mut output.report.groups {
+                let t = method_tint(&g.method);
+                g.tint = Some(t);
+                for &c in &g.characters {
+                    tint_of[c] = t;
+                }
+            }
+            let rgba = tint_characters(&capture.ldr, ids, &tint_of);
+            write_rgba8_png(&out.join("groups.png"), capture.width, capture.height, rgba)?;
+        }
+    }
     write_png(&out.join("frame.png"), capture)?;
     write_diffuse_exr(&out.join("diffuse.exr"), capture)?;
     write_depth_exr(&out.join("depth.exr"), capture)?;

@@ -314,6 +314,8 @@ mod tests {
             floor_ratio: None,
             work: Some(work),
             images: vec![],
+            group: None,
+            characters: vec![],
         };
         // What every report holds (an old one's fields default), then the passes.
         let mut r: Report = serde_json::from_value(serde_json::json!({

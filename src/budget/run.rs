@@ -22,6 +22,7 @@ use crate::graph::work::Work;
 use crate::method::METHODS;
 use crate::output::{prepare_out_dir, write_json};
 use crate::render::counting::{decode_site, PassCounts};
+use crate::render::groups::MIX_NAME;
 use crate::render::{RenderSettings, Renderer};
 use crate::report::PassReport;
 use crate::run::{run, RunOptions};
@@ -202,6 +203,8 @@ pub fn budget(
             .filter(|m| !m.ground_truth)
             .map(|m| RenderSettings {
                 method: m,
+                // --compare-methods prices each method on every character.
+                assignment: None,
                 ..settings.clone()
             })
             .collect()
@@ -211,8 +214,15 @@ pub fn budget(
     let params = ParamSet::fitted();
     let mut runs = Vec::new();
     for s in &methods {
+        // A frame of several methods is priced as one frame: its passes carry
+        // their group in their names (`#N ...`, the merges `mix merge #N`).
+        let name = if s.assignment.is_some() {
+            MIX_NAME
+        } else {
+            s.method.name
+        };
         let frame = method_frame(&ctx, counting.as_ref(), scene, s, opts)
-            .with_context(|| format!("method {}", s.method.name))?;
+            .with_context(|| format!("method {name}"))?;
         let budgets: Vec<FrameBudget> = profiles
             .iter()
             .map(|p| price_frame(p, &frame, &params, opts.rescale))
@@ -223,14 +233,11 @@ pub fn budget(
             }
         }
         write_json(
-            &opts
-                .out
-                .join("frames")
-                .join(format!("{}.json", s.method.name)),
+            &opts.out.join("frames").join(format!("{name}.json")),
             &frame,
         )?;
         runs.push(MethodBudget {
-            method: s.method.name.to_string(),
+            method: name.to_string(),
             frame,
             budgets,
         });

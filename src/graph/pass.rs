@@ -113,6 +113,9 @@ pub struct Pass<'a> {
     /// step of a readback).
     cost: Option<Cost>,
     pub record: Record<'a>,
+    /// The method group the pass belongs to (`mix::Group::index`), `None` for
+    /// the frame's own passes (shadow, geometry, composite, tone map).
+    pub group: Option<usize>,
 }
 
 impl<'a> Pass<'a> {
@@ -124,6 +127,7 @@ impl<'a> Pass<'a> {
             buffers: Vec::new(),
             cost: None,
             record: Box::new(|_| {}),
+            group: None,
         }
     }
 

@@ -74,16 +74,28 @@ pub struct Resources {
     slots: Vec<Slot>,
     images: Vec<ImageEntry>,
     buffers: Vec<BufferEntry>,
+    /// Put before the name of every image declared from now on (a frame of
+    /// several groups builds each group's method under its own prefix, so two
+    /// groups of one method declare images that dumps and errors tell apart).
+    prefix: String,
 }
 
 impl Resources {
+    /// Sets the prefix of the names of images declared from now on (empty: none).
+    pub fn set_name_prefix(&mut self, prefix: &str) {
+        self.prefix = prefix.to_string();
+    }
+
     /// Declares an image; returns the id of level 0 (level `l` is
     /// [`Resources::level`]). It is created by [`Resources::create`].
     ///
     /// Panics when the format has no name in the work vocabulary: formats are
     /// chosen by dermis's code, so one missing from [`Format`] is a programmer
     /// error caught where it is made, and [`Resources::texel_format`] is total.
-    pub fn declare(&mut self, desc: ImageDesc) -> ImageId {
+    pub fn declare(&mut self, mut desc: ImageDesc) -> ImageId {
+        if !self.prefix.is_empty() {
+            desc.name = format!("{}{}", self.prefix, desc.name);
+        }
         let texel = work_format(desc.format).unwrap_or_else(|| {
             panic!(
                 "image '{}' is declared with {:?}, which the work vocabulary cannot name",

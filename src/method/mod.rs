@@ -36,17 +36,23 @@ use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
 pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
 
-/// The stencil bit the geometry pass sets on skin pixels; SSS passes test it.
-pub const STENCIL_SKIN: u32 = 1;
+/// The stencil bit the geometry pass sets on skin pixels (group 0's code,
+/// `mix::stencil_code(0)`): what a single-method frame writes and tests.
+pub const STENCIL_SKIN: u32 = crate::mix::SKIN_BIT;
 
-/// Stencil state of every stencil-masked SSS pass: shade only where the skin bit is set.
+/// Stencil state of every stencil-masked SSS pass: shade only where the stencil
+/// holds the pass's group code. The whole 8 bits are compared (a group's code
+/// is the skin bit and the group index above it, `mix::stencil_code`); the
+/// reference is dynamic state the executor sets from the pass's declaration
+/// (`FrameView::stencil`). In a single-method frame the stencil holds only 0
+/// and 1, so the full mask tests what the skin bit alone did.
 pub fn skin_stencil_test() -> vk::StencilOpState {
     vk::StencilOpState {
         fail_op: vk::StencilOp::KEEP,
         pass_op: vk::StencilOp::KEEP,
         depth_fail_op: vk::StencilOp::KEEP,
         compare_op: vk::CompareOp::EQUAL,
-        compare_mask: STENCIL_SKIN,
+        compare_mask: 0xff,
         write_mask: 0,
         reference: STENCIL_SKIN,
     }
@@ -125,15 +131,17 @@ impl ViewInfo {
 /// Everything a method is built from.
 pub struct MethodSetup<'a> {
     pub ctx: &'a Context,
-    /// Declare the method's own images here (created after the usages are known).
+    /// Declare the method's own images here (created after the usages are known;
+    /// in a frame of several groups their names carry the group's prefix).
     pub res: &'a mut Resources,
     pub targets: &'a FrameTargets,
     pub samplers: &'a Samplers,
     pub options: Opts<'a>,
     pub view: ViewInfo,
     pub depth_stencil_format: vk::Format,
-    /// The scene and the model matrix of every character (the ground truth
-    /// samples the skin surface itself).
+    /// The scene and the model matrix of every character this instance works
+    /// on (all of them in a single-method frame; its group's in a mix). The
+    /// ground truth samples the skin surface itself; tsd draws these heads.
     pub scene: &'a Scene,
     pub instances: &'a [Mat4],
 }
@@ -165,6 +173,10 @@ pub struct FrameView<'a, 'r> {
     pub region: &'a [vk::Rect2D],
     /// One rectangle covering the screen.
     pub screen: &'a [vk::Rect2D],
+    /// The stencil code of this instance's pixels (`mix::stencil_code` of its
+    /// group; [`STENCIL_SKIN`] in a single-method frame): the reference of
+    /// every stencil test of its passes.
+    pub stencil: u32,
 }
 
 /// An SSS method as the frame sees it.

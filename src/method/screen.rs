@@ -11,7 +11,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::{FrameView, MethodBind, STENCIL_SKIN};
+use super::{FrameView, MethodBind};
 use crate::graph::draw::fullscreen_in;
 use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
 use crate::graph::{
@@ -71,7 +71,8 @@ pub struct Masked<'a> {
     /// The colour targets (loaded: pixels outside the mask keep their
     /// contents), each with whether it is blended.
     pub targets: Vec<(ImageId, bool)>,
-    /// Stencil-tested on the skin bit / depth-tested (against the depth the
+    /// Stencil-tested on the group's code (`FrameView::stencil`) /
+    /// depth-tested (against the depth the
     /// pipeline's triangle is drawn at).
     pub stencil: bool,
     pub depth_test: bool,
@@ -100,7 +101,7 @@ pub fn masked_pass<'a>(
     pass = pass.depth_stencil(
         DepthStencil::test_only(ds)
             .depth_test(m.depth_test)
-            .stencil_test(m.stencil.then_some(STENCIL_SKIN)),
+            .stencil_test(m.stencil.then_some(f.stencil)),
     );
     for (t, blend) in m.targets {
         let target = ColorTarget::new(t, Load::Keep);

@@ -63,10 +63,12 @@ impl Renderer<'_> {
         let id = self.resources.add_buffer("fetch counters", raw);
         let mut out = Vec::new();
         // One frame, recorded pass by pass.
-        self.method.begin_frame();
+        self.begin_frame();
         let n = self.passes().len();
         for i in 0..n {
-            let mut passes = self.frame.passes(self.method.as_ref(), &self.resources);
+            let mut passes = self
+                .frame
+                .passes(&self.groups, &self.merge, &self.resources);
             let mut pass = passes.swap_remove(i);
             drop(passes);
             let counted = match pass.declared_work(&self.resources) {

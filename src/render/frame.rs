@@ -1,12 +1,16 @@
-//! The frame around the SSS method: shadow map (key light, orthographic, so its
+//! The frame around the SSS methods: shadow map (key light, orthographic, so its
 //! depth is linear) -> geometry pass into the targets (Lambert + transmittance,
-//! Kelemen/Szirmay-Kalos specular, linear depth, the skin stencil bit) -> the
-//! method's passes -> composite (diffuse after SSS + specular) -> Hable tone map.
+//! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
+//! the stencil) -> each group's method's passes (one group in a single-method
+//! frame) and, in a frame of several, the merges (`merge.rs`) -> composite
+//! (diffuse after SSS + specular) -> Hable tone map.
 
 use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
+use super::groups::GroupMethod;
+use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
 use super::targets::{LDR_FORMAT, SHADOW_FORMAT};
@@ -69,6 +73,16 @@ struct ShadowPush {
     light_view_proj: [[f32; 4]; 4],
 }
 
+/// Push constants of the character-id pass: geometry.vert's model, then the id.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct IdPush {
+    model: [[f32; 4]; 4],
+    id: f32,
+}
+
+const IDS_SHADER: &str = "geometry_ids.frag";
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct TonemapPush {
@@ -104,17 +118,31 @@ pub struct Frame {
     geometry_pipeline: Pipeline,
     composite_pipeline: Pipeline,
     tonemap_pipeline: Pipeline,
+    /// `--character-ids` only: the pass that writes each head's index + 1
+    /// into `character_ids` after the frame (null otherwise).
+    ids_pipeline: Pipeline,
+    ids_set: vk::DescriptorSet,
+    pub character_ids: Option<ImageId>,
     frame_set: vk::DescriptorSet,
     composite_set: vk::DescriptorSet,
     tonemap_set: vk::DescriptorSet,
     frame_ubo: Buffer,
     beckmann: Image,
     pub objects: Vec<GpuObject>,
-    /// Where the SSS passes work (see `method::region`); change it with
-    /// `set_region`, which keeps the scissors the passes read in step.
-    pub region_px: Vec<PixelRect>,
-    sss_region: Vec<vk::Rect2D>,
+    /// The characters of each group with its stencil code, in group order:
+    /// the geometry pass draws each group's heads with its code as the
+    /// stencil reference (one group of every character, code 1, until
+    /// `set_skin_groups`).
+    pub skin_groups: Vec<SkinGroup>,
     screen_rect: Vec<vk::Rect2D>,
+}
+
+/// The heads of one group as the geometry pass draws them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinGroup {
+    pub stencil: u32,
+    /// Frame indices (into `Frame::instances`).
+    pub characters: Vec<usize>,
 }
 
 /// The rectangles of a pixel region as scissors.
@@ -154,6 +182,7 @@ impl Frame {
             height: settings.height,
         };
         let full = PixelRect::full(extent.width, extent.height);
+        let every = (0..framing.instances.len()).collect();
         let f = Frame {
             settings: settings.clone(),
             extent,
@@ -169,14 +198,19 @@ impl Frame {
             geometry_pipeline: Pipeline::default(),
             composite_pipeline: Pipeline::default(),
             tonemap_pipeline: Pipeline::default(),
+            ids_pipeline: Pipeline::default(),
+            ids_set: vk::DescriptorSet::null(),
+            character_ids: None,
             frame_set: vk::DescriptorSet::null(),
             composite_set: vk::DescriptorSet::null(),
             tonemap_set: vk::DescriptorSet::null(),
             frame_ubo: Buffer::default(),
             beckmann: Image::default(),
             objects: Vec::new(),
-            region_px: vec![full],
-            sss_region: scissors(&[full]),
+            skin_groups: vec![SkinGroup {
+                stencil: STENCIL_SKIN,
+                characters: every,
+            }],
             screen_rect: scissors(&[full]),
         };
         // Filled in by `build`: on an error, the guard frees what exists.
@@ -280,14 +314,16 @@ impl Frame {
                 depth_test: true,
                 depth_write: true,
                 depth_compare: vk::CompareOp::LESS,
-                // Every drawn pixel gets the object's skin bit (reference per draw).
+                // Every drawn pixel gets its object's group code, all 8 bits
+                // (reference per draw: 0 off skin, `mix::stencil_code` on it;
+                // a single-method frame writes 0 and 1 as the skin bit did).
                 stencil: Some(vk::StencilOpState {
                     fail_op: vk::StencilOp::KEEP,
                     pass_op: vk::StencilOp::REPLACE,
                     depth_fail_op: vk::StencilOp::KEEP,
                     compare_op: vk::CompareOp::ALWAYS,
                     compare_mask: 0xff,
-                    write_mask: STENCIL_SKIN,
+                    write_mask: 0xff,
                     reference: 0,
                 }),
                 depth_bias: None,
@@ -302,6 +338,39 @@ impl Frame {
             ctx,
             &GraphicsDesc::fullscreen("tonemap", TONEMAP_SHADER, LDR_FORMAT),
         )?;
+        Ok(())
+    }
+
+    /// Adds the character-id pass (`--character-ids`) writing into `ids`
+    /// (before the usages are derived: the pass declares its target).
+    pub fn enable_character_ids(
+        &mut self,
+        ctx: &Context,
+        res: &Resources,
+        ids: ImageId,
+    ) -> Result<()> {
+        let ds_format = res.format(self.targets.depth_stencil);
+        // The geometry pass's vertex shader, so positions match its depth exactly.
+        self.ids_pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "character ids".into(),
+                vert: "geometry.vert",
+                frag: Some(IDS_SHADER),
+                color_formats: vec![res.format(ids)],
+                depth_format: Some(ds_format),
+                stencil_format: Some(ds_format),
+                vertex_input: VertexInput::Mesh,
+                cull: vk::CullModeFlags::BACK,
+                depth_test: true,
+                depth_write: false,
+                depth_compare: vk::CompareOp::EQUAL,
+                stencil: None,
+                depth_bias: None,
+                blend: Blend::None,
+            },
+        )?;
+        self.character_ids = Some(ids);
         Ok(())
     }
 
@@ -351,8 +420,14 @@ impl Frame {
         }
     }
 
-    /// Where `method` has work in `scene` (the whole screen without a region).
-    pub fn region_for(&self, scene: &Scene, method: &dyn SssMethod) -> Vec<PixelRect> {
+    /// Where `method`, working on the characters `instances`, has work in
+    /// `scene` (the whole screen without a region).
+    pub fn region_for(
+        &self,
+        scene: &Scene,
+        method: &dyn SssMethod,
+        instances: &[Mat4],
+    ) -> Vec<PixelRect> {
         let full = PixelRect::full(self.extent.width, self.extent.height);
         let s = &self.settings;
         let view = self.view_info();
@@ -374,7 +449,7 @@ impl Frame {
         };
         scene_region(
             scene,
-            &self.instances,
+            instances,
             &rv,
             view.tan_half_fovy(),
             s.sss_region_tile,
@@ -382,9 +457,9 @@ impl Frame {
         )
     }
 
-    pub fn set_region(&mut self, px: Vec<PixelRect>) {
-        self.sss_region = scissors(&px);
-        self.region_px = px;
+    /// The groups' heads and codes the geometry pass draws.
+    pub fn set_skin_groups(&mut self, groups: Vec<SkinGroup>) {
+        self.skin_groups = groups;
     }
 
     /// The bindings of `lighting.glsl`'s set 0 (frame).
@@ -406,7 +481,8 @@ impl Frame {
     }
 
     /// The descriptor sets that read frame images (after they exist); the
-    /// composite reads whatever image the method names as its output.
+    /// composite reads `sss_output`: the method's output in a single-method
+    /// frame, the (merged) diffuse target in a frame of several.
     pub fn bind(&mut self, ctx: &Context, res: &Resources, sss_output: ImageId) -> Result<()> {
         let t = self.targets;
         self.frame_set =
@@ -427,26 +503,105 @@ impl Frame {
             0,
             &[("hdrTex", Bind::Texture(res.view(t.hdr)))],
         )?;
+        if self.character_ids.is_some() {
+            self.ids_set =
+                self.pool
+                    .write_set(ctx, &self.ids_pipeline, 0, &self.frame_binds(res)[..1])?;
+        }
         Ok(())
     }
 
-    pub fn view<'a, 'r>(&'a self, res: &'r Resources) -> FrameView<'a, 'r> {
+    /// What group `g`'s passes are built against: its region and stencil code.
+    pub fn view<'a, 'r>(&'a self, res: &'r Resources, g: &'a GroupMethod) -> FrameView<'a, 'r> {
         FrameView {
             targets: &self.targets,
             res,
             extent: self.extent,
-            region: &self.sss_region,
+            region: &g.scissors,
             screen: &self.screen_rect,
+            stencil: g.spec.stencil(),
         }
     }
 
-    /// The frame's passes in order, the method's in the middle.
-    pub fn passes<'a>(&'a self, method: &'a dyn SssMethod, res: &Resources) -> Vec<Pass<'a>> {
-        let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
-        passes.extend(method.passes(&self.view(res)));
-        passes.push(self.composite_pass(res, method.output()));
-        passes.push(self.tonemap_pass(res));
+    /// What the composite reads: the one group's output, or the diffuse
+    /// target every group's result is merged into.
+    pub fn composite_source(&self, groups: &[GroupMethod]) -> ImageId {
+        match groups {
+            [one] => one.method.output(),
+            _ => self.targets.diffuse,
+        }
+    }
+
+    /// The passes of the groups' methods, each marked with its group (a
+    /// frame of several names them `#N ...`), then the merges.
+    pub fn group_passes<'a>(
+        &'a self,
+        groups: &'a [GroupMethod],
+        merge: &'a Merge,
+        res: &Resources,
+    ) -> Vec<Pass<'a>> {
+        let mixed = groups.len() > 1;
+        let mut passes = Vec::new();
+        for g in groups {
+            let i = g.spec.index;
+            for mut p in g.method.passes(&self.view(res, g)) {
+                p.group = Some(i);
+                if mixed {
+                    p.name = format!("#{i} {}", p.name);
+                }
+                passes.push(p);
+            }
+        }
+        if mixed {
+            for g in groups {
+                if let Some(p) = merge.pass(&self.view(res, g), g.spec.index, g.method.output()) {
+                    passes.push(p);
+                }
+            }
+        }
         passes
+    }
+
+    /// The frame's passes in order, the groups' in the middle.
+    pub fn passes<'a>(
+        &'a self,
+        groups: &'a [GroupMethod],
+        merge: &'a Merge,
+        res: &Resources,
+    ) -> Vec<Pass<'a>> {
+        let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
+        passes.extend(self.group_passes(groups, merge, res));
+        passes.push(self.composite_pass(res, self.composite_source(groups)));
+        passes.push(self.tonemap_pass(res));
+        if let Some(ids) = self.character_ids {
+            passes.push(self.character_ids_pass(ids));
+        }
+        passes
+    }
+
+    /// After the frame (`--character-ids`): every head again, depth-tested
+    /// EQUAL against the frame's depth, writing its frame index + 1. Set-up
+    /// work, not frame cost; only the flag adds it.
+    fn character_ids_pass<'a>(&'a self, ids: ImageId) -> Pass<'a> {
+        Pass::new("character ids", PassRole::Setup)
+            .color(ColorTarget::new(ids, Load::Clear([0.0; 4])))
+            .depth_stencil(DepthStencil::test_only(self.targets.depth_stencil).depth_test(true))
+            .draws(None, self.triangles(true))
+            .record(move |pc: &PassContext| {
+                let (ctx, cmd) = (pc.ctx, pc.cmd);
+                let p = &self.ids_pipeline;
+                p.bind(ctx, cmd, &[self.ids_set]);
+                for obj in self.objects.iter().filter(|o| o.skin) {
+                    for (c, m) in self.instances.iter().enumerate() {
+                        let push = IdPush {
+                            model: m.to_cols_array_2d(),
+                            id: (c + 1) as f32,
+                        };
+                        p.push(ctx, cmd, &push);
+                        obj.bind_and_draw(ctx, cmd);
+                    }
+                }
+            })
     }
 
     /// Triangles the skin objects submit per frame (every character), and all objects.
@@ -552,20 +707,29 @@ impl Frame {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.geometry_pipeline;
                 p.bind(ctx, cmd, &[self.frame_set]);
+                let set_reference = |r: u32| unsafe {
+                    ctx.device.cmd_set_stencil_reference(
+                        cmd,
+                        vk::StencilFaceFlags::FRONT_AND_BACK,
+                        r,
+                    );
+                };
                 for obj in &self.objects {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
-                    unsafe {
-                        ctx.device.cmd_set_stencil_reference(
-                            cmd,
-                            vk::StencilFaceFlags::FRONT_AND_BACK,
-                            if obj.skin { STENCIL_SKIN } else { 0 },
-                        );
-                    }
-                    let backdrop = [self.backdrop];
-                    let models: &[Mat4] = if obj.skin { &self.instances } else { &backdrop };
-                    for m in models {
-                        p.push(ctx, cmd, &m.to_cols_array_2d());
+                    if !obj.skin {
+                        set_reference(0);
+                        p.push(ctx, cmd, &self.backdrop.to_cols_array_2d());
                         obj.bind_and_draw(ctx, cmd);
+                        continue;
+                    }
+                    // Each group's heads with its code (one group: every
+                    // head in frame order, code 1, as before groups).
+                    for g in &self.skin_groups {
+                        set_reference(g.stencil);
+                        for &c in &g.characters {
+                            p.push(ctx, cmd, &self.instances[c].to_cols_array_2d());
+                            obj.bind_and_draw(ctx, cmd);
+                        }
                     }
                 }
             })
@@ -658,6 +822,7 @@ impl Frame {
             &mut self.geometry_pipeline,
             &mut self.composite_pipeline,
             &mut self.tonemap_pipeline,
+            &mut self.ids_pipeline,
         ] {
             p.destroy(ctx);
         }

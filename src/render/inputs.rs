@@ -82,7 +82,11 @@ fn upload_pass<'a>(
 impl Renderer<'_> {
     /// Fills every intermediate of the method with `value` in every channel.
     pub(super) fn fill_intermediates(&mut self, value: f32) -> Result<()> {
-        let ids = self.method.intermediates();
+        let ids: Vec<_> = self
+            .groups
+            .iter()
+            .flat_map(|g| g.method.intermediates())
+            .collect();
         let passes: Vec<Pass> = ids
             .into_iter()
             .map(|id| {
@@ -167,7 +171,7 @@ impl Renderer<'_> {
         ];
         self.upload(uploads.into_iter().collect(), extent)?;
         let full = crate::method::region::PixelRect::full(extent.width, extent.height);
-        self.frame.set_region(vec![full]);
+        self.set_region(vec![full]);
         Ok(())
     }
 

@@ -1,11 +1,15 @@
-//! The renderer: the frame (`frame.rs`) around one SSS method (`crate::method`),
-//! set up in the graph's three steps (declare images, derive their usages from
+//! The renderer: the frame (`frame.rs`) around its SSS methods
+//! (`crate::method`): one in a single-method frame, one per group of
+//! characters in a frame of several (`groups.rs`, `merge.rs`), set up in the
+//! graph's three steps (declare images, derive their usages from
 //! the passes, create them and write the descriptor sets), then recorded,
 //! submitted and measured frame by frame.
 
 pub mod counting;
 pub mod frame;
+pub mod groups;
 pub mod inputs;
+pub mod merge;
 pub mod readback;
 pub mod scene_gpu;
 pub mod settings;
@@ -17,14 +21,16 @@ use ash::vk;
 use crate::graph::work::PassRole;
 use crate::graph::{record_passes, ImageId, Pass, PassSample, Resources};
 use crate::method::region::PixelRect;
-use crate::method::{MethodBind, MethodSetup, SssMethod};
-use crate::scene::framing::{frame as frame_scene, Shot};
+use crate::method::{MethodBind, MethodSetup};
+use crate::scene::framing::frame as frame_scene;
 use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
-use frame::{skin_material_binds, Frame};
+use frame::{skin_material_binds, Frame, SkinGroup};
+use groups::{frame_needs, group_specs, GroupMethod};
+use merge::{needs_merge, Merge};
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use settings::RenderSettings;
 
@@ -46,6 +52,8 @@ pub struct Capture {
     /// Texels of the HDR composite (what the tone map reads) that are NaN or
     /// infinite: the tone map turns them into black pixels of `ldr`.
     pub hdr_nonfinite: usize,
+    /// With `--character-ids`: each pixel's character (frame index + 1; 0: no skin).
+    pub character_ids: Option<Vec<u32>>,
 }
 
 /// The submission objects of a renderer.
@@ -53,6 +61,8 @@ struct Submit {
     profiler: Profiler,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
+    /// CPU milliseconds the last submission spent recording its command buffer.
+    record_ms: std::cell::Cell<f64>,
 }
 
 impl Submit {
@@ -76,6 +86,7 @@ impl Submit {
             profiler: profiler.keep(),
             cmd: cmd.keep(),
             fence,
+            record_ms: std::cell::Cell::new(0.0),
         })
     }
 }
@@ -107,9 +118,20 @@ impl Destroy for Resources {
 pub struct Renderer<'c> {
     pub ctx: &'c Context,
     pub frame: Frame,
-    pub method: Box<dyn SssMethod>,
+    /// One method instance per group, in group order (one in a
+    /// single-method frame).
+    pub groups: Vec<GroupMethod>,
+    /// The copies of a frame of several into the diffuse target (empty otherwise).
+    merge: Merge,
     pub resources: Resources,
     submit: Submit,
+    last_record_ms: f64,
+}
+
+impl Destroy for Merge {
+    fn destroy(&mut self, ctx: &Context) {
+        Merge::destroy(self, ctx)
+    }
 }
 
 /// Refuses a frame whose images (and the readback of its output) would take
@@ -145,8 +167,9 @@ fn profiler_slots(passes: &[Pass]) -> u32 {
 }
 
 /// Images a capture reads back after the frame: the tone-mapped frame, the
-/// method's output, the linear depth and the HDR composite.
-const CAPTURED_IMAGES: usize = 4;
+/// method's output, the linear depth and the HDR composite (and the character
+/// ids with `--character-ids`).
+const CAPTURED_IMAGES: usize = 5;
 
 impl<'c> Renderer<'c> {
     pub fn new(ctx: &'c Context, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
@@ -155,23 +178,20 @@ impl<'c> Renderer<'c> {
             width: settings.width,
             height: settings.height,
         };
-        let entry = settings.method;
-        let opts = entry.opts(&settings.options);
-        let needs = (entry.needs)(&opts, extent);
-        // 1. Declare the frame's and the method's images.
+        let specs = group_specs(scene, settings)?;
+        let needs = frame_needs(&specs, extent);
+        let mixed = specs.len() > 1;
+        // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
         let targets = targets::declare(ctx, &mut resources, extent, settings.shadow_size, needs)?;
-        let framing = frame_scene(
-            scene,
-            &Shot {
-                layout: settings.layout,
-                heads: settings.heads,
-                distance_heads: settings.distance_heads,
-                fovy_deg: settings.fovy_deg,
-                aspect: settings.width as f32 / settings.height as f32,
-                light_dir: settings.light.direction_to_light(scene.forward),
-            },
-        );
+        let ids = settings.character_ids.then(|| {
+            resources.declare(crate::graph::ImageDesc::new(
+                "character ids",
+                extent,
+                vk::Format::R32_SFLOAT,
+            ))
+        });
+        let framing = frame_scene(scene, &groups::shot(scene, settings));
         let mut frame = Guard::new(
             ctx,
             Frame::new(
@@ -184,25 +204,69 @@ impl<'c> Renderer<'c> {
                 needs.geometry_transmittance,
             )?,
         );
+        if let Some(ids) = ids {
+            frame.enable_character_ids(ctx, &resources, ids)?;
+        }
+        frame.set_skin_groups(
+            specs
+                .iter()
+                .map(|g| SkinGroup {
+                    stencil: g.stencil(),
+                    characters: g.characters.clone(),
+                })
+                .collect(),
+        );
         let depth_stencil_format = resources.format(frame.targets.depth_stencil);
-        let method = (entry.build)(&mut MethodSetup {
-            ctx,
-            res: &mut resources,
-            targets: &frame.targets,
-            samplers: &frame.samplers,
-            options: opts,
-            view: frame.view_info(),
-            depth_stencil_format,
-            scene,
-            instances: &frame.instances,
-        })
-        .with_context(|| format!("setting up {}", entry.name))?;
-        let mut method = Guard::new(ctx, method);
-        let region = frame.region_for(scene, &**method);
-        frame.set_region(region);
+        let mut groups = Guard::new(ctx, Vec::<GroupMethod>::new());
+        for spec in specs {
+            let instances: Vec<glam::Mat4> = spec
+                .characters
+                .iter()
+                .map(|&c| frame.instances[c])
+                .collect();
+            // Two groups of one method declare images of one name: each
+            // group's carry its prefix (none in a single-method frame).
+            resources.set_name_prefix(&if mixed {
+                format!("#{} ", spec.index)
+            } else {
+                String::new()
+            });
+            let method = (spec.entry.build)(&mut MethodSetup {
+                ctx,
+                res: &mut resources,
+                targets: &frame.targets,
+                samplers: &frame.samplers,
+                options: spec.entry.opts(&spec.options),
+                view: frame.view_info(),
+                depth_stencil_format,
+                scene,
+                instances: &instances,
+            })
+            .with_context(|| format!("setting up {}", spec.label))?;
+            let mut g = GroupMethod {
+                spec,
+                instances,
+                method,
+                region_px: Vec::new(),
+                scissors: Vec::new(),
+            };
+            // A group with no SSS records no pass: in a mix it has no region.
+            let region = if mixed && g.is_none() {
+                Vec::new()
+            } else {
+                frame.region_for(scene, &*g.method, &g.instances)
+            };
+            g.set_region(region);
+            groups.push(g);
+        }
+        resources.set_name_prefix("");
+        let mut merge = Guard::new(ctx, Merge::default());
+        if mixed && groups.iter().any(|g| needs_merge(g, &frame.targets)) {
+            *merge = Merge::new(ctx, &resources, &frame.targets, &groups)?;
+        }
         // 2. Every image's usage from the passes that touch it: the frame's, and
         //    the uploads and fills the renderer offers (tests, set-up).
-        let passes = frame.passes(&**method, &resources);
+        let passes = frame.passes(&groups, &merge, &resources);
         let mut accesses: Vec<(ImageId, AccessKind)> = passes
             .iter()
             .flat_map(|q| q.images.iter().copied())
@@ -211,69 +275,130 @@ impl<'c> Renderer<'c> {
         drop(passes);
         accesses.extend(inputs::upload_accesses(&frame.targets));
         accesses.extend(
-            method
-                .intermediates()
-                .into_iter()
+            groups
+                .iter()
+                .flat_map(|g| g.method.intermediates())
                 .map(|i| (i, inputs::FILL_ACCESS)),
         );
         resources.allow(&accesses);
         check_memory(ctx, &resources, extent)?;
         // 3. Create the images and write what reads them.
         resources.create(ctx)?;
-        frame.bind(ctx, &resources, method.output())?;
-        method.bind(&MethodBind {
-            ctx,
-            res: &resources,
-            pool: &frame.pool,
-            samplers: &frame.samplers,
-            targets: &frame.targets,
-            frame_binds: frame.frame_binds(&resources),
-            skin_material_binds: skin_material_binds(&frame),
-        })?;
+        let source = frame.composite_source(&groups);
+        frame.bind(ctx, &resources, source)?;
+        merge.bind(ctx, &frame.pool, &resources, &frame.targets, &groups)?;
+        for g in groups.iter_mut() {
+            g.method.bind(&MethodBind {
+                ctx,
+                res: &resources,
+                pool: &frame.pool,
+                samplers: &frame.samplers,
+                targets: &frame.targets,
+                frame_binds: frame.frame_binds(&resources),
+                skin_material_binds: skin_material_binds(&frame),
+            })?;
+        }
         let submit = Submit::new(ctx, slots)?;
         // Complete: the renderer owns (and frees, in its drop) every part.
         let mut r = Renderer {
             ctx,
             frame: frame.keep(),
-            method: method.keep(),
+            groups: groups.keep(),
+            merge: merge.keep(),
             resources: resources.keep(),
             submit,
+            last_record_ms: 0.0,
         };
         // Texels of the intermediates outside the region are never written: zero
         // them once so a dump of an intermediate shows black there, not old memory.
         let full = PixelRect::full(extent.width, extent.height);
-        if r.frame.region_px != [full] {
+        if r.groups.iter().any(|g| g.region_px != [full]) {
             r.fill_intermediates(0.0)?;
         }
         ctx.check_validation("while setting up the renderer")?;
         Ok(r)
     }
 
-    /// The method as its concrete type (tests that inspect one method's state).
+    /// The SSS region of every group, one after another (one group's in a
+    /// single-method frame).
+    pub fn region_px(&self) -> Vec<PixelRect> {
+        self.groups
+            .iter()
+            .flat_map(|g| g.region_px.iter().copied())
+            .collect()
+    }
+
+    /// Sets every group's SSS region (tests that upload their own inputs).
+    pub fn set_region(&mut self, px: Vec<PixelRect>) {
+        for g in &mut self.groups {
+            g.set_region(px.clone());
+        }
+    }
+
+    /// Calls every group's `begin_frame` (once before a frame's passes are built).
+    fn begin_frame(&mut self) {
+        for g in &mut self.groups {
+            g.method.begin_frame();
+        }
+    }
+
+    /// The first group's method (a single-method frame's only one) as its
+    /// concrete type (tests that inspect one method's state).
     pub fn method_as<T: 'static>(&self) -> Option<&T> {
-        self.method.as_any().downcast_ref::<T>()
+        self.groups[0].method.as_any().downcast_ref::<T>()
     }
 
     /// The frame's passes as they are recorded (tests, reports).
     pub fn passes(&self) -> Vec<Pass<'_>> {
-        self.frame.passes(self.method.as_ref(), &self.resources)
+        self.frame
+            .passes(&self.groups, &self.merge, &self.resources)
     }
 
     /// Records, submits and waits for one frame; returns its per-pass samples.
+    /// [`Renderer::last_record_ms`] is then its CPU recording time.
     fn run_frame(&mut self, plan: Option<&mut ReadbackPlan>) -> Result<Vec<PassSample>> {
-        self.method.begin_frame();
-        let mut passes = self.frame.passes(self.method.as_ref(), &self.resources);
+        let start = std::time::Instant::now();
+        self.begin_frame();
+        let mut passes = self
+            .frame
+            .passes(&self.groups, &self.merge, &self.resources);
+        let built_ms = start.elapsed().as_secs_f64() * 1e3;
         if let Some(plan) = plan {
             passes = plan.interleave(self.ctx, &mut self.resources, passes)?;
         }
-        submit_passes(
+        let samples = submit_passes(
             self.ctx,
             &self.submit,
             &mut self.resources,
             &passes,
             true,
             "during the frame",
-        )
+        )?;
+        self.last_record_ms = built_ms + self.submit.record_ms.get();
+        Ok(samples)
+    }
+
+    /// CPU milliseconds the last frame took to build its passes and record
+    /// them (the submission and the wait left out).
+    pub fn last_record_ms(&self) -> f64 {
+        self.last_record_ms
+    }
+
+    /// Renders `n` frames and returns each frame's pass samples and CPU
+    /// recording time (ms).
+    pub fn frames_timed(
+        &mut self,
+        n: usize,
+        mut progress: impl FnMut(usize),
+    ) -> Result<(Vec<Vec<PassSample>>, Vec<f64>)> {
+        let mut all = Vec::new();
+        let mut record = Vec::new();
+        for i in 0..n {
+            all.push(self.run_frame(None)?);
+            record.push(self.last_record_ms);
+            progress(i + 1);
+        }
+        Ok((all, record))
     }
 
     /// Renders `n` frames and returns each frame's pass samples (memory grows
@@ -306,8 +431,13 @@ impl<'c> Renderer<'c> {
     pub fn capture(&mut self, dump: bool) -> Result<Capture> {
         // Everything a capture returns, read back in the frame's own submission.
         let t = &self.frame.targets;
-        let finals: [ImageId; CAPTURED_IMAGES] =
-            [t.ldr, self.method.output(), t.linear_depth, t.hdr];
+        let mut finals = vec![
+            t.ldr,
+            self.frame.composite_source(&self.groups),
+            t.linear_depth,
+            t.hdr,
+        ];
+        finals.extend(self.frame.character_ids);
         let mut plan = ReadbackPlan::new(dump, &finals);
         let samples = match self.run_frame(Some(&mut plan)) {
             Ok(s) => s,
@@ -317,9 +447,23 @@ impl<'c> Renderer<'c> {
             }
         };
         let (finals, dumps) = plan.finish(self.ctx, &mut self.resources)?;
-        let [ldr, diffuse, depth, hdr] = <[_; 4]>::try_from(finals)
-            .map_err(|_| anyhow::anyhow!("the capture read back the wrong number of images"))?;
+        let mut finals = finals.into_iter();
+        let mut next = || {
+            finals
+                .next()
+                .ok_or_else(|| anyhow::anyhow!("the capture read back too few images"))
+        };
+        let (ldr, diffuse, depth, hdr) = (next()?, next()?, next()?, next()?);
         let float = |(format, bytes): readback::RawImage| to_rgba_f32(format, &bytes);
+        let character_ids = match self.frame.character_ids {
+            Some(_) => Some(
+                float(next()?)?
+                    .iter()
+                    .map(|p| p[0].max(0.0) as u32)
+                    .collect(),
+            ),
+            None => None,
+        };
         let hdr = float(hdr)?;
         Ok(Capture {
             ldr: ldr.1,
@@ -336,6 +480,7 @@ impl<'c> Renderer<'c> {
                 .iter()
                 .filter(|p| !p.iter().all(|c| c.is_finite()))
                 .count(),
+            character_ids,
         })
     }
 
@@ -373,15 +518,18 @@ impl<'c> Renderer<'c> {
         self.frame.view_info().ndc_depth(d)
     }
 
-    /// Runs only the SSS passes on whatever the targets hold (tests) and reads
-    /// back the method's output as f32 RGBA with the pass samples.
+    /// Runs only the SSS passes (every group's, and the merges) on whatever
+    /// the targets hold (tests) and reads back what the composite would read
+    /// as f32 RGBA with the pass samples.
     pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
-        self.method.begin_frame();
-        let passes = self.method.passes(&self.frame.view(&self.resources));
+        self.begin_frame();
+        let passes = self
+            .frame
+            .group_passes(&self.groups, &self.merge, &self.resources);
         if passes.is_empty() {
             bail!("the SSS-only run needs a method with passes");
         }
-        let output = self.method.output();
+        let output = self.frame.composite_source(&self.groups);
         submit_and_read(
             self.ctx,
             &self.submit,
@@ -403,7 +551,10 @@ impl Drop for Renderer<'_> {
             let _ = ctx.device.device_wait_idle();
         }
         self.submit.destroy(ctx);
-        self.method.destroy(ctx);
+        Destroy::destroy(&mut self.merge, ctx);
+        for g in &mut self.groups {
+            g.destroy(ctx);
+        }
         self.frame.destroy(ctx);
         self.resources.destroy(ctx);
     }
@@ -463,9 +614,11 @@ fn submit_passes(
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
         )?;
     }
+    let start = std::time::Instant::now();
     record_passes(ctx, s.cmd, resources, passes, profiler);
     unsafe {
         ctx.device.end_command_buffer(s.cmd)?;
+        s.record_ms.set(start.elapsed().as_secs_f64() * 1e3);
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(s.cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         ctx.device

@@ -5,6 +5,8 @@ use anyhow::{bail, Context as _, Result};
 
 use crate::method::region::{RegionMode, TILE_PX};
 use crate::method::{default_method, MethodEntry, MethodOptions};
+use crate::mix::assign::Rules;
+use crate::mix::plan_file::PlanFile;
 use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
@@ -32,6 +34,15 @@ pub fn check_fovy(fovy_deg: f32) -> Result<()> {
     Ok(())
 }
 
+/// Where the methods of a frame of several come from (`render --assign` or
+/// `--plan`): resolved against the frame's characters by
+/// `render::groups::group_specs`.
+#[derive(Clone, Debug)]
+pub enum Assignment {
+    Rules(Rules),
+    Plan(PlanFile),
+}
+
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
     pub width: u32,
@@ -39,6 +50,13 @@ pub struct RenderSettings {
     pub method: &'static MethodEntry,
     /// Options given to the methods (each reads its own; see `method::options`).
     pub options: MethodOptions,
+    /// A method per character (`None`: every character gets `method` with
+    /// `options`, the single-method frame); `method` and `options` are then
+    /// not read.
+    pub assignment: Option<Assignment>,
+    /// Also write each character's skin pixels (`render --character-ids`: an
+    /// extra pass after the frame; the frame itself is unchanged).
+    pub character_ids: bool,
     pub transmittance: bool,
     /// Which T(s) transmittance uses (eq. 5.12 as published, or the plane integral).
     pub transmittance_profile: TransmittanceProfile,
@@ -99,6 +117,8 @@ impl RenderSettings {
             height: 720,
             method: default_method(),
             options: MethodOptions::default(),
+            assignment: None,
+            character_ids: false,
             transmittance: true,
             transmittance_profile: TransmittanceProfile::Thesis,
             sss_region: RegionMode::Skin,

@@ -47,7 +47,7 @@ fn render(scene: &Scene, s: &RenderSettings) -> Frame {
         diffuse: cap.diffuse,
         ldr: cap.ldr,
         counts,
-        region_pixels: r.frame.region_px.iter().map(|t| t.area()).sum(),
+        region_pixels: r.region_px().iter().map(|t| t.area()).sum(),
     }
 }
 
@@ -229,7 +229,7 @@ fn a_camera_inside_the_skin_box_falls_back_to_the_whole_screen() {
     };
     let ctx = common::ctx();
     let r = Renderer::new(&ctx, &scene, &s).expect("renderer");
-    assert_eq!(r.frame.region_px, vec![PixelRect::full(96, 64)]);
+    assert_eq!(r.region_px(), vec![PixelRect::full(96, 64)]);
 }
 
 #[test]
@@ -245,7 +245,7 @@ fn many_heads_far_away_get_rectangles_of_their_own() {
         ..RenderSettings::study()
     };
     let r = Renderer::new(&ctx, &egg_scene(), &s).expect("renderer");
-    let region = &r.frame.region_px;
+    let region = &r.region_px();
     // A 2x2 grid of heads centred on the screen: the centre lies between them.
     assert!(region.iter().all(|t| !t.contains(480, 270)), "{region:?}");
     assert!(region.len() >= 4, "{region:?}");
