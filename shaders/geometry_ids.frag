@@ -4,7 +4,7 @@
 // `render --character-ids`: each head drawn again with the geometry pass's
 // vertex shader, depth-tested EQUAL against the frame's depth, writes its
 // character's frame index + 1 (0 stays: no skin). R32F holds it exactly.
-layout(push_constant) uniform Push { layout(offset = 64) float id; } pc;
+layout(push_constant) uniform Push { float id; } pc;
 // The vertex shader's outputs, read so the interfaces match (the R32F
 // target stores the red channel alone: the id).
 layout(location = 0) in vec3 vWorldPos;

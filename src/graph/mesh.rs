@@ -70,6 +70,25 @@ impl GpuMesh {
         }
     }
 
+    /// Binds the buffers and draws every triangle of instances
+    /// `first..first + count` in one draw (the vertex shader reads each
+    /// instance's model matrix by `gl_InstanceIndex`). Primitives are
+    /// rasterised instance by instance, so this draws the same triangles in
+    /// the same order as `count` draws of one instance each.
+    pub fn draw_instances(&self, ctx: &Context, cmd: vk::CommandBuffer, first: u32, count: u32) {
+        if count == 0 {
+            return;
+        }
+        unsafe {
+            ctx.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
+            ctx.device
+                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
+            ctx.device
+                .cmd_draw_indexed(cmd, self.index_count, count, 0, 0, first);
+        }
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);

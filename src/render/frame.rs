@@ -69,19 +69,21 @@ pub struct FrameUniforms {
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadowPush {
-    model: [[f32; 4]; 4],
     light_view_proj: [[f32; 4]; 4],
 }
 
-/// Push constants of the character-id pass: geometry.vert's model, then the id.
+/// Push constants of the character-id pass: the id.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct IdPush {
-    model: [[f32; 4]; 4],
     id: f32,
 }
 
 const IDS_SHADER: &str = "geometry_ids.frag";
+/// The geometry pass's vertex shader: geometry.vert (what tsd's final pass and
+/// the ground truth's surface pass draw one head with) with the model matrix
+/// read per instance.
+const GEOMETRY_VERT: &str = "geometry_instanced.vert";
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -134,6 +136,19 @@ pub struct Frame {
     /// stencil reference (one group of every character, code 1, until
     /// `set_skin_groups`).
     pub skin_groups: Vec<SkinGroup>,
+    /// Every character's model matrix, group after group, then the
+    /// backdrop's: the shadow, geometry and id passes draw instances of it.
+    instance_buffer: Buffer,
+    /// Each group's first slot in it and count; the backdrop's slot; each
+    /// character's slot.
+    group_slots: Vec<(u32, u32)>,
+    backdrop_slot: u32,
+    character_slots: Vec<u32>,
+    /// The instance buffer as the shadow pipeline's set 0 and the geometry
+    /// and id pipelines' set 2.
+    shadow_set: vk::DescriptorSet,
+    instance_set: vk::DescriptorSet,
+    ids_instance_set: vk::DescriptorSet,
     screen_rect: Vec<vk::Rect2D>,
 }
 
@@ -211,6 +226,13 @@ impl Frame {
                 stencil: STENCIL_SKIN,
                 characters: every,
             }],
+            instance_buffer: Buffer::default(),
+            group_slots: Vec::new(),
+            backdrop_slot: 0,
+            character_slots: Vec::new(),
+            shadow_set: vk::DescriptorSet::null(),
+            instance_set: vk::DescriptorSet::null(),
+            ids_instance_set: vk::DescriptorSet::null(),
             screen_rect: scissors(&[full]),
         };
         // Filled in by `build`: on an error, the guard frees what exists.
@@ -268,6 +290,46 @@ impl Frame {
             )?;
             self.objects.push(g);
         }
+        self.write_instances(ctx)
+    }
+
+    /// The instance buffer of `skin_groups` (group after group, then the
+    /// backdrop) and the sets that read it.
+    fn write_instances(&mut self, ctx: &Context) -> Result<()> {
+        let mut models: Vec<[[f32; 4]; 4]> = Vec::new();
+        self.group_slots.clear();
+        self.character_slots = vec![0; self.instances.len()];
+        for g in &self.skin_groups {
+            self.group_slots
+                .push((models.len() as u32, g.characters.len() as u32));
+            for &c in &g.characters {
+                self.character_slots[c] = models.len() as u32;
+                models.push(self.instances[c].to_cols_array_2d());
+            }
+        }
+        self.backdrop_slot = models.len() as u32;
+        models.push(self.backdrop.to_cols_array_2d());
+        self.instance_buffer.destroy(ctx);
+        self.instance_buffer = Buffer::with_data(
+            ctx,
+            "character instances",
+            bytemuck::cast_slice(&models),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let bind = [(
+            "Instances",
+            Bind::Uniform {
+                buffer: self.instance_buffer.raw,
+                size: (models.len() * std::mem::size_of::<[[f32; 4]; 4]>()) as u64,
+            },
+        )];
+        self.shadow_set = self.pool.write_set(ctx, &self.shadow_pipeline, 0, &bind)?;
+        self.instance_set = self
+            .pool
+            .write_set(ctx, &self.geometry_pipeline, 2, &bind)?;
+        if self.character_ids.is_some() {
+            self.ids_instance_set = self.pool.write_set(ctx, &self.ids_pipeline, 2, &bind)?;
+        }
         Ok(())
     }
 
@@ -304,7 +366,7 @@ impl Frame {
             ctx,
             &GraphicsDesc {
                 name: "geometry".into(),
-                vert: "geometry.vert",
+                vert: GEOMETRY_VERT,
                 frag: Some(geometry_shader(&targets)),
                 color_formats,
                 depth_format: Some(ds_format),
@@ -355,7 +417,7 @@ impl Frame {
             ctx,
             &GraphicsDesc {
                 name: "character ids".into(),
-                vert: "geometry.vert",
+                vert: GEOMETRY_VERT,
                 frag: Some(IDS_SHADER),
                 color_formats: vec![res.format(ids)],
                 depth_format: Some(ds_format),
@@ -371,7 +433,7 @@ impl Frame {
             },
         )?;
         self.character_ids = Some(ids);
-        Ok(())
+        self.write_instances(ctx)
     }
 
     /// The frame's uniforms: camera, key light, shadow and transmittance parameters.
@@ -457,9 +519,11 @@ impl Frame {
         )
     }
 
-    /// The groups' heads and codes the geometry pass draws.
-    pub fn set_skin_groups(&mut self, groups: Vec<SkinGroup>) {
+    /// The groups' heads and codes the geometry pass draws (rewrites the
+    /// instance buffer in group order).
+    pub fn set_skin_groups(&mut self, ctx: &Context, groups: Vec<SkinGroup>) -> Result<()> {
         self.skin_groups = groups;
+        self.write_instances(ctx)
     }
 
     /// The bindings of `lighting.glsl`'s set 0 (frame).
@@ -591,14 +655,11 @@ impl Frame {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.ids_pipeline;
                 p.bind(ctx, cmd, &[self.ids_set]);
+                p.bind_sets(ctx, cmd, 2, &[self.ids_instance_set]);
                 for obj in self.objects.iter().filter(|o| o.skin) {
-                    for (c, m) in self.instances.iter().enumerate() {
-                        let push = IdPush {
-                            model: m.to_cols_array_2d(),
-                            id: (c + 1) as f32,
-                        };
-                        p.push(ctx, cmd, &push);
-                        obj.bind_and_draw(ctx, cmd);
+                    for (c, &slot) in self.character_slots.iter().enumerate() {
+                        p.push(ctx, cmd, &IdPush { id: (c + 1) as f32 });
+                        obj.draw_instances(ctx, cmd, slot, 1);
                     }
                 }
             })
@@ -622,17 +683,16 @@ impl Frame {
             .draws(None, self.triangles(true))
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
-                self.shadow_pipeline.bind(ctx, cmd, &[]);
-                // Heads only: the backdrop receives shadows but casts none worth a texel.
+                self.shadow_pipeline.bind(ctx, cmd, &[self.shadow_set]);
+                let push = ShadowPush {
+                    light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
+                };
+                self.shadow_pipeline.push(ctx, cmd, &push);
+                // Heads only: the backdrop receives shadows but casts none worth
+                // a texel. Every character in one instanced draw.
+                let heads = self.backdrop_slot;
                 for obj in self.objects.iter().filter(|o| o.skin) {
-                    for m in &self.instances {
-                        let push = ShadowPush {
-                            model: m.to_cols_array_2d(),
-                            light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
-                        };
-                        self.shadow_pipeline.push(ctx, cmd, &push);
-                        obj.bind_and_draw(ctx, cmd);
-                    }
+                    obj.draw_instances(ctx, cmd, 0, heads);
                 }
             })
     }
@@ -707,6 +767,7 @@ impl Frame {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.geometry_pipeline;
                 p.bind(ctx, cmd, &[self.frame_set]);
+                p.bind_sets(ctx, cmd, 2, &[self.instance_set]);
                 let set_reference = |r: u32| unsafe {
                     ctx.device.cmd_set_stencil_reference(
                         cmd,
@@ -718,18 +779,15 @@ impl Frame {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
                     if !obj.skin {
                         set_reference(0);
-                        p.push(ctx, cmd, &self.backdrop.to_cols_array_2d());
-                        obj.bind_and_draw(ctx, cmd);
+                        obj.draw_instances(ctx, cmd, self.backdrop_slot, 1);
                         continue;
                     }
-                    // Each group's heads with its code (one group: every
-                    // head in frame order, code 1, as before groups).
-                    for g in &self.skin_groups {
+                    // Each group's heads in one instanced draw with its code
+                    // (one group: every head in frame order, code 1, as
+                    // before groups).
+                    for (g, &(first, count)) in self.skin_groups.iter().zip(&self.group_slots) {
                         set_reference(g.stencil);
-                        for &c in &g.characters {
-                            p.push(ctx, cmd, &self.instances[c].to_cols_array_2d());
-                            obj.bind_and_draw(ctx, cmd);
-                        }
+                        obj.draw_instances(ctx, cmd, first, count);
                     }
                 }
             })
@@ -817,6 +875,7 @@ impl Frame {
         }
         self.beckmann.destroy(ctx);
         self.frame_ubo.destroy(ctx);
+        self.instance_buffer.destroy(ctx);
         for p in [
             &mut self.shadow_pipeline,
             &mut self.geometry_pipeline,

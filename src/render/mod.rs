@@ -208,6 +208,7 @@ impl<'c> Renderer<'c> {
             frame.enable_character_ids(ctx, &resources, ids)?;
         }
         frame.set_skin_groups(
+            ctx,
             specs
                 .iter()
                 .map(|g| SkinGroup {
@@ -215,7 +216,7 @@ impl<'c> Renderer<'c> {
                     characters: g.characters.clone(),
                 })
                 .collect(),
-        );
+        )?;
         let depth_stencil_format = resources.format(frame.targets.depth_stencil);
         let mut groups = Guard::new(ctx, Vec::<GroupMethod>::new());
         for spec in specs {

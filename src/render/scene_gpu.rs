@@ -179,6 +179,11 @@ impl GpuObject {
         self.mesh.bind_and_draw(ctx, cmd);
     }
 
+    /// Instances `first..first + count` in one draw (`GpuMesh::draw_instances`).
+    pub fn draw_instances(&self, ctx: &Context, cmd: vk::CommandBuffer, first: u32, count: u32) {
+        self.mesh.draw_instances(ctx, cmd, first, count);
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         self.mesh.destroy(ctx);
         self.uniforms.destroy(ctx);
