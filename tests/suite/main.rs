@@ -24,6 +24,7 @@ mod common;
 mod accuracy;
 mod budget_cli;
 mod harness;
+mod mix;
 mod reference;
 mod region;
 mod scenes;
