@@ -122,55 +122,12 @@ pub fn run(
     } else {
         None
     };
-    let decls: Vec<PassDecl> = renderer
-        .passes()
-        .iter()
-        .map(|p| PassDecl {
-            work: p.declared_work(&renderer.resources),
-            images: renderer.resources.image_uses(&p.images),
-            group: p.group,
-            characters: p
-                .group
-                .and_then(|g| renderer.groups.iter().find(|m| m.spec.index == g))
-                .map(|m| m.spec.characters.clone())
-                .unwrap_or_default(),
-        })
-        .collect();
+    let decls = pass_decls(&renderer);
     let (mut passes, mut frame) = aggregate(&frames, &decls);
     if let Some(f) = &mut frame {
         f.cpu_record_ms = Stats::of(&record_ms);
     }
-    let skin = capture
-        .as_ref()
-        .and_then(|c| group_skin_pixels(c, &renderer.groups));
-    let groups: Vec<GroupReport> = renderer
-        .groups
-        .iter()
-        .enumerate()
-        .map(|(i, g)| GroupReport {
-            index: g.spec.index,
-            choice: g.spec.label.clone(),
-            method: g.spec.entry.name.to_string(),
-            options: g
-                .spec
-                .entry
-                .opts(&g.spec.options)
-                .resolved()
-                .into_iter()
-                .map(|(k, v)| (k.to_string(), v))
-                .collect(),
-            stencil: g.spec.stencil(),
-            characters: g.spec.characters.clone(),
-            region_rects: g
-                .region_px
-                .iter()
-                .map(|r| [r.x0, r.y0, r.x1, r.y1])
-                .collect(),
-            region_pixels: g.region_px.iter().map(|r| r.area()).sum(),
-            skin_pixels: skin.as_ref().and_then(|s| s.get(i).copied()),
-            tint: None,
-        })
-        .collect();
+    let groups = group_reports(&renderer, capture.as_ref());
     let sss_totals: Vec<f64> = frames
         .iter()
         .map(|f| {
@@ -265,6 +222,57 @@ pub fn run(
         capture,
         frames,
     })
+}
+
+/// Each pass's declaration, with its group and that group's characters.
+fn pass_decls(renderer: &Renderer) -> Vec<PassDecl> {
+    renderer
+        .passes()
+        .iter()
+        .map(|p| PassDecl {
+            work: p.declared_work(&renderer.resources),
+            images: renderer.resources.image_uses(&p.images),
+            group: p.group,
+            characters: p
+                .group
+                .and_then(|g| renderer.groups.iter().find(|m| m.spec.index == g))
+                .map(|m| m.spec.characters.clone())
+                .unwrap_or_default(),
+        })
+        .collect()
+}
+
+/// The report's groups (skin pixels counted when the capture has character ids).
+fn group_reports(renderer: &Renderer, capture: Option<&Capture>) -> Vec<GroupReport> {
+    let skin = capture.and_then(|c| group_skin_pixels(c, &renderer.groups));
+    renderer
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(i, g)| GroupReport {
+            index: g.spec.index,
+            choice: g.spec.label.clone(),
+            method: g.spec.entry.name.to_string(),
+            options: g
+                .spec
+                .entry
+                .opts(&g.spec.options)
+                .resolved()
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
+            stencil: g.spec.stencil(),
+            characters: g.spec.characters.clone(),
+            region_rects: g
+                .region_px
+                .iter()
+                .map(|r| [r.x0, r.y0, r.x1, r.y1])
+                .collect(),
+            region_pixels: g.region_px.iter().map(|r| r.area()).sum(),
+            skin_pixels: skin.as_ref().and_then(|s| s.get(i).copied()),
+            tint: None,
+        })
+        .collect()
 }
 
 /// Skin pixels of each group's characters in a captured frame with

@@ -4,12 +4,17 @@
 //! the stencil) -> each group's method's passes (one group in a single-method
 //! frame) and, in a frame of several, the merges (`merge.rs`) -> composite
 //! (diffuse after SSS + specular) -> Hable tone map.
+//!
+//! Over 800 lines because every pass the frame itself records (shadow,
+//! geometry, composite, tone map, the character ids) reads the private
+//! pipelines, sets and instance slots of the one `Frame` they draw from: their
+//! pipelines, descriptor sets and passes read best beside that struct.
 
 use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
-use super::groups::GroupMethod;
+use super::groups::{scissors, GroupMethod};
 use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
@@ -158,23 +163,6 @@ pub struct SkinGroup {
     pub stencil: u32,
     /// Frame indices (into `Frame::instances`).
     pub characters: Vec<usize>,
-}
-
-/// The rectangles of a pixel region as scissors.
-pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
-    region
-        .iter()
-        .map(|r| vk::Rect2D {
-            offset: vk::Offset2D {
-                x: r.x0 as i32,
-                y: r.y0 as i32,
-            },
-            extent: vk::Extent2D {
-                width: r.width(),
-                height: r.height(),
-            },
-        })
-        .collect()
 }
 
 impl Frame {

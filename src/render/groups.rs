@@ -153,9 +153,26 @@ pub struct GroupMethod {
     pub scissors: Vec<vk::Rect2D>,
 }
 
+/// The rectangles of a pixel region as scissors.
+pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
+    region
+        .iter()
+        .map(|r| vk::Rect2D {
+            offset: vk::Offset2D {
+                x: r.x0 as i32,
+                y: r.y0 as i32,
+            },
+            extent: vk::Extent2D {
+                width: r.width(),
+                height: r.height(),
+            },
+        })
+        .collect()
+}
+
 impl GroupMethod {
     pub fn set_region(&mut self, px: Vec<PixelRect>) {
-        self.scissors = super::frame::scissors(&px);
+        self.scissors = scissors(&px);
         self.region_px = px;
     }
 

@@ -16,6 +16,7 @@ use crate::graph::{ImageId, Pass, Resources};
 use crate::method::screen::{fetch, masked_pass, Masked};
 use crate::method::{skin_stencil_test, FrameTargets, FrameView};
 use crate::vk::context::Context;
+use crate::vk::guard::Destroy;
 use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline};
 
 pub const MERGE_SHADER: &str = "composite_merge.frag";
@@ -116,5 +117,11 @@ impl Merge {
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
+    }
+}
+
+impl Destroy for Merge {
+    fn destroy(&mut self, ctx: &Context) {
+        Merge::destroy(self, ctx)
     }
 }

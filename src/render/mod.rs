@@ -7,6 +7,7 @@
 
 pub mod counting;
 pub mod frame;
+pub mod group_setup;
 pub mod groups;
 pub mod inputs;
 pub mod merge;
@@ -21,7 +22,7 @@ use ash::vk;
 use crate::graph::work::PassRole;
 use crate::graph::{record_passes, ImageId, Pass, PassSample, Resources};
 use crate::method::region::PixelRect;
-use crate::method::{MethodBind, MethodSetup};
+use crate::method::MethodBind;
 use crate::scene::framing::frame as frame_scene;
 use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
@@ -29,6 +30,7 @@ use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
 use frame::{skin_material_binds, Frame, SkinGroup};
+use group_setup::build_groups;
 use groups::{frame_needs, group_specs, GroupMethod};
 use merge::{needs_merge, Merge};
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
@@ -128,12 +130,6 @@ pub struct Renderer<'c> {
     last_record_ms: f64,
 }
 
-impl Destroy for Merge {
-    fn destroy(&mut self, ctx: &Context) {
-        Merge::destroy(self, ctx)
-    }
-}
-
 /// Refuses a frame whose images (and the readback of its output) would take
 /// more than half the device's memory: the allocation would fail late, or on a
 /// CPU device succeed and then exhaust the host. Checked before any image exists.
@@ -217,50 +213,8 @@ impl<'c> Renderer<'c> {
                 })
                 .collect(),
         )?;
-        let depth_stencil_format = resources.format(frame.targets.depth_stencil);
-        let mut groups = Guard::new(ctx, Vec::<GroupMethod>::new());
-        for spec in specs {
-            let instances: Vec<glam::Mat4> = spec
-                .characters
-                .iter()
-                .map(|&c| frame.instances[c])
-                .collect();
-            // Two groups of one method declare images of one name: each
-            // group's carry its prefix (none in a single-method frame).
-            resources.set_name_prefix(&if mixed {
-                format!("#{} ", spec.index)
-            } else {
-                String::new()
-            });
-            let method = (spec.entry.build)(&mut MethodSetup {
-                ctx,
-                res: &mut resources,
-                targets: &frame.targets,
-                samplers: &frame.samplers,
-                options: spec.entry.opts(&spec.options),
-                view: frame.view_info(),
-                depth_stencil_format,
-                scene,
-                instances: &instances,
-            })
-            .with_context(|| format!("setting up {}", spec.label))?;
-            let mut g = GroupMethod {
-                spec,
-                instances,
-                method,
-                region_px: Vec::new(),
-                scissors: Vec::new(),
-            };
-            // A group with no SSS records no pass: in a mix it has no region.
-            let region = if mixed && g.is_none() {
-                Vec::new()
-            } else {
-                frame.region_for(scene, &*g.method, &g.instances)
-            };
-            g.set_region(region);
-            groups.push(g);
-        }
-        resources.set_name_prefix("");
+        let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
+        let mut groups = Guard::new(ctx, groups);
         let mut merge = Guard::new(ctx, Merge::default());
         if mixed && groups.iter().any(|g| needs_merge(g, &frame.targets)) {
             *merge = Merge::new(ctx, &resources, &frame.targets, &groups)?;

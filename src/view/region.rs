@@ -14,7 +14,7 @@
 //! reach, and the union is covered by 32-pixel screen tiles and returned as
 //! disjoint rectangles: disjoint so that a pass drawn once per rectangle never
 //! blends a pixel twice. (The frame turns them into Vulkan scissors:
-//! `render::frame::scissors`.)
+//! `render::groups::scissors`.)
 
 use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
