@@ -37,8 +37,10 @@ pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
 
 /// The stencil bit the geometry pass sets on skin pixels (group 0's code,
-/// `mix::stencil_code(0)`): what a single-method frame writes and tests.
-pub const STENCIL_SKIN: u32 = crate::mix::SKIN_BIT;
+/// `mix::stencil_code(0)`, which reads this layer and not the other way
+/// round; render/groups.rs's tests hold the two equal): what a
+/// single-method frame writes and tests.
+pub const STENCIL_SKIN: u32 = 1;
 
 /// Stencil state of every stencil-masked SSS pass: shade only where the stencil
 /// holds the pass's group code. The whole 8 bits are compared (a group's code

@@ -213,6 +213,7 @@ mod tests {
         assert_eq!(g.len(), 1);
         assert_eq!(g[0].characters, vec![0, 1, 2]);
         assert_eq!(g[0].stencil(), crate::method::STENCIL_SKIN);
+        assert_eq!(crate::mix::SKIN_BIT, crate::method::STENCIL_SKIN);
         assert_eq!(g[0].label, "separable");
     }
 
