@@ -36,7 +36,8 @@ const LAYERS: &[&[&str]] = &[
     ],
     &["vk"],
     &["graph"],
-    &["method"],
+    // mix: which method each character gets (it reads the registry).
+    &["method", "mix"],
     &["render"],
     &[
         "report", "bench", "run", "output", "trace", "budget", "plot",
