@@ -1,9 +1,8 @@
 #version 450
-#extension GL_GOOGLE_include_directive : require
-#include "fetch_count.glsl"
 // `render --character-ids`: each head drawn again with the geometry pass's
 // vertex shader, depth-tested EQUAL against the frame's depth, writes its
 // character's frame index + 1 (0 stays: no skin). R32F holds it exactly.
+// It fetches nothing, so its fetch-counting build counts nothing either.
 layout(push_constant) uniform Push { float id; } pc;
 // The vertex shader's outputs, read so the interfaces match (the R32F
 // target stores the red channel alone: the id).
@@ -14,7 +13,6 @@ layout(location = 3) in vec2 vUv;
 layout(location = 4) in float vViewDepth;
 layout(location = 0) out vec4 outId;
 void main() {
-    COUNT_INVOCATION();
     float unused = vWorldPos.x + vNormal.x + vTangent.x + vUv.x + vViewDepth;
     outId = vec4(pc.id, unused, 0.0, 1.0);
 }

@@ -304,3 +304,33 @@ fn a_crowd_of_256_renders_with_a_mix() {
     );
     assert!(r.last_record_ms() > 0.0);
 }
+
+/// With --assign, --method and the method flags are ignored, and said so.
+#[test]
+fn assign_names_the_flags_it_makes_ignored() {
+    let o = common::dermis()
+        .args([
+            "render",
+            "--device",
+            "no-such-device-here",
+            "--assign",
+            "*=none",
+        ])
+        .args(["--method", "ssg", "--samples", "9", "--no-lod"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    for flag in ["--method", "--samples", "--no-lod"] {
+        assert!(
+            stderr.contains(&format!(
+                "note: {flag} is ignored: --assign gives each character its method"
+            )),
+            "{stderr}"
+        );
+    }
+    // The assignment was checked and the device looked for only then.
+    assert!(
+        stderr.contains("no Vulkan device whose name contains"),
+        "{stderr}"
+    );
+}
