@@ -208,7 +208,7 @@ mod tests {
             method: "ssg".into(),
             setting: setting.into(),
             px_per_mm: 0.1 * 3.0f64.sqrt(),
-            light_deg: 69.295188945364572,
+            light_deg: 69.29518894536457,
             interior: 0.123456789012345,
             silhouette: sil,
         }

@@ -15,17 +15,15 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result};
-use serde::Serialize;
-
 use super::chart;
-use super::sweep::{load, EvalRow, SceneSpec};
+use super::sweep::{load, AccuracyPoint, EvalRow, SceneSpec};
 use crate::accuracy::data::{to_toml, Header, Row};
 use crate::accuracy::loso::{leave_one_scale_out, table};
 use crate::accuracy::{AccuracyModel, Asset};
 use crate::render::RenderSettings;
 use crate::scene::light::KeyLight;
 use crate::view::ViewScale;
+use anyhow::{Context as _, Result};
 
 /// Rows of the frame the views are crops of (the eval's 1280x720).
 pub const REFERENCE_HEIGHT_PX: u32 = 720;
@@ -37,17 +35,6 @@ pub const SCALE_RANGE: (f64, f64) = (0.1, 10.0);
 /// the thesis scene set's.
 pub const AZIMUTHS: [f32; 4] = [0.0, 60.0, 110.0, 150.0];
 pub const ELEVATION_DEG: f32 = 45.0;
-
-/// What a row of the accuracy model records about its view.
-#[derive(Clone, Debug, Serialize)]
-pub struct AccuracyPoint {
-    pub asset: String,
-    /// Pixels per millimetre at the head centre's depth.
-    pub px_per_mm: f64,
-    /// Degrees between the key light's direction and the direction from the
-    /// head to the camera.
-    pub light_deg: f64,
-}
 
 /// The measured scales, ascending.
 pub fn scales() -> Vec<f64> {

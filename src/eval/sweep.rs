@@ -55,7 +55,18 @@ pub struct SceneSpec {
     pub fovy_deg: Option<f32>,
     /// What the accuracy model's rows record (the accuracy set only).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
-    pub accuracy: Option<super::accuracy_set::AccuracyPoint>,
+    pub accuracy: Option<AccuracyPoint>,
+}
+
+/// What a row of the accuracy model records about its view.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyPoint {
+    pub asset: String,
+    /// Pixels per millimetre at the head centre's depth.
+    pub px_per_mm: f64,
+    /// Degrees between the key light's direction and the direction from the
+    /// head to the camera.
+    pub light_deg: f64,
 }
 
 /// The thesis' perceptual study (section 4.3.2): zoom, near and far (28, 50 and
