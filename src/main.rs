@@ -129,8 +129,10 @@ enum Command {
         out: PathBuf,
         /// Scene set: thesis (the Lee Perry-Smith head at the perceptual study's 3
         /// distances x 4 lights, plus the procedural scene), dolly (the head from 1 to
-        /// 24 head heights in 12 steps; adds distance.png/svg, error against distance)
-        /// or quick (procedural only).
+        /// 24 head heights in 12 steps; adds distance.png/svg, error against distance),
+        /// quick (procedural only) or accuracy (the accuracy model's sweep: both heads at
+        /// 8 scales x 4 lights; accuracy:scan, accuracy:procedural one head; writes
+        /// ASSET.toml for profiles/accuracy/, the charts and the leave-one-scale-out error).
         #[arg(long, default_value = "thesis")]
         scenes: String,
         #[arg(long, default_value_t = 2)]

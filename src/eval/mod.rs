@@ -11,7 +11,11 @@
 //! - `pareto`: cost/error points, their Pareto front and CSV export;
 //! - `chart`: the cost-versus-error chart (PNG and SVG) a report shows;
 //! - `sweep`: the sweep of every registered method and setting over a scene set;
+//! - `accuracy_set`: the accuracy model's scene set (scales x lights on both
+//!   heads) and what it writes: the model's data, its chart and its
+//!   leave-one-scale-out error;
 //! - `study`: `dermis eval` and `dermis compare`: scene sets, outputs, charts.
+pub mod accuracy_set;
 pub mod bands;
 pub mod chart;
 pub mod metrics;

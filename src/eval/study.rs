@@ -9,7 +9,8 @@ use serde::Serialize;
 
 use super::bands::{bands, Band, BandErrors, BandInput};
 use super::metrics::{abs_error_map, false_colour, flip_ldr, relative_rmse};
-use super::{chart, pareto, sweep};
+use super::{accuracy_set, chart, pareto, sweep};
+use crate::accuracy::Asset;
 use crate::method::lookup;
 use crate::output::{read_exr, write_json, write_rgba8_png};
 use crate::render::RenderSettings;
@@ -38,7 +39,16 @@ pub fn scene_set(
             distance_heads: base.distance_heads,
             ..sweep::procedural_scene()
         }],
-        other => bail!("unknown scene set '{other}' (valid: thesis, dolly, quick)"),
+        // The accuracy model's sweep: both heads, or one.
+        "accuracy" => accuracy_set::accuracy_scenes(
+            &[(Asset::Scan, Some(head()?)), (Asset::Procedural, None)],
+            base,
+        )?,
+        "accuracy:scan" => accuracy_set::accuracy_scenes(&[(Asset::Scan, Some(head()?))], base)?,
+        "accuracy:procedural" => {
+            accuracy_set::accuracy_scenes(&[(Asset::Procedural, None)], base)?
+        }
+        other => bail!("unknown scene set '{other}' (valid: thesis, dolly, quick, accuracy, accuracy:scan, accuracy:procedural)"),
     })
 }
 
@@ -135,6 +145,25 @@ pub fn eval(
             &out.join("distance.svg"),
         )?;
         files.extend([out.join("distance.png"), out.join("distance.svg")]);
+    }
+    if specs.iter().any(|s| s.accuracy.is_some()) {
+        // The accuracy model's data, chart and leave-one-scale-out error.
+        let header = crate::accuracy::data::Header {
+            command: command.to_string(),
+            device: format!("{} ({})", ctx.facts.name, ctx.facts.driver),
+            frame: format!(
+                "{}x{}, the centre of the {}-row frame at {} deg vertical field of view (this frame's: {:.4} deg)",
+                opts.base.width,
+                opts.base.height,
+                accuracy_set::REFERENCE_HEIGHT_PX,
+                opts.base.fovy_deg,
+                specs.iter().find_map(|s| s.fovy_deg).unwrap_or(opts.base.fovy_deg)
+            ),
+        };
+        let rows = accuracy_set::rows_of(specs, &rows)?;
+        let (loso, written) = accuracy_set::write(&rows, &header, out)?;
+        println!("leave-one-scale-out prediction error (absolute err/none):\n{loso}");
+        files.extend(written);
     }
     Ok(EvalOutcome { summary, files })
 }

@@ -49,6 +49,24 @@ pub struct SceneSpec {
     pub distance_heads: f32,
     pub azimuth_deg: f32,
     pub elevation_deg: f32,
+    /// The scene set's own field of view (the accuracy set's narrowed frame);
+    /// `None`: the run's `--fovy`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fovy_deg: Option<f32>,
+    /// What the accuracy model's rows record (the accuracy set only).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<AccuracyPoint>,
+}
+
+/// What a row of the accuracy model records about its view.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyPoint {
+    pub asset: String,
+    /// Pixels per millimetre at the head centre's depth.
+    pub px_per_mm: f64,
+    /// Degrees between the key light's direction and the direction from the
+    /// head to the camera.
+    pub light_deg: f64,
 }
 
 /// The thesis' perceptual study (section 4.3.2): zoom, near and far (28, 50 and
@@ -70,6 +88,8 @@ pub fn thesis_scenes(head: Option<PathBuf>) -> Vec<SceneSpec> {
                     distance_heads: d,
                     azimuth_deg: az,
                     elevation_deg: 45.0,
+                    fovy_deg: None,
+                    accuracy: None,
                 });
             }
         }
@@ -94,6 +114,8 @@ pub fn dolly_scenes(head: PathBuf) -> Vec<SceneSpec> {
                 distance_heads: d,
                 azimuth_deg: 60.0,
                 elevation_deg: 45.0,
+                fovy_deg: None,
+                accuracy: None,
             }
         })
         .collect()
@@ -108,6 +130,8 @@ pub fn procedural_scene() -> SceneSpec {
         distance_heads: d.distance_heads,
         azimuth_deg: d.light.azimuth_deg,
         elevation_deg: d.light.elevation_deg,
+        fovy_deg: None,
+        accuracy: None,
     }
 }
 
@@ -203,7 +227,7 @@ pub struct EvalOptions {
     pub progress: bool,
 }
 
-fn load(spec: &SceneSpec) -> Result<Scene> {
+pub(super) fn load(spec: &SceneSpec) -> Result<Scene> {
     match &spec.gltf {
         None => Ok(default_scene()),
         Some(p) => load_gltf_scene(p, &TextureOverrides::default(), None),
@@ -233,6 +257,9 @@ pub fn sweep(
         base.distance_heads = spec.distance_heads;
         base.light.azimuth_deg = spec.azimuth_deg;
         base.light.elevation_deg = spec.elevation_deg;
+        if let Some(f) = spec.fovy_deg {
+            base.fovy_deg = f;
+        }
         let once = RunOptions::capture_once("eval");
         let step = |what: &str| {
             if let Some(b) = &bar {

@@ -33,6 +33,7 @@ const LAYERS: &[&[&str]] = &[
         "scene",
         "skin",
         "reference",
+        "accuracy",
     ],
     &["vk"],
     &["graph"],

@@ -22,6 +22,7 @@
 mod common;
 
 mod accuracy;
+mod accuracy_model;
 mod budget_cli;
 mod harness;
 mod mix;
