@@ -4,12 +4,13 @@
 //! depth, the key light's angle to the camera, skin pixels and the screen
 //! rectangle of its skin.
 //!
-//! Skin pixels are estimated as the projected area of the skin mesh's
-//! front-facing triangles, clipped to the screen: exact for a convex head,
-//! an overestimate where the face hides itself (nose over cheek, ears) and
-//! where characters hide each other (not modelled; it only makes the plan's
-//! costs conservative). `tests/suite/plan.rs` holds the estimate to the skin
-//! pixels of the stored lavapipe frames (samples passed).
+//! Skin pixels are counted by rasterising every character's front-facing
+//! triangles on the CPU into one depth buffer of the frame's size (pixel
+//! centres inside a triangle, nearest depth wins), so a face hiding itself
+//! and characters hiding each other are counted as the geometry pass counts
+//! them (the backdrop, behind every character, is left out).
+//! `tests/suite/plan.rs` holds the count to the skin pixels of the stored
+//! lavapipe frames (samples passed).
 
 use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
@@ -73,7 +74,11 @@ pub fn estimate(
     let head_h = scene.head_height_units();
     let centre = scene.head_center();
     let mesh = &scene.head.mesh;
-    let skin = scene.head.material.skin;
+    let visible = if scene.head.material.skin {
+        rasterise(mesh, &framing.instances, &vp, cam.eye, width, height)
+    } else {
+        vec![(0.0, [0; 4]); framing.instances.len()]
+    };
     framing
         .instances
         .iter()
@@ -85,11 +90,7 @@ pub fn estimate(
             let light_deg = f64::from(to_eye.dot(light_dir.normalize_or_zero()).clamp(-1.0, 1.0))
                 .acos()
                 .to_degrees();
-            let (area, rect) = if skin {
-                projected_skin(mesh, m, &vp, cam.eye, width, height)
-            } else {
-                (0.0, [0, 0, 0, 0])
-            };
+            let (area, rect) = visible[index];
             let px_per_mm = f64::from(scale.px_per_mm(depth.max(1e-6)));
             CharacterInput {
                 index,
@@ -106,110 +107,97 @@ pub fn estimate(
         .collect()
 }
 
-/// Screen area (pixels) of the front-facing triangles of `mesh` placed by
-/// `model`, clipped to the screen, and their bounding rectangle.
-fn projected_skin(
+/// Pixels of each instance of `mesh` left visible in one depth buffer of
+/// `width` x `height` (front-facing triangles, pixel centres inside, the
+/// nearest depth kept), with each instance's bounding rectangle.
+fn rasterise(
     mesh: &crate::scene::mesh::Mesh,
-    model: &Mat4,
+    instances: &[Mat4],
     vp: &Mat4,
     eye: Vec3,
     width: u32,
     height: u32,
-) -> (f64, [u32; 4]) {
-    let (w, h) = (width as f64, height as f64);
-    let world: Vec<Vec3> = mesh
-        .vertices
-        .iter()
-        .map(|v| model.transform_point3(Vec3::from(v.position)))
-        .collect();
-    let screen: Vec<Option<[f64; 2]>> = world
-        .iter()
-        .map(|p| {
-            let c: Vec4 = *vp * p.extend(1.0);
-            (c.w > 1e-6).then(|| {
-                let x = f64::from(c.x / c.w);
-                let y = f64::from(c.y / c.w);
-                [(x * 0.5 + 0.5) * w, (y * 0.5 + 0.5) * h]
+) -> Vec<(f64, [u32; 4])> {
+    let (w, h) = (width as usize, height as usize);
+    let mut depth = vec![f32::INFINITY; w * h];
+    let mut owner = vec![u32::MAX; w * h];
+    for (k, model) in instances.iter().enumerate() {
+        let world: Vec<Vec3> = mesh
+            .vertices
+            .iter()
+            .map(|v| model.transform_point3(Vec3::from(v.position)))
+            .collect();
+        // Screen position (pixels) and depth (NDC z), behind the eye: None.
+        let screen: Vec<Option<[f32; 3]>> = world
+            .iter()
+            .map(|p| {
+                let c: Vec4 = *vp * p.extend(1.0);
+                (c.w > 1e-6).then(|| {
+                    [
+                        (c.x / c.w * 0.5 + 0.5) * width as f32,
+                        (c.y / c.w * 0.5 + 0.5) * height as f32,
+                        c.z / c.w,
+                    ]
+                })
             })
-        })
-        .collect();
-    let mut area = 0.0;
-    let mut bounds = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
-    for t in mesh.indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-        let (Some(pa), Some(pb), Some(pc)) = (screen[a], screen[b], screen[c]) else {
-            continue;
-        };
-        // Front-facing: the face's normal toward the eye.
-        let n = (world[b] - world[a]).cross(world[c] - world[a]);
-        if n.dot(eye - world[a]) <= 0.0 {
-            continue;
-        }
-        let poly = clip(&[pa, pb, pc], w, h);
-        if poly.len() < 3 {
-            continue;
-        }
-        area += polygon_area(&poly);
-        for p in &poly {
-            bounds[0] = bounds[0].min(p[0]);
-            bounds[1] = bounds[1].min(p[1]);
-            bounds[2] = bounds[2].max(p[0]);
-            bounds[3] = bounds[3].max(p[1]);
-        }
-    }
-    let rect = if area > 0.0 {
-        [
-            bounds[0].floor() as u32,
-            bounds[1].floor() as u32,
-            (bounds[2].ceil() as u32).min(width),
-            (bounds[3].ceil() as u32).min(height),
-        ]
-    } else {
-        [0, 0, 0, 0]
-    };
-    (area, rect)
-}
-
-fn polygon_area(p: &[[f64; 2]]) -> f64 {
-    let mut s = 0.0;
-    for i in 0..p.len() {
-        let (a, b) = (p[i], p[(i + 1) % p.len()]);
-        s += a[0] * b[1] - b[0] * a[1];
-    }
-    0.5 * s.abs()
-}
-
-/// Sutherland-Hodgman clipping of a polygon to `[0, w] x [0, h]`.
-fn clip(poly: &[[f64; 2]], w: f64, h: f64) -> Vec<[f64; 2]> {
-    let mut out: Vec<[f64; 2]> = poly.to_vec();
-    // (axis, bound, keep below)
-    for (axis, bound, below) in [(0, 0.0, false), (0, w, true), (1, 0.0, false), (1, h, true)] {
-        let inside = |p: &[f64; 2]| {
-            if below {
-                p[axis] <= bound
-            } else {
-                p[axis] >= bound
-            }
-        };
-        let input = std::mem::take(&mut out);
-        for i in 0..input.len() {
-            let (cur, prev) = (input[i], input[(i + input.len() - 1) % input.len()]);
-            let cross = |a: [f64; 2], b: [f64; 2]| {
-                let t = (bound - a[axis]) / (b[axis] - a[axis]);
-                [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+            .collect();
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let (Some(pa), Some(pb), Some(pc)) = (screen[a], screen[b], screen[c]) else {
+                continue;
             };
-            match (inside(&cur), inside(&prev)) {
-                (true, true) => out.push(cur),
-                (true, false) => {
-                    out.push(cross(prev, cur));
-                    out.push(cur);
+            let n = (world[b] - world[a]).cross(world[c] - world[a]);
+            if n.dot(eye - world[a]) <= 0.0 {
+                continue;
+            }
+            let area = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]);
+            if area == 0.0 {
+                continue;
+            }
+            let lo = |i: usize| pa[i].min(pb[i]).min(pc[i]);
+            let hi = |i: usize| pa[i].max(pb[i]).max(pc[i]);
+            let x0 = (lo(0) - 0.5).ceil().max(0.0) as usize;
+            let y0 = (lo(1) - 0.5).ceil().max(0.0) as usize;
+            let x1 = ((hi(0) - 0.5).floor() + 1.0).clamp(0.0, w as f32) as usize;
+            let y1 = ((hi(1) - 0.5).floor() + 1.0).clamp(0.0, h as f32) as usize;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    let e = |p: [f32; 3], q: [f32; 3]| {
+                        ((q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0])) / area
+                    };
+                    let (wa, wb, wc) = (e(pb, pc), e(pc, pa), e(pa, pb));
+                    if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                        continue;
+                    }
+                    let z = wa * pa[2] + wb * pb[2] + wc * pc[2];
+                    let i = y * w + x;
+                    if z < depth[i] && (0.0..=1.0).contains(&z) {
+                        depth[i] = z;
+                        owner[i] = k as u32;
+                    }
                 }
-                (false, true) => out.push(cross(prev, cur)),
-                (false, false) => {}
             }
         }
-        if out.is_empty() {
-            break;
+    }
+    let mut out = vec![(0.0, [u32::MAX, u32::MAX, 0, 0]); instances.len()];
+    for (i, &o) in owner.iter().enumerate() {
+        if o == u32::MAX {
+            continue;
+        }
+        let (x, y) = ((i % w) as u32, (i / w) as u32);
+        let r = &mut out[o as usize];
+        r.0 += 1.0;
+        r.1 = [
+            r.1[0].min(x),
+            r.1[1].min(y),
+            r.1[2].max(x + 1),
+            r.1[3].max(y + 1),
+        ];
+    }
+    for r in &mut out {
+        if r.0 == 0.0 {
+            r.1 = [0; 4];
         }
     }
     out
@@ -220,13 +208,36 @@ mod tests {
     use super::*;
 
     #[test]
-    fn clipping_keeps_the_inside_area() {
-        // A triangle half off the left edge: area 50 of 100 x 2 / 2... a right
-        // triangle (-10,0) (10,0) (-10,20): area 200, the part x >= 0 is the
-        // triangle (0,0) (10,0) (0,10): 50.
-        let p = clip(&[[-10.0, 0.0], [10.0, 0.0], [-10.0, 20.0]], 100.0, 100.0);
-        assert!((polygon_area(&p) - 50.0).abs() < 1e-9, "{p:?}");
-        assert!(clip(&[[-3.0, 1.0], [-1.0, 1.0], [-2.0, 5.0]], 10.0, 10.0).len() < 3);
+    fn a_square_nearer_hides_one_behind() {
+        use crate::scene::mesh::{Mesh, Vertex};
+        // A unit square at z = 0 facing +z, seen from z = 5 with a 90 degree
+        // view: it spans half the screen height, 50 x 50 of 100 x 100 pixels.
+        let v = |x: f32, y: f32| Vertex {
+            position: [x, y, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0, 0.0],
+            tangent: [1.0, 0.0, 0.0, 1.0],
+        };
+        let mesh = Mesh {
+            vertices: vec![v(-2.5, -2.5), v(2.5, -2.5), v(2.5, 2.5), v(-2.5, 2.5)],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        };
+        let cam = crate::scene::camera::Camera {
+            eye: Vec3::new(0.0, 0.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_rad: 90f32.to_radians(),
+            near: 0.1,
+            far: 100.0,
+        };
+        let vp = cam.view_proj(1.0);
+        let near = Mat4::IDENTITY;
+        let behind = Mat4::from_translation(Vec3::new(6.0, 0.0, -5.0));
+        let r = rasterise(&mesh, &[near, behind], &vp, cam.eye, 100, 100);
+        assert_eq!(r[0].0, 2500.0, "{r:?}");
+        assert_eq!(r[0].1, [25, 25, 75, 75]);
+        // The one behind is half as large (twice as far) and half hidden.
+        assert!(r[1].0 > 0.0 && r[1].0 < 625.0, "{r:?}");
     }
 
     #[test]

@@ -332,13 +332,23 @@ impl SettingModel {
         };
         let base = self.samples[base_i].frame.rescaled(width, height);
         let mut passes = Vec::with_capacity(base.passes.len());
-        for (k, kind) in self.kinds.iter().enumerate() {
-            match *kind {
+        let mut k = 0;
+        while k < self.kinds.len() {
+            match self.kinds[k] {
                 PassKind::Context => passes.push(base.passes[k].clone()),
                 PassKind::PerCharacter => {
+                    // A run of per-character passes is one character's chain:
+                    // every character runs the whole chain in turn.
+                    let end = (k..self.kinds.len())
+                        .find(|&j| self.kinds[j] != PassKind::PerCharacter)
+                        .unwrap_or(self.kinds.len());
                     for l in loads {
-                        passes.push(self.own_pass(k, l));
+                        for j in k..end {
+                            passes.push(self.own_pass(j, l));
+                        }
                     }
+                    k = end;
+                    continue;
                 }
                 PassKind::Shared {
                     shade,
@@ -408,6 +418,7 @@ impl SettingModel {
                     passes.push(q);
                 }
             }
+            k += 1;
         }
         FrameInput {
             label: format!(

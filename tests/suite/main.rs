@@ -24,6 +24,7 @@ mod common;
 mod accuracy;
 mod budget_cli;
 mod harness;
+mod plan;
 mod reference;
 mod region;
 mod scenes;
