@@ -203,3 +203,137 @@ pub fn plan(a: &Ask) -> Plan {
         groups,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic table: "cheap" measured over 1-8 px/mm, "ts" (a
+    /// texture-space setting) everywhere, both far better than none.
+    struct Table;
+    impl Accuracy for Table {
+        fn predict(&self, _m: &str, setting: &str, x: f64, _l: f64) -> Option<(f64, f64)> {
+            match setting {
+                "cheap" => (1.0..=8.0).contains(&x).then_some((0.3, 0.4)),
+                "ts" => Some((0.1, 0.1)),
+                _ => None,
+            }
+        }
+    }
+
+    fn character(index: usize, px_per_mm: f64) -> CharacterInput {
+        CharacterInput {
+            index,
+            distance_heads: 9.0 / px_per_mm,
+            px_per_mm,
+            light_deg: 60.0,
+            skin_pixels: 1e4 * px_per_mm * px_per_mm,
+            region_pixels: 0.0,
+            region_rects: 0.0,
+            silhouette_share: 0.1,
+            screen_rect: [0; 4],
+        }
+    }
+
+    fn settings(n: usize, texel_mm: f64) -> Vec<SettingCosts> {
+        vec![
+            SettingCosts {
+                method: "a".into(),
+                setting: "cheap".into(),
+                fixed_ms: 0.01,
+                parts_ms: vec![Some(0.01); n],
+                texel_mm: vec![None; n],
+            },
+            SettingCosts {
+                method: "b".into(),
+                setting: "ts".into(),
+                fixed_ms: 0.01,
+                parts_ms: vec![Some(0.01); n],
+                texel_mm: vec![Some(texel_mm); n],
+            },
+            SettingCosts {
+                method: "c".into(),
+                setting: "unmeasured".into(),
+                fixed_ms: 0.0,
+                parts_ms: vec![Some(0.0); n],
+                texel_mm: vec![None; n],
+            },
+        ]
+    }
+
+    fn ask<'a>(c: &'a [CharacterInput], s: &'a [SettingCosts], budget: f64) -> Plan {
+        plan(&Ask {
+            characters: c,
+            settings: s,
+            accuracy: &Table,
+            budget_ms: budget,
+            previous: None,
+            switch_margin: 0.0,
+            node_limit: None,
+        })
+    }
+
+    #[test]
+    fn never_outside_the_measured_range_and_never_unmeasured() {
+        // 0.5 px/mm: "cheap" is unmeasured there; "ts" is barred (texel 1 mm).
+        let chars = [character(0, 4.0), character(1, 0.5)];
+        let s = settings(2, 1.0);
+        let p = ask(&chars, &s, 10.0);
+        assert_eq!(p.rows[0].setting, Some(0));
+        assert_eq!(p.rows[1].setting, None);
+        assert!(p.rows[1]
+            .excluded
+            .contains(&(0, Excluded::OutsideMeasuredRange)));
+        for r in &p.rows {
+            assert_ne!(
+                r.setting,
+                Some(2),
+                "a setting with no prediction was chosen"
+            );
+        }
+    }
+
+    #[test]
+    fn under_a_pixel_gets_no_sss() {
+        // The reach is 2.72 mm: at 0.3 px/mm it spans 0.82 pixels.
+        assert!(under_a_pixel(0.3) && !under_a_pixel(0.4));
+        let chars = [character(0, 0.3)];
+        let p = ask(&chars, &settings(1, 0.01), 10.0);
+        assert_eq!(p.rows[0].setting, None);
+        assert!(p.rows[0]
+            .excluded
+            .iter()
+            .all(|e| e.1 == Excluded::UnderAPixel));
+    }
+
+    #[test]
+    fn texture_space_is_never_chosen_where_its_texel_exceeds_the_narrow_reach() {
+        let chars = [character(0, 4.0)];
+        // A fine map: the accurate texture-space setting wins.
+        let p = ask(&chars, &settings(1, 0.2), 10.0);
+        assert_eq!(p.rows[0].setting, Some(1));
+        // Its texel over 0.43 mm: barred however accurate its prediction.
+        let p = ask(&chars, &settings(1, 0.5), 10.0);
+        assert_eq!(p.rows[0].setting, Some(0));
+        assert!(p.rows[0]
+            .excluded
+            .contains(&(1, Excluded::TexelOverNarrowReach)));
+    }
+
+    #[test]
+    fn the_budget_holds_with_the_fixed_costs() {
+        let chars: Vec<CharacterInput> = (0..6).map(|i| character(i, 2.0 + i as f64)).collect();
+        let s = settings(6, 0.2);
+        for budget in [0.005, 0.02, 0.035, 0.05, 1.0] {
+            let p = ask(&chars, &s, budget);
+            assert!(
+                p.solution.cost_ms <= budget + 1e-12,
+                "{budget}: {}",
+                p.solution.cost_ms
+            );
+            let fixed: f64 = p.groups.iter().map(|g| g.1).sum();
+            let parts: f64 = p.rows.iter().map(|r| r.part_ms).sum();
+            assert!((fixed + parts - p.solution.cost_ms).abs() < 1e-12);
+        }
+    }
+}
