@@ -30,6 +30,7 @@ pub mod graph;
 pub mod method;
 pub mod mix;
 pub mod output;
+pub mod plan;
 pub mod plot;
 pub mod reference;
 pub mod render;

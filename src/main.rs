@@ -168,6 +168,21 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         frames: usize,
     },
+    /// Choose a method setting per character under a skin-SSS budget on a profile (no
+    /// device opens): prints the plan's table, writes DIR/plan.json (what `render --plan`
+    /// reads) and a schematic of the plan, DIR/plan.png and .svg (docs/plan.md).
+    Plan {
+        #[command(flatten)]
+        common: Common,
+        /// Profile name (profiles/NAME.toml) or path.
+        #[arg(long)]
+        profile: String,
+        /// The skin-SSS budget on the profile, in milliseconds.
+        #[arg(long, allow_negative_numbers = true)]
+        budget_ms: String,
+        #[arg(long, default_value = "out/plan")]
+        out: PathBuf,
+    },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
     Kernel {
         #[arg(long, default_value_t = 17)]
@@ -675,6 +690,18 @@ fn main_result() -> Result<()> {
             };
             budget(&common, &opts)?;
         }
+        Command::Plan {
+            common,
+            profile,
+            budget_ms,
+            out,
+        } => dermis::plan::cli::command(
+            &profile,
+            &budget_ms,
+            &out,
+            || common.settings(),
+            || common.scene(),
+        )?,
         Command::Kernel {
             samples,
             preset,

@@ -26,6 +26,7 @@ mod accuracy_model;
 mod budget_cli;
 mod harness;
 mod mix;
+mod plan;
 mod reference;
 mod region;
 mod scenes;

@@ -1,0 +1,251 @@
+//! What the planner knows of each character (a plain struct, so exact counts
+//! from a render can replace the estimates), and the pure estimate of it from
+//! the scene's geometry: distance, pixels per millimetre at the character's
+//! depth, the key light's angle to the camera, skin pixels and the screen
+//! rectangle of its skin.
+//!
+//! Skin pixels are counted by rasterising every character's front-facing
+//! triangles on the CPU into one depth buffer of the frame's size (pixel
+//! centres inside a triangle, nearest depth wins), so a face hiding itself
+//! and characters hiding each other are counted as the geometry pass counts
+//! them (the backdrop, behind every character, is left out).
+//! `tests/suite/plan.rs` holds the count to the skin pixels of the stored
+//! lavapipe frames (samples passed).
+
+use glam::{Mat4, Vec3, Vec4};
+use serde::Serialize;
+
+use crate::scene::framing::Framing;
+use crate::scene::Scene;
+use crate::view::ViewScale;
+
+/// Width of the eval's silhouette band on the skin, mm (`eval::bands`).
+pub const SILHOUETTE_BAND_MM: f64 = 2.0;
+
+/// One character as the planner sees it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CharacterInput {
+    /// Frame index (`Framing::instances` order; 0 is the front character).
+    pub index: usize,
+    /// Camera distance in head heights.
+    pub distance_heads: f64,
+    /// Pixels per millimetre at the depth of the head's centre.
+    pub px_per_mm: f64,
+    /// Degrees between the direction to the key light and to the camera.
+    pub light_deg: f64,
+    /// Skin pixels (from a render: the samples a stencil-tested SSS pass passes).
+    pub skin_pixels: f64,
+    /// The reference setting's SSS region of this character: pixels, rectangles.
+    pub region_pixels: f64,
+    pub region_rects: f64,
+    /// Share of the skin pixels in the eval's silhouette band.
+    pub silhouette_share: f64,
+    /// Screen rectangle of its skin `[x0, y0, x1, y1]` (pixels, half-open).
+    pub screen_rect: [u32; 4],
+}
+
+impl CharacterInput {
+    /// The share of a skin area of `skin` pixels within the silhouette band:
+    /// the band along the perimeter of a disc of the same area, at most all
+    /// of it.
+    pub fn band_share(skin: f64, px_per_mm: f64) -> f64 {
+        if skin <= 0.0 {
+            return 0.0;
+        }
+        let perimeter = 2.0 * (std::f64::consts::PI * skin).sqrt();
+        (perimeter * SILHOUETTE_BAND_MM * px_per_mm / skin).min(1.0)
+    }
+}
+
+/// The geometric estimate of one character (region fields left at 0: the
+/// cost model fills them from its reference frames).
+pub fn estimate(
+    scene: &Scene,
+    framing: &Framing,
+    width: u32,
+    height: u32,
+    light_dir: Vec3,
+) -> Vec<CharacterInput> {
+    let cam = framing.camera;
+    let aspect = width as f32 / height as f32;
+    let view = cam.view();
+    let vp = cam.view_proj(aspect);
+    let scale = ViewScale::new(height, cam.fovy_rad, scene.mm_per_unit);
+    let head_h = scene.head_height_units();
+    let centre = scene.head_center();
+    let mesh = &scene.head.mesh;
+    let visible = if scene.head.material.skin {
+        rasterise(mesh, &framing.instances, &vp, cam.eye, width, height)
+    } else {
+        vec![(0.0, [0; 4]); framing.instances.len()]
+    };
+    framing
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(index, m)| {
+            let c = m.transform_point3(centre);
+            let depth = -view.transform_point3(c).z;
+            let to_eye = (cam.eye - c).normalize_or_zero();
+            let light_deg = f64::from(to_eye.dot(light_dir.normalize_or_zero()).clamp(-1.0, 1.0))
+                .acos()
+                .to_degrees();
+            let (area, rect) = visible[index];
+            let px_per_mm = f64::from(scale.px_per_mm(depth.max(1e-6)));
+            CharacterInput {
+                index,
+                distance_heads: f64::from(cam.eye.distance(c) / head_h),
+                px_per_mm,
+                light_deg,
+                skin_pixels: area,
+                region_pixels: 0.0,
+                region_rects: 0.0,
+                silhouette_share: CharacterInput::band_share(area, px_per_mm),
+                screen_rect: rect,
+            }
+        })
+        .collect()
+}
+
+/// Pixels of each instance of `mesh` left visible in one depth buffer of
+/// `width` x `height` (front-facing triangles, pixel centres inside, the
+/// nearest depth kept), with each instance's bounding rectangle.
+fn rasterise(
+    mesh: &crate::scene::mesh::Mesh,
+    instances: &[Mat4],
+    vp: &Mat4,
+    eye: Vec3,
+    width: u32,
+    height: u32,
+) -> Vec<(f64, [u32; 4])> {
+    let (w, h) = (width as usize, height as usize);
+    let mut depth = vec![f32::INFINITY; w * h];
+    let mut owner = vec![u32::MAX; w * h];
+    for (k, model) in instances.iter().enumerate() {
+        let world: Vec<Vec3> = mesh
+            .vertices
+            .iter()
+            .map(|v| model.transform_point3(Vec3::from(v.position)))
+            .collect();
+        // Screen position (pixels) and depth (NDC z), behind the eye: None.
+        let screen: Vec<Option<[f32; 3]>> = world
+            .iter()
+            .map(|p| {
+                let c: Vec4 = *vp * p.extend(1.0);
+                (c.w > 1e-6).then(|| {
+                    [
+                        (c.x / c.w * 0.5 + 0.5) * width as f32,
+                        (c.y / c.w * 0.5 + 0.5) * height as f32,
+                        c.z / c.w,
+                    ]
+                })
+            })
+            .collect();
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let (Some(pa), Some(pb), Some(pc)) = (screen[a], screen[b], screen[c]) else {
+                continue;
+            };
+            let n = (world[b] - world[a]).cross(world[c] - world[a]);
+            if n.dot(eye - world[a]) <= 0.0 {
+                continue;
+            }
+            let area = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]);
+            if area == 0.0 {
+                continue;
+            }
+            let lo = |i: usize| pa[i].min(pb[i]).min(pc[i]);
+            let hi = |i: usize| pa[i].max(pb[i]).max(pc[i]);
+            let x0 = (lo(0) - 0.5).ceil().max(0.0) as usize;
+            let y0 = (lo(1) - 0.5).ceil().max(0.0) as usize;
+            let x1 = ((hi(0) - 0.5).floor() + 1.0).clamp(0.0, w as f32) as usize;
+            let y1 = ((hi(1) - 0.5).floor() + 1.0).clamp(0.0, h as f32) as usize;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    let e = |p: [f32; 3], q: [f32; 3]| {
+                        ((q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0])) / area
+                    };
+                    let (wa, wb, wc) = (e(pb, pc), e(pc, pa), e(pa, pb));
+                    if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                        continue;
+                    }
+                    let z = wa * pa[2] + wb * pb[2] + wc * pc[2];
+                    let i = y * w + x;
+                    if z < depth[i] && (0.0..=1.0).contains(&z) {
+                        depth[i] = z;
+                        owner[i] = k as u32;
+                    }
+                }
+            }
+        }
+    }
+    let mut out = vec![(0.0, [u32::MAX, u32::MAX, 0, 0]); instances.len()];
+    for (i, &o) in owner.iter().enumerate() {
+        if o == u32::MAX {
+            continue;
+        }
+        let (x, y) = ((i % w) as u32, (i / w) as u32);
+        let r = &mut out[o as usize];
+        r.0 += 1.0;
+        r.1 = [
+            r.1[0].min(x),
+            r.1[1].min(y),
+            r.1[2].max(x + 1),
+            r.1[3].max(y + 1),
+        ];
+    }
+    for r in &mut out {
+        if r.0 == 0.0 {
+            r.1 = [0; 4];
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_square_nearer_hides_one_behind() {
+        use crate::scene::mesh::{Mesh, Vertex};
+        // A unit square at z = 0 facing +z, seen from z = 5 with a 90 degree
+        // view: it spans half the screen height, 50 x 50 of 100 x 100 pixels.
+        let v = |x: f32, y: f32| Vertex {
+            position: [x, y, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0, 0.0],
+            tangent: [1.0, 0.0, 0.0, 1.0],
+        };
+        let mesh = Mesh {
+            vertices: vec![v(-2.5, -2.5), v(2.5, -2.5), v(2.5, 2.5), v(-2.5, 2.5)],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        };
+        let cam = crate::scene::camera::Camera {
+            eye: Vec3::new(0.0, 0.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_rad: 90f32.to_radians(),
+            near: 0.1,
+            far: 100.0,
+        };
+        let vp = cam.view_proj(1.0);
+        let near = Mat4::IDENTITY;
+        let behind = Mat4::from_translation(Vec3::new(6.0, 0.0, -5.0));
+        let r = rasterise(&mesh, &[near, behind], &vp, cam.eye, 100, 100);
+        assert_eq!(r[0].0, 2500.0, "{r:?}");
+        assert_eq!(r[0].1, [25, 25, 75, 75]);
+        // The one behind is half as large (twice as far) and half hidden.
+        assert!(r[1].0 > 0.0 && r[1].0 < 625.0, "{r:?}");
+    }
+
+    #[test]
+    fn the_band_share_of_a_disc() {
+        // A disc of radius 100 px at 1 px/mm: band 2 px along a 628 px perimeter.
+        let a = std::f64::consts::PI * 1e4;
+        let s = CharacterInput::band_share(a, 1.0);
+        assert!((s - 2.0 * 2.0 / 100.0).abs() < 1e-9, "{s}");
+        assert_eq!(CharacterInput::band_share(10.0, 100.0), 1.0);
+    }
+}

@@ -1,0 +1,607 @@
+//! `dermis plan --profile P --budget-ms B [scene options]`: loads the scene
+//! (no device opens), estimates every character (`character`), prices every
+//! registered eval setting per character on P (`cost`, from the stored frames
+//! of `profiles/frames/plan/`), plans (`choose`, `solve`), prints the table,
+//! and writes DIR/plan.json (`mix::plan_file::PlanFile`) and a schematic of
+//! the frame (DIR/plan.png and .svg: every character's skin rectangle
+//! coloured by its method).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use serde::Deserialize;
+
+use super::character::{estimate, CharacterInput};
+use super::choose::{narrow_reach_mm, plan, scatter_reach_mm, Accuracy, Ask, Plan, SettingCosts};
+use super::cost::{reference_counts, CostModel, Reference, Sample, SettingModel};
+use super::dolly::{DollyTable, Point};
+use super::picture;
+use crate::budget::frames::{check_frame, frames_dir, perf_dir};
+use crate::budget::input::FrameInput;
+use crate::budget::params::ParamSet;
+use crate::budget::profile::Profile;
+use crate::method::METHODS;
+use crate::mix::plan_file::{PlanFile, PlannedCharacter, PredictedError, PLAN_VERSION};
+use crate::mix::Choice;
+use crate::render::RenderSettings;
+use crate::scene::framing::{frame as frame_scene, Shot};
+use crate::scene::Scene;
+use crate::view::ViewScale;
+use crate::work::Work;
+
+/// The checked arguments of `dermis plan`.
+pub struct PlanArgs {
+    pub profile: Profile,
+    pub budget_ms: f64,
+    pub out: PathBuf,
+}
+
+impl PlanArgs {
+    /// Checks the profile and the budget (one-line errors; nothing opened).
+    pub fn parse(profile: &str, budget_ms: &str, out: &Path) -> Result<PlanArgs> {
+        let b: f64 = budget_ms
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--budget-ms '{budget_ms}' is not a number"))?;
+        if !(b.is_finite() && b > 0.0) {
+            bail!("--budget-ms {budget_ms} is not a positive number of milliseconds");
+        }
+        let profile = Profile::load(profile).with_context(|| format!("--profile {profile}"))?;
+        Ok(PlanArgs {
+            profile,
+            budget_ms: b,
+            out: out.to_path_buf(),
+        })
+    }
+}
+
+/// A registered method setting the planner may choose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Registered {
+    pub method: &'static str,
+    pub setting: &'static str,
+    pub options: BTreeMap<String, String>,
+}
+
+/// Every eval setting of every registered method but the ground truth and
+/// none (none is always an option, cost 0).
+pub fn registered() -> Vec<Registered> {
+    METHODS
+        .iter()
+        .filter(|m| !m.ground_truth && Choice::none().method != m.name)
+        .flat_map(|m| {
+            m.eval.iter().map(move |e| Registered {
+                method: m.name,
+                setting: e.label,
+                options: e
+                    .options
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), v.to_string()))
+                    .collect(),
+            })
+        })
+        .collect()
+}
+
+/// The reference setting: the default method at its default options.
+pub fn reference_setting() -> Result<(String, String)> {
+    let d = RenderSettings::default();
+    let c = Choice::new(d.method.name, BTreeMap::new())?;
+    let s = c.eval_setting()?.with_context(|| {
+        format!(
+            "the default method {} has no eval setting at its defaults",
+            c.method
+        )
+    })?;
+    Ok((c.method, s.label.to_string()))
+}
+
+#[derive(Deserialize)]
+struct IndexRow {
+    method: String,
+    setting: String,
+    file: String,
+    distance_heads: f64,
+    height: u32,
+    fovy_deg: f64,
+}
+
+#[derive(Deserialize)]
+struct Index {
+    frames: Vec<IndexRow>,
+}
+
+/// `profiles/frames/plan/`.
+pub fn plan_frames_dir() -> PathBuf {
+    frames_dir().join("plan")
+}
+
+/// The px/mm at the centre of a head `distance_heads` head heights away
+/// (a 230 mm head: the stored frames' scenes are scaled to it).
+fn stored_px_per_mm(height: u32, fovy_deg: f64, distance_heads: f64) -> f64 {
+    let s = ViewScale::new(
+        height,
+        (fovy_deg as f32).to_radians(),
+        crate::skin::tsd::HEAD_MM,
+    );
+    f64::from(s.px_per_mm(distance_heads as f32))
+}
+
+/// A stored frame, read through the one door and checked as `budget` checks
+/// one, after one repair: the recorder gives a texture-space pass (render
+/// area a map's, drawn once) the screen's SSS region as its rasterised
+/// pixels, more than its triangle can cover; such a pass rasterises at most
+/// its render area, which it is given instead.
+pub fn load_stored(path: &Path) -> Result<FrameInput> {
+    let text = crate::files::read_text(path, "stored frame", crate::files::MAX_TEXT_FILE)?;
+    let mut f: FrameInput =
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    for p in &mut f.passes {
+        if let (
+            Work::Raster {
+                width,
+                height,
+                msaa,
+                triangles: 1,
+                ..
+            },
+            Some(r),
+        ) = (&p.work, p.rasterized_pixels)
+        {
+            let area = u64::from(*width) * u64::from(*height) * u64::from(*msaa);
+            if r > area {
+                p.rasterized_pixels = Some(area);
+            }
+        }
+    }
+    check_frame(&f).with_context(|| format!("stored frame {}", path.display()))?;
+    Ok(f)
+}
+
+/// The stored frames of every registered setting, as cost models; settings
+/// without frames are named in the returned notes.
+pub fn load_models(dir: &Path) -> Result<(Vec<SettingModel>, Vec<String>)> {
+    let index_path = dir.join("index.json");
+    let text =
+        crate::files::read_text(&index_path, "plan frame index", crate::files::MAX_TEXT_FILE)?;
+    let index: Index = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .with_context(|| format!("{}: not an index of stored frames", index_path.display()))?;
+    let samples_of = |method: &str, setting: &str| -> Result<Vec<Sample>> {
+        index
+            .frames
+            .iter()
+            .filter(|r| r.method == method && r.setting == setting)
+            .map(|r| {
+                Ok(Sample {
+                    px_per_mm: stored_px_per_mm(r.height, r.fovy_deg, r.distance_heads),
+                    frame: load_stored(&dir.join(&r.file))?,
+                })
+            })
+            .collect()
+    };
+    let (rm, rs) = reference_setting()?;
+    let refs: Vec<(f64, Reference)> = samples_of(&rm, &rs)?
+        .iter()
+        .filter_map(|s| Some((s.px_per_mm, reference_counts(&s.frame)?)))
+        .collect();
+    if refs.is_empty() {
+        bail!(
+            "{}: no stored frame of the reference setting {rm} '{rs}' (run tools/plan_frames.sh)",
+            dir.display()
+        );
+    }
+    let reference = |x: f64| {
+        refs.iter()
+            .find(|(p, _)| (p / x - 1.0).abs() < 1e-6)
+            .map(|r| r.1)
+    };
+    let mut models = Vec::new();
+    let mut notes = Vec::new();
+    for r in registered() {
+        let samples = samples_of(r.method, r.setting)?;
+        if samples.is_empty() {
+            notes.push(format!(
+                "{} '{}' has no stored frames in {} (tools/plan_frames.sh): not planned",
+                r.method,
+                r.setting,
+                dir.display()
+            ));
+            continue;
+        }
+        models.push(
+            SettingModel::new(r.method, r.setting, samples, reference)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?,
+        );
+    }
+    Ok((models, notes))
+}
+
+/// The stand-in accuracy model (`dolly`): the H100 dolly's err/none.
+pub fn dolly_accuracy() -> Result<DollyTable> {
+    let path = perf_dir().join("h100/dolly/eval.json");
+    #[derive(Deserialize)]
+    struct Row {
+        method: String,
+        setting: String,
+        scene: String,
+        error: f64,
+    }
+    #[derive(Deserialize)]
+    struct SceneRow {
+        name: String,
+        distance_heads: f64,
+    }
+    #[derive(Deserialize)]
+    struct Eval {
+        command: String,
+        rows: Vec<Row>,
+        scenes: Vec<SceneRow>,
+    }
+    let text = crate::files::read_text(&path, "eval results", crate::files::MAX_TEXT_FILE)?;
+    let e: Eval = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .with_context(|| format!("{}: not an eval.json", path.display()))?;
+    // The dolly's frame: 1280x720 at the default field of view.
+    let (h, fovy) = (720, f64::from(RenderSettings::default().fovy_deg));
+    let none = Choice::none().method;
+    let mut points = Vec::new();
+    for s in &e.scenes {
+        let Some(z) = e
+            .rows
+            .iter()
+            .find(|r| r.scene == s.name && r.method == none)
+            .map(|r| r.error)
+            .filter(|z| *z > 0.0)
+        else {
+            continue;
+        };
+        for r in e
+            .rows
+            .iter()
+            .filter(|r| r.scene == s.name && r.method != none)
+        {
+            points.push(Point {
+                method: r.method.clone(),
+                setting: r.setting.clone(),
+                px_per_mm: stored_px_per_mm(h, fovy, s.distance_heads),
+                err_over_none: r.error / z,
+            });
+        }
+    }
+    Ok(DollyTable {
+        points,
+        source: format!("err/none of {} ({})", path.display(), e.command),
+    })
+}
+
+/// Millimetres of skin per unit of the texture-space atlas (area-weighted
+/// over the triangles): a map of T texels has texels of this / T mm.
+pub fn atlas_mm(scene: &Scene) -> f64 {
+    let mesh = &scene.head.mesh;
+    let a = crate::skin::tsd::atlas(mesh, scene.mm_per_unit);
+    let mm = f64::from(scene.mm_per_unit);
+    let (mut area3, mut area_uv) = (0.0, 0.0);
+    for t in mesh.indices.chunks_exact(3) {
+        let [i, j, k] = [t[0], t[1], t[2]].map(|x| x as usize);
+        let p = |v: usize| glam::Vec3::from(mesh.vertices[v].position);
+        area3 += f64::from(0.5 * (p(j) - p(i)).cross(p(k) - p(i)).length()) * mm * mm;
+        let (u0, u1, u2) = (a.uv[i], a.uv[j], a.uv[k]);
+        area_uv += 0.5
+            * f64::from(
+                ((u1[0] - u0[0]) * (u2[1] - u0[1]) - (u1[1] - u0[1]) * (u2[0] - u0[0])).abs(),
+            );
+    }
+    if area_uv > 0.0 {
+        (area3 / area_uv).sqrt()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The characters of a scene as `render` would place them, with the
+/// reference region from the reference setting's stored frames.
+pub fn characters(
+    scene: &Scene,
+    s: &RenderSettings,
+    reference: &SettingModel,
+) -> Vec<CharacterInput> {
+    let shot = Shot {
+        layout: s.layout,
+        heads: s.heads,
+        distance_heads: s.distance_heads,
+        fovy_deg: s.fovy_deg,
+        aspect: s.width as f32 / s.height as f32,
+        light_dir: s.light.direction_to_light(scene.forward),
+    };
+    let framing = frame_scene(scene, &shot);
+    let mut cs = estimate(scene, &framing, s.width, s.height, shot.light_dir);
+    for c in &mut cs {
+        let (r, n) = reference.region_of(c.px_per_mm, c.skin_pixels);
+        c.region_pixels = r;
+        c.region_rects = if c.skin_pixels > 0.0 { n.max(1.0) } else { 0.0 };
+    }
+    cs
+}
+
+/// Every setting's costs for `chars` on the profile.
+pub fn setting_costs(
+    models: &[SettingModel],
+    chars: &[CharacterInput],
+    prof: &Profile,
+    width: u32,
+    height: u32,
+    atlas_mm: f64,
+) -> Vec<SettingCosts> {
+    let cm = CostModel {
+        profile: prof,
+        params: ParamSet::fitted(),
+        width,
+        height,
+    };
+    let loads: Vec<_> = chars.iter().map(super::load_of).collect();
+    models
+        .iter()
+        .filter_map(|m| {
+            let fixed = cm.fixed_ms(m)?;
+            Some(SettingCosts {
+                method: m.method.clone(),
+                setting: m.setting.clone(),
+                fixed_ms: fixed,
+                parts_ms: loads.iter().map(|l| cm.part_ms(m, fixed, l)).collect(),
+                texel_mm: chars
+                    .iter()
+                    .map(|c| m.map_side(c.px_per_mm).map(|t| atlas_mm / t.max(1.0)))
+                    .collect(),
+            })
+        })
+        .collect()
+}
+
+/// Node limit of the branch and bound in `dermis plan` (beyond it the plan
+/// is the best found and the bound says how far from optimal it can be).
+pub const NODE_LIMIT: u64 = 20_000;
+
+/// `dermis plan`.
+pub fn run(
+    args: &PlanArgs,
+    settings: &RenderSettings,
+    scene: &Scene,
+    accuracy: &dyn Accuracy,
+    accuracy_source: &str,
+) -> Result<()> {
+    let (models, mut notes) = load_models(&plan_frames_dir())?;
+    let (rm, rs) = reference_setting()?;
+    let reference = models
+        .iter()
+        .find(|m| m.method == rm && m.setting == rs)
+        .context("the reference setting has no stored frames")?;
+    let t0 = Instant::now();
+    let chars = characters(scene, settings, reference);
+    let costs = setting_costs(
+        &models,
+        &chars,
+        &args.profile,
+        settings.width,
+        settings.height,
+        atlas_mm(scene),
+    );
+    let t1 = Instant::now();
+    let p = plan(&Ask {
+        characters: &chars,
+        settings: &costs,
+        accuracy,
+        budget_ms: args.budget_ms,
+        previous: None,
+        switch_margin: 0.0,
+        node_limit: Some(NODE_LIMIT),
+    });
+    let t2 = Instant::now();
+    notes.extend(plan_notes(&p, accuracy_source));
+    notes.push(format!(
+        "time: characters and costs {:.1} ms, solve {:.2} ms ({} nodes)",
+        (t1 - t0).as_secs_f64() * 1e3,
+        (t2 - t1).as_secs_f64() * 1e3,
+        p.solution.nodes
+    ));
+    let file = plan_file(
+        &args.profile.profile.name,
+        args.budget_ms,
+        &chars,
+        &costs,
+        &p,
+        notes,
+    )?;
+    crate::output::prepare_out_dir(&args.out)?;
+    print!("{}", table(&chars, &costs, &p, &args.profile.profile.name));
+    for n in &file.notes {
+        println!("note: {n}");
+    }
+    crate::output::write_json(&args.out.join("plan.json"), &file)?;
+    picture::write(
+        &args.out,
+        settings.width,
+        settings.height,
+        &chars,
+        &p,
+        &costs,
+    )?;
+    println!(
+        "wrote {}, {} and {}",
+        args.out.join("plan.json").display(),
+        args.out.join("plan.png").display(),
+        args.out.join("plan.svg").display()
+    );
+    Ok(())
+}
+
+/// What the plan says about itself (algorithm, bound, rules, sources).
+pub fn plan_notes(p: &Plan, accuracy_source: &str) -> Vec<String> {
+    let s = &p.solution;
+    let mut n = vec![format!(
+        "algorithm: branch and bound over characters with the LP (Lagrangian) bound of the \
+         multiple-choice knapsack, group fixed costs exact; {}",
+        if s.optimal {
+            "search finished: the plan is optimal for the model".to_string()
+        } else {
+            format!("node limit {NODE_LIMIT} reached: best plan found")
+        }
+    )];
+    if let Some(lb) = s.lower_bound {
+        n.push(format!(
+            "skin-weighted err/none {:.4}; the root's LP (Lagrangian) bound {:.4}, gap {:.4} \
+             (the bound relaxes the groups' fixed costs to 0: loose where they matter)",
+            s.error,
+            lb,
+            s.error - lb
+        ));
+    }
+    n.push(format!(
+        "rules: no SSS where the scattering's reach ({:.2} mm, the profile's widest Gaussian) \
+         spans under a pixel; no texture-space setting whose map texel exceeds the narrow reach \
+         ({:.2} mm, Gaussian 3); no setting outside its accuracy model's measured range",
+        scatter_reach_mm(),
+        narrow_reach_mm()
+    ));
+    n.push(
+        "costs: each character's part priced alone plus each used group's fixed cost (an \
+         upper bound of the group's price, the max of sums being at most the sum of maxes, but \
+         for the model's hi-Z rule: measured -5.2% to +6.0% of it on a 16-character crowd); \
+         per-character ms in this file carry an equal share of their group's fixed cost"
+            .to_string(),
+    );
+    n.push(format!("accuracy: {accuracy_source}"));
+    n
+}
+
+fn label(costs: &[SettingCosts], s: Option<usize>) -> (String, String) {
+    match s {
+        Some(s) => (costs[s].method.clone(), costs[s].setting.clone()),
+        None => (Choice::none().method, "-".to_string()),
+    }
+}
+
+/// Per-character ms with an equal share of the group's fixed cost.
+fn with_share(p: &Plan, ci: usize) -> f64 {
+    let r = &p.rows[ci];
+    let Some(s) = r.setting else { return 0.0 };
+    let n = p
+        .rows
+        .iter()
+        .filter(|x| x.setting == Some(s))
+        .count()
+        .max(1);
+    let fixed = p.groups.iter().find(|g| g.0 == s).map_or(0.0, |g| g.1);
+    r.part_ms + fixed / n as f64
+}
+
+/// The printed table.
+pub fn table(chars: &[CharacterInput], costs: &[SettingCosts], p: &Plan, profile: &str) -> String {
+    let mut s = format!(
+        "{:>4} {:>7} {:>9}  {:<12} {:<24} {:>10} {:>9} {:>9}\n",
+        "char", "px/mm", "skin px", "method", "setting", "ms", "interior", "silh."
+    );
+    s.push_str(&format!(
+        "(ms on {profile}; err/none predicted, interior and silhouette bands)\n"
+    ));
+    for (ci, (c, r)) in chars.iter().zip(&p.rows).enumerate() {
+        let (m, st) = label(costs, r.setting);
+        s.push_str(&format!(
+            "{:>4} {:>7.3} {:>9.0}  {:<12} {:<24} {:>10.4} {:>9.3} {:>9.3}\n",
+            c.index,
+            c.px_per_mm,
+            c.skin_pixels,
+            m,
+            st,
+            with_share(p, ci),
+            r.predicted.0,
+            r.predicted.1
+        ));
+    }
+    for (g, f) in &p.groups {
+        s.push_str(&format!(
+            "group {} '{}': fixed {:.4} ms (in the shares above)\n",
+            costs[*g].method, costs[*g].setting, f
+        ));
+    }
+    s.push_str(&format!(
+        "skin SSS {:.4} ms; skin-weighted err/none {:.4}\n",
+        p.solution.cost_ms, p.solution.error
+    ));
+    s
+}
+
+/// The plan as `mix::plan_file::PlanFile` (every field filled).
+pub fn plan_file(
+    profile: &str,
+    budget_ms: f64,
+    chars: &[CharacterInput],
+    costs: &[SettingCosts],
+    p: &Plan,
+    notes: Vec<String>,
+) -> Result<PlanFile> {
+    let mut assignments = Vec::new();
+    let (mut wi, mut ws, mut w) = (0.0, 0.0, 0.0);
+    for (ci, (c, r)) in chars.iter().zip(&p.rows).enumerate() {
+        let (method, setting) = label(costs, r.setting);
+        let options = registered()
+            .into_iter()
+            .find(|x| x.method == method && x.setting == setting)
+            .map(|x| x.options)
+            .unwrap_or_default();
+        // Checked as a plan file is checked on reading.
+        let choice = Choice::new(&method, options.clone())?;
+        wi += r.predicted.0 * c.skin_pixels;
+        ws += r.predicted.1 * c.skin_pixels;
+        w += c.skin_pixels;
+        assignments.push(PlannedCharacter {
+            character: c.index,
+            method: choice.method.clone(),
+            options,
+            setting: Some(setting),
+            px_per_mm: Some(c.px_per_mm),
+            skin_pixels: Some(c.skin_pixels.round().max(0.0) as u64),
+            predicted_ms: Some(with_share(p, ci)),
+            predicted_error: Some(PredictedError {
+                interior: r.predicted.0,
+                silhouette: r.predicted.1,
+            }),
+        });
+    }
+    let w = w.max(1e-12);
+    let f = PlanFile {
+        version: PLAN_VERSION,
+        profile: Some(profile.to_string()),
+        budget_ms: Some(budget_ms),
+        characters: chars.len(),
+        assignments,
+        predicted_ms: Some(p.solution.cost_ms),
+        predicted_error: Some(PredictedError {
+            interior: wi / w,
+            silhouette: ws / w,
+        }),
+        notes,
+    };
+    f.check()?;
+    Ok(f)
+}
+
+/// The `plan` subcommand: checks the profile and the budget, then the
+/// render settings and the scene (each a one-line error, before anything is
+/// written; no device ever opens), and plans with the stand-in accuracy
+/// model (`dolly`) until the per-setting model of item 2 is wired in.
+pub fn command(
+    profile: &str,
+    budget_ms: &str,
+    out: &Path,
+    settings: impl FnOnce() -> Result<RenderSettings>,
+    scene: impl FnOnce() -> Result<Scene>,
+) -> Result<()> {
+    let args = PlanArgs::parse(profile, budget_ms, out)?;
+    let settings = settings()?;
+    let scene = scene()?;
+    let acc = dolly_accuracy()?;
+    run(&args, &settings, &scene, &acc, &acc.source)
+}

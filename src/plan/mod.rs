@@ -1,0 +1,29 @@
+//! `dermis plan` (issue 16, items 3 and 4): a method setting per character
+//! under a skin-SSS budget on a hardware profile.
+//!
+//! Pure (no device; tests/suite/layers.rs holds them to it): [`cost`] (the
+//! budget model's pass costs split per character, from the stored frames of
+//! `profiles/frames/plan/`), [`character`] (what the planner knows of a
+//! character, estimated from the scene's geometry), [`choose`] (the rules,
+//! the accuracy model's interface, the weighted error), [`solve`] (the exact
+//! branch and bound), [`dolly`] (a stand-in accuracy model from the dolly
+//! sweep). With the registry and files: [`cli`] (the command) and
+//! [`picture`] (the schematic of the plan). docs/plan.md says how it works.
+
+pub mod character;
+pub mod choose;
+pub mod cli;
+pub mod cost;
+pub mod dolly;
+pub mod picture;
+pub mod solve;
+
+/// The cost model's view of a character.
+pub fn load_of(c: &character::CharacterInput) -> cost::CharacterLoad {
+    cost::CharacterLoad {
+        px_per_mm: c.px_per_mm,
+        skin_pixels: c.skin_pixels,
+        region_pixels: c.region_pixels,
+        region_rects: c.region_rects,
+    }
+}
