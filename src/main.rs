@@ -183,6 +183,31 @@ enum Command {
         #[arg(long, default_value = "out/plan")]
         out: PathBuf,
     },
+    /// Check plans against the ground truth (issue 16, docs/plan.md): for each scene and
+    /// (profile, budget), plan, render the plan, the ground truth and every uniform
+    /// assignment that fits, and score them; on a GPU also time each plan's skin SSS.
+    /// Writes DIR/plan-check.json, .md and error-vs-budget charts.
+    PlanCheck {
+        #[command(flatten)]
+        common: Common,
+        /// Scenes, comma-separated: close (one close, eight in rows behind), crowd16,
+        /// crowd64, grid.
+        #[arg(long, default_value = "close,crowd16,crowd64,grid")]
+        scenes: String,
+        /// PROFILE:MS cases, comma-separated (default: 1, 2 and 4 ms on xbox360,
+        /// switch-handheld and steam-deck; 0.25 and 0.5 ms on nvidia-h200).
+        #[arg(long)]
+        cases: Option<String>,
+        /// Frames timed per plan after a warm-up (0: no timing, as on lavapipe), for the
+        /// cases of --timed-profile; each plan's groups are also timed alone.
+        #[arg(long, default_value_t = 0)]
+        timed_frames: usize,
+        /// The profile of the device the check runs on (whose predictions timing checks).
+        #[arg(long, default_value = "nvidia-h200")]
+        timed_profile: String,
+        #[arg(long, default_value = "out/plan-check")]
+        out: PathBuf,
+    },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
     Kernel {
         #[arg(long, default_value_t = 17)]
@@ -699,9 +724,46 @@ fn main_result() -> Result<()> {
             &profile,
             &budget_ms,
             &out,
+            common.scene.as_deref(),
             || common.settings(),
             || common.scene(),
         )?,
+        Command::PlanCheck {
+            common,
+            scenes,
+            cases,
+            timed_frames,
+            timed_profile,
+            out,
+        } => {
+            use dermis::plan::{check, measured::Measured};
+            let scenes = check::pick_scenes(&scenes)?;
+            let cases = match cases {
+                Some(c) => check::parse_cases(&c)?,
+                None => check::cases(),
+            };
+            let base = common.settings()?;
+            let scene = common.scene()?;
+            dermis::output::prepare_out_dir(&out)?;
+            let acc = Measured::load_default(Measured::asset_of(common.scene.as_deref()))?;
+            let ctx = common.context()?;
+            let r = check::run(
+                &ctx,
+                &check::CheckOptions {
+                    base,
+                    scene: &scene,
+                    accuracy: &acc,
+                    accuracy_source: acc.source(),
+                    scenes,
+                    cases,
+                    timed_frames,
+                    timed_profile,
+                    out: &out,
+                },
+            )?;
+            print!("{}", check::markdown(&r));
+            println!("wrote {}", out.join("plan-check.json").display());
+        }
         Command::Kernel {
             samples,
             preset,

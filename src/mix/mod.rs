@@ -73,8 +73,7 @@ impl Choice {
             method: entry.name.to_string(),
             options,
         };
-        (entry.check)(&entry.opts(&c.method_options()))
-            .with_context(|| c.label())?;
+        (entry.check)(&entry.opts(&c.method_options())).with_context(|| c.label())?;
         Ok(c)
     }
 

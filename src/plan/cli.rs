@@ -590,18 +590,21 @@ pub fn plan_file(
 
 /// The `plan` subcommand: checks the profile and the budget, then the
 /// render settings and the scene (each a one-line error, before anything is
-/// written; no device ever opens), and plans with the stand-in accuracy
-/// model (`dolly`) until the per-setting model of item 2 is wired in.
+/// written; no device ever opens), and plans with the measured accuracy
+/// table of the scene's head (`measured`: the scan's for a loaded model, the
+/// procedural face's for a built-in scene).
 pub fn command(
     profile: &str,
     budget_ms: &str,
     out: &Path,
+    scene_path: Option<&Path>,
     settings: impl FnOnce() -> Result<RenderSettings>,
     scene: impl FnOnce() -> Result<Scene>,
 ) -> Result<()> {
     let args = PlanArgs::parse(profile, budget_ms, out)?;
     let settings = settings()?;
     let scene = scene()?;
-    let acc = dolly_accuracy()?;
-    run(&args, &settings, &scene, &acc, &acc.source)
+    let acc =
+        super::measured::Measured::load_default(super::measured::Measured::asset_of(scene_path))?;
+    run(&args, &settings, &scene, &acc, &acc.source())
 }

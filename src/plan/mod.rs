@@ -7,14 +7,19 @@
 //! character, estimated from the scene's geometry), [`choose`] (the rules,
 //! the accuracy model's interface, the weighted error), [`solve`] (the exact
 //! branch and bound), [`dolly`] (a stand-in accuracy model from the dolly
-//! sweep). With the registry and files: [`cli`] (the command) and
-//! [`picture`] (the schematic of the plan). docs/plan.md says how it works.
+//! sweep), [`measured`] (the measured accuracy table, what the planner uses).
+//! With the registry and files: [`cli`] (the command) and [`picture`] (the
+//! schematic of the plan); with a device, [`check`] (`dermis plan-check`:
+//! plans against the ground truth) and its charts [`check_chart`]. docs/plan.md says how it works.
 
 pub mod character;
+pub mod check;
+pub mod check_chart;
 pub mod choose;
 pub mod cli;
 pub mod cost;
 pub mod dolly;
+pub mod measured;
 pub mod picture;
 pub mod solve;
 

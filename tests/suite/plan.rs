@@ -423,3 +423,79 @@ fn plan_time_for_a_64_crowd() {
         }
     }
 }
+
+/// `plan-check` on lavapipe at a small frame (issue 16 item 5's machinery;
+/// the recorded check runs on the H200, docs/plan.md): no SSS scored against
+/// itself is exactly 1 for every character (an invariant no code of the
+/// planner produced), every plan fits its budget, the timed case times each
+/// group alone, and the outputs are written.
+#[test]
+fn plan_check_scores_plans_against_the_ground_truth() {
+    use dermis::plan::check::{self, CheckOptions};
+    use dermis::plan::measured::Measured;
+    let ctx = common::ctx();
+    let scene = dermis::scene::builtin_scene("face", &TextureOverrides::default(), None).unwrap();
+    let mut base = RenderSettings::study();
+    base.width = 160;
+    base.height = 90;
+    base.options.set("density", "1");
+    let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
+    let out = tmp("check");
+    let r = check::run(
+        &ctx,
+        &CheckOptions {
+            base,
+            scene: &scene,
+            accuracy: &acc,
+            accuracy_source: acc.source(),
+            scenes: check::pick_scenes("grid").unwrap(),
+            cases: check::parse_cases("xbox360:2,nvidia-h200:0.5").unwrap(),
+            timed_frames: 1,
+            timed_profile: "nvidia-h200".into(),
+            out: &out,
+        },
+    )
+    .unwrap();
+    assert_eq!(r.cases.len(), 2);
+    for c in &r.cases {
+        assert!(c.predicted_ms <= c.budget_ms + 1e-9, "{c:?}");
+        assert!(c.measured_error.is_finite() && c.best_uniform_error.is_finite());
+        assert_eq!(c.characters.len(), 16);
+        // No SSS scored against itself: every character with a band is 1.
+        for ch in c.characters.iter().filter(|ch| ch.setting == "none") {
+            if ch.measured.interior.is_some() || ch.measured.silhouette.is_some() {
+                assert!((ch.measured.error - 1.0).abs() < 1e-12, "{ch:?}");
+            }
+        }
+        let timed = c.profile == "nvidia-h200";
+        assert_eq!(c.measured_sss_ms.is_some(), timed);
+        let groups = c.plan_groups.iter().filter(|g| *g != "none").count();
+        assert_eq!(
+            c.parts_sss_ms.len(),
+            if timed { groups } else { 0 },
+            "{c:?}"
+        );
+    }
+    let none = r.uniform[0].1.iter().find(|u| u.method == "none");
+    assert!(
+        none.is_none(),
+        "none is the floor of every case, not a uniform row"
+    );
+    for f in [
+        "plan-check.json",
+        "plan-check.md",
+        "error-vs-budget-xbox360.png",
+        "error-vs-budget-nvidia-h200.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} written");
+    }
+    assert_eq!(
+        check::pick_scenes("crowd16,nope")
+            .unwrap_err()
+            .to_string()
+            .lines()
+            .count(),
+        1
+    );
+    assert!(check::parse_cases("xbox360:-1").is_err() && check::parse_cases("xbox360").is_err());
+}

@@ -1,0 +1,796 @@
+//! `dermis plan-check` (issue 16 item 5): plans checked against the ground
+//! truth, not assumed. For each scene (one character close with eight in rows
+//! behind it, 16 and 64 in a crowd, the grid) and each (profile, budget): plan
+//! the frame, render the plan and the ground truth of the same frame, and
+//! measure the plan's skin-weighted err/none; render every uniform assignment
+//! (every registered eval setting for every character, and none) whose
+//! modelled cost fits some budget, and compare the plan with the best uniform
+//! one that fits the same budget. On a GPU it also times each plan's skin-SSS
+//! passes (the prediction on the profile `nvidia-h200` is then checked against
+//! the device it models).
+//!
+//! The measured error of a frame is the planner's objective measured: per
+//! character, err/none over its interior and its silhouette band (the eval's
+//! definition: RMS error of the diffuse light against the ground truth over
+//! that of no SSS), blended by the character's measured silhouette share, and
+//! averaged over characters weighted by their skin pixels. Characters are
+//! told apart by `render --character-ids` (the ground truth's frame).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use serde::Serialize;
+
+use super::character::CharacterInput;
+use super::choose::{plan, Accuracy, Ask, SettingCosts};
+use super::cli::{
+    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_setting, registered,
+    setting_costs, NODE_LIMIT,
+};
+use super::cost::SettingModel;
+use crate::budget::profile::Profile;
+use crate::eval::bands::{bands, Band, BandInput};
+use crate::method::{ground_truth, lookup, MethodOptions};
+use crate::mix::plan_file::PlanFile;
+use crate::output::write_json;
+use crate::render::settings::Assignment;
+use crate::render::{RenderSettings, Renderer};
+use crate::scene::layout::Layout;
+use crate::scene::Scene;
+use crate::vk::context::Context;
+use crate::work::PassRole;
+
+/// One scene of the check.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckScene {
+    /// What `--scenes` calls it.
+    pub key: &'static str,
+    pub name: &'static str,
+    pub heads: u32,
+    pub layout: Layout,
+    /// Camera distance in head heights (`None`: the portrait's close shot).
+    pub distance_heads: Option<f32>,
+}
+
+/// The issue's four scenes.
+pub fn scenes() -> Vec<CheckScene> {
+    vec![
+        CheckScene {
+            key: "close",
+            name: "close + 8 behind",
+            heads: 9,
+            layout: Layout::Crowd,
+            distance_heads: None,
+        },
+        CheckScene {
+            key: "crowd16",
+            name: "crowd 16",
+            heads: 16,
+            layout: Layout::Crowd,
+            distance_heads: Some(4.0),
+        },
+        CheckScene {
+            key: "crowd64",
+            name: "crowd 64",
+            heads: 64,
+            layout: Layout::Crowd,
+            distance_heads: Some(4.0),
+        },
+        CheckScene {
+            key: "grid",
+            name: "grid 16",
+            heads: 16,
+            layout: Layout::Grid,
+            distance_heads: Some(4.0),
+        },
+    ]
+}
+
+/// The scenes named in `list` (comma-separated keys of [`scenes`]).
+pub fn pick_scenes(list: &str) -> Result<Vec<CheckScene>> {
+    let all = scenes();
+    list.split(',')
+        .map(|k| {
+            let k = k.trim();
+            all.iter().find(|s| s.key == k).cloned().with_context(|| {
+                let keys: Vec<&str> = all.iter().map(|s| s.key).collect();
+                format!("--scenes: no scene {k:?} (there are {})", keys.join(", "))
+            })
+        })
+        .collect()
+}
+
+/// Cases from `PROFILE:MS,PROFILE:MS...` (the profile checked when loaded).
+pub fn parse_cases(list: &str) -> Result<Vec<(String, f64)>> {
+    list.split(',')
+        .map(|c| {
+            let (p, ms) = c
+                .trim()
+                .split_once(':')
+                .with_context(|| format!("--cases: {c:?} is not PROFILE:MS"))?;
+            let ms: f64 = ms
+                .parse()
+                .ok()
+                .filter(|m: &f64| m.is_finite() && *m > 0.0)
+                .with_context(|| format!("--cases: {ms:?} is not a positive number of ms"))?;
+            Ok((p.to_string(), ms))
+        })
+        .collect()
+}
+
+/// The issue's budgets: 1, 2 and 4 ms on the consoles, 0.25 and 0.5 ms on the H200.
+pub fn cases() -> Vec<(String, f64)> {
+    let mut v = Vec::new();
+    for p in ["xbox360", "switch-handheld", "steam-deck"] {
+        for b in [1.0, 2.0, 4.0] {
+            v.push((p.to_string(), b));
+        }
+    }
+    v.push(("nvidia-h200".to_string(), 0.25));
+    v.push(("nvidia-h200".to_string(), 0.5));
+    v
+}
+
+/// A frame's measured error (see the module doc).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FrameError {
+    /// Skin-weighted err/none of the characters' blended interior/silhouette error.
+    pub weighted: f64,
+    /// Per character.
+    pub characters: Vec<CharacterScore>,
+}
+
+/// One character's measured error.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CharacterScore {
+    /// Its skin pixels in the ground truth's frame.
+    pub skin: usize,
+    /// Interior and silhouette err/none (`None`: no pixel of the band, or
+    /// no SSS is exact there), and the blend of the two by pixel count.
+    pub interior: Option<f64>,
+    pub silhouette: Option<f64>,
+    pub silhouette_pixels: usize,
+    pub error: f64,
+}
+
+/// One character of a planned case: what was predicted and what was measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseCharacter {
+    pub character: usize,
+    pub px_per_mm: f64,
+    pub light_deg: f64,
+    pub setting: String,
+    pub predicted_interior: f64,
+    pub predicted_silhouette: f64,
+    pub predicted_silhouette_share: f64,
+    pub measured: CharacterScore,
+}
+
+/// What every frame of one scene is scored against.
+struct Truth {
+    diffuse: Vec<[f32; 4]>,
+    none: Vec<[f32; 4]>,
+    bands: Vec<Option<Band>>,
+    ids: Vec<u32>,
+    characters: usize,
+}
+
+impl Truth {
+    /// Per character and band (interior, silhouette): the sums of squared
+    /// error of `test` and of no SSS against the truth, and the pixel count.
+    fn score(&self, test: &[[f32; 4]]) -> Result<FrameError> {
+        if test.len() != self.diffuse.len() {
+            bail!("a frame of another size than the ground truth's");
+        }
+        // [character][band]: (d2, n2, pixels); band 0 interior, 1 silhouette.
+        let mut acc = vec![[(0.0f64, 0.0f64, 0usize); 2]; self.characters];
+        let mut skin = vec![0usize; self.characters];
+        for (i, t) in test.iter().enumerate() {
+            let id = self.ids[i] as usize;
+            if id == 0 || id > self.characters {
+                continue;
+            }
+            let c = id - 1;
+            let b = match self.bands[i] {
+                Some(Band::Interior) => 0,
+                Some(Band::Silhouette) => 1,
+                Some(Band::DepthStep) => {
+                    skin[c] += 1;
+                    continue;
+                }
+                None => continue,
+            };
+            skin[c] += 1;
+            let a = &mut acc[c][b];
+            for ((&t, &r), &z) in t.iter().zip(&self.diffuse[i]).zip(&self.none[i]).take(3) {
+                let r = f64::from(r);
+                let d = f64::from(t) - r;
+                let z = f64::from(z) - r;
+                a.0 += d * d;
+                a.1 += z * z;
+            }
+            a.2 += 1;
+        }
+        let mut out = FrameError::default();
+        let (mut num, mut den) = (0.0, 0.0);
+        for c in 0..self.characters {
+            // A band where no SSS is exact (nothing scatters at this scale)
+            // holds no information: it is left out of the blend.
+            let err = |(d2, n2, _): (f64, f64, usize)| (n2 > 0.0).then(|| (d2 / n2).sqrt());
+            let (int, sil) = (err(acc[c][0]), err(acc[c][1]));
+            let (pi, ps) = (acc[c][0].2 as f64, acc[c][1].2 as f64);
+            let blended = match (int, sil) {
+                (Some(i), Some(s)) => (pi * i + ps * s) / (pi + ps),
+                (Some(i), None) => i,
+                (None, Some(s)) => s,
+                (None, None) => 1.0,
+            };
+            out.characters.push(CharacterScore {
+                skin: skin[c],
+                interior: int,
+                silhouette: sil,
+                silhouette_pixels: acc[c][1].2,
+                error: blended,
+            });
+            if skin[c] > 0 {
+                num += skin[c] as f64 * blended;
+                den += skin[c] as f64;
+            }
+        }
+        out.weighted = if den > 0.0 { num / den } else { 1.0 };
+        Ok(out)
+    }
+}
+
+/// A uniform assignment: every character with one setting.
+#[derive(Clone, Debug, Serialize)]
+pub struct Uniform {
+    pub method: String,
+    pub setting: String,
+    /// Modelled skin-SSS ms per profile (`None`: not priced there).
+    pub modelled_ms: Vec<(String, Option<f64>)>,
+    /// Measured error (`None`: not rendered, as it fits no budget).
+    pub measured: Option<f64>,
+}
+
+/// One (scene, profile, budget).
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseRow {
+    pub scene: String,
+    pub profile: String,
+    pub budget_ms: f64,
+    pub plan_groups: Vec<String>,
+    pub predicted_ms: f64,
+    pub predicted_error: f64,
+    /// The planner's lower bound and whether its search finished.
+    pub lower_bound: Option<f64>,
+    pub optimal: bool,
+    pub plan_ms_to_solve: f64,
+    pub measured_error: f64,
+    /// The best uniform assignment that fits the budget, and its error.
+    pub best_uniform: String,
+    pub best_uniform_error: f64,
+    pub uniform_fitting: usize,
+    /// Skin-SSS ms measured on this device (median over the timed frames),
+    /// and of that the merges (the mixed frame's own overhead).
+    pub measured_sss_ms: Option<f64>,
+    pub measured_merge_ms: Option<f64>,
+    /// Each group's skin-SSS ms timed alone (its characters with its method,
+    /// every other character with none): the parts the mixed frame is made
+    /// of. The mixed frame's own overhead is `measured_sss_ms` minus their sum.
+    pub parts_sss_ms: Vec<(String, f64)>,
+    pub characters: Vec<CaseCharacter>,
+}
+
+/// The whole check.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckReport {
+    pub device: String,
+    pub width: u32,
+    pub height: u32,
+    pub accuracy: String,
+    pub scenes: Vec<CheckScene>,
+    pub uniform: Vec<(String, Vec<Uniform>)>,
+    pub cases: Vec<CaseRow>,
+    pub summary: Summary,
+}
+
+/// The issue's questions answered.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    pub cases: usize,
+    /// Plan no worse than the best fitting uniform (within `TIE`), and better.
+    pub no_worse: usize,
+    pub better: usize,
+    pub mean_abs_prediction_error: f64,
+    pub max_abs_prediction_error: f64,
+    /// Where timed: measured over predicted skin-SSS ms on nvidia-h200.
+    pub h200_measured_over_predicted: Vec<f64>,
+}
+
+/// Two measured errors closer than this are the same (a tap that crosses
+/// into another character's pixels differs between a mixed and a uniform
+/// frame by less; see docs/methods.md's mixed-frame section).
+pub const TIE: f64 = 1e-3;
+
+/// What the check needs besides the device.
+pub struct CheckOptions<'a> {
+    pub base: RenderSettings,
+    pub scene: &'a Scene,
+    pub accuracy: &'a dyn Accuracy,
+    pub accuracy_source: String,
+    pub scenes: Vec<CheckScene>,
+    pub cases: Vec<(String, f64)>,
+    /// Frames timed per plan (0: no timing, as on lavapipe), for the cases
+    /// of `timed_profile` (the profile of the device the check runs on: the
+    /// other profiles' predictions are not about it).
+    pub timed_frames: usize,
+    pub timed_profile: String,
+    pub out: &'a Path,
+}
+
+fn settings_for(base: &RenderSettings, s: &CheckScene) -> RenderSettings {
+    let mut r = base.clone();
+    r.heads = s.heads;
+    r.layout = s.layout;
+    if let Some(d) = s.distance_heads {
+        r.distance_heads = d;
+    }
+    r.assignment = None;
+    r.character_ids = false;
+    r
+}
+
+fn with_method(
+    base: &RenderSettings,
+    method: &str,
+    options: &[(String, String)],
+) -> Result<RenderSettings> {
+    let mut r = base.clone();
+    r.method = lookup(method)?;
+    let mut o = MethodOptions::default();
+    for (k, v) in options {
+        o.set(k, v.clone());
+    }
+    r.options = o;
+    Ok(r)
+}
+
+/// Renders one frame of `s` and reads back its diffuse light (and with
+/// `ids`, the character ids and depth).
+fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<crate::render::Capture> {
+    let mut r = Renderer::new(ctx, scene, s)?;
+    r.capture(false)
+}
+
+/// Median skin-SSS ms (and of it the merges) over `n` timed frames after a warm-up.
+fn time_sss(ctx: &Context, scene: &Scene, s: &RenderSettings, n: usize) -> Result<(f64, f64)> {
+    let mut r = Renderer::new(ctx, scene, s)?;
+    r.run_frames(3, |_| {})?;
+    let (frames, _) = r.frames_timed(n, |_| {})?;
+    let mut sss: Vec<f64> = Vec::new();
+    let mut merge: Vec<f64> = Vec::new();
+    for f in &frames {
+        let on = f.iter().filter(|p| p.role == PassRole::Sss);
+        sss.push(on.clone().map(|p| p.gpu_ms).sum());
+        merge.push(
+            on.filter(|p| p.name.starts_with("mix merge"))
+                .map(|p| p.gpu_ms)
+                .sum(),
+        );
+    }
+    let med = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        crate::report::median_of_sorted(v)
+    };
+    Ok((med(&mut sss), med(&mut merge)))
+}
+
+/// A setting's modelled cost for every character with it: its fixed cost and
+/// every part (`None` where a part is unpriced).
+fn uniform_ms(c: &SettingCosts) -> Option<f64> {
+    let parts: Option<Vec<f64>> = c.parts_ms.iter().copied().collect();
+    parts.map(|p| c.fixed_ms + p.iter().sum::<f64>())
+}
+
+/// Runs the check and writes DIR/plan-check.json, DIR/plan-check.md and the
+/// charts (DIR/error-vs-budget-PROFILE.png and .svg).
+pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
+    let (models, _) = load_models(&plan_frames_dir())?;
+    let (rm, rs) = reference_setting()?;
+    let reference: &SettingModel = models
+        .iter()
+        .find(|m| m.method == rm && m.setting == rs)
+        .context("the reference setting has no stored frames")?;
+    let mut profiles: Vec<(String, Profile)> = Vec::new();
+    for (p, _) in &o.cases {
+        if !profiles.iter().any(|(n, _)| n == p) {
+            profiles.push((
+                p.to_string(),
+                Profile::load(p).with_context(|| format!("profile {p}"))?,
+            ));
+        }
+    }
+    let atlas = atlas_mm(o.scene);
+    let mut report = CheckReport {
+        device: ctx.facts.name.clone(),
+        width: o.base.width,
+        height: o.base.height,
+        accuracy: o.accuracy_source.clone(),
+        scenes: o.scenes.clone(),
+        uniform: Vec::new(),
+        cases: Vec::new(),
+        summary: Summary::default(),
+    };
+    let progress = indicatif::ProgressBar::new(o.scenes.len() as u64);
+    for cs in &o.scenes {
+        progress.set_message(cs.name);
+        let s = settings_for(&o.base, cs);
+        let chars: Vec<CharacterInput> = characters(o.scene, &s, reference);
+        let costs: Vec<(String, Vec<SettingCosts>)> = profiles
+            .iter()
+            .map(|(n, p)| {
+                (
+                    n.clone(),
+                    setting_costs(&models, &chars, p, s.width, s.height, atlas),
+                )
+            })
+            .collect();
+        // The ground truth (with the character ids) and no SSS.
+        // The ground truth keeps the run's options that it reads (--density:
+        // a crowd of 64 at the default density is more surface than lavapipe holds).
+        let truth_opts: Vec<(String, String)> = o
+            .base
+            .options
+            .given("density")
+            .map(|d| ("density".to_string(), d.to_string()))
+            .into_iter()
+            .collect();
+        let mut gt_s = with_method(&s, ground_truth().name, &truth_opts)?;
+        gt_s.character_ids = true;
+        let gt =
+            render(ctx, o.scene, &gt_s).with_context(|| format!("{}: ground truth", cs.name))?;
+        let none = render(ctx, o.scene, &with_method(&s, "none", &[])?)?;
+        let skin: Vec<bool> = gt.diffuse.iter().map(|p| p[3] > 0.0).collect();
+        let band_input = BandInput::for_view(
+            (gt.width as usize, gt.height as usize),
+            &skin,
+            &gt.depth,
+            s.fovy_deg,
+            o.scene.mm_per_unit,
+        );
+        let truth = Truth {
+            bands: bands(&band_input),
+            ids: gt
+                .character_ids
+                .clone()
+                .context("the ground truth's character ids")?,
+            diffuse: gt.diffuse,
+            none: none.diffuse,
+            characters: cs.heads as usize,
+        };
+        // Uniform assignments: every registered setting, rendered where it
+        // fits one of the budgets.
+        let biggest = |p: &str| {
+            o.cases
+                .iter()
+                .filter(|(q, _)| *q == p)
+                .map(|(_, b)| *b)
+                .fold(0.0, f64::max)
+        };
+        let mut uniforms = Vec::new();
+        for r in registered() {
+            let modelled: Vec<(String, Option<f64>)> = costs
+                .iter()
+                .map(|(p, c)| {
+                    let ms = c
+                        .iter()
+                        .find(|x| x.method == r.method && x.setting == r.setting)
+                        .and_then(uniform_ms);
+                    (p.clone(), ms)
+                })
+                .collect();
+            let fits_some = modelled
+                .iter()
+                .any(|(p, ms)| ms.is_some_and(|m| m <= biggest(p)));
+            let measured = if fits_some {
+                let opts: Vec<(String, String)> = r.options.clone().into_iter().collect();
+                let f = render(ctx, o.scene, &with_method(&s, r.method, &opts)?)
+                    .with_context(|| format!("{}: uniform {} {}", cs.name, r.method, r.setting))?;
+                Some(truth.score(&f.diffuse)?.weighted)
+            } else {
+                None
+            };
+            uniforms.push(Uniform {
+                method: r.method.to_string(),
+                setting: r.setting.to_string(),
+                modelled_ms: modelled,
+                measured,
+            });
+        }
+        let none_err = truth.score(&truth.none)?.weighted;
+        for (pname, budget) in &o.cases {
+            let (pname, budget) = (pname.as_str(), *budget);
+            let c = &costs.iter().find(|(n, _)| n == pname).expect("priced").1;
+            let t0 = Instant::now();
+            let p = plan(&Ask {
+                characters: &chars,
+                settings: c,
+                accuracy: o.accuracy,
+                budget_ms: budget,
+                previous: None,
+                switch_margin: 0.0,
+                node_limit: Some(NODE_LIMIT),
+            });
+            let solve_ms = t0.elapsed().as_secs_f64() * 1e3;
+            let file: PlanFile = plan_file(pname, budget, &chars, c, &p, Vec::new())?;
+            let mut ps = s.clone();
+            ps.assignment = Some(Assignment::Plan(file.clone()));
+            let f = render(ctx, o.scene, &ps)
+                .with_context(|| format!("{}: plan {pname} {budget} ms", cs.name))?;
+            let scored = truth.score(&f.diffuse)?;
+            let measured = scored.weighted;
+            let case_chars: Vec<CaseCharacter> = p
+                .rows
+                .iter()
+                .zip(&chars)
+                .zip(&scored.characters)
+                .map(|((row, ch), m)| CaseCharacter {
+                    character: ch.index,
+                    px_per_mm: ch.px_per_mm,
+                    light_deg: ch.light_deg,
+                    setting: row.setting.map_or("none".to_string(), |si| {
+                        format!("{} {}", c[si].method, c[si].setting)
+                    }),
+                    predicted_interior: row.predicted.0,
+                    predicted_silhouette: row.predicted.1,
+                    predicted_silhouette_share: ch.silhouette_share,
+                    measured: *m,
+                })
+                .collect();
+            let (mut best, mut best_err, mut fitting) = ("none".to_string(), none_err, 1);
+            for u in &uniforms {
+                let fits = u
+                    .modelled_ms
+                    .iter()
+                    .any(|(q, ms)| q == pname && ms.is_some_and(|m| m <= budget));
+                if let (true, Some(e)) = (fits, u.measured) {
+                    fitting += 1;
+                    if e < best_err {
+                        best_err = e;
+                        best = format!("{} {}", u.method, u.setting);
+                    }
+                }
+            }
+            let timed = o.timed_frames > 0 && pname == o.timed_profile;
+            let (measured_sss_ms, measured_merge_ms) = if timed {
+                let (a, b) = time_sss(ctx, o.scene, &ps, o.timed_frames)?;
+                (Some(a), Some(b))
+            } else {
+                (None, None)
+            };
+            let mut parts_sss_ms = Vec::new();
+            if timed {
+                for (label, alone) in group_parts(&file) {
+                    let mut gs = s.clone();
+                    gs.assignment = Some(Assignment::Plan(alone));
+                    parts_sss_ms.push((label, time_sss(ctx, o.scene, &gs, o.timed_frames)?.0));
+                }
+            }
+            let mut groups: Vec<String> = Vec::new();
+            for a in &file.assignments {
+                let l = match (a.method.as_str(), &a.setting) {
+                    ("none", _) | (_, None) => a.method.clone(),
+                    (m, Some(s)) => format!("{m} {s}"),
+                };
+                if !groups.contains(&l) {
+                    groups.push(l);
+                }
+            }
+            report.cases.push(CaseRow {
+                scene: cs.name.to_string(),
+                profile: pname.to_string(),
+                budget_ms: budget,
+                plan_groups: groups,
+                predicted_ms: p.solution.cost_ms,
+                predicted_error: p.solution.error,
+                lower_bound: p.solution.lower_bound,
+                optimal: p.solution.optimal,
+                plan_ms_to_solve: solve_ms,
+                measured_error: measured,
+                best_uniform: best,
+                best_uniform_error: best_err,
+                uniform_fitting: fitting,
+                measured_sss_ms,
+                measured_merge_ms,
+                parts_sss_ms,
+                characters: case_chars,
+            });
+        }
+        report.uniform.push((cs.name.to_string(), uniforms));
+        // Written after every scene: a long check cut short keeps what it did.
+        report.summary = summarise(&report.cases);
+        write_outputs(o.out, &report)?;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    Ok(report)
+}
+
+fn write_outputs(out: &Path, report: &CheckReport) -> Result<()> {
+    write_json(&out.join("plan-check.json"), report)?;
+    crate::output::write_bytes(&out.join("plan-check.md"), markdown(report).as_bytes())?;
+    super::check_chart::write(out, report)
+}
+
+/// A plan's groups, each alone: (the group's label, the plan with every
+/// character of another group given none).
+pub fn group_parts(file: &PlanFile) -> Vec<(String, PlanFile)> {
+    let key = |a: &crate::mix::plan_file::PlannedCharacter| (a.method.clone(), a.options.clone());
+    let mut keys = Vec::new();
+    for a in &file.assignments {
+        if a.method != "none" && !keys.contains(&key(a)) {
+            keys.push(key(a));
+        }
+    }
+    keys.into_iter()
+        .map(|k| {
+            let mut alone = file.clone();
+            let mut label = k.0.clone();
+            for a in &mut alone.assignments {
+                if key(a) == k {
+                    if let Some(s) = &a.setting {
+                        label = format!("{} {}", a.method, s);
+                    }
+                } else {
+                    a.method = "none".into();
+                    a.options.clear();
+                    a.setting = None;
+                    a.predicted_ms = None;
+                    a.predicted_error = None;
+                }
+            }
+            (label, alone)
+        })
+        .collect()
+}
+
+/// The summary of the cases.
+pub fn summarise(cases: &[CaseRow]) -> Summary {
+    let mut s = Summary {
+        cases: cases.len(),
+        ..Default::default()
+    };
+    let mut errs = Vec::new();
+    for c in cases {
+        if c.measured_error <= c.best_uniform_error + TIE {
+            s.no_worse += 1;
+        }
+        if c.measured_error < c.best_uniform_error - TIE {
+            s.better += 1;
+        }
+        errs.push((c.predicted_error - c.measured_error).abs());
+        if c.profile == "nvidia-h200" {
+            if let Some(m) = c.measured_sss_ms {
+                if c.predicted_ms > 0.0 {
+                    s.h200_measured_over_predicted.push(m / c.predicted_ms);
+                }
+            }
+        }
+    }
+    if !errs.is_empty() {
+        s.mean_abs_prediction_error = errs.iter().sum::<f64>() / errs.len() as f64;
+        s.max_abs_prediction_error = errs.iter().copied().fold(0.0, f64::max);
+    }
+    s
+}
+
+/// The cases as a markdown table, with the summary.
+pub fn markdown(r: &CheckReport) -> String {
+    let mut s = format!(
+        "Plans against the ground truth: {} at {}x{}, accuracy from {}.\n\n",
+        r.device, r.width, r.height, r.accuracy
+    );
+    s.push_str(
+        "| scene | profile | budget ms | plan | predicted ms | measured SSS ms | predicted err/none | measured err/none | best uniform that fits | its err/none |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for c in &r.cases {
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.3} | {} | {:.3} |\n",
+            c.scene,
+            c.profile,
+            c.budget_ms,
+            c.plan_groups.join(" + "),
+            c.predicted_ms,
+            c.measured_sss_ms.map_or("-".into(), |m| format!("{m:.3}")),
+            c.predicted_error,
+            c.measured_error,
+            c.best_uniform,
+            c.best_uniform_error
+        ));
+    }
+    let m = &r.summary;
+    s.push_str(&format!(
+        "\nPlan no worse than the best fitting uniform assignment (within {TIE}): {} of {}; better: {} of {}. \
+         Predicted against measured err/none: mean |difference| {:.3}, max {:.3}.\n",
+        m.no_worse, m.cases, m.better, m.cases, m.mean_abs_prediction_error, m.max_abs_prediction_error
+    ));
+    if !m.h200_measured_over_predicted.is_empty() {
+        let v: Vec<String> = m
+            .h200_measured_over_predicted
+            .iter()
+            .map(|x| format!("{x:.2}"))
+            .collect();
+        s.push_str(&format!(
+            "Measured over predicted skin-SSS ms on nvidia-h200: {}.\n",
+            v.join(", ")
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(measured: f64, best: f64, pred: f64) -> CaseRow {
+        CaseRow {
+            scene: "s".into(),
+            profile: "nvidia-h200".into(),
+            budget_ms: 1.0,
+            plan_groups: vec![],
+            predicted_ms: 0.5,
+            predicted_error: pred,
+            lower_bound: None,
+            optimal: true,
+            plan_ms_to_solve: 0.0,
+            measured_error: measured,
+            best_uniform: "none".into(),
+            best_uniform_error: best,
+            uniform_fitting: 1,
+            measured_sss_ms: Some(0.55),
+            measured_merge_ms: Some(0.01),
+            parts_sss_ms: vec![],
+            characters: vec![],
+        }
+    }
+
+    #[test]
+    fn the_summary_counts_ties_as_no_worse_and_not_better() {
+        let s = summarise(&[row(0.5, 0.5, 0.55), row(0.4, 0.5, 0.4), row(0.6, 0.5, 0.5)]);
+        assert_eq!((s.no_worse, s.better, s.cases), (2, 1, 3));
+        assert!((s.mean_abs_prediction_error - 0.05).abs() < 1e-12);
+        assert!((s.max_abs_prediction_error - 0.1).abs() < 1e-12);
+        assert_eq!(s.h200_measured_over_predicted.len(), 3);
+    }
+
+    // Two characters: one exact, one as wrong as no SSS; the weighted error
+    // is their skin-weighted mean; a band where none is exact is left out.
+    #[test]
+    fn the_frame_error_is_the_skin_weighted_mean_of_the_characters() {
+        let r = [1.0f32, 0.5, 0.25, 1.0];
+        let z = [0.5f32, 0.5, 0.25, 1.0];
+        let n = 4;
+        let truth = Truth {
+            diffuse: vec![r; n],
+            none: vec![z, z, z, r],
+            bands: vec![Some(Band::Interior); n],
+            ids: vec![1, 2, 2, 2],
+            characters: 2,
+        };
+        let test = vec![r, z, z, [9.0, 9.0, 9.0, 1.0]];
+        let e = truth.score(&test).unwrap();
+        assert_eq!((e.characters[0].skin, e.characters[0].error), (1, 0.0));
+        // Character 1: the last pixel's none is exact (n2 = 0 there) but its
+        // error still counts in d2: sqrt((0 + 0 + d) / (0.25 + 0.25)).
+        let d = 8.0f64 * 8.0 + 8.5 * 8.5 + 8.75 * 8.75;
+        let want = ((0.5 + d) / 0.5).sqrt();
+        assert!(
+            (e.characters[1].error - want).abs() < 1e-9,
+            "{:?}",
+            e.characters
+        );
+        assert!((e.weighted - 3.0 * want / 4.0).abs() < 1e-9);
+    }
+}
