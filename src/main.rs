@@ -191,7 +191,7 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// Scenes, comma-separated: close (one close, eight in rows behind), crowd16,
-        /// crowd64, grid.
+        /// crowd64, grid, and single (the close character alone: the control).
         #[arg(long, default_value = "close,crowd16,crowd64,grid")]
         scenes: String,
         /// PROFILE:MS cases, comma-separated (default: 1, 2 and 4 ms on xbox360,

@@ -459,8 +459,8 @@ pub fn plan_notes(p: &Plan, accuracy_source: &str) -> Vec<String> {
         ));
     }
     n.push(format!(
-        "rules: no SSS where the scattering's reach ({:.2} mm, the profile's widest Gaussian) \
-         spans under a pixel; no texture-space setting whose map texel exceeds the narrow reach \
+        "rules: no SSS where the scattering's reach ({:.2} mm, 3 sigma of the profile's widest \
+         Gaussian) spans under a pixel; no texture-space setting whose map texel exceeds the narrow reach \
          ({:.2} mm, Gaussian 3); no setting outside its accuracy model's measured range",
         scatter_reach_mm(),
         narrow_reach_mm()
