@@ -1,0 +1,25 @@
+//! Anti-aliasing's device-free core (issue 17, part 1): the lookup tables and
+//! CPU references of Jimenez's MLAA (thesis ch. 9) and SMAA (ch. 10), plain
+//! Rust that the GPU passes will upload and be checked against.
+//!
+//! - `revector`: the orthogonal re-vectorisation both share: crossing edges,
+//!   the 16 patterns, the exact areas of L, Z and U shapes (ch. 9.2, 10.4.2).
+//! - `mlaa_area`: MLAA's 45 x 45 area texture, 5 x 5 subtextures of 9 x 9
+//!   (ch. 9.4.3, Listing 9.4).
+//! - `smaa_area`, `smaa_diag`: SMAA's 160 x 560 area texture, orthogonal
+//!   (quadratically compressed distances, 7 subpixel offsets) and diagonal
+//!   (5 offsets) halves, as `SMAA.hlsl` addresses it; R8G8 bytes, generated
+//!   once per process.
+//! - `smaa_search`: SMAA's 64 x 16 search texture, the decoding of the
+//!   searches' last bilinear fetch (ch. 10.4.2, Eq. 10.5).
+//! - `edges`: MLAA luma and depth edges, SMAA luma and colour edges with local
+//!   contrast adaptation (ch. 9.3, 10.4.1, Eq. 10.1).
+//!
+//! Orientation: every table and image here is stored row 0 first and read
+//! with `v = 0` at row 0, rows running top to bottom as Vulkan stores,
+//! samples and rasterises them (NDC y down, positive viewport height). That is
+//! D3D's convention, which SMAA's tables were made for, so no flip is needed
+//! (`smaa_area` tests it on a staircase). docs/aa.md says what each function
+//! computes and what the GPU passes still need.
+pub mod mlaa_area;
+pub mod revector;
