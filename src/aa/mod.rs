@@ -21,5 +21,6 @@
 //! D3D's convention, which SMAA's tables were made for, so no flip is needed
 //! (`smaa_area` tests it on a staircase). docs/aa.md says what each function
 //! computes and what the GPU passes still need.
+pub mod edges;
 pub mod mlaa_area;
 pub mod revector;
