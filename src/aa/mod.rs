@@ -24,3 +24,5 @@
 pub mod edges;
 pub mod mlaa_area;
 pub mod revector;
+pub mod smaa_area;
+pub mod smaa_diag;
