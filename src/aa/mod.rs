@@ -26,3 +26,44 @@ pub mod mlaa_area;
 pub mod revector;
 pub mod smaa_area;
 pub mod smaa_diag;
+pub mod smaa_search;
+
+#[cfg(test)]
+mod tests {
+    use std::time::{Duration, Instant};
+
+    /// Each table well under a second (the brief's bound; iryoku's Python
+    /// takes minutes, ANCHORS.md). Run with `--nocapture` for the times
+    /// docs/aa.md quotes: the best of five, so a busy machine inflates less.
+    #[test]
+    fn tables_generate_well_under_a_second() {
+        fn best<T>(f: impl Fn() -> T) -> Duration {
+            (0..5)
+                .map(|_| {
+                    let t0 = Instant::now();
+                    std::hint::black_box(f());
+                    t0.elapsed()
+                })
+                .min()
+                .unwrap_or_default()
+        }
+        let times = [
+            (
+                "MLAA area 45x45",
+                best(super::mlaa_area::MlaaAreaTex::generate),
+            ),
+            (
+                "SMAA area 160x560",
+                best(super::smaa_area::SmaaAreaTex::generate),
+            ),
+            (
+                "SMAA search 64x16",
+                best(super::smaa_search::SmaaSearchTex::generate),
+            ),
+        ];
+        for (what, dt) in times {
+            eprintln!("{what}: generated in {dt:?}");
+            assert!(dt < Duration::from_millis(500), "{what} took {dt:?}");
+        }
+    }
+}
