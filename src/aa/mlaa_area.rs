@@ -8,7 +8,7 @@
 //! `9 * round(4 e) + d`, column from the left end, row from the right end;
 //! codes 2 (`e = 0.5`) never occur, so their row and column stay empty.
 
-use super::revector::{self, Crossing, Pattern};
+use super::revector::{self, Pattern};
 
 /// Distances 0..=8 per subtexture (Listing 9.4's `NUM_DISTANCES`).
 pub const NUM_DISTANCES: usize = 9;
@@ -90,11 +90,6 @@ impl MlaaAreaTex {
     }
 }
 
-/// The crossing edges of the 0.25-offset fetch of Listing 9.2, read back.
-pub fn crossing(e: f32) -> Option<Crossing> {
-    Crossing::from_fetched(e)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -129,8 +124,13 @@ mod tests {
     }
 
     #[test]
-    fn the_code_2_row_and_column_stay_empty() {
+    fn no_crossing_edge_no_area_and_code_2_stays_empty() {
         let t = MlaaAreaTex::generate();
+        for l in 0..=MAX_DISTANCE {
+            for r in 0..=MAX_DISTANCE {
+                assert_eq!(t.area(p(0), l, r), Some([0.0, 0.0]));
+            }
+        }
         for k in 0..AREA_SIZE {
             for j in 2 * NUM_DISTANCES..3 * NUM_DISTANCES {
                 assert_eq!(t.at(j, k), [0.0, 0.0]);
@@ -219,6 +219,5 @@ mod tests {
         let i = 2 * (y * AREA_SIZE + x);
         // 0.375 * 255 = 95.6.
         assert_eq!((b[i], b[i + 1]), (96, 0));
-        assert_eq!(crossing(0.75), Some(Crossing::new(true, false)));
     }
 }

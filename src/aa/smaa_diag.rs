@@ -10,8 +10,9 @@
 //! `[1 + left, 2 + left] x [left, 1 + left]` and its opposite is the one above
 //! it. The areas are the parts of those two pixels on either side of the
 //! segment, computed exactly here by clipping the unit square with the line's
-//! half-plane (the released script estimates them with 30 x 30 point samples,
-//! whose bias reaches about 1/60).
+//! half-plane (the released script counts 30 x 30 point samples on a closed
+//! grid, whose bias reaches 1/30 where a row of samples lies on the line: its
+//! bytes differ from these by -8 .. +5, docs/aa.md).
 //!
 //! Each end of a diagonal line may be cut by a vertical or a horizontal
 //! crossing edge (2 bits, codes 0..3): the segment's end moves one pixel left
