@@ -14,7 +14,8 @@
 //! covers: channel 0, the weight with which that pixel takes the other's colour
 //! (SMAA's `.r` / `.b`). Area above (`y > 0`) is the weight with which the
 //! pixel across the edge takes the owner's colour: channel 1 (`.g` / `.a`).
-//! Both are non-zero only for the centre pixel of a Z of odd length (ch. 9.4).
+//! At offset 0 both are non-zero only for the centre pixel of a Z of odd length
+//! (ch. 9.4); a subpixel offset moves that crossing point along the line.
 
 /// Crossing edges at one end of a line (ch. 9.4.2, Fig. 9.4): the edgels
 /// perpendicular to the line at the boundary just past its last pixel, on the

@@ -235,3 +235,25 @@ fn vulkan_rows_hold_the_z_of_a_rising_staircase() {
     // first pixel blends the other way: the orientation decides the channel.
     assert!(near(ortho(area_tex(), 6, 0, 3, 0), [0.0, 0.45]));
 }
+
+#[test]
+fn offset_0_agrees_with_mlaa_where_both_reach() {
+    // One geometry in two layouts: MLAA's linear 9 x 9 tiles and SMAA's
+    // squared 16 x 16 ones hold the same areas at the distances both store
+    // (0, 1, 4), but for the U shapes SMAA softens.
+    let mlaa = crate::aa::mlaa_area::MlaaAreaTex::generate();
+    let t = area_tex();
+    for i in 0..16 {
+        for y in 0..3 {
+            for x in 0..3 {
+                let a = t.ortho_at(p(i), x, y, 0);
+                let b = mlaa.area(p(i), x * x, y * y).expect("in reach");
+                if i == 3 || i == 12 {
+                    assert!(a[0] + a[1] > b[0] + b[1], "pattern {i} at {x},{y}");
+                } else {
+                    assert_eq!(a, b, "pattern {i} at {x},{y}");
+                }
+            }
+        }
+    }
+}
