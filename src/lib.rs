@@ -4,11 +4,12 @@
 //! Layers, bottom up (a module uses only the ones before it; tests/suite/layers.rs
 //! checks it on every path the code names):
 //! the pure core, `files`, `shader_constants`, `work`, `view`, `scene`, `skin`,
-//! `reference`, `accuracy` (no Vulkan: the one door every user-supplied file is read
+//! `reference`, `accuracy`, `aa` (no Vulkan: the one door every user-supplied file is read
 //! through, regular files only and sizes bounded; the numbers shared with the shaders, the
 //! vocabulary of a pass's work, the view's scale and the SSS region, meshes and
 //! framing, profiles, kernels and the CPU mirrors of the passes, the ground
-//! truth's sampling and chunk plan, the measured accuracy model) -> `vk` (device, barrier table, memory,
+//! truth's sampling and chunk plan, the measured accuracy model, the MLAA and
+//! SMAA lookup tables and edge references) -> `vk` (device, barrier table, memory,
 //! shaders and their statistics, uploads, profiler) -> `graph` (declared images,
 //! passes with their role, work and accesses; barriers and usages derived, never
 //! written at call sites) -> `method` (the SSS methods, one module each behind
@@ -21,6 +22,7 @@
 //! The pure core and, above it, `eval::metrics` and `budget::model` name
 //! neither `ash`, `crate::vk` nor `crate::graph`, nor reach them through any
 //! file they lead to (tests/suite/layers.rs).
+pub mod aa;
 pub mod accuracy;
 pub mod bench;
 pub mod budget;

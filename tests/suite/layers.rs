@@ -34,6 +34,7 @@ const LAYERS: &[&[&str]] = &[
         "skin",
         "reference",
         "accuracy",
+        "aa",
     ],
     &["vk"],
     &["graph"],
