@@ -20,6 +20,12 @@ pub struct Shot {
     pub aspect: f32,
     /// Unit vector toward the key light.
     pub light_dir: Vec3,
+    /// Every character moved this many head heights toward the camera along
+    /// the view after the layout is placed (a rigid crowd walking toward a
+    /// fixed camera, issue 16 item 6; 0: where the layout puts them). The
+    /// layout itself is placed for `distance_heads`, so the crowd keeps its
+    /// rows and every character its index while it walks.
+    pub walk_heads: f32,
 }
 
 /// The placed shot.
@@ -90,6 +96,18 @@ pub fn frame(scene: &Scene, shot: &Shot) -> Framing {
             }
             (instances, camera)
         }
+    };
+    // The walk: the camera looks along -forward from in front of the first
+    // head, so toward it is +forward. The far plane placed above still holds
+    // (every character only comes nearer).
+    let walk = scene.forward.try_normalize().unwrap_or(Vec3::Z) * shot.walk_heads * head_height;
+    let instances: Vec<Mat4> = if shot.walk_heads == 0.0 {
+        instances
+    } else {
+        instances
+            .into_iter()
+            .map(|m| Mat4::from_translation(walk) * m)
+            .collect()
     };
     let bounds = instances
         .iter()
@@ -180,6 +198,7 @@ mod tests {
             fovy_deg: 20.0,
             aspect: 16.0 / 9.0,
             light_dir: Vec3::new(0.5, 0.5, 0.7).normalize(),
+            walk_heads: 0.0,
         }
     }
 
