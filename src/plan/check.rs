@@ -167,19 +167,50 @@ pub struct CaseCharacter {
     pub measured: CharacterScore,
 }
 
-/// What every frame of one scene is scored against.
-struct Truth {
-    diffuse: Vec<[f32; 4]>,
-    none: Vec<[f32; 4]>,
-    bands: Vec<Option<Band>>,
-    ids: Vec<u32>,
-    characters: usize,
+/// What every frame of one scene is scored against (also `motion`'s, frame
+/// by frame).
+pub struct Truth {
+    pub diffuse: Vec<[f32; 4]>,
+    pub none: Vec<[f32; 4]>,
+    pub bands: Vec<Option<Band>>,
+    /// The ground truth's character ids (0: no character's skin).
+    pub ids: Vec<u32>,
+    pub characters: usize,
 }
 
 impl Truth {
+    /// Renders the ground truth of the frame `s` describes (with the
+    /// character ids, and the run's `--density` passed through: a crowd of
+    /// 64 at the default density is more surface than lavapipe holds) and
+    /// the same frame with no SSS, and finds the eval's bands.
+    pub fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<Truth> {
+        let mut gt_s = truth_settings(s)?;
+        gt_s.character_ids = true;
+        let gt = render(ctx, scene, &gt_s).context("ground truth")?;
+        let none = render(ctx, scene, &with_method(s, "none", &[])?).context("no SSS")?;
+        let skin: Vec<bool> = gt.diffuse.iter().map(|p| p[3] > 0.0).collect();
+        let band_input = BandInput::for_view(
+            (gt.width as usize, gt.height as usize),
+            &skin,
+            &gt.depth,
+            s.fovy_deg,
+            scene.mm_per_unit,
+        );
+        Ok(Truth {
+            bands: bands(&band_input),
+            ids: gt
+                .character_ids
+                .clone()
+                .context("the ground truth's character ids")?,
+            diffuse: gt.diffuse,
+            none: none.diffuse,
+            characters: s.heads as usize,
+        })
+    }
+
     /// Per character and band (interior, silhouette): the sums of squared
     /// error of `test` and of no SSS against the truth, and the pixel count.
-    fn score(&self, test: &[[f32; 4]]) -> Result<FrameError> {
+    pub fn score(&self, test: &[[f32; 4]]) -> Result<FrameError> {
         if test.len() != self.diffuse.len() {
             bail!("a frame of another size than the ground truth's");
         }
@@ -342,12 +373,28 @@ fn settings_for(base: &RenderSettings, s: &CheckScene) -> RenderSettings {
     r
 }
 
-fn with_method(
+/// The ground truth's settings for the frame `s` describes: the method
+/// options it reads kept (`--density`), every other option dropped.
+pub fn truth_settings(s: &RenderSettings) -> Result<RenderSettings> {
+    let truth_opts: Vec<(String, String)> = s
+        .options
+        .given("density")
+        .map(|d| ("density".to_string(), d.to_string()))
+        .into_iter()
+        .collect();
+    let mut t = with_method(s, ground_truth().name, &truth_opts)?;
+    t.assignment = None;
+    Ok(t)
+}
+
+/// `base` with one method for every character.
+pub fn with_method(
     base: &RenderSettings,
     method: &str,
     options: &[(String, String)],
 ) -> Result<RenderSettings> {
     let mut r = base.clone();
+    r.assignment = None;
     r.method = lookup(method)?;
     let mut o = MethodOptions::default();
     for (k, v) in options {
@@ -359,7 +406,7 @@ fn with_method(
 
 /// Renders one frame of `s` and reads back its diffuse light (and with
 /// `ids`, the character ids and depth).
-fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<crate::render::Capture> {
+pub fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<crate::render::Capture> {
     let mut r = Renderer::new(ctx, scene, s)?;
     r.capture(false)
 }
@@ -437,39 +484,8 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
                 )
             })
             .collect();
-        // The ground truth (with the character ids) and no SSS.
-        // The ground truth keeps the run's options that it reads (--density:
-        // a crowd of 64 at the default density is more surface than lavapipe holds).
-        let truth_opts: Vec<(String, String)> = o
-            .base
-            .options
-            .given("density")
-            .map(|d| ("density".to_string(), d.to_string()))
-            .into_iter()
-            .collect();
-        let mut gt_s = with_method(&s, ground_truth().name, &truth_opts)?;
-        gt_s.character_ids = true;
-        let gt =
-            render(ctx, o.scene, &gt_s).with_context(|| format!("{}: ground truth", cs.name))?;
-        let none = render(ctx, o.scene, &with_method(&s, "none", &[])?)?;
-        let skin: Vec<bool> = gt.diffuse.iter().map(|p| p[3] > 0.0).collect();
-        let band_input = BandInput::for_view(
-            (gt.width as usize, gt.height as usize),
-            &skin,
-            &gt.depth,
-            s.fovy_deg,
-            o.scene.mm_per_unit,
-        );
-        let truth = Truth {
-            bands: bands(&band_input),
-            ids: gt
-                .character_ids
-                .clone()
-                .context("the ground truth's character ids")?,
-            diffuse: gt.diffuse,
-            none: none.diffuse,
-            characters: cs.heads as usize,
-        };
+        let truth = Truth::render(ctx, o.scene, &s)
+            .with_context(|| format!("{}: ground truth", cs.name))?;
         // Uniform assignments: every registered setting, rendered where it
         // fits one of the budgets.
         let biggest = |p: &str| {
