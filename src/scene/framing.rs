@@ -239,6 +239,31 @@ mod tests {
 
     // Issue 11: a flat object was framed edge-on (only its shadow showed). It
     // now faces the camera with its largest extent, whichever way it lies.
+    // A walking crowd keeps its camera and its rows: every character comes
+    // `walk` head heights nearer the eye, its index unchanged.
+    #[test]
+    fn a_walk_moves_every_character_toward_the_fixed_camera() {
+        let s = default_scene();
+        let still = frame(&s, &shot(Layout::Crowd, 16));
+        let walked = frame(
+            &s,
+            &Shot {
+                walk_heads: 1.5,
+                ..shot(Layout::Crowd, 16)
+            },
+        );
+        assert_eq!(walked.camera.eye, still.camera.eye);
+        let h = s.head_height_units();
+        for (a, b) in still.instances.iter().zip(&walked.instances) {
+            let (pa, pb) = (
+                a.transform_point3(s.head_center()),
+                b.transform_point3(s.head_center()),
+            );
+            let toward = s.forward.normalize() * 1.5 * h;
+            assert!((pb - pa - toward).length() < 1e-3 * h, "{pa} -> {pb}");
+        }
+    }
+
     #[test]
     fn a_flat_object_faces_the_camera_with_its_largest_extent() {
         use std::f32::consts::{FRAC_PI_2, PI};
