@@ -208,6 +208,31 @@ enum Command {
         #[arg(long, default_value = "out/plan-check")]
         out: PathBuf,
     },
+    /// Re-plan a crowd walking toward a fixed camera every frame, with hysteresis (issue 16
+    /// item 6, docs/plan-over-time.md): renders each frame's plan and its ground truth,
+    /// measures every switching character's frame-to-frame change against the truth's own,
+    /// reports the plan's time per frame. Writes DIR/plan-motion.json, .png and .svg.
+    PlanMotion {
+        #[command(flatten)]
+        common: Common,
+        /// Profile name (profiles/NAME.toml) or path.
+        #[arg(long)]
+        profile: String,
+        /// The skin-SSS budget on the profile, in milliseconds.
+        #[arg(long, allow_negative_numbers = true)]
+        budget_ms: String,
+        /// Frames of the sequence (each renders the plan, the ground truth and no SSS).
+        #[arg(long, default_value_t = 24)]
+        frames: usize,
+        /// Head heights the crowd walks toward the camera over the frames.
+        #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+        walk_heads: f32,
+        /// The err/none a character's switch must gain (0: no hysteresis).
+        #[arg(long, default_value_t = dermis::plan::over_time::DEFAULT_MARGIN, allow_negative_numbers = true)]
+        switch_margin: f64,
+        #[arg(long, default_value = "out/plan-motion")]
+        out: PathBuf,
+    },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
     Kernel {
         #[arg(long, default_value_t = 17)]
@@ -763,6 +788,41 @@ fn main_result() -> Result<()> {
             )?;
             print!("{}", check::markdown(&r));
             println!("wrote {}", out.join("plan-check.json").display());
+        }
+        Command::PlanMotion {
+            common,
+            profile,
+            budget_ms,
+            frames,
+            walk_heads,
+            switch_margin,
+            out,
+        } => {
+            use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
+            let args = PlanArgs::parse(&profile, &budget_ms, &out)?;
+            let walk = over_time::Walk::new(frames, walk_heads)?;
+            over_time::check_margin(switch_margin)?;
+            let base = common.settings()?;
+            let scene = common.scene()?;
+            dermis::output::prepare_out_dir(&out)?;
+            let acc = Measured::load_default(Measured::asset_of(common.scene.as_deref()))?;
+            let ctx = common.context()?;
+            let r = motion::run(
+                &ctx,
+                &motion::MotionOptions {
+                    base,
+                    scene: &scene,
+                    accuracy: &acc,
+                    accuracy_source: acc.source(),
+                    profile: args.profile,
+                    budget_ms: args.budget_ms,
+                    walk,
+                    switch_margin,
+                    out: &out,
+                },
+            )?;
+            print!("{}", motion::summary(&r));
+            println!("wrote {}", out.join("plan-motion.json").display());
         }
         Command::Kernel {
             samples,

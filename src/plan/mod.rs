@@ -20,6 +20,9 @@ pub mod cli;
 pub mod cost;
 pub mod dolly;
 pub mod measured;
+pub mod motion;
+pub mod motion_chart;
+pub mod over_time;
 pub mod picture;
 pub mod solve;
 

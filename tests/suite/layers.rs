@@ -57,6 +57,7 @@ const PURE_FILES: &[&str] = &[
     "plan/choose.rs",
     "plan/solve.rs",
     "plan/dolly.rs",
+    "plan/over_time.rs",
 ];
 
 /// What no pure file may name: the Vulkan bindings, and the crate's device
