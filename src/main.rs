@@ -649,6 +649,47 @@ fn warn_foreign(s: &RenderSettings) {
     }
 }
 
+/// `dermis plan-motion`: every argument checked (one line each) before the
+/// scene loads and the device opens.
+fn plan_motion(
+    common: &Common,
+    profile: &str,
+    budget_ms: &str,
+    frames: usize,
+    walk_heads: f32,
+    switch_margin: f64,
+    out: &Path,
+) -> Result<()> {
+    use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
+    let args = PlanArgs::parse(profile, budget_ms, out)?;
+    let walk = over_time::Walk::new(frames, walk_heads)?;
+    over_time::check_margin(switch_margin)?;
+    let base = common.settings()?;
+    let scene = common.scene()?;
+    dermis::output::prepare_out_dir(out)?;
+    let acc = Measured::load_default(Measured::asset_of(common.scene.as_deref()))?;
+    let ctx = common.context()?;
+    let r = motion::run(
+        &ctx,
+        &motion::MotionOptions {
+            base,
+            scene: &scene,
+            accuracy: &acc,
+            accuracy_source: acc.source(),
+            profile: args.profile,
+            budget_ms: args.budget_ms,
+            walk,
+            switch_margin,
+            out,
+        },
+    )?;
+    print!("{}", motion::summary(&r));
+    println!("wrote {}", out.join("plan-motion.json").display());
+    Ok(())
+}
+
+// Long because it is the one dispatch of every subcommand: each arm
+// destructures its options and makes one call or a few lines.
 fn main_result() -> Result<()> {
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
@@ -797,33 +838,15 @@ fn main_result() -> Result<()> {
             walk_heads,
             switch_margin,
             out,
-        } => {
-            use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
-            let args = PlanArgs::parse(&profile, &budget_ms, &out)?;
-            let walk = over_time::Walk::new(frames, walk_heads)?;
-            over_time::check_margin(switch_margin)?;
-            let base = common.settings()?;
-            let scene = common.scene()?;
-            dermis::output::prepare_out_dir(&out)?;
-            let acc = Measured::load_default(Measured::asset_of(common.scene.as_deref()))?;
-            let ctx = common.context()?;
-            let r = motion::run(
-                &ctx,
-                &motion::MotionOptions {
-                    base,
-                    scene: &scene,
-                    accuracy: &acc,
-                    accuracy_source: acc.source(),
-                    profile: args.profile,
-                    budget_ms: args.budget_ms,
-                    walk,
-                    switch_margin,
-                    out: &out,
-                },
-            )?;
-            print!("{}", motion::summary(&r));
-            println!("wrote {}", out.join("plan-motion.json").display());
-        }
+        } => plan_motion(
+            &common,
+            &profile,
+            &budget_ms,
+            frames,
+            walk_heads,
+            switch_margin,
+            &out,
+        )?,
         Command::Kernel {
             samples,
             preset,

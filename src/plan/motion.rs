@@ -17,16 +17,17 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 use serde::Serialize;
 
-use super::check::{render, Truth};
 use super::choose::Accuracy;
 use super::cli::{
     atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_setting,
     setting_costs, NODE_LIMIT,
 };
+use super::motion_chart::Line;
 use super::over_time::{
-    changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, Pop, Replan,
-    Walk, FLICKER_BOUND,
+    changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, FramePlan, Pop,
+    Replan, Walk, FLICKER_BOUND,
 };
+use super::truth::{render, Truth};
 use crate::budget::profile::Profile;
 use crate::output::write_json;
 use crate::render::settings::Assignment;
@@ -137,8 +138,12 @@ fn group_label(l: &Option<(String, String)>) -> String {
     }
 }
 
-/// Runs the sequence (see the module doc) and writes its outputs.
-pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
+/// The frame before: the plan's diffuse, the truth's, the truth's ids.
+type Previous = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>);
+
+/// Every frame's settings (the crowd walked `walk.at(k)`) and planning
+/// input (its characters and every setting's costs, timed).
+fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInput>)> {
     let (models, _) = load_models(&plan_frames_dir())?;
     let (rm, rs) = reference_setting()?;
     let reference = models
@@ -146,7 +151,6 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         .find(|m| m.method == rm && m.setting == rs)
         .context("the reference setting has no stored frames")?;
     let atlas = atlas_mm(o.scene);
-    let n = o.base.heads as usize;
     let frame_settings: Vec<RenderSettings> = (0..o.walk.frames)
         .map(|k| {
             let mut s = o.base.clone();
@@ -171,28 +175,28 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
             }
         })
         .collect();
-    let ask = |margin: f64| Replan {
-        accuracy: o.accuracy,
-        budget_ms: o.budget_ms,
-        switch_margin: margin,
-        node_limit: Some(NODE_LIMIT),
-    };
-    let with = replan(&inputs, &ask(o.switch_margin));
-    let without = replan(&inputs, &ask(0.0));
-    let labels = |plans: &[super::over_time::FramePlan]| -> Vec<Vec<String>> {
-        plans
-            .iter()
-            .map(|p| p.labels.iter().map(group_label).collect())
-            .collect()
-    };
-    let (lw, lwo) = (labels(&with), labels(&without));
-    let (cw, cwo) = (switch_counts(&lw, n), switch_counts(&lwo, n));
+    Ok((frame_settings, inputs))
+}
 
-    // Render frame by frame, keeping only the frame before.
+/// Every frame's row, and per frame (from frame 1) every character's change
+/// under the plan and the truth's.
+type Rendered = (Vec<FrameRow>, Vec<Vec<Change>>, Vec<Vec<Change>>);
+
+/// Renders frame by frame the truth, no SSS and the frame's plan `with[k]`
+/// (`labels[k]` its groups), keeping only the frame before.
+fn render_frames(
+    ctx: &Context,
+    o: &MotionOptions,
+    frame_settings: &[RenderSettings],
+    inputs: &[FrameInput],
+    with: &[FramePlan],
+    labels: &[Vec<String>],
+) -> Result<Rendered> {
+    let n = o.base.heads as usize;
     let mut plan_changes: Vec<Vec<Change>> = vec![Vec::new()];
     let mut truth_changes: Vec<Vec<Change>> = vec![Vec::new()];
     let mut rows = Vec::new();
-    let mut before: Option<(Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>)> = None;
+    let mut before: Option<Previous> = None;
     let progress = indicatif::ProgressBar::new(o.walk.frames as u64);
     for (k, s) in frame_settings.iter().enumerate() {
         let truth = Truth::render(ctx, o.scene, s).with_context(|| format!("frame {k}"))?;
@@ -215,7 +219,7 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
             truth_changes.push(changes(tb, &truth.diffuse, ib, &truth.ids, n)?);
         }
         let mut groups: Vec<String> = Vec::new();
-        for l in &lw[k] {
+        for l in &labels[k] {
             if !groups.contains(l) {
                 groups.push(l.clone());
             }
@@ -236,7 +240,32 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         progress.inc(1);
     }
     progress.finish_and_clear();
+    Ok((rows, plan_changes, truth_changes))
+}
 
+/// Runs the sequence (see the module doc) and writes its outputs.
+pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
+    let n = o.base.heads as usize;
+    let (frame_settings, inputs) = frame_inputs(o)?;
+    let ask = |margin: f64| Replan {
+        accuracy: o.accuracy,
+        budget_ms: o.budget_ms,
+        switch_margin: margin,
+        node_limit: Some(NODE_LIMIT),
+    };
+    let with = replan(&inputs, &ask(o.switch_margin));
+    let without = replan(&inputs, &ask(0.0));
+    let labels = |plans: &[FramePlan]| -> Vec<Vec<String>> {
+        plans
+            .iter()
+            .map(|p| p.labels.iter().map(group_label).collect())
+            .collect()
+    };
+    let (lw, lwo) = (labels(&with), labels(&without));
+    let (cw, cwo) = (switch_counts(&lw, n), switch_counts(&lwo, n));
+
+    let (rows, plan_changes, truth_changes) =
+        render_frames(ctx, o, &frame_settings, &inputs, &with, &lw)?;
     let sw = switches(&lw);
     let measured_pops = pops(&sw, &plan_changes, &truth_changes);
     let series: Vec<CharacterSeries> = (0..n)
@@ -318,8 +347,27 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         verdict,
     };
     write_json(&o.out.join("plan-motion.json"), &report)?;
-    super::motion_chart::write(o.out, &report)?;
+    super::motion_chart::write(o.out, o.walk.frames, FLICKER_BOUND, &chart_lines(&report))?;
     Ok(report)
+}
+
+/// The chart's lines: every character that switches, its switches marked.
+fn chart_lines(r: &MotionReport) -> Vec<Line> {
+    r.characters
+        .iter()
+        .filter(|c| c.switches_with_margin > 0)
+        .map(|c| Line {
+            label: format!("character {}", c.character),
+            plan: c.plan_change.clone(),
+            truth: c.truth_change.clone(),
+            switches: r
+                .pops
+                .iter()
+                .filter(|p| p.character == c.character)
+                .map(|p| (p.frame, p.plan_change))
+                .collect(),
+        })
+        .collect()
 }
 
 /// The report as text: the frames, the switches, the times and the verdict.
