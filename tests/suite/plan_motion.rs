@@ -34,7 +34,8 @@ fn tmp(name: &str) -> PathBuf {
 /// 1280x720 on the Xbox 360 at 2 ms: every frame re-planned with and without
 /// the margin. The solve per frame (printed) is far below a 60 Hz frame; the
 /// inputs (estimating the characters, pricing every setting) are printed
-/// beside it. The margin never adds switches.
+/// beside it. On this walk the margin adds no switch (it could in general:
+/// a held choice can leave the budget tighter for a later frame).
 #[test]
 fn plan_time_per_frame_for_a_64_crowd_walking() {
     let scene = face();
@@ -100,8 +101,8 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
             "a plan with no SSS at all proves nothing"
         );
     }
-    // Far below a frame: under a tenth of a 60 Hz frame even in this build.
-    assert!(max < 1.67, "the solve took {max} ms");
+    // Far below a frame: under 1 ms (a 60 Hz frame is 16.7) even in this build.
+    assert!(max < 1.0, "the solve took {max} ms");
     assert!(sw <= swo, "the margin added switches ({sw} > {swo})");
 }
 
@@ -162,7 +163,7 @@ fn plan_motion_measures_switches_against_the_truth() {
     }
     assert!(!r.cross_fade_needed, "{}", r.verdict);
     assert!(r.switches_with_margin <= r.switches_without_margin);
-    assert!(r.timing.solve_max_ms < 1.67, "{:?}", r.timing);
+    assert!(r.timing.solve_max_ms < 1.0, "{:?}", r.timing);
     for f in ["plan-motion.json", "plan-motion.png", "plan-motion.svg"] {
         assert!(out.join(f).is_file(), "{f} written");
     }
