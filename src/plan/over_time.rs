@@ -23,6 +23,11 @@ use super::choose::{plan, Accuracy, Ask, Plan, SettingCosts};
 /// The most frames a sequence may have (each is two or three renders).
 pub const MAX_FRAMES: usize = 1000;
 
+/// The longest walk: `RenderSettings::validate`'s bound on it
+/// (`render::settings::MAX_DISTANCE_HEADS`, held equal by
+/// tests/suite/plan_motion.rs; not imported, as that module reaches Vulkan).
+pub const MAX_WALK_HEADS: f32 = 1000.0;
+
 /// What the flicker test (`tests/suite/stability.rs`,
 /// `slow_orbit_does_not_flicker`) allows a method: its mean frame-to-frame
 /// change over the skin within this of the ground truth's own change
@@ -59,8 +64,10 @@ impl Walk {
         if !(2..=MAX_FRAMES).contains(&frames) {
             bail!("--frames must be within 2..={MAX_FRAMES}, got {frames}");
         }
-        if !walk_heads.is_finite() {
-            bail!("--walk-heads must be a number of head heights, got {walk_heads}");
+        // Checked here before any character is estimated or a device opens.
+        let max = MAX_WALK_HEADS;
+        if !(walk_heads.is_finite() && walk_heads.abs() <= max) {
+            bail!("--walk-heads must be within +-{max} head heights, got {walk_heads}");
         }
         Ok(Walk { frames, walk_heads })
     }
@@ -511,5 +518,6 @@ mod tests {
         let w = Walk::new(5, 2.0).unwrap();
         assert_eq!((w.at(0), w.at(2), w.at(4)), (0.0, 1.0, 2.0));
         assert!(Walk::new(1, 1.0).is_err() && Walk::new(4, f32::NAN).is_err());
+        assert!(Walk::new(4, 1e30).is_err() && Walk::new(4, -1000.0).is_ok());
     }
 }

@@ -178,6 +178,8 @@ fn plan_motion_errors_are_one_line_and_need_no_device() {
     for (args, want) in [
         (vec!["--frames", "1"], "--frames"),
         (vec!["--walk-heads", "nan"], "--walk-heads"),
+        (vec!["--walk-heads", "1e30"], "--walk-heads"),
+        (vec!["--frames", "100000"], "--frames"),
         (vec!["--switch-margin", "-0.1"], "--switch-margin"),
         (vec!["--budget-ms", "0"], "not a positive number"),
     ] {
@@ -207,4 +209,9 @@ fn plan_motion_errors_are_one_line_and_need_no_device() {
         );
         assert!(!out.exists(), "{args:?} wrote {o}");
     }
+    // The walk's bound is the renderer's.
+    assert_eq!(
+        dermis::plan::over_time::MAX_WALK_HEADS,
+        dermis::render::settings::MAX_DISTANCE_HEADS
+    );
 }
