@@ -230,6 +230,9 @@ enum Command {
         /// The err/none a character's switch must gain (0: no hysteresis).
         #[arg(long, default_value_t = dermis::plan::over_time::DEFAULT_MARGIN, allow_negative_numbers = true)]
         switch_margin: f64,
+        /// Plan each frame against the costs of the next N frames too (0: its own).
+        #[arg(long, default_value_t = 0)]
+        look_ahead: usize,
         #[arg(long, default_value = "out/plan-motion")]
         out: PathBuf,
     },
@@ -655,15 +658,17 @@ fn plan_motion(
     common: &Common,
     profile: &str,
     budget_ms: &str,
-    frames: usize,
-    walk_heads: f32,
-    switch_margin: f64,
+    (frames, walk_heads): (usize, f32),
+    (switch_margin, look_ahead): (f64, usize),
     out: &Path,
 ) -> Result<()> {
     use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
     let args = PlanArgs::parse(profile, budget_ms, out)?;
     let walk = over_time::Walk::new(frames, walk_heads)?;
     over_time::check_margin(switch_margin)?;
+    if look_ahead >= frames {
+        anyhow::bail!("--look-ahead {look_ahead} must be under --frames {frames}");
+    }
     let base = common.settings()?;
     let scene = common.scene()?;
     dermis::output::prepare_out_dir(out)?;
@@ -680,6 +685,7 @@ fn plan_motion(
             budget_ms: args.budget_ms,
             walk,
             switch_margin,
+            look_ahead,
             out,
         },
     )?;
@@ -837,14 +843,14 @@ fn main_result() -> Result<()> {
             frames,
             walk_heads,
             switch_margin,
+            look_ahead,
             out,
         } => plan_motion(
             &common,
             &profile,
             &budget_ms,
-            frames,
-            walk_heads,
-            switch_margin,
+            (frames, walk_heads),
+            (switch_margin, look_ahead),
             &out,
         )?,
         Command::Kernel {

@@ -51,6 +51,8 @@ pub struct MotionOptions<'a> {
     pub budget_ms: f64,
     pub walk: Walk,
     pub switch_margin: f64,
+    /// Frames looked ahead (`over_time::Replan::look_ahead`).
+    pub look_ahead: usize,
     pub out: &'a Path,
 }
 
@@ -112,6 +114,7 @@ pub struct MotionReport {
     pub profile: String,
     pub budget_ms: f64,
     pub switch_margin: f64,
+    pub look_ahead: usize,
     pub accuracy: String,
     /// The ground truth's `--density` (`None`: its default).
     pub truth_density: Option<String>,
@@ -252,6 +255,7 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         budget_ms: o.budget_ms,
         switch_margin: margin,
         node_limit: Some(NODE_LIMIT),
+        look_ahead: o.look_ahead,
     };
     let with = replan(&inputs, &ask(o.switch_margin));
     let without = replan(&inputs, &ask(0.0));
@@ -325,6 +329,7 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         profile: o.profile.profile.name.clone(),
         budget_ms: o.budget_ms,
         switch_margin: o.switch_margin,
+        look_ahead: o.look_ahead,
         accuracy: o.accuracy_source.clone(),
         truth_density: o.base.options.given("density").map(|d| d.to_string()),
         timing: Timing {
@@ -374,7 +379,7 @@ fn chart_lines(r: &MotionReport) -> Vec<Line> {
 pub fn summary(r: &MotionReport) -> String {
     let mut s = format!(
         "{} at {}x{}: {} characters ({:?}) {} head heights away, walking {} head heights \
-         toward the camera over {} frames; {} at {} ms, margin {}\n",
+         toward the camera over {} frames; {} at {} ms, margin {}, looking {} frames ahead\n",
         r.device,
         r.width,
         r.height,
@@ -385,7 +390,8 @@ pub fn summary(r: &MotionReport) -> String {
         r.walk.frames,
         r.profile,
         r.budget_ms,
-        r.switch_margin
+        r.switch_margin,
+        r.look_ahead
     );
     s.push_str(&format!(
         "{:>5} {:>6}  {:<40} {:>9} {:>9} {:>9} {:>9}\n",

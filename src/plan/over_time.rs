@@ -99,6 +99,39 @@ pub struct Replan<'a> {
     /// hysteresis (every frame planned afresh).
     pub switch_margin: f64,
     pub node_limit: Option<u64>,
+    /// Frames looked ahead: each frame is planned against every setting's
+    /// costs at their highest over it and the next `look_ahead` frames, so a
+    /// choice made now still fits while the crowd keeps coming nearer (the
+    /// sequence's own later frames stand for what a game would extrapolate
+    /// from the characters' motion). 0: each frame's own costs.
+    pub look_ahead: usize,
+}
+
+/// The costs frame `k` is planned against (see [`Replan::look_ahead`]):
+/// per setting (matched by name) its fixed cost and every character's part
+/// at their highest over frames `k..=k + look_ahead`; a part unpriced at
+/// frame `k` stays unpriced; the texels are frame `k`'s.
+pub fn planning_costs(frames: &[FrameInput], k: usize, look_ahead: usize) -> Vec<SettingCosts> {
+    let mut costs = frames[k].costs.clone();
+    let last = (k + look_ahead).min(frames.len().saturating_sub(1));
+    for f in frames.iter().take(last + 1).skip(k + 1) {
+        for s in &mut costs {
+            let Some(later) = f
+                .costs
+                .iter()
+                .find(|x| x.method == s.method && x.setting == s.setting)
+            else {
+                continue;
+            };
+            s.fixed_ms = s.fixed_ms.max(later.fixed_ms);
+            for (p, q) in s.parts_ms.iter_mut().zip(&later.parts_ms) {
+                if let (Some(p), Some(q)) = (p.as_mut(), q) {
+                    *p = p.max(*q);
+                }
+            }
+        }
+    }
+    costs
 }
 
 /// Times each frame's solve is run (the best one is its time).
@@ -123,7 +156,8 @@ fn label(costs: &[SettingCosts], s: Option<usize>) -> Option<(String, String)> {
 /// settings in one order) when the margin is above 0.
 pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
     let mut out: Vec<FramePlan> = Vec::with_capacity(frames.len());
-    for f in frames {
+    for (k, f) in frames.iter().enumerate() {
+        let costs = planning_costs(frames, k, r.look_ahead);
         let previous = out
             .last()
             .filter(|_| r.switch_margin > 0.0)
@@ -131,7 +165,7 @@ pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
                 (0..f.characters.len())
                     .map(|c| {
                         let l = last.labels.get(c).cloned().flatten()?;
-                        f.costs
+                        costs
                             .iter()
                             .position(|s| s.method == l.0 && s.setting == l.1)
                     })
@@ -139,7 +173,7 @@ pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
             });
         let ask = Ask {
             characters: &f.characters,
-            settings: &f.costs,
+            settings: &costs,
             accuracy: r.accuracy,
             budget_ms: r.budget_ms,
             previous,
@@ -162,7 +196,7 @@ pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
             .solution
             .choice
             .iter()
-            .map(|&s| label(&f.costs, s))
+            .map(|&s| label(&costs, s))
             .collect();
         out.push(FramePlan {
             plan: p,
@@ -397,6 +431,7 @@ mod tests {
                 budget_ms: 1.0,
                 switch_margin: margin,
                 node_limit: None,
+                look_ahead: 0,
             },
         )
         .into_iter()
@@ -452,6 +487,7 @@ mod tests {
                 budget_ms: 1.0,
                 switch_margin: 0.05,
                 node_limit: None,
+                look_ahead: 0,
             },
         )
         .into_iter()
@@ -461,6 +497,45 @@ mod tests {
         assert_eq!(s.len(), 1, "{labels:?}");
         assert_eq!(s[0].frame, 6);
         assert_eq!(s[0].to.as_ref().map(|l| l.1.as_str()), Some("wobbly"));
+    }
+
+    #[test]
+    fn looking_ahead_a_choice_the_budget_takes_back_next_frame_is_not_made() {
+        // "wobbly" (0.48 on odd frames, else 0.52: take frame 1 at 2.01
+        // px/mm) fits the budget at frames 0-1 and not from frame 2 on, its
+        // part growing; "steady" at 0.50 always fits. Frame 1 alone would
+        // switch to "wobbly" (a 0.02 gain over a 0.01 margin) and the budget
+        // would take it back at frame 2; looking one frame ahead, never.
+        let frames: Vec<FrameInput> = (0..4)
+            .map(|k| {
+                let mut f = frame(if k == 1 { 2.01 } else { 2.0 });
+                f.costs[1].parts_ms = vec![Some(if k < 2 { 0.5 } else { 2.0 })];
+                f
+            })
+            .collect();
+        let go = |look_ahead| -> Vec<Vec<Option<(String, String)>>> {
+            replan(
+                &frames,
+                &Replan {
+                    accuracy: &Crossing,
+                    budget_ms: 1.0,
+                    switch_margin: 0.01,
+                    node_limit: None,
+                    look_ahead,
+                },
+            )
+            .into_iter()
+            .map(|f| f.labels)
+            .collect()
+        };
+        let (now, ahead) = (go(0), go(1));
+        assert_eq!(switch_counts(&now, 1), vec![2], "{now:?}");
+        assert_eq!(switch_counts(&ahead, 1), vec![0], "{ahead:?}");
+        // The costs planned against: the highest over the frames looked at.
+        let c = planning_costs(&frames, 1, 1);
+        assert_eq!(c[1].parts_ms, vec![Some(2.0)]);
+        assert_eq!(planning_costs(&frames, 3, 5)[1].parts_ms, vec![Some(2.0)]);
+        assert_eq!(planning_costs(&frames, 0, 1)[1].parts_ms, vec![Some(0.5)]);
     }
 
     #[test]

@@ -74,6 +74,7 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
         budget_ms: 2.0,
         switch_margin: m,
         node_limit: Some(NODE_LIMIT),
+        look_ahead: 0,
     };
     let with = replan(&frames, &ask(DEFAULT_MARGIN));
     let without = replan(&frames, &ask(0.0));
@@ -139,6 +140,7 @@ fn plan_motion_measures_switches_against_the_truth() {
             budget_ms: 0.2,
             walk: Walk::new(5, 1.0).unwrap(),
             switch_margin: DEFAULT_MARGIN,
+            look_ahead: 0,
             out: &out,
         },
     )
@@ -180,6 +182,7 @@ fn plan_motion_errors_are_one_line_and_need_no_device() {
         (vec!["--walk-heads", "nan"], "--walk-heads"),
         (vec!["--walk-heads", "1e30"], "--walk-heads"),
         (vec!["--frames", "100000"], "--frames"),
+        (vec!["--frames", "4", "--look-ahead", "4"], "--look-ahead"),
         (vec!["--switch-margin", "-0.1"], "--switch-margin"),
         (vec!["--budget-ms", "0"], "not a positive number"),
     ] {
