@@ -4,7 +4,8 @@
 //! the crowd: the key light is directional and its shadow frustum is fitted
 //! to the characters, so only a backdrop would tell the two apart), planned
 //! frame by frame with the previous frame's choice and a switching margin
-//! (`solve`'s hysteresis), the switches it makes counted per character, and
+//! (`solve`'s hysteresis) and optionally against the costs of the frames
+//! ahead (`planning_costs`), the switches it makes counted per character, and
 //! the measure of a switch on screen: a character's frame-to-frame change
 //! against the ground truth's own change over the same pixels at the same
 //! frames (the measure of `tests/suite/stability.rs`'s flicker test).
