@@ -208,6 +208,34 @@ enum Command {
         #[arg(long, default_value = "out/plan-check")]
         out: PathBuf,
     },
+    /// Re-plan a crowd walking toward a fixed camera every frame, with hysteresis (issue 16
+    /// item 6, docs/plan-over-time.md): renders each frame's plan and its ground truth,
+    /// measures every switching character's frame-to-frame change against the truth's own,
+    /// reports the plan's time per frame. Writes DIR/plan-motion.json, .png and .svg.
+    PlanMotion {
+        #[command(flatten)]
+        common: Common,
+        /// Profile name (profiles/NAME.toml) or path.
+        #[arg(long)]
+        profile: String,
+        /// The skin-SSS budget on the profile, in milliseconds.
+        #[arg(long, allow_negative_numbers = true)]
+        budget_ms: String,
+        /// Frames of the sequence (each renders the plan, the ground truth and no SSS).
+        #[arg(long, default_value_t = 24)]
+        frames: usize,
+        /// Head heights the crowd walks toward the camera over the frames.
+        #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+        walk_heads: f32,
+        /// The err/none a character's switch must gain (0: no hysteresis).
+        #[arg(long, default_value_t = dermis::plan::over_time::DEFAULT_MARGIN, allow_negative_numbers = true)]
+        switch_margin: f64,
+        /// Plan each frame against the costs of the next N frames too (0: its own).
+        #[arg(long, default_value_t = 0)]
+        look_ahead: usize,
+        #[arg(long, default_value = "out/plan-motion")]
+        out: PathBuf,
+    },
     /// Print the separable SSS kernel (offsets in mm and RGB weights) as JSON.
     Kernel {
         #[arg(long, default_value_t = 17)]
@@ -624,6 +652,50 @@ fn warn_foreign(s: &RenderSettings) {
     }
 }
 
+/// `dermis plan-motion`: every argument checked (one line each) before the
+/// scene loads and the device opens.
+fn plan_motion(
+    common: &Common,
+    profile: &str,
+    budget_ms: &str,
+    (frames, walk_heads): (usize, f32),
+    (switch_margin, look_ahead): (f64, usize),
+    out: &Path,
+) -> Result<()> {
+    use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
+    let args = PlanArgs::parse(profile, budget_ms, out)?;
+    let walk = over_time::Walk::new(frames, walk_heads)?;
+    over_time::check_margin(switch_margin)?;
+    if look_ahead >= frames {
+        anyhow::bail!("--look-ahead {look_ahead} must be under --frames {frames}");
+    }
+    let base = common.settings()?;
+    let scene = common.scene()?;
+    dermis::output::prepare_out_dir(out)?;
+    let acc = Measured::load_default(Measured::asset_of(common.scene.as_deref()))?;
+    let ctx = common.context()?;
+    let r = motion::run(
+        &ctx,
+        &motion::MotionOptions {
+            base,
+            scene: &scene,
+            accuracy: &acc,
+            accuracy_source: acc.source(),
+            profile: args.profile,
+            budget_ms: args.budget_ms,
+            walk,
+            switch_margin,
+            look_ahead,
+            out,
+        },
+    )?;
+    print!("{}", motion::summary(&r));
+    println!("wrote {}", out.join("plan-motion.json").display());
+    Ok(())
+}
+
+// Long because it is the one dispatch of every subcommand: each arm
+// destructures its options and makes one call or a few lines.
 fn main_result() -> Result<()> {
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
@@ -764,6 +836,23 @@ fn main_result() -> Result<()> {
             print!("{}", check::markdown(&r));
             println!("wrote {}", out.join("plan-check.json").display());
         }
+        Command::PlanMotion {
+            common,
+            profile,
+            budget_ms,
+            frames,
+            walk_heads,
+            switch_margin,
+            look_ahead,
+            out,
+        } => plan_motion(
+            &common,
+            &profile,
+            &budget_ms,
+            (frames, walk_heads),
+            (switch_margin, look_ahead),
+            &out,
+        )?,
         Command::Kernel {
             samples,
             preset,

@@ -19,7 +19,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::character::CharacterInput;
@@ -29,9 +29,8 @@ use super::cli::{
     setting_costs, NODE_LIMIT,
 };
 use super::cost::SettingModel;
+pub use super::truth::{render, truth_settings, with_method, CharacterScore, FrameError, Truth};
 use crate::budget::profile::Profile;
-use crate::eval::bands::{bands, Band, BandInput};
-use crate::method::{ground_truth, lookup, MethodOptions};
 use crate::mix::plan_file::PlanFile;
 use crate::output::write_json;
 use crate::render::settings::Assignment;
@@ -141,28 +140,6 @@ pub fn cases() -> Vec<(String, f64)> {
     v
 }
 
-/// A frame's measured error (see the module doc).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct FrameError {
-    /// Skin-weighted err/none of the characters' blended interior/silhouette error.
-    pub weighted: f64,
-    /// Per character.
-    pub characters: Vec<CharacterScore>,
-}
-
-/// One character's measured error.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct CharacterScore {
-    /// Its skin pixels in the ground truth's frame.
-    pub skin: usize,
-    /// Interior and silhouette err/none (`None`: no pixel of the band, or
-    /// no SSS is exact there), and the blend of the two by pixel count.
-    pub interior: Option<f64>,
-    pub silhouette: Option<f64>,
-    pub silhouette_pixels: usize,
-    pub error: f64,
-}
-
 /// One character of a planned case: what was predicted and what was measured.
 #[derive(Clone, Debug, Serialize)]
 pub struct CaseCharacter {
@@ -174,82 +151,6 @@ pub struct CaseCharacter {
     pub predicted_silhouette: f64,
     pub predicted_silhouette_share: f64,
     pub measured: CharacterScore,
-}
-
-/// What every frame of one scene is scored against.
-struct Truth {
-    diffuse: Vec<[f32; 4]>,
-    none: Vec<[f32; 4]>,
-    bands: Vec<Option<Band>>,
-    ids: Vec<u32>,
-    characters: usize,
-}
-
-impl Truth {
-    /// Per character and band (interior, silhouette): the sums of squared
-    /// error of `test` and of no SSS against the truth, and the pixel count.
-    fn score(&self, test: &[[f32; 4]]) -> Result<FrameError> {
-        if test.len() != self.diffuse.len() {
-            bail!("a frame of another size than the ground truth's");
-        }
-        // [character][band]: (d2, n2, pixels); band 0 interior, 1 silhouette.
-        let mut acc = vec![[(0.0f64, 0.0f64, 0usize); 2]; self.characters];
-        let mut skin = vec![0usize; self.characters];
-        for (i, t) in test.iter().enumerate() {
-            let id = self.ids[i] as usize;
-            if id == 0 || id > self.characters {
-                continue;
-            }
-            let c = id - 1;
-            let b = match self.bands[i] {
-                Some(Band::Interior) => 0,
-                Some(Band::Silhouette) => 1,
-                Some(Band::DepthStep) => {
-                    skin[c] += 1;
-                    continue;
-                }
-                None => continue,
-            };
-            skin[c] += 1;
-            let a = &mut acc[c][b];
-            for ((&t, &r), &z) in t.iter().zip(&self.diffuse[i]).zip(&self.none[i]).take(3) {
-                let r = f64::from(r);
-                let d = f64::from(t) - r;
-                let z = f64::from(z) - r;
-                a.0 += d * d;
-                a.1 += z * z;
-            }
-            a.2 += 1;
-        }
-        let mut out = FrameError::default();
-        let (mut num, mut den) = (0.0, 0.0);
-        for c in 0..self.characters {
-            // A band where no SSS is exact (nothing scatters at this scale)
-            // holds no information: it is left out of the blend.
-            let err = |(d2, n2, _): (f64, f64, usize)| (n2 > 0.0).then(|| (d2 / n2).sqrt());
-            let (int, sil) = (err(acc[c][0]), err(acc[c][1]));
-            let (pi, ps) = (acc[c][0].2 as f64, acc[c][1].2 as f64);
-            let blended = match (int, sil) {
-                (Some(i), Some(s)) => (pi * i + ps * s) / (pi + ps),
-                (Some(i), None) => i,
-                (None, Some(s)) => s,
-                (None, None) => 1.0,
-            };
-            out.characters.push(CharacterScore {
-                skin: skin[c],
-                interior: int,
-                silhouette: sil,
-                silhouette_pixels: acc[c][1].2,
-                error: blended,
-            });
-            if skin[c] > 0 {
-                num += skin[c] as f64 * blended;
-                den += skin[c] as f64;
-            }
-        }
-        out.weighted = if den > 0.0 { num / den } else { 1.0 };
-        Ok(out)
-    }
 }
 
 /// What a plan renders: every character's method and options.
@@ -356,28 +257,6 @@ fn settings_for(base: &RenderSettings, s: &CheckScene) -> RenderSettings {
     r
 }
 
-fn with_method(
-    base: &RenderSettings,
-    method: &str,
-    options: &[(String, String)],
-) -> Result<RenderSettings> {
-    let mut r = base.clone();
-    r.method = lookup(method)?;
-    let mut o = MethodOptions::default();
-    for (k, v) in options {
-        o.set(k, v.clone());
-    }
-    r.options = o;
-    Ok(r)
-}
-
-/// Renders one frame of `s` and reads back its diffuse light (and with
-/// `ids`, the character ids and depth).
-fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<crate::render::Capture> {
-    let mut r = Renderer::new(ctx, scene, s)?;
-    r.capture(false)
-}
-
 /// Frames rendered before timing.
 pub const WARMUP_FRAMES: usize = 30;
 
@@ -416,6 +295,8 @@ fn uniform_ms(c: &SettingCosts) -> Option<f64> {
 
 /// Runs the check and writes DIR/plan-check.json, DIR/plan-check.md and the
 /// charts (DIR/error-vs-budget-PROFILE.png and .svg).
+/// Long because one scene's truth, uniform renders and cases share its
+/// characters and costs, and the outputs are rewritten after every scene.
 pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
     let (models, _) = load_models(&plan_frames_dir())?;
     let (rm, rs) = reference_setting()?;
@@ -457,39 +338,8 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
                 )
             })
             .collect();
-        // The ground truth (with the character ids) and no SSS.
-        // The ground truth keeps the run's options that it reads (--density:
-        // a crowd of 64 at the default density is more surface than lavapipe holds).
-        let truth_opts: Vec<(String, String)> = o
-            .base
-            .options
-            .given("density")
-            .map(|d| ("density".to_string(), d.to_string()))
-            .into_iter()
-            .collect();
-        let mut gt_s = with_method(&s, ground_truth().name, &truth_opts)?;
-        gt_s.character_ids = true;
-        let gt =
-            render(ctx, o.scene, &gt_s).with_context(|| format!("{}: ground truth", cs.name))?;
-        let none = render(ctx, o.scene, &with_method(&s, "none", &[])?)?;
-        let skin: Vec<bool> = gt.diffuse.iter().map(|p| p[3] > 0.0).collect();
-        let band_input = BandInput::for_view(
-            (gt.width as usize, gt.height as usize),
-            &skin,
-            &gt.depth,
-            s.fovy_deg,
-            o.scene.mm_per_unit,
-        );
-        let truth = Truth {
-            bands: bands(&band_input),
-            ids: gt
-                .character_ids
-                .clone()
-                .context("the ground truth's character ids")?,
-            diffuse: gt.diffuse,
-            none: none.diffuse,
-            characters: cs.heads as usize,
-        };
+        let truth = Truth::render(ctx, o.scene, &s)
+            .with_context(|| format!("{}: ground truth", cs.name))?;
         // Uniform assignments: every registered setting, rendered where it
         // fits one of the budgets.
         let biggest = |p: &str| {
@@ -658,7 +508,19 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
 fn write_outputs(out: &Path, report: &CheckReport) -> Result<()> {
     write_json(&out.join("plan-check.json"), report)?;
     crate::output::write_bytes(&out.join("plan-check.md"), markdown(report).as_bytes())?;
-    super::check_chart::write(out, report)
+    let points: Vec<super::check_chart::Point> = report
+        .cases
+        .iter()
+        .map(|c| super::check_chart::Point {
+            profile: c.profile.clone(),
+            scene: c.scene.clone(),
+            budget_ms: c.budget_ms,
+            plan: c.measured_error,
+            uniform: c.best_uniform_error,
+        })
+        .collect();
+    let scenes: Vec<String> = report.scenes.iter().map(|s| s.name.to_string()).collect();
+    super::check_chart::write(out, &scenes, &points)
 }
 
 /// A plan's groups, each alone: (the group's label, the plan with every
@@ -800,34 +662,5 @@ mod tests {
         assert!((s.mean_abs_prediction_error - 0.05).abs() < 1e-12);
         assert!((s.max_abs_prediction_error - 0.1).abs() < 1e-12);
         assert_eq!(s.h200_measured_over_predicted.len(), 3);
-    }
-
-    // Two characters: one exact, one as wrong as no SSS; the weighted error
-    // is their skin-weighted mean; a band where none is exact is left out.
-    #[test]
-    fn the_frame_error_is_the_skin_weighted_mean_of_the_characters() {
-        let r = [1.0f32, 0.5, 0.25, 1.0];
-        let z = [0.5f32, 0.5, 0.25, 1.0];
-        let n = 4;
-        let truth = Truth {
-            diffuse: vec![r; n],
-            none: vec![z, z, z, r],
-            bands: vec![Some(Band::Interior); n],
-            ids: vec![1, 2, 2, 2],
-            characters: 2,
-        };
-        let test = vec![r, z, z, [9.0, 9.0, 9.0, 1.0]];
-        let e = truth.score(&test).unwrap();
-        assert_eq!((e.characters[0].skin, e.characters[0].error), (1, 0.0));
-        // Character 1: the last pixel's none is exact (n2 = 0 there) but its
-        // error still counts in d2: sqrt((0 + 0 + d) / (0.25 + 0.25)).
-        let d = 8.0f64 * 8.0 + 8.5 * 8.5 + 8.75 * 8.75;
-        let want = ((0.5 + d) / 0.5).sqrt();
-        assert!(
-            (e.characters[1].error - want).abs() < 1e-9,
-            "{:?}",
-            e.characters
-        );
-        assert!((e.weighted - 3.0 * want / 4.0).abs() < 1e-9);
     }
 }

@@ -8,11 +8,22 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::check::CheckReport;
 use crate::plot::{plot_err, write_png_svg, Plot, COLOURS};
 
+/// One case on the chart: its own type, so this file needs nothing of
+/// `check` (sibling files import each other in no cycle).
+pub struct Point {
+    pub profile: String,
+    pub scene: String,
+    pub budget_ms: f64,
+    /// Measured err/none of the plan and of the best fitting uniform assignment.
+    pub plan: f64,
+    pub uniform: f64,
+}
+
 struct Panel<'a> {
-    report: &'a CheckReport,
+    scenes: &'a [String],
+    points: &'a [Point],
     profile: &'a str,
 }
 
@@ -20,8 +31,7 @@ impl Plot for Panel<'_> {
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         root.fill(&WHITE).map_err(plot_err)?;
         let rows: Vec<_> = self
-            .report
-            .cases
+            .points
             .iter()
             .filter(|c| c.profile == self.profile)
             .collect();
@@ -30,7 +40,7 @@ impl Plot for Panel<'_> {
         });
         let ymax = rows
             .iter()
-            .map(|c| c.measured_error.max(c.best_uniform_error))
+            .map(|c| c.plan.max(c.uniform))
             .fold(1.0f64, f64::max)
             * 1.05;
         let mut chart = ChartBuilder::on(root)
@@ -49,12 +59,12 @@ impl Plot for Panel<'_> {
             .y_desc("err/none (skin-weighted)")
             .draw()
             .map_err(plot_err)?;
-        for (i, sc) in self.report.scenes.iter().enumerate() {
+        for (i, sc) in self.scenes.iter().enumerate() {
             let col = COLOURS[i % COLOURS.len()];
             let mut pts: Vec<(f64, f64, f64)> = rows
                 .iter()
-                .filter(|c| c.scene == sc.name)
-                .map(|c| (c.budget_ms, c.measured_error, c.best_uniform_error))
+                .filter(|c| &c.scene == sc)
+                .map(|c| (c.budget_ms, c.plan, c.uniform))
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             chart
@@ -63,7 +73,7 @@ impl Plot for Panel<'_> {
                     col.stroke_width(2),
                 ))
                 .map_err(plot_err)?
-                .label(format!("{}: plan", sc.name))
+                .label(format!("{sc}: plan"))
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
                 });
@@ -78,7 +88,7 @@ impl Plot for Panel<'_> {
                     col.stroke_width(1),
                 ))
                 .map_err(plot_err)?
-                .label(format!("{}: best uniform", sc.name))
+                .label(format!("{sc}: best uniform"))
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(1))
                 });
@@ -94,16 +104,20 @@ impl Plot for Panel<'_> {
     }
 }
 
-/// Writes DIR/error-vs-budget-PROFILE.png and .svg for every profile of the report.
-pub fn write(dir: &Path, report: &CheckReport) -> Result<()> {
+/// Writes DIR/error-vs-budget-PROFILE.png and .svg for every profile of `points`.
+pub fn write(dir: &Path, scenes: &[String], points: &[Point]) -> Result<()> {
     let mut profiles: Vec<&str> = Vec::new();
-    for c in &report.cases {
+    for c in points {
         if !profiles.contains(&c.profile.as_str()) {
             profiles.push(&c.profile);
         }
     }
     for p in profiles {
-        let panel = Panel { report, profile: p };
+        let panel = Panel {
+            scenes,
+            points,
+            profile: p,
+        };
         write_png_svg(
             &panel,
             (900, 560),

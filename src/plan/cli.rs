@@ -26,7 +26,7 @@ use crate::method::METHODS;
 use crate::mix::plan_file::{PlanFile, PlannedCharacter, PredictedError, PLAN_VERSION};
 use crate::mix::Choice;
 use crate::render::RenderSettings;
-use crate::scene::framing::{frame as frame_scene, Shot};
+use crate::scene::framing::frame as frame_scene;
 use crate::scene::Scene;
 use crate::view::ViewScale;
 use crate::work::Work;
@@ -308,14 +308,8 @@ pub fn characters(
     s: &RenderSettings,
     reference: &SettingModel,
 ) -> Vec<CharacterInput> {
-    let shot = Shot {
-        layout: s.layout,
-        heads: s.heads,
-        distance_heads: s.distance_heads,
-        fovy_deg: s.fovy_deg,
-        aspect: s.width as f32 / s.height as f32,
-        light_dir: s.light.direction_to_light(scene.forward),
-    };
+    // render's own shot, so what is planned is what is rendered.
+    let shot = crate::render::groups::shot(scene, s);
     let framing = frame_scene(scene, &shot);
     let mut cs = estimate(scene, &framing, s.width, s.height, shot.light_dir);
     for c in &mut cs {

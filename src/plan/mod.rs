@@ -10,7 +10,12 @@
 //! sweep), [`measured`] (the measured accuracy table, what the planner uses).
 //! With the registry and files: [`cli`] (the command) and [`picture`] (the
 //! schematic of the plan); with a device, [`check`] (`dermis plan-check`:
-//! plans against the ground truth) and its charts [`check_chart`]. docs/plan.md says how it works.
+//! plans against the ground truth) and its charts [`check_chart`], both
+//! scoring frames with [`truth`]. docs/plan.md says how it works.
+//! Over time (issue 16 item 6, docs/plan-over-time.md): [`over_time`]
+//! (pure: the walking crowd re-planned with hysteresis, switches and their
+//! measure) and, with a device, [`motion`] (`dermis plan-motion`) and its
+//! chart [`motion_chart`].
 
 pub mod character;
 pub mod check;
@@ -20,8 +25,12 @@ pub mod cli;
 pub mod cost;
 pub mod dolly;
 pub mod measured;
+pub mod motion;
+pub mod motion_chart;
+pub mod over_time;
 pub mod picture;
 pub mod solve;
+pub mod truth;
 
 /// The cost model's view of a character.
 pub fn load_of(c: &character::CharacterInput) -> cost::CharacterLoad {

@@ -58,6 +58,7 @@ pub fn shot(scene: &Scene, s: &RenderSettings) -> Shot {
         fovy_deg: s.fovy_deg,
         aspect: s.width as f32 / s.height as f32,
         light_dir: s.light.direction_to_light(scene.forward),
+        walk_heads: s.walk_heads,
     }
 }
 

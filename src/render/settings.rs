@@ -69,6 +69,10 @@ pub struct RenderSettings {
     pub layout: Layout,
     /// Camera distance from the (first) head's centre, in head heights.
     pub distance_heads: f32,
+    /// The characters walked this many head heights toward the camera, the
+    /// layout kept as `distance_heads` places it (`scene::framing::Shot`;
+    /// `dermis plan-motion`'s sequence). 0 everywhere else.
+    pub walk_heads: f32,
     pub fovy_deg: f32,
     pub light: KeyLight,
     /// Constant ambient irradiance (white), so unlit skin is not black.
@@ -126,6 +130,7 @@ impl RenderSettings {
             heads: 1,
             layout: Layout::Crowd,
             distance_heads: 4.0,
+            walk_heads: 0.0,
             fovy_deg: 20.0,
             light: KeyLight {
                 azimuth_deg: 60.0,
@@ -204,6 +209,14 @@ impl RenderSettings {
             bail!(
                 "camera distance must be within (0, {MAX_DISTANCE_HEADS}] head heights, got {}",
                 self.distance_heads
+            );
+        }
+        // Walking past the camera is allowed (a character behind it shows no
+        // pixel), but not without bound.
+        if !self.walk_heads.is_finite() || self.walk_heads.abs() > MAX_DISTANCE_HEADS {
+            bail!(
+                "the crowd's walk must be within +-{MAX_DISTANCE_HEADS} head heights, got {}",
+                self.walk_heads
             );
         }
         check_fovy(self.fovy_deg)?;

@@ -20,6 +20,12 @@ pub struct Shot {
     pub aspect: f32,
     /// Unit vector toward the key light.
     pub light_dir: Vec3,
+    /// Every character moved this many head heights toward the camera along
+    /// the view after the layout is placed (a rigid crowd walking toward a
+    /// fixed camera, issue 16 item 6; 0: where the layout puts them). The
+    /// layout itself is placed for `distance_heads`, so the crowd keeps its
+    /// rows and every character its index while it walks.
+    pub walk_heads: f32,
 }
 
 /// The placed shot.
@@ -90,6 +96,18 @@ pub fn frame(scene: &Scene, shot: &Shot) -> Framing {
             }
             (instances, camera)
         }
+    };
+    // The walk: the camera looks along -forward from in front of the first
+    // head, so toward it is +forward. The far plane placed above still holds
+    // (every character only comes nearer).
+    let walk = scene.forward.try_normalize().unwrap_or(Vec3::Z) * shot.walk_heads * head_height;
+    let instances: Vec<Mat4> = if shot.walk_heads == 0.0 {
+        instances
+    } else {
+        instances
+            .into_iter()
+            .map(|m| Mat4::from_translation(walk) * m)
+            .collect()
     };
     let bounds = instances
         .iter()
@@ -180,6 +198,7 @@ mod tests {
             fovy_deg: 20.0,
             aspect: 16.0 / 9.0,
             light_dir: Vec3::new(0.5, 0.5, 0.7).normalize(),
+            walk_heads: 0.0,
         }
     }
 
@@ -220,6 +239,31 @@ mod tests {
 
     // Issue 11: a flat object was framed edge-on (only its shadow showed). It
     // now faces the camera with its largest extent, whichever way it lies.
+    // A walking crowd keeps its camera and its rows: every character comes
+    // `walk` head heights nearer the eye, its index unchanged.
+    #[test]
+    fn a_walk_moves_every_character_toward_the_fixed_camera() {
+        let s = default_scene();
+        let still = frame(&s, &shot(Layout::Crowd, 16));
+        let walked = frame(
+            &s,
+            &Shot {
+                walk_heads: 1.5,
+                ..shot(Layout::Crowd, 16)
+            },
+        );
+        assert_eq!(walked.camera.eye, still.camera.eye);
+        let h = s.head_height_units();
+        for (a, b) in still.instances.iter().zip(&walked.instances) {
+            let (pa, pb) = (
+                a.transform_point3(s.head_center()),
+                b.transform_point3(s.head_center()),
+            );
+            let toward = s.forward.normalize() * 1.5 * h;
+            assert!((pb - pa - toward).length() < 1e-3 * h, "{pa} -> {pb}");
+        }
+    }
+
     #[test]
     fn a_flat_object_faces_the_camera_with_its_largest_extent() {
         use std::f32::consts::{FRAC_PI_2, PI};

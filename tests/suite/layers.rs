@@ -16,6 +16,10 @@
 //! would rewrite every one of them while six branches edit the same files.
 //! The rule below states the same boundary and fails on the first path that
 //! crosses it; a crate can follow once the tree is quiet.
+//!
+//! Over 800 lines because every rule shares the one reader of paths above
+//! it, and the reader's own tests sit beside it: split, each part would need
+//! the reader again.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -58,6 +62,7 @@ const PURE_FILES: &[&str] = &[
     "plan/choose.rs",
     "plan/solve.rs",
     "plan/dolly.rs",
+    "plan/over_time.rs",
 ];
 
 /// What no pure file may name: the Vulkan bindings, and the crate's device
@@ -743,6 +748,15 @@ fn the_renderer_stays_small_and_long_functions_say_why() {
                 || t.starts_with("pub(crate) fn "))
                 && !t.ends_with(';');
             if !is_fn {
+                continue;
+            }
+            // A signature over several lines that ends in `;` before any `{` is
+            // a declaration (a trait's method): it has no body to measure.
+            let declared_only = all[i..]
+                .iter()
+                .find(|m| m.contains('{') || m.trim_end().ends_with(';'))
+                .is_some_and(|m| !m.contains('{'));
+            if declared_only {
                 continue;
             }
             let indent = l.len() - t.len();

@@ -27,6 +27,7 @@ mod budget_cli;
 mod harness;
 mod mix;
 mod plan;
+mod plan_motion;
 mod reference;
 mod region;
 mod scenes;

@@ -1,0 +1,444 @@
+//! `dermis plan-motion` (issue 16 item 6): a crowd walking toward a fixed
+//! camera (`over_time`'s sequence: for the skin the same relative motion as
+//! the camera dollying toward the crowd), re-planned every frame with
+//! hysteresis, rendered frame by frame with the frame's plan and with the
+//! ground truth, and every switch measured: the switching character's
+//! frame-to-frame change over its pixels (the ground truth's character ids
+//! of both frames) against the truth's own change over the same pixels at
+//! the same frames. The plan's time per frame is reported, the solver's apart
+//! from the inputs' (estimating the characters and pricing every setting).
+//!
+//! Writes DIR/plan-motion.json and DIR/plan-motion.png / .svg (each
+//! switching character's change against the truth's, frame by frame).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use serde::Serialize;
+
+use super::choose::Accuracy;
+use super::cli::{
+    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_setting,
+    setting_costs, NODE_LIMIT,
+};
+use super::motion_chart::Line;
+use super::over_time::{
+    changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, FramePlan, Pop,
+    Replan, Walk, FLICKER_BOUND,
+};
+use super::truth::{render, Truth};
+use crate::budget::profile::Profile;
+use crate::output::write_json;
+use crate::render::settings::Assignment;
+use crate::render::RenderSettings;
+use crate::scene::layout::Layout;
+use crate::scene::Scene;
+use crate::vk::context::Context;
+
+/// A 60 Hz frame (ms): what "far below a frame" is measured against.
+pub const FRAME_MS: f64 = 1000.0 / 60.0;
+
+/// What the command needs besides the device.
+pub struct MotionOptions<'a> {
+    /// The scene options (size, heads, layout, distance, light; `--density`
+    /// for the ground truth).
+    pub base: RenderSettings,
+    pub scene: &'a Scene,
+    pub accuracy: &'a dyn Accuracy,
+    pub accuracy_source: String,
+    pub profile: Profile,
+    pub budget_ms: f64,
+    pub walk: Walk,
+    pub switch_margin: f64,
+    /// Frames looked ahead (`over_time::Replan::look_ahead`).
+    pub look_ahead: usize,
+    pub out: &'a Path,
+}
+
+/// One frame of the sequence.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameRow {
+    pub frame: usize,
+    pub walk_heads: f32,
+    /// The plan's groups ("method setting", "none").
+    pub groups: Vec<String>,
+    pub predicted_ms: f64,
+    pub predicted_error: f64,
+    /// The plan's skin-weighted err/none against this frame's ground truth.
+    pub measured_error: f64,
+    pub solve_ms: f64,
+    pub inputs_ms: f64,
+    pub nodes: u64,
+    pub optimal: bool,
+}
+
+/// One character over the sequence.
+#[derive(Clone, Debug, Serialize)]
+pub struct CharacterSeries {
+    pub character: usize,
+    /// Its setting at every frame (with the margin).
+    pub settings: Vec<String>,
+    pub px_per_mm: Vec<f64>,
+    /// Change from the frame before (frame 0: none) of the plan and of the
+    /// truth over its pixels (`None`: no pixel of it in both frames).
+    pub plan_change: Vec<Option<f64>>,
+    pub truth_change: Vec<Option<f64>>,
+    pub switches_with_margin: usize,
+    pub switches_without_margin: usize,
+}
+
+/// The plan's time per frame.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timing {
+    pub solve_mean_ms: f64,
+    pub solve_max_ms: f64,
+    /// Estimating the characters and pricing every setting for each.
+    pub inputs_mean_ms: f64,
+    pub inputs_max_ms: f64,
+    /// Of the inputs, pricing every setting for every character (mean).
+    pub costs_mean_ms: f64,
+    pub frame_ms: f64,
+}
+
+/// The command's report (DIR/plan-motion.json).
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionReport {
+    pub device: String,
+    pub width: u32,
+    pub height: u32,
+    pub heads: u32,
+    pub layout: Layout,
+    pub distance_heads: f32,
+    pub walk: Walk,
+    pub profile: String,
+    pub budget_ms: f64,
+    pub switch_margin: f64,
+    pub look_ahead: usize,
+    pub accuracy: String,
+    /// The ground truth's `--density` (`None`: its default).
+    pub truth_density: Option<String>,
+    pub timing: Timing,
+    pub switches_with_margin: usize,
+    pub switches_without_margin: usize,
+    pub frames: Vec<FrameRow>,
+    pub characters: Vec<CharacterSeries>,
+    /// Every switch of the plan with the margin that is on screen, measured.
+    pub pops: Vec<Pop>,
+    /// The flicker test's bound on a method's excess change.
+    pub bound: f64,
+    pub max_abs_excess_at_switches: Option<f64>,
+    /// Largest |excess| of the switching characters at their other frames.
+    pub max_abs_excess_elsewhere: Option<f64>,
+    pub cross_fade_needed: bool,
+    pub verdict: String,
+}
+
+fn group_label(l: &Option<(String, String)>) -> String {
+    match l {
+        Some((m, s)) => format!("{m} {s}"),
+        None => crate::mix::Choice::none().method,
+    }
+}
+
+/// The frame before: the plan's diffuse, the truth's, the truth's ids.
+type Previous = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>);
+
+/// Every frame's settings (the crowd walked `walk.at(k)`) and planning
+/// input (its characters and every setting's costs, timed).
+fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInput>)> {
+    let (models, _) = load_models(&plan_frames_dir())?;
+    let (rm, rs) = reference_setting()?;
+    let reference = models
+        .iter()
+        .find(|m| m.method == rm && m.setting == rs)
+        .context("the reference setting has no stored frames")?;
+    let atlas = atlas_mm(o.scene);
+    let frame_settings: Vec<RenderSettings> = (0..o.walk.frames)
+        .map(|k| {
+            let mut s = o.base.clone();
+            s.walk_heads = o.walk.at(k);
+            s.assignment = None;
+            s.character_ids = false;
+            s
+        })
+        .collect();
+    let inputs: Vec<FrameInput> = frame_settings
+        .iter()
+        .map(|s| {
+            let t = Instant::now();
+            let chars = characters(o.scene, s, reference);
+            let t1 = Instant::now();
+            let costs = setting_costs(&models, &chars, &o.profile, s.width, s.height, atlas);
+            FrameInput {
+                characters: chars,
+                costs,
+                inputs_ms: t.elapsed().as_secs_f64() * 1e3,
+                costs_ms: t1.elapsed().as_secs_f64() * 1e3,
+            }
+        })
+        .collect();
+    Ok((frame_settings, inputs))
+}
+
+/// Every frame's row, and per frame (from frame 1) every character's change
+/// under the plan and the truth's.
+type Rendered = (Vec<FrameRow>, Vec<Vec<Change>>, Vec<Vec<Change>>);
+
+/// Renders frame by frame the truth, no SSS and the frame's plan `with[k]`
+/// (`labels[k]` its groups), keeping only the frame before.
+fn render_frames(
+    ctx: &Context,
+    o: &MotionOptions,
+    frame_settings: &[RenderSettings],
+    inputs: &[FrameInput],
+    with: &[FramePlan],
+    labels: &[Vec<String>],
+) -> Result<Rendered> {
+    let n = o.base.heads as usize;
+    let mut plan_changes: Vec<Vec<Change>> = vec![Vec::new()];
+    let mut truth_changes: Vec<Vec<Change>> = vec![Vec::new()];
+    let mut rows = Vec::new();
+    let mut before: Option<Previous> = None;
+    let progress = indicatif::ProgressBar::new(o.walk.frames as u64);
+    for (k, s) in frame_settings.iter().enumerate() {
+        let truth = Truth::render(ctx, o.scene, s).with_context(|| format!("frame {k}"))?;
+        let fp = &with[k];
+        let inp = &inputs[k];
+        let file = plan_file(
+            &o.profile.profile.name,
+            o.budget_ms,
+            &inp.characters,
+            &inp.costs,
+            &fp.plan,
+            Vec::new(),
+        )?;
+        let mut ps = s.clone();
+        ps.assignment = Some(Assignment::Plan(file));
+        let planned = render(ctx, o.scene, &ps).with_context(|| format!("frame {k}: the plan"))?;
+        let measured = truth.score(&planned.diffuse)?.weighted;
+        if let Some((pb, tb, ib)) = &before {
+            plan_changes.push(changes(pb, &planned.diffuse, ib, &truth.ids, n)?);
+            truth_changes.push(changes(tb, &truth.diffuse, ib, &truth.ids, n)?);
+        }
+        let mut groups: Vec<String> = Vec::new();
+        for l in &labels[k] {
+            if !groups.contains(l) {
+                groups.push(l.clone());
+            }
+        }
+        rows.push(FrameRow {
+            frame: k,
+            walk_heads: s.walk_heads,
+            groups,
+            predicted_ms: fp.plan.solution.cost_ms,
+            predicted_error: fp.plan.solution.error,
+            measured_error: measured,
+            solve_ms: fp.solve_ms,
+            inputs_ms: inp.inputs_ms,
+            nodes: fp.plan.solution.nodes,
+            optimal: fp.plan.solution.optimal,
+        });
+        before = Some((planned.diffuse, truth.diffuse, truth.ids));
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    Ok((rows, plan_changes, truth_changes))
+}
+
+/// Runs the sequence (see the module doc) and writes its outputs.
+pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
+    let n = o.base.heads as usize;
+    let (frame_settings, inputs) = frame_inputs(o)?;
+    let ask = |margin: f64| Replan {
+        accuracy: o.accuracy,
+        budget_ms: o.budget_ms,
+        switch_margin: margin,
+        node_limit: Some(NODE_LIMIT),
+        look_ahead: o.look_ahead,
+    };
+    let with = replan(&inputs, &ask(o.switch_margin));
+    let without = replan(&inputs, &ask(0.0));
+    let labels = |plans: &[FramePlan]| -> Vec<Vec<String>> {
+        plans
+            .iter()
+            .map(|p| p.labels.iter().map(group_label).collect())
+            .collect()
+    };
+    let (lw, lwo) = (labels(&with), labels(&without));
+    let (cw, cwo) = (switch_counts(&lw, n), switch_counts(&lwo, n));
+
+    let (rows, plan_changes, truth_changes) =
+        render_frames(ctx, o, &frame_settings, &inputs, &with, &lw)?;
+    let sw = switches(&lw);
+    let measured_pops = pops(&sw, &plan_changes, &truth_changes);
+    let series: Vec<CharacterSeries> = (0..n)
+        .map(|c| {
+            let pick = |v: &[Vec<Change>], k: usize| {
+                v.get(k)
+                    .and_then(|f| f.get(c))
+                    .filter(|x| x.pixels > 0)
+                    .map(|x| x.mean_abs)
+            };
+            CharacterSeries {
+                character: c,
+                settings: lw.iter().map(|f| f[c].clone()).collect(),
+                px_per_mm: inputs.iter().map(|f| f.characters[c].px_per_mm).collect(),
+                plan_change: (0..o.walk.frames).map(|k| pick(&plan_changes, k)).collect(),
+                truth_change: (0..o.walk.frames)
+                    .map(|k| pick(&truth_changes, k))
+                    .collect(),
+                switches_with_margin: cw[c],
+                switches_without_margin: cwo[c],
+            }
+        })
+        .collect();
+    let at = measured_pops
+        .iter()
+        .map(|p| p.excess.abs())
+        .reduce(f64::max);
+    let elsewhere = measured_pops
+        .iter()
+        .filter_map(|p| p.excess_elsewhere)
+        .reduce(f64::max);
+    let needed = at.is_some_and(|a| a > FLICKER_BOUND);
+    let solve: Vec<f64> = with.iter().map(|f| f.solve_ms).collect();
+    let inp: Vec<f64> = inputs.iter().map(|f| f.inputs_ms).collect();
+    let ((sm, sx), (im, ix)) = (mean_max(&solve), mean_max(&inp));
+    let verdict = match at {
+        None => "no switch was on screen: nothing to measure".to_string(),
+        Some(a) if needed => format!(
+            "a switch pops: its excess change {a:.5} exceeds the flicker test's bound \
+             {FLICKER_BOUND}: a cross-fade is needed"
+        ),
+        Some(a) => format!(
+            "no cross-fade needed: the largest excess change at a switch, {a:.5}, is within \
+             the flicker test's bound {FLICKER_BOUND} (the same characters at their other \
+             frames: {})",
+            elsewhere.map_or("-".to_string(), |e| format!("{e:.5}"))
+        ),
+    };
+    let report = MotionReport {
+        device: ctx.facts.name.clone(),
+        width: o.base.width,
+        height: o.base.height,
+        heads: o.base.heads,
+        layout: o.base.layout,
+        distance_heads: o.base.distance_heads,
+        walk: o.walk,
+        profile: o.profile.profile.name.clone(),
+        budget_ms: o.budget_ms,
+        switch_margin: o.switch_margin,
+        look_ahead: o.look_ahead,
+        accuracy: o.accuracy_source.clone(),
+        truth_density: o.base.options.given("density").map(|d| d.to_string()),
+        timing: Timing {
+            solve_mean_ms: sm,
+            solve_max_ms: sx,
+            inputs_mean_ms: im,
+            inputs_max_ms: ix,
+            costs_mean_ms: mean_max(&inputs.iter().map(|f| f.costs_ms).collect::<Vec<_>>()).0,
+            frame_ms: FRAME_MS,
+        },
+        switches_with_margin: cw.iter().sum(),
+        switches_without_margin: cwo.iter().sum(),
+        frames: rows,
+        characters: series,
+        pops: measured_pops,
+        bound: FLICKER_BOUND,
+        max_abs_excess_at_switches: at,
+        max_abs_excess_elsewhere: elsewhere,
+        cross_fade_needed: needed,
+        verdict,
+    };
+    write_json(&o.out.join("plan-motion.json"), &report)?;
+    super::motion_chart::write(o.out, o.walk.frames, FLICKER_BOUND, &chart_lines(&report))?;
+    Ok(report)
+}
+
+/// The chart's lines: every character that switches, its switches marked.
+fn chart_lines(r: &MotionReport) -> Vec<Line> {
+    r.characters
+        .iter()
+        .filter(|c| c.switches_with_margin > 0)
+        .map(|c| Line {
+            label: format!("character {}", c.character),
+            plan: c.plan_change.clone(),
+            truth: c.truth_change.clone(),
+            switches: r
+                .pops
+                .iter()
+                .filter(|p| p.character == c.character)
+                .map(|p| (p.frame, p.plan_change))
+                .collect(),
+        })
+        .collect()
+}
+
+/// The report as text: the frames, the switches, the times and the verdict.
+pub fn summary(r: &MotionReport) -> String {
+    let mut s = format!(
+        "{} at {}x{}: {} characters ({:?}) {} head heights away, walking {} head heights \
+         toward the camera over {} frames; {} at {} ms, margin {}, looking {} frames ahead\n",
+        r.device,
+        r.width,
+        r.height,
+        r.heads,
+        r.layout,
+        r.distance_heads,
+        r.walk.walk_heads,
+        r.walk.frames,
+        r.profile,
+        r.budget_ms,
+        r.switch_margin,
+        r.look_ahead
+    );
+    s.push_str(&format!(
+        "{:>5} {:>6}  {:<40} {:>9} {:>9} {:>9} {:>9}\n",
+        "frame", "walk", "groups", "pred ms", "pred err", "meas err", "solve ms"
+    ));
+    for f in &r.frames {
+        s.push_str(&format!(
+            "{:>5} {:>6.2}  {:<40} {:>9.4} {:>9.4} {:>9.4} {:>9.3}\n",
+            f.frame,
+            f.walk_heads,
+            f.groups.join(" + "),
+            f.predicted_ms,
+            f.predicted_error,
+            f.measured_error,
+            f.solve_ms
+        ));
+    }
+    s.push_str(&format!(
+        "switches: {} with the margin, {} without\n",
+        r.switches_with_margin, r.switches_without_margin
+    ));
+    for p in &r.pops {
+        s.push_str(&format!(
+            "switch at frame {} of character {} ({} -> {}), {} px: change {:.5}, truth's \
+             {:.5}, excess {:+.5} ({:+.2}% of its level)\n",
+            p.frame,
+            p.character,
+            p.from,
+            p.to,
+            p.pixels,
+            p.plan_change,
+            p.truth_change,
+            p.excess,
+            100.0 * p.relative_excess
+        ));
+    }
+    let t = &r.timing;
+    s.push_str(&format!(
+        "plan time per frame: solve mean {:.3} ms, max {:.3} ms; inputs (characters and \
+         costs) mean {:.1} ms, max {:.1} ms, of it pricing {:.1} ms; a 60 Hz frame is {:.1} ms\n",
+        t.solve_mean_ms,
+        t.solve_max_ms,
+        t.inputs_mean_ms,
+        t.inputs_max_ms,
+        t.costs_mean_ms,
+        t.frame_ms
+    ));
+    s.push_str(&format!("{}\n", r.verdict));
+    s
+}
