@@ -32,7 +32,8 @@ fn tmp(name: &str) -> PathBuf {
 
 /// 64 characters walking 1 head height toward the camera over 6 frames at
 /// 1280x720 on the Xbox 360 at 2 ms: every frame re-planned with and without
-/// the margin. The solve per frame (printed) is far below a 60 Hz frame; the
+/// the margin. The solve per frame (printed; its search finishes in a bounded
+/// number of nodes, asserted) is far below a 60 Hz frame; the
 /// inputs (estimating the characters, pricing every setting) are printed
 /// beside it. On this walk the margin adds no switch (it could in general:
 /// a held choice can leave the budget tighter for a later frame).
@@ -102,8 +103,14 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
             "a plan with no SSS at all proves nothing"
         );
     }
-    // Far below a frame: under 1 ms (a 60 Hz frame is 16.7) even in this build.
-    assert!(max < 1.0, "the solve took {max} ms");
+    // The time is printed, not asserted (speed is a benchmark's business,
+    // never a timed test's: a loaded CI machine measured 1.3 ms once). What
+    // bounds it deterministically: every frame's search finished (exact)
+    // inside the node limit.
+    for f in &with {
+        let s = &f.plan.solution;
+        assert!(s.optimal, "the search stopped at {} nodes", s.nodes);
+    }
     assert!(sw <= swo, "the margin added switches ({sw} > {swo})");
 }
 
