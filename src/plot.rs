@@ -70,6 +70,20 @@ pub fn write_png_svg(
     write_bytes(svg_path, svg.as_bytes()).context("writing the chart's SVG")
 }
 
+/// The legend of the plan charts: top right, a white box with a black border.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    font_px: u32,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font_px))
+        .draw()
+        .map_err(plot_err)
+}
+
 /// plotters' errors borrow nothing but are not always `Send + Sync`: keep the text.
 pub fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow!("plotting: {e}")

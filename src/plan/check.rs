@@ -25,7 +25,7 @@ use serde::Serialize;
 use super::character::CharacterInput;
 use super::choose::{plan, Accuracy, Ask, SettingCosts};
 use super::cli::{
-    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_setting, registered,
+    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_model, registered,
     setting_costs, NODE_LIMIT,
 };
 use super::cost::SettingModel;
@@ -299,11 +299,7 @@ fn uniform_ms(c: &SettingCosts) -> Option<f64> {
 /// characters and costs, and the outputs are rewritten after every scene.
 pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
     let (models, _) = load_models(&plan_frames_dir())?;
-    let (rm, rs) = reference_setting()?;
-    let reference: &SettingModel = models
-        .iter()
-        .find(|m| m.method == rm && m.setting == rs)
-        .context("the reference setting has no stored frames")?;
+    let reference: &SettingModel = reference_model(&models)?;
     let mut profiles: Vec<(String, Profile)> = Vec::new();
     for (p, _) in &o.cases {
         if !profiles.iter().any(|(n, _)| n == p) {

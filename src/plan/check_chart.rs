@@ -93,13 +93,7 @@ impl Plot for Panel<'_> {
                     PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(1))
                 });
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(plot_err)?;
+        crate::plot::draw_legend(&mut chart, 12)?;
         Ok(())
     }
 }

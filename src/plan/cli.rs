@@ -85,6 +85,38 @@ pub fn registered() -> Vec<Registered> {
         .collect()
 }
 
+/// The stored frames of the reference setting among `models`: what every
+/// character's skin and region are estimated against.
+pub fn reference_model(models: &[SettingModel]) -> Result<&SettingModel> {
+    let (rm, rs) = reference_setting()?;
+    models
+        .iter()
+        .find(|m| m.method == rm && m.setting == rs)
+        .context("the reference setting has no stored frames")
+}
+
+/// One frame's planner inputs: its characters estimated and every setting
+/// priced for them on `profile`, each step timed.
+pub fn frame_input(
+    scene: &Scene,
+    s: &RenderSettings,
+    models: &[SettingModel],
+    reference: &SettingModel,
+    profile: &Profile,
+    atlas: f64,
+) -> super::over_time::FrameInput {
+    let t = Instant::now();
+    let chars = characters(scene, s, reference);
+    let t1 = Instant::now();
+    let costs = setting_costs(models, &chars, profile, s.width, s.height, atlas);
+    super::over_time::FrameInput {
+        characters: chars,
+        costs,
+        inputs_ms: t.elapsed().as_secs_f64() * 1e3,
+        costs_ms: t1.elapsed().as_secs_f64() * 1e3,
+    }
+}
+
 /// The reference setting: the default method at its default options.
 pub fn reference_setting() -> Result<(String, String)> {
     let d = RenderSettings::default();
@@ -367,11 +399,7 @@ pub fn run(
     accuracy_source: &str,
 ) -> Result<()> {
     let (models, mut notes) = load_models(&plan_frames_dir())?;
-    let (rm, rs) = reference_setting()?;
-    let reference = models
-        .iter()
-        .find(|m| m.method == rm && m.setting == rs)
-        .context("the reference setting has no stored frames")?;
+    let reference = reference_model(&models)?;
     let t0 = Instant::now();
     let chars = characters(scene, settings, reference);
     let costs = setting_costs(

@@ -12,15 +12,13 @@
 //! switching character's change against the truth's, frame by frame).
 
 use std::path::Path;
-use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::choose::Accuracy;
 use super::cli::{
-    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_setting,
-    setting_costs, NODE_LIMIT,
+    atlas_mm, frame_input, load_models, plan_file, plan_frames_dir, reference_model, NODE_LIMIT,
 };
 use super::motion_chart::Line;
 use super::over_time::{
@@ -148,11 +146,7 @@ type Previous = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>);
 /// input (its characters and every setting's costs, timed).
 fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInput>)> {
     let (models, _) = load_models(&plan_frames_dir())?;
-    let (rm, rs) = reference_setting()?;
-    let reference = models
-        .iter()
-        .find(|m| m.method == rm && m.setting == rs)
-        .context("the reference setting has no stored frames")?;
+    let reference = reference_model(&models)?;
     let atlas = atlas_mm(o.scene);
     let frame_settings: Vec<RenderSettings> = (0..o.walk.frames)
         .map(|k| {
@@ -165,18 +159,7 @@ fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInpu
         .collect();
     let inputs: Vec<FrameInput> = frame_settings
         .iter()
-        .map(|s| {
-            let t = Instant::now();
-            let chars = characters(o.scene, s, reference);
-            let t1 = Instant::now();
-            let costs = setting_costs(&models, &chars, &o.profile, s.width, s.height, atlas);
-            FrameInput {
-                characters: chars,
-                costs,
-                inputs_ms: t.elapsed().as_secs_f64() * 1e3,
-                costs_ms: t1.elapsed().as_secs_f64() * 1e3,
-            }
-        })
+        .map(|s| frame_input(o.scene, s, &models, reference, &o.profile, atlas))
         .collect();
     Ok((frame_settings, inputs))
 }

@@ -88,13 +88,7 @@ impl Plot for Chart<'_> {
                 .map_err(plot_err)?;
         }
         if !shown.is_empty() {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 12))
-                .draw()
-                .map_err(plot_err)?;
+            crate::plot::draw_legend(&mut chart, 12)?;
         }
         Ok(())
     }

@@ -37,11 +37,7 @@ fn models() -> Vec<SettingModel> {
 }
 
 fn reference(models: &[SettingModel]) -> &SettingModel {
-    let (rm, rs) = reference_setting().unwrap();
-    models
-        .iter()
-        .find(|m| m.method == rm && m.setting == rs)
-        .unwrap()
+    dermis::plan::cli::reference_model(models).unwrap()
 }
 
 /// The stored frame of the reference setting at `d` head heights.

@@ -10,8 +10,7 @@ use std::path::PathBuf;
 use crate::common;
 use dermis::budget::profile::Profile;
 use dermis::plan::cli::{
-    atlas_mm, characters, load_models, plan_frames_dir, reference_setting, setting_costs,
-    NODE_LIMIT,
+    atlas_mm, frame_input, load_models, plan_frames_dir, reference_model, NODE_LIMIT,
 };
 use dermis::plan::measured::Measured;
 use dermis::plan::over_time::{
@@ -41,11 +40,7 @@ fn tmp(name: &str) -> PathBuf {
 fn plan_time_per_frame_for_a_64_crowd_walking() {
     let scene = face();
     let (models, _) = load_models(&plan_frames_dir()).unwrap();
-    let (rm, rs) = reference_setting().unwrap();
-    let refm = models
-        .iter()
-        .find(|m| m.method == rm && m.setting == rs)
-        .unwrap();
+    let refm = reference_model(&models).unwrap();
     let prof = Profile::load("xbox360").unwrap();
     let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
     let atlas = atlas_mm(&scene);
@@ -58,16 +53,7 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
                 walk_heads: walk.at(k),
                 ..RenderSettings::study()
             };
-            let t = std::time::Instant::now();
-            let chars = characters(&scene, &s, refm);
-            let t1 = std::time::Instant::now();
-            let costs = setting_costs(&models, &chars, &prof, s.width, s.height, atlas);
-            FrameInput {
-                characters: chars,
-                costs,
-                inputs_ms: t.elapsed().as_secs_f64() * 1e3,
-                costs_ms: t1.elapsed().as_secs_f64() * 1e3,
-            }
+            frame_input(&scene, &s, &models, refm, &prof, atlas)
         })
         .collect();
     let ask = |m: f64| Replan {
