@@ -2,17 +2,26 @@
 # The accuracy model's sweep (docs/accuracy.md, "The accuracy model"): every
 # registered method's eval settings and none, on the Lee Perry-Smith head and the
 # procedural face, at 8 scales from 0.1 to 10 px/mm x 4 key-light angles, against
-# the ground truth. Writes DIR/scan/ and DIR/procedural/ (eval.csv, eval.json,
-# ASSET.toml, accuracy-ASSET.png/svg, loso.json, the log); copy DIR/*/ASSET.toml
-# into profiles/accuracy/ to update the model.
+# the ground truth, at each shadow-map size of SHADOWS (the shadow texel at the
+# character is the model's third axis). Writes DIR/ASSET-sSIZE/ (eval.csv,
+# eval.json, ASSET.toml, accuracy-ASSET.png/svg, loso.json, the log); then
+#   dermis accuracy-merge DIR/*/ASSET.toml --out profiles/accuracy/ASSET.toml
+# per asset updates the model.
 #
 #   bash tools/accuracy_sweep.sh [DERMIS] [DIR]
 #     DERMIS   the binary (default target/release/dermis)
 #     DIR      where to write (default out/accuracy)
 #   W, H       the frame (default 640x360: the centre of the 1280x720 eval view)
 #   HEAD       the head scan (default ../shared/assets/lee-perry-smith/LeePerrySmith.glb)
-#   DEADLINE   seconds after which no asset's sweep is started or left running
+#   ASSETS     which heads (default "scan procedural")
+#   SHADOWS    shadow-map sizes (default "2048 512 128 32")
+#   SWEEPS     the sweeps in the order to run, as ASSET:SIZE words (default:
+#              every size of SHADOWS for every asset of ASSETS, size by size)
+#   JOBS       sweeps run at once (default 1; the sweep is mostly CPU work per
+#              view, so a many-core host with one GPU runs several side by side)
+#   DEADLINE   seconds after which no sweep is started, or left running
 #              (default: none)
+#   MIN_LEFT   seconds a sweep needs to be started (default 20)
 #
 # Measured: NVIDIA H200 at 640x360, see docs/perf/h200-accuracy/commands.txt;
 # lavapipe on 2 cores, docs/accuracy.md.
@@ -22,23 +31,39 @@ DIR=${2:-out/accuracy}
 W=${W:-640}
 H=${H:-360}
 HEAD=${HEAD:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
+ASSETS=${ASSETS:-scan procedural}
+SHADOWS=${SHADOWS:-2048 512 128 32}
+JOBS=${JOBS:-1}
+MIN_LEFT=${MIN_LEFT:-20}
 START=$SECONDS
 mkdir -p "$DIR"
-for asset in scan procedural; do
+sweep() { # asset size
+  local asset=$1 size=$2 left=$3
+  local out="$DIR/$asset-s$size"
+  local cmd=("$B" eval --scene "$HEAD" --scenes "accuracy:$asset" --width "$W" --height "$H" \
+    --shadow-size "$size" --warmup 1 --frames 3 --out "$out")
+  local t0=$SECONDS rc=0
+  ${left:+timeout "$left"} "${cmd[@]}" > "$DIR/$asset-s$size.log" 2>&1 || rc=$?
+  if (( rc == 0 )); then
+    echo "+ ${cmd[*]}"$'\n'"    ok in $((SECONDS - t0)) s" >> "$DIR/commands.txt"
+  else
+    echo "+ ${cmd[*]}"$'\n'"    FAILED (rc $rc) after $((SECONDS - t0)) s" >> "$DIR/commands.txt"
+  fi
+}
+if [ -z "${SWEEPS:-}" ]; then
+  SWEEPS=$(for size in $SHADOWS; do for asset in $ASSETS; do printf '%s:%s ' "$asset" "$size"; done; done)
+fi
+for job in $SWEEPS; do
+  asset=${job%%:*}
+  size=${job##*:}
+  while (( $(jobs -rp | wc -l) >= JOBS )); do wait -n; done
   left=${DEADLINE:+$((DEADLINE - (SECONDS - START)))}
-  if [ -n "$left" ] && (( left < 20 )); then
-    echo "SKIPPED (deadline): $asset" | tee -a "$DIR/commands.txt"
+  if [ -n "$left" ] && (( left < MIN_LEFT )); then
+    echo "SKIPPED (deadline): $asset at shadow $size" >> "$DIR/commands.txt"
     continue
   fi
-  cmd=("$B" eval --scene "$HEAD" --scenes "accuracy:$asset" --width "$W" --height "$H" \
-    --warmup 1 --frames 3 --out "$DIR/$asset")
-  echo "+ ${cmd[*]}" >> "$DIR/commands.txt"
-  t0=$SECONDS
-  if ${left:+timeout "$left"} "${cmd[@]}" > "$DIR/$asset.log" 2>&1; then
-    echo "    ok in $((SECONDS - t0)) s" >> "$DIR/commands.txt"
-  else
-    echo "    FAILED (rc $?) after $((SECONDS - t0)) s" >> "$DIR/commands.txt"
-  fi
+  sweep "$asset" "$size" "$left" &
 done
+wait
 echo "done in $((SECONDS - START)) s" >> "$DIR/commands.txt"
 cat "$DIR/commands.txt"

@@ -1,5 +1,6 @@
 //! The accuracy model's data file: what `dermis eval --scenes accuracy`
-//! measured, one row per (asset, method, setting, scale, light), as TOML.
+//! measured, one row per (asset, method, setting, scale, light, shadow
+//! texel), as TOML.
 //!
 //! TOML because it carries comments (the command that regenerates the file
 //! heads it) and the project's other data (`profiles/*.toml`) is TOML; one
@@ -27,6 +28,9 @@ pub struct Row {
     /// Angle between the key light's direction and the direction from the
     /// character to the camera, 0..=180 degrees.
     pub light_deg: f64,
+    /// Width of a shadow-map texel at the character, mm (the map is fitted to
+    /// every character's bounds, so a crowd's texel is wider than one head's).
+    pub shadow_mm: f64,
     /// err/none over the interior band.
     pub interior: f64,
     /// err/none over the silhouette band; `None` where the frame had no
@@ -62,6 +66,7 @@ struct RowIn {
     setting: String,
     px_per_mm: f64,
     light_deg: f64,
+    shadow_mm: f64,
     interior: f64,
     silhouette: Option<f64>,
 }
@@ -93,6 +98,13 @@ pub fn parse(text: &str, file: &str) -> Result<(Header, Vec<Row>)> {
                 r.light_deg
             );
         }
+        if !(r.shadow_mm.is_finite() && r.shadow_mm > 0.0) {
+            bail!(
+                "{}: shadow_mm must be a positive number, got {}",
+                at(),
+                r.shadow_mm
+            );
+        }
         for (band, v) in [("interior", Some(r.interior)), ("silhouette", r.silhouette)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= 0.0) {
@@ -106,6 +118,7 @@ pub fn parse(text: &str, file: &str) -> Result<(Header, Vec<Row>)> {
             setting: r.setting,
             px_per_mm: r.px_per_mm,
             light_deg: r.light_deg,
+            shadow_mm: r.shadow_mm,
             interior: r.interior,
             silhouette: r.silhouette,
         });
@@ -132,7 +145,8 @@ pub fn to_toml(header: &Header, rows: &[Row]) -> Result<String> {
     s.push_str(
         "# scale (px/mm at the head centre's depth) and key-light angle (degrees between the\n",
     );
-    s.push_str("# light and the direction to the camera), measured against the ground truth.\n");
+    s.push_str("# light and the direction to the camera) and shadow-map texel at the character (mm),\n");
+    s.push_str("# measured against the ground truth.\n");
     s.push_str("# Regenerate (the `command` below; then copy the file here):\n");
     s.push_str(&format!("#   {}\n", header.command));
     s.push_str(&format!("command = {}\n", quoted(&header.command)));
@@ -140,7 +154,7 @@ pub fn to_toml(header: &Header, rows: &[Row]) -> Result<String> {
     s.push_str(&format!("frame = {}\n", quoted(&header.frame)));
     s.push_str("rows = [\n");
     for r in rows {
-        let nums = [r.px_per_mm, r.light_deg, r.interior]
+        let nums = [r.px_per_mm, r.light_deg, r.shadow_mm, r.interior]
             .into_iter()
             .chain(r.silhouette);
         for v in nums {
@@ -157,12 +171,13 @@ pub fn to_toml(header: &Header, rows: &[Row]) -> Result<String> {
             .silhouette
             .map_or(String::new(), |v| format!(", silhouette = {v:?}"));
         s.push_str(&format!(
-            "  {{ asset = {}, method = {}, setting = {}, px_per_mm = {:?}, light_deg = {:?}, interior = {:?}{sil} }},\n",
+            "  {{ asset = {}, method = {}, setting = {}, px_per_mm = {:?}, light_deg = {:?}, shadow_mm = {:?}, interior = {:?}{sil} }},\n",
             quoted(r.asset.name()),
             quoted(&r.method),
             quoted(&r.setting),
             r.px_per_mm,
             r.light_deg,
+            r.shadow_mm,
             r.interior,
         ));
     }
@@ -209,6 +224,7 @@ mod tests {
             setting: setting.into(),
             px_per_mm: 0.1 * 3.0f64.sqrt(),
             light_deg: 69.29518894536457,
+            shadow_mm: 0.16792,
             interior: 0.123456789012345,
             silhouette: sil,
         }
@@ -235,23 +251,31 @@ mod tests {
         let cases = [
             ("command = \"c\"\nrows = [", "t.toml:"),
             (
-                &format!("{ok}{{ asset = \"robot\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, interior = 0.5 }},\n]\n"),
+                &format!("{ok}{{ asset = \"robot\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, shadow_mm = 0.2, interior = 0.5 }},\n]\n"),
                 "row 1: unknown asset 'robot'",
             ),
             (
-                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = -1.0, light_deg = 0.0, interior = 0.5 }},\n]\n"),
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = -1.0, light_deg = 0.0, shadow_mm = 0.2, interior = 0.5 }},\n]\n"),
                 "px_per_mm must be a positive number",
             ),
             (
-                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 200.0, interior = 0.5 }},\n]\n"),
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 200.0, shadow_mm = 0.2, interior = 0.5 }},\n]\n"),
                 "light_deg must be within 0..=180",
             ),
             (
-                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, interior = nan }},\n]\n"),
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, shadow_mm = 0.0, interior = 0.5 }},\n]\n"),
+                "shadow_mm must be a positive number",
+            ),
+            (
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, interior = 0.5 }},\n]\n"),
+                "shadow_mm",
+            ),
+            (
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, shadow_mm = 0.2, interior = nan }},\n]\n"),
                 "interior err/none must be a number >= 0",
             ),
             (
-                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, interior = 0.5, colour = 1 }},\n]\n"),
+                &format!("{ok}{{ asset = \"scan\", method = \"m\", setting = \"s\", px_per_mm = 1.0, light_deg = 0.0, shadow_mm = 0.2, interior = 0.5, colour = 1 }},\n]\n"),
                 "t.toml:5:",
             ),
         ];

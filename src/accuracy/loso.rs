@@ -1,8 +1,9 @@
-//! Leave-one-scale-out: how well the model predicts a scale it was not given.
-//! For every setting and every measured scale strictly inside its range (the
-//! ends cannot be interpolated from the others), the scale is dropped, its
-//! errors predicted from the remaining ones at each measured light, and
-//! compared with what was measured there.
+//! Leave-one-out: how well the model predicts a point it was not given.
+//! Leave-one-scale-out: for every setting and every measured scale strictly
+//! inside its range (the ends cannot be interpolated from the others), the
+//! scale is dropped, its errors predicted from the remaining ones at each
+//! measured light and shadow texel, and compared with what was measured
+//! there. Leave-one-shadow-out does the same along the shadow texel axis.
 
 use serde::Serialize;
 
@@ -47,17 +48,42 @@ impl Acc {
     }
 }
 
-fn errors(c: &Curve, interior: &mut Acc, silhouette: &mut Acc) {
-    for k in 1..c.scales.len().saturating_sub(1) {
-        let rest = c.without_scale(k);
-        for (j, &light) in c.lights.iter().enumerate() {
-            let Some(p) = rest.predict(c.scales[k], light) else {
-                continue;
-            };
-            interior.add((p.interior - c.interior[j][k]).abs());
-            // A silhouette carried from a neighbour is no measurement to test against.
-            if c.silhouette_measured[j][k] {
-                silhouette.add((p.silhouette - c.silhouette[j][k]).abs());
+/// Which axis a point is left out along.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    Scale,
+    Shadow,
+}
+
+fn errors(c: &Curve, axis: Axis, interior: &mut Acc, silhouette: &mut Acc) {
+    let n = match axis {
+        Axis::Scale => c.scales.len(),
+        Axis::Shadow => c.shadows.len(),
+    };
+    for q in 1..n.saturating_sub(1) {
+        let rest = match axis {
+            Axis::Scale => c.without_scale(q),
+            Axis::Shadow => c.without_shadow(q),
+        };
+        for (k, &shadow) in c.shadows.iter().enumerate() {
+            for (j, &light) in c.lights.iter().enumerate() {
+                for (i, &scale) in c.scales.iter().enumerate() {
+                    let left_out = match axis {
+                        Axis::Scale => i == q,
+                        Axis::Shadow => k == q,
+                    };
+                    if !left_out {
+                        continue;
+                    }
+                    let Some(p) = rest.predict(scale, light, shadow) else {
+                        continue;
+                    };
+                    interior.add((p.interior - c.interior[k][j][i]).abs());
+                    // A silhouette carried from a neighbour is no measurement to test against.
+                    if c.silhouette_measured[k][j][i] {
+                        silhouette.add((p.silhouette - c.silhouette[k][j][i]).abs());
+                    }
+                }
             }
         }
     }
@@ -80,6 +106,16 @@ fn row(asset: &str, method: &str, setting: &str, i: &Acc, s: &Acc) -> Loso {
 /// One row per setting, then one per asset over its settings and a last one
 /// over everything (`method` "all").
 pub fn leave_one_scale_out(m: &AccuracyModel) -> Vec<Loso> {
+    leave_one_out(m, Axis::Scale)
+}
+
+/// The same along the shadow texel axis (empty points where a setting has
+/// fewer than three measured texels).
+pub fn leave_one_shadow_out(m: &AccuracyModel) -> Vec<Loso> {
+    leave_one_out(m, Axis::Shadow)
+}
+
+fn leave_one_out(m: &AccuracyModel, axis: Axis) -> Vec<Loso> {
     let mut out = Vec::new();
     let (mut all_i, mut all_s) = (Acc::default(), Acc::default());
     for asset in Asset::ALL {
@@ -88,9 +124,9 @@ pub fn leave_one_scale_out(m: &AccuracyModel) -> Vec<Loso> {
         for c in m.curves.iter().filter(|c| c.asset == asset) {
             any = true;
             let (mut i, mut s) = (Acc::default(), Acc::default());
-            errors(c, &mut i, &mut s);
-            errors(c, &mut ai, &mut as_);
-            errors(c, &mut all_i, &mut all_s);
+            errors(c, axis, &mut i, &mut s);
+            errors(c, axis, &mut ai, &mut as_);
+            errors(c, axis, &mut all_i, &mut all_s);
             out.push(row(asset.name(), &c.method, &c.setting, &i, &s));
         }
         if any {
@@ -146,6 +182,7 @@ mod tests {
                 setting: "s".into(),
                 px_per_mm: p,
                 light_deg: 60.0,
+                shadow_mm: 0.2,
                 interior: f(p),
                 silhouette: Some(f(p) * 2.0),
             })
@@ -172,5 +209,32 @@ mod tests {
         assert!((r[0].interior_max - 0.5).abs() < 1e-12);
         assert!((r[0].silhouette_max - 1.0).abs() < 1e-12);
         assert!(table(&r).contains("0.5000"));
+    }
+
+    #[test]
+    fn the_shadow_axis_is_left_out_alone() {
+        // Linear in log texel at three texels: the middle one is predicted exactly.
+        let rows: Vec<Row> = [0.2, 0.4, 0.8]
+            .into_iter()
+            .flat_map(|sh: f64| {
+                [1.0, 2.0].into_iter().map(move |p| Row {
+                    asset: Asset::Scan,
+                    method: "m".into(),
+                    setting: "s".into(),
+                    px_per_mm: p,
+                    light_deg: 60.0,
+                    shadow_mm: sh,
+                    interior: 0.5 + 0.1 * sh.log2(),
+                    silhouette: Some(1.0 + sh.log2()),
+                })
+            })
+            .collect();
+        let m = AccuracyModel::from_rows(&rows).unwrap();
+        let r = leave_one_shadow_out(&m);
+        // The middle texel at both scales.
+        assert_eq!(r[0].points, 2);
+        assert!(r[0].interior_max < 1e-12 && r[0].silhouette_max < 1e-12, "{r:?}");
+        // Two scales: no inner scale to leave out.
+        assert_eq!(leave_one_scale_out(&m)[0].points, 0);
     }
 }

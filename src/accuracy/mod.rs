@@ -1,13 +1,17 @@
 //! The accuracy model: how wrong each method setting is (err/none over the
 //! interior and silhouette bands, as `dermis eval` scores it) as a function of
-//! the character's scale on screen (pixels per millimetre at its depth) and
-//! the key light's angle, read from the table `dermis eval --scenes accuracy`
-//! measured against the ground truth (`profiles/accuracy/`).
+//! the character's scale on screen (pixels per millimetre at its depth), the
+//! key light's angle and the shadow map's texel at the character (a crowd's
+//! map spans every character, so its texel is wider than one head's), read
+//! from the table `dermis eval --scenes accuracy` measured against the ground
+//! truth (`profiles/accuracy/`).
 //!
 //! Between measured scales the model is linear in log px/mm, between measured
-//! light angles linear in degrees; outside the measured scales it predicts
-//! nothing (a planner must not pick a setting where it was never measured),
-//! outside the measured light angles it holds the nearest one. Pure: no
+//! light angles linear in degrees, between measured shadow texels linear in
+//! log mm; outside the measured scales or beyond the widest measured texel it
+//! predicts nothing (a planner must not pick a setting where it was never
+//! measured), outside the measured light angles it holds the nearest one, and
+//! below the finest texel the finest. Pure: no
 //! Vulkan, no graph, no registry (the data names methods and settings; the
 //! tests check that it covers the registry).
 
@@ -61,7 +65,7 @@ impl Asset {
 /// the tolerance only forgives a hand-edited file's rounding).
 const SAME: f64 = 1e-9;
 
-/// One setting's measured grid: every scale at every light.
+/// One setting's measured grid: every scale at every light and shadow texel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
     pub asset: Asset,
@@ -71,17 +75,20 @@ pub struct Curve {
     pub scales: Vec<f64>,
     /// Measured light angles, ascending.
     pub lights: Vec<f64>,
-    /// `interior[light][scale]`.
-    pub interior: Vec<Vec<f64>>,
-    /// `silhouette[light][scale]`: where a frame had no silhouette pixels, the
-    /// value at the nearest scale of the same light that had (marked in
-    /// `silhouette_measured`).
-    pub silhouette: Vec<Vec<f64>>,
-    pub silhouette_measured: Vec<Vec<bool>>,
+    /// Measured shadow-map texels at the character (mm), ascending.
+    pub shadows: Vec<f64>,
+    /// `interior[shadow][light][scale]`.
+    pub interior: Vec<Vec<Vec<f64>>>,
+    /// `silhouette[shadow][light][scale]`: where a frame had no silhouette
+    /// pixels, the value at the nearest scale of the same light and shadow
+    /// that had (marked in `silhouette_measured`).
+    pub silhouette: Vec<Vec<Vec<f64>>>,
+    pub silhouette_measured: Vec<Vec<Vec<bool>>>,
 }
 
 impl Curve {
-    /// The grid of one setting's rows; every (scale, light) pair exactly once.
+    /// The grid of one setting's rows; every (scale, light, shadow) triple
+    /// exactly once.
     fn from_rows(rows: &[&Row]) -> Result<Curve> {
         let first = rows.first().context("a setting without rows")?;
         let name = format!(
@@ -92,74 +99,100 @@ impl Curve {
         );
         let scales = distinct(rows.iter().map(|r| r.px_per_mm));
         let lights = distinct(rows.iter().map(|r| r.light_deg));
-        let (ns, nl) = (scales.len(), lights.len());
-        let mut interior = vec![vec![None; ns]; nl];
-        let mut sil = vec![vec![None; ns]; nl];
+        let shadows = distinct(rows.iter().map(|r| r.shadow_mm));
+        let (ns, nl, nk) = (scales.len(), lights.len(), shadows.len());
+        let mut interior = vec![vec![vec![None; ns]; nl]; nk];
+        let mut sil = vec![vec![vec![None; ns]; nl]; nk];
         for r in rows {
-            let (i, j) = (index(&scales, r.px_per_mm), index(&lights, r.light_deg));
-            if interior[j][i].is_some() {
+            let (i, j, k) = (
+                index(&scales, r.px_per_mm),
+                index(&lights, r.light_deg),
+                index(&shadows, r.shadow_mm),
+            );
+            if interior[k][j][i].is_some() {
                 bail!(
-                    "accuracy data: {name} has two rows at {} px/mm, light {} deg",
+                    "accuracy data: {name} has two rows at {} px/mm, light {} deg, shadow texel {} mm",
                     r.px_per_mm,
-                    r.light_deg
+                    r.light_deg,
+                    r.shadow_mm
                 );
             }
-            interior[j][i] = Some(r.interior);
-            sil[j][i] = r.silhouette;
+            interior[k][j][i] = Some(r.interior);
+            sil[k][j][i] = r.silhouette;
         }
-        let mut measured = vec![vec![false; ns]; nl];
-        let mut silhouette = vec![vec![0.0; ns]; nl];
-        for j in 0..nl {
-            for i in 0..ns {
-                if interior[j][i].is_none() {
-                    bail!(
-                        "accuracy data: {name} has no row at {} px/mm, light {} deg (every scale needs every light)",
-                        scales[i],
-                        lights[j]
-                    );
+        let mut measured = vec![vec![vec![false; ns]; nl]; nk];
+        let mut silhouette = vec![vec![vec![0.0; ns]; nl]; nk];
+        for k in 0..nk {
+            for j in 0..nl {
+                for i in 0..ns {
+                    if interior[k][j][i].is_none() {
+                        bail!(
+                            "accuracy data: {name} has no row at {} px/mm, light {} deg, shadow texel {} mm (every scale needs every light and shadow)",
+                            scales[i],
+                            lights[j],
+                            shadows[k]
+                        );
+                    }
+                    measured[k][j][i] = sil[k][j][i].is_some();
                 }
-                measured[j][i] = sil[j][i].is_some();
-            }
-            // The nearest measured scale (in log px/mm) of the same light.
-            for i in 0..ns {
-                let nearest = (0..ns)
-                    .filter(|&k| sil[j][k].is_some())
-                    .min_by(|&a, &b| {
-                        let d = |k: usize| (scales[k] / scales[i]).ln().abs();
-                        d(a).total_cmp(&d(b))
-                    })
-                    .with_context(|| {
-                        format!(
-                            "accuracy data: {name} has no silhouette at any scale at light {} deg",
-                            lights[j]
-                        )
-                    })?;
-                silhouette[j][i] = sil[j][nearest].unwrap_or_default();
+                // The nearest measured scale (in log px/mm) of the same light and shadow.
+                for i in 0..ns {
+                    let nearest = (0..ns)
+                        .filter(|&q| sil[k][j][q].is_some())
+                        .min_by(|&a, &b| {
+                            let d = |q: usize| (scales[q] / scales[i]).ln().abs();
+                            d(a).total_cmp(&d(b))
+                        })
+                        .with_context(|| {
+                            format!(
+                                "accuracy data: {name} has no silhouette at any scale at light {} deg, shadow texel {} mm",
+                                lights[j], shadows[k]
+                            )
+                        })?;
+                    silhouette[k][j][i] = sil[k][j][nearest].unwrap_or_default();
+                }
             }
         }
+        let unwrap = |g: Vec<Vec<Vec<Option<f64>>>>| -> Vec<Vec<Vec<f64>>> {
+            g.into_iter()
+                .map(|l| {
+                    l.into_iter()
+                        .map(|v| v.into_iter().map(Option::unwrap_or_default).collect())
+                        .collect()
+                })
+                .collect()
+        };
         Ok(Curve {
             asset: first.asset,
             method: first.method.clone(),
             setting: first.setting.clone(),
             scales,
             lights,
-            interior: interior
-                .into_iter()
-                .map(|l| l.into_iter().map(Option::unwrap_or_default).collect())
-                .collect(),
+            shadows,
+            interior: unwrap(interior),
             silhouette,
             silhouette_measured: measured,
         })
     }
 
-    /// The interpolated errors at `px_per_mm` and `light_deg`; `None` outside
-    /// the measured scales or for a value that is not a number.
-    pub fn predict(&self, px_per_mm: f64, light_deg: f64) -> Option<Predicted> {
+    /// The interpolated errors at `px_per_mm`, `light_deg` and a shadow texel
+    /// of `shadow_mm`; `None` outside the measured scales, beyond the widest
+    /// measured shadow texel, or for a value that is not a number. A texel
+    /// finer than the finest measured takes the finest's errors: a sharper
+    /// shadow only leaves SSS more to do, so the held value errs on the
+    /// pessimistic side (measured: docs/accuracy.md, "The shadow axis").
+    pub fn predict(&self, px_per_mm: f64, light_deg: f64, shadow_mm: f64) -> Option<Predicted> {
         let (i, wi) = scale_weight(&self.scales, px_per_mm)?;
         let (j, wj) = light_weight(&self.lights, light_deg)?;
-        let at = |g: &Vec<Vec<f64>>| {
-            let row = |j: usize| lerp(g[j][i], g[j][(i + 1).min(g[j].len() - 1)], wi);
-            lerp(row(j), row((j + 1).min(g.len() - 1)), wj)
+        let (k, wk) = shadow_weight(&self.shadows, shadow_mm)?;
+        let at = |g: &Vec<Vec<Vec<f64>>>| {
+            let up = |n: usize, x: usize| (x + 1).min(n - 1);
+            let row = |k: usize, j: usize| {
+                let r = &g[k][j];
+                lerp(r[i], r[up(r.len(), i)], wi)
+            };
+            let plane = |k: usize| lerp(row(k, j), row(k, up(g[k].len(), j)), wj);
+            lerp(plane(k), plane(up(g.len(), k)), wk)
         };
         Some(Predicted {
             interior: at(&self.interior),
@@ -167,26 +200,42 @@ impl Curve {
         })
     }
 
-    /// This curve without scale `k` (the leave-one-scale-out test).
-    pub fn without_scale(&self, k: usize) -> Curve {
-        let drop = |v: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+    /// This curve without scale `q` (the leave-one-scale-out test).
+    pub fn without_scale(&self, q: usize) -> Curve {
+        let drop = |v: &Vec<Vec<Vec<f64>>>| -> Vec<Vec<Vec<f64>>> {
             v.iter()
-                .map(|l| {
-                    l.iter()
-                        .enumerate()
-                        .filter(|&(i, _)| i != k)
-                        .map(|(_, &x)| x)
+                .map(|k| {
+                    k.iter()
+                        .map(|l| {
+                            l.iter()
+                                .enumerate()
+                                .filter(|&(i, _)| i != q)
+                                .map(|(_, &x)| x)
+                                .collect()
+                        })
                         .collect()
                 })
                 .collect()
         };
         let mut c = self.clone();
-        c.scales.remove(k);
+        c.scales.remove(q);
         c.interior = drop(&self.interior);
         c.silhouette = drop(&self.silhouette);
-        for l in &mut c.silhouette_measured {
-            l.remove(k);
+        for k in &mut c.silhouette_measured {
+            for l in k {
+                l.remove(q);
+            }
         }
+        c
+    }
+
+    /// This curve without shadow texel `q` (the leave-one-shadow-out test).
+    pub fn without_shadow(&self, q: usize) -> Curve {
+        let mut c = self.clone();
+        c.shadows.remove(q);
+        c.interior.remove(q);
+        c.silhouette.remove(q);
+        c.silhouette_measured.remove(q);
         c
     }
 }
@@ -250,6 +299,28 @@ fn light_weight(lights: &[f64], deg: f64) -> Option<(usize, f64)> {
     }
     let j = lights.iter().rposition(|&l| l < a)?;
     Some((j, (a - lights[j]) / (lights[j + 1] - lights[j])))
+}
+
+/// The measured shadow texel at or below `mm` and the weight of the next one,
+/// linear in log mm; finer than the finest measured holds it, wider than the
+/// widest is `None`.
+fn shadow_weight(shadows: &[f64], mm: f64) -> Option<(usize, f64)> {
+    let (&lo, &hi) = (shadows.first()?, shadows.last()?);
+    if !mm.is_finite() || mm <= 0.0 {
+        return None;
+    }
+    if let Some(k) = shadows.iter().position(|&s| same(s, mm)) {
+        return Some((k, 0.0));
+    }
+    if mm < lo {
+        return Some((0, 0.0));
+    }
+    if mm > hi {
+        return None;
+    }
+    let k = shadows.iter().rposition(|&s| s < mm)?;
+    let (a, b) = (shadows[k], shadows[k + 1]);
+    Some((k, (mm / a).ln() / (b / a).ln()))
 }
 
 /// The measured table, one [`Curve`] per (asset, method, setting).
@@ -332,8 +403,8 @@ impl AccuracyModel {
             .find(|c| c.asset == asset && c.method == method && c.setting == setting)
     }
 
-    /// Predicted err/none; `None` for a setting not measured on `asset` or a
-    /// scale outside its measured range.
+    /// Predicted err/none; `None` for a setting not measured on `asset`, a
+    /// scale outside its measured range or a shadow texel wider than measured.
     pub fn predict(
         &self,
         asset: Asset,
@@ -341,9 +412,15 @@ impl AccuracyModel {
         setting: &str,
         px_per_mm: f64,
         light_deg: f64,
+        shadow_mm: f64,
     ) -> Option<Predicted> {
         self.curve(asset, method, setting)?
-            .predict(px_per_mm, light_deg)
+            .predict(px_per_mm, light_deg, shadow_mm)
+    }
+
+    /// The widest shadow texel (mm) measured for a setting.
+    pub fn widest_shadow_mm(&self, asset: Asset, method: &str, setting: &str) -> Option<f64> {
+        self.curve(asset, method, setting)?.shadows.last().copied()
     }
 
     /// The measured px/mm range (smallest, largest) of a setting.
@@ -366,28 +443,35 @@ impl AccuracyModel {
 mod tests {
     use super::*;
 
-    /// A setting measured at 1, 2, 4 px/mm and lights 30 and 90 degrees:
-    /// interior = scale index + light / 100 (+ 10 on the procedural face),
-    /// silhouette measured only below 4 px/mm.
+    /// The finest of the two measured shadow texels (mm); the other is 4x.
+    const FINE: f64 = 0.25;
+
+    /// A setting measured at 1, 2, 4 px/mm, lights 30 and 90 degrees and
+    /// shadow texels 0.25 and 1 mm: interior = scale index + light / 100
+    /// (+ 100 at the wide texel, + 10 on the procedural face), silhouette
+    /// measured only below 4 px/mm.
     fn rows() -> Vec<Row> {
         let mut v = Vec::new();
         for asset in Asset::ALL {
-            for (i, p) in [1.0, 2.0, 4.0].into_iter().enumerate() {
-                for l in [30.0, 90.0] {
-                    let base = if asset == Asset::Procedural {
-                        10.0
-                    } else {
-                        0.0
-                    };
-                    v.push(Row {
-                        asset,
-                        method: "ssg".into(),
-                        setting: "4 Gaussians, LOD".into(),
-                        px_per_mm: p,
-                        light_deg: l,
-                        interior: base + i as f64 + l / 100.0,
-                        silhouette: (p < 3.0).then_some(5.0 + i as f64),
-                    });
+            for (k, sh) in [FINE, 4.0 * FINE].into_iter().enumerate() {
+                for (i, p) in [1.0, 2.0, 4.0].into_iter().enumerate() {
+                    for l in [30.0, 90.0] {
+                        let base = if asset == Asset::Procedural {
+                            10.0
+                        } else {
+                            0.0
+                        } + 100.0 * k as f64;
+                        v.push(Row {
+                            asset,
+                            method: "ssg".into(),
+                            setting: "4 Gaussians, LOD".into(),
+                            px_per_mm: p,
+                            light_deg: l,
+                            shadow_mm: sh,
+                            interior: base + i as f64 + l / 100.0,
+                            silhouette: (p < 3.0).then_some(5.0 + i as f64),
+                        });
+                    }
                 }
             }
         }
@@ -403,7 +487,14 @@ mod tests {
         let m = model();
         for r in rows() {
             let p = m
-                .predict(r.asset, &r.method, &r.setting, r.px_per_mm, r.light_deg)
+                .predict(
+                    r.asset,
+                    &r.method,
+                    &r.setting,
+                    r.px_per_mm,
+                    r.light_deg,
+                    r.shadow_mm,
+                )
                 .unwrap();
             assert_eq!(p.interior, r.interior, "{r:?}");
             if let Some(s) = r.silhouette {
@@ -416,7 +507,7 @@ mod tests {
     fn linear_in_log_scale_and_in_angle_between() {
         let m = model();
         let p = |px: f64, l: f64| {
-            m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", px, l)
+            m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", px, l, FINE)
                 .unwrap()
         };
         // sqrt(2) is halfway between 1 and 2 in log px/mm.
@@ -429,15 +520,40 @@ mod tests {
         assert!((p(2f64.sqrt() * 2.0, 45.0).interior - (1.5 + 0.45)).abs() < 1e-12);
         // The procedural face has its own curve.
         let q = m
-            .predict(Asset::Procedural, "ssg", "4 Gaussians, LOD", 1.0, 30.0)
+            .predict(Asset::Procedural, "ssg", "4 Gaussians, LOD", 1.0, 30.0, FINE)
             .unwrap();
         assert!((q.interior - 10.3).abs() < 1e-12);
     }
 
     #[test]
+    fn linear_in_log_shadow_texel_held_below_and_nothing_beyond() {
+        let m = model();
+        let p = |sh: f64| {
+            m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 1.0, 30.0, sh)
+                .map(|p| p.interior)
+        };
+        // 0.5 mm is halfway between 0.25 and 1 in log mm: 0.3 and 100.3.
+        assert!((p(0.5).unwrap() - 50.3).abs() < 1e-9);
+        // Sharper than measured: the finest texel's value.
+        assert_eq!(p(0.01), p(FINE));
+        // Wider than measured: no prediction.
+        assert!(p(1.001).is_none());
+        assert!(p(0.0).is_none() && p(f64::NAN).is_none());
+        assert_eq!(
+            m.widest_shadow_mm(Asset::Scan, "ssg", "4 Gaussians, LOD"),
+            Some(1.0)
+        );
+        let c = m.curve(Asset::Scan, "ssg", "4 Gaussians, LOD").unwrap();
+        let one = c.without_shadow(1);
+        assert_eq!(one.shadows, vec![FINE]);
+        assert!(one.predict(1.0, 30.0, 1.0).is_none());
+        assert!((one.predict(1.0, 30.0, 0.1).unwrap().interior - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
     fn nothing_outside_the_measured_scales() {
         let m = model();
-        let p = |px: f64| m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", px, 30.0);
+        let p = |px: f64| m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", px, 30.0, FINE);
         assert!(p(0.999).is_none());
         assert!(p(4.001).is_none());
         assert!(p(0.0).is_none() && p(-1.0).is_none() && p(f64::NAN).is_none());
@@ -448,7 +564,7 @@ mod tests {
             Some((1.0, 4.0))
         );
         assert!(m
-            .predict(Asset::Scan, "ssg", "6 Gaussians", 2.0, 30.0)
+            .predict(Asset::Scan, "ssg", "6 Gaussians", 2.0, 30.0, FINE)
             .is_none());
         assert!(m.range(Asset::Scan, "tsd", "-").is_none());
     }
@@ -457,7 +573,7 @@ mod tests {
     fn light_angles_fold_and_clamp() {
         let m = model();
         let p = |l: f64| {
-            m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 2.0, l)
+            m.predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 2.0, l, FINE)
                 .unwrap()
                 .interior
         };
@@ -469,7 +585,7 @@ mod tests {
         assert_eq!(p(0.0), p(30.0));
         assert_eq!(p(180.0), p(90.0));
         assert!(m
-            .predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 2.0, f64::NAN)
+            .predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 2.0, f64::NAN, FINE)
             .is_none());
     }
 
@@ -477,9 +593,9 @@ mod tests {
     fn a_missing_silhouette_takes_the_nearest_measured_scale() {
         let m = model();
         let c = m.curve(Asset::Scan, "ssg", "4 Gaussians, LOD").unwrap();
-        assert_eq!(c.silhouette_measured[0], vec![true, true, false]);
+        assert_eq!(c.silhouette_measured[0][0], vec![true, true, false]);
         let p = m
-            .predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 4.0, 30.0)
+            .predict(Asset::Scan, "ssg", "4 Gaussians, LOD", 4.0, 30.0, FINE)
             .unwrap();
         assert_eq!(p.silhouette, 6.0);
     }
@@ -494,7 +610,10 @@ mod tests {
         let mut r = rows();
         r.remove(3);
         let e = AccuracyModel::from_rows(&r).unwrap_err().to_string();
-        assert!(e.contains("no row at 2 px/mm, light 90 deg"), "{e}");
+        assert!(
+            e.contains("no row at 2 px/mm, light 90 deg, shadow texel 0.25 mm"),
+            "{e}"
+        );
         let mut r = rows();
         r.push(r[0].clone());
         let e = AccuracyModel::from_rows(&r).unwrap_err().to_string();

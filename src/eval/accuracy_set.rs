@@ -18,12 +18,13 @@ use std::path::{Path, PathBuf};
 use super::chart;
 use super::sweep::{load, AccuracyPoint, EvalRow, SceneSpec};
 use crate::accuracy::data::{to_toml, Header, Row};
-use crate::accuracy::loso::{leave_one_scale_out, table};
+use crate::accuracy::loso::{leave_one_scale_out, leave_one_shadow_out, table};
 use crate::accuracy::{AccuracyModel, Asset};
 use crate::render::RenderSettings;
-use crate::scene::light::KeyLight;
+use crate::scene::light::{shadow_frame, KeyLight};
 use crate::view::ViewScale;
 use anyhow::{Context as _, Result};
+use glam::Vec3;
 
 /// Rows of the frame the views are crops of (the eval's 1280x720).
 pub const REFERENCE_HEIGHT_PX: u32 = 720;
@@ -69,6 +70,11 @@ pub fn accuracy_scenes(
         let head_units = scene.head_height_units();
         let head_mm = f64::from(head_units * scene.mm_per_unit);
         let view = ViewScale::new(base.height, fovy_deg.to_radians(), scene.mm_per_unit);
+        // One head, so the shadow map is fitted to its bounds whatever the
+        // view (scene::framing::frame does the same with one instance), and
+        // the texel is the same at every scale and light.
+        let shadow_mm = shadow_frame(Vec3::Y, Vec3::ZERO, scene.head_bounds.bounding_radius())
+            .texel_mm(base.shadow_size, scene.mm_per_unit);
         for p in scales() {
             // Where the reference frame has `p` px/mm at the head centre.
             let distance_heads =
@@ -95,6 +101,7 @@ pub fn accuracy_scenes(
                         asset: asset.name().into(),
                         px_per_mm,
                         light_deg,
+                        shadow_mm,
                     }),
                 });
             }
@@ -131,6 +138,7 @@ pub fn rows_of(specs: &[SceneSpec], rows: &[EvalRow]) -> Result<Vec<Row>> {
             setting: p.setting.clone(),
             px_per_mm: a.px_per_mm,
             light_deg: a.light_deg,
+            shadow_mm: a.shadow_mm,
             interior,
             silhouette: if none {
                 Some(1.0)
@@ -164,56 +172,73 @@ pub fn write(rows: &[Row], header: &Header, out: &Path) -> Result<(String, Vec<P
     let f = out.join("loso.json");
     crate::output::write_json(&f, &loso)?;
     files.push(f);
-    let text = table(&loso);
+    let mut text = table(&loso);
+    // Along the shadow axis where it has an inner texel to leave out.
+    let loss = leave_one_shadow_out(&model);
+    if loss.last().is_some_and(|r| r.points > 0) {
+        let f = out.join("loso-shadow.json");
+        crate::output::write_json(&f, &loss)?;
+        files.push(f);
+        text.push_str("\nleave one shadow texel out:\n");
+        text.push_str(&table(&loss));
+    }
     Ok((text, files))
 }
 
-/// One chart per asset: each setting's interior err/none, averaged over the
-/// measured lights, against px/mm (log).
+/// One chart per asset and measured shadow texel: each setting's interior
+/// err/none, averaged over the measured lights, against px/mm (log). The
+/// finest texel's is `accuracy-ASSET.png/svg` (one head's own shadow map),
+/// each wider one `accuracy-ASSET-shadow-MMmm.png/svg`.
 pub fn charts(model: &AccuracyModel, out: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for asset in Asset::ALL {
-        let series: Vec<chart::Series> = model
-            .curves
-            .iter()
-            .filter(|c| c.asset == asset)
-            .map(|c| chart::Series {
-                label: format!("{} {}", c.method, c.setting),
-                points: c
-                    .scales
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &p)| {
-                        let n = c.lights.len() as f64;
-                        (p, c.interior.iter().map(|l| l[i]).sum::<f64>() / n)
-                    })
-                    .collect(),
-            })
-            .collect();
-        if series.is_empty() {
+        let Some(first) = model.curves.iter().find(|c| c.asset == asset) else {
             continue;
+        };
+        for (k, &shadow_mm) in first.shadows.iter().enumerate() {
+            let series: Vec<chart::Series> = model
+                .curves
+                .iter()
+                .filter(|c| c.asset == asset)
+                .filter_map(|c| {
+                    let grid = c.interior.get(k)?;
+                    Some(chart::Series {
+                        label: format!("{} {}", c.method, c.setting),
+                        points: c
+                            .scales
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &p)| {
+                                let n = c.lights.len() as f64;
+                                (p, grid.iter().map(|l| l[i]).sum::<f64>() / n)
+                            })
+                            .collect(),
+                    })
+                })
+                .collect();
+            let stem = if k == 0 {
+                format!("accuracy-{}", asset.name())
+            } else {
+                format!("accuracy-{}-shadow-{shadow_mm:.2}mm", asset.name())
+            };
+            let (png, svg) = (
+                out.join(format!("{stem}.png")),
+                out.join(format!("{stem}.svg")),
+            );
+            chart::series_chart(
+                &series,
+                &format!(
+                    "err/none against scale, {}, shadow texel {shadow_mm:.2} mm (mean over {} lights)",
+                    asset.name(),
+                    first.lights.len()
+                ),
+                "pixels per mm at the head centre",
+                "err/none over the interior",
+                &png,
+                &svg,
+            )?;
+            files.extend([png, svg]);
         }
-        let (png, svg) = (
-            out.join(format!("accuracy-{}.png", asset.name())),
-            out.join(format!("accuracy-{}.svg", asset.name())),
-        );
-        chart::series_chart(
-            &series,
-            &format!(
-                "err/none against scale, {} (mean over {} lights)",
-                asset.name(),
-                model
-                    .curves
-                    .iter()
-                    .find(|c| c.asset == asset)
-                    .map_or(0, |c| c.lights.len())
-            ),
-            "pixels per mm at the head centre",
-            "err/none over the interior",
-            &png,
-            &svg,
-        )?;
-        files.extend([png, svg]);
     }
     Ok(files)
 }
@@ -252,6 +277,15 @@ mod tests {
             assert!((f.fovy_deg.unwrap() - 20.0).abs() < 1e-5);
             assert!(c.fovy_deg.unwrap() < 5.1);
         }
+        // One head's shadow map at 2048: a texel of its fitted extent over 2048,
+        // the same in every view, and 4x as wide at 512.
+        let sh = full[0].accuracy.as_ref().unwrap().shadow_mm;
+        assert!(sh > 0.05 && sh < 0.5, "{sh}");
+        assert!(full.iter().all(|f| f.accuracy.as_ref().unwrap().shadow_mm == sh));
+        base.shadow_size = 512;
+        let wide = accuracy_scenes(&[(Asset::Procedural, None)], &base).unwrap();
+        let sw = wide[0].accuracy.as_ref().unwrap().shadow_mm;
+        assert!((sw / sh - 4.0).abs() < 1e-9, "{sw} {sh}");
         let want = scales();
         for (i, p) in want.iter().enumerate() {
             let a = full[i * AZIMUTHS.len()].accuracy.as_ref().unwrap();

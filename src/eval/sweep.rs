@@ -67,6 +67,9 @@ pub struct AccuracyPoint {
     /// Degrees between the key light's direction and the direction from the
     /// head to the camera.
     pub light_deg: f64,
+    /// Width of a shadow-map texel at the head, mm (the run's --shadow-size
+    /// over the map fitted to the head).
+    pub shadow_mm: f64,
 }
 
 /// The thesis' perceptual study (section 4.3.2): zoom, near and far (28, 50 and

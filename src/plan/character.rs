@@ -33,6 +33,9 @@ pub struct CharacterInput {
     pub px_per_mm: f64,
     /// Degrees between the direction to the key light and to the camera.
     pub light_deg: f64,
+    /// Width of a shadow-map texel at the character, mm (one map fitted to
+    /// every character: a crowd's is wider than one head's).
+    pub shadow_mm: f64,
     /// Skin pixels (from a render: the samples a stencil-tested SSS pass passes).
     pub skin_pixels: f64,
     /// The reference setting's SSS region of this character: pixels, rectangles.
@@ -65,7 +68,9 @@ pub fn estimate(
     width: u32,
     height: u32,
     light_dir: Vec3,
+    shadow_size: u32,
 ) -> Vec<CharacterInput> {
+    let shadow_mm = framing.light.texel_mm(shadow_size, scene.mm_per_unit);
     let cam = framing.camera;
     let aspect = width as f32 / height as f32;
     let view = cam.view();
@@ -97,6 +102,7 @@ pub fn estimate(
                 distance_heads: f64::from(cam.eye.distance(c) / head_h),
                 px_per_mm,
                 light_deg,
+                shadow_mm,
                 skin_pixels: area,
                 region_pixels: 0.0,
                 region_rects: 0.0,

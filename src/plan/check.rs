@@ -146,6 +146,7 @@ pub struct CaseCharacter {
     pub character: usize,
     pub px_per_mm: f64,
     pub light_deg: f64,
+    pub shadow_mm: f64,
     pub setting: String,
     pub predicted_interior: f64,
     pub predicted_silhouette: f64,
@@ -423,6 +424,7 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
                     character: ch.index,
                     px_per_mm: ch.px_per_mm,
                     light_deg: ch.light_deg,
+                    shadow_mm: ch.shadow_mm,
                     setting: row.setting.map_or("none".to_string(), |si| {
                         format!("{} {}", c[si].method, c[si].setting)
                     }),

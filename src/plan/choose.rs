@@ -12,8 +12,9 @@ use super::solve::{solve, Opt, Problem, Solution};
 use crate::skin::profile::SIX_GAUSSIAN_VARIANCES_MM2;
 
 /// What the planner asks of an accuracy model: the predicted err/none
-/// (interior, silhouette: the eval's bands) of a method setting at a scale
-/// and a key-light angle; `None` outside its measured range.
+/// (interior, silhouette: the eval's bands) of a method setting at a scale,
+/// a key-light angle and a shadow-map texel at the character (mm); `None`
+/// outside its measured range.
 pub trait Accuracy {
     fn predict(
         &self,
@@ -21,6 +22,7 @@ pub trait Accuracy {
         setting: &str,
         px_per_mm: f64,
         light_deg: f64,
+        shadow_mm: f64,
     ) -> Option<(f64, f64)>;
 }
 
@@ -143,7 +145,7 @@ pub fn plan(a: &Ask) -> Plan {
             }
             let Some(p) = a
                 .accuracy
-                .predict(&s.method, &s.setting, c.px_per_mm, c.light_deg)
+                .predict(&s.method, &s.setting, c.px_per_mm, c.light_deg, c.shadow_mm)
                 .filter(|p| p.0.is_finite() && p.1.is_finite())
             else {
                 ex.push((si, Excluded::OutsideMeasuredRange));
@@ -218,7 +220,14 @@ mod tests {
     /// texture-space setting) everywhere, both far better than none.
     struct Table;
     impl Accuracy for Table {
-        fn predict(&self, _m: &str, setting: &str, x: f64, _l: f64) -> Option<(f64, f64)> {
+        fn predict(
+            &self,
+            _m: &str,
+            setting: &str,
+            x: f64,
+            _l: f64,
+            _sh: f64,
+        ) -> Option<(f64, f64)> {
             match setting {
                 "cheap" => (1.0..=8.0).contains(&x).then_some((0.3, 0.4)),
                 "ts" => Some((0.1, 0.1)),
@@ -233,6 +242,7 @@ mod tests {
             distance_heads: 9.0 / px_per_mm,
             px_per_mm,
             light_deg: 60.0,
+            shadow_mm: 0.2,
             skin_pixels: 1e4 * px_per_mm * px_per_mm,
             region_pixels: 0.0,
             region_rects: 0.0,

@@ -343,7 +343,14 @@ pub fn characters(
     // render's own shot, so what is planned is what is rendered.
     let shot = crate::render::groups::shot(scene, s);
     let framing = frame_scene(scene, &shot);
-    let mut cs = estimate(scene, &framing, s.width, s.height, shot.light_dir);
+    let mut cs = estimate(
+        scene,
+        &framing,
+        s.width,
+        s.height,
+        shot.light_dir,
+        s.shadow_size,
+    );
     for c in &mut cs {
         let (r, n) = reference.region_of(c.px_per_mm, c.skin_pixels);
         c.region_pixels = r;
@@ -528,6 +535,13 @@ pub fn table(chars: &[CharacterInput], costs: &[SettingCosts], p: &Plan, profile
     s.push_str(&format!(
         "(ms on {profile}; err/none predicted, interior and silhouette bands)\n"
     ));
+    if let Some(c) = chars.first() {
+        s.push_str(&format!(
+            "(shadow-map texel {:.3} mm at every character: one map fitted to all {})\n",
+            c.shadow_mm,
+            chars.len()
+        ));
+    }
     for (ci, (c, r)) in chars.iter().zip(&p.rows).enumerate() {
         let (m, st) = label(costs, r.setting);
         s.push_str(&format!(

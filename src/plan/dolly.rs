@@ -33,6 +33,7 @@ impl Accuracy for DollyTable {
         setting: &str,
         px_per_mm: f64,
         _light: f64,
+        _shadow_mm: f64,
     ) -> Option<(f64, f64)> {
         let mut pts: Vec<(f64, f64)> = self
             .points
@@ -76,10 +77,10 @@ mod tests {
             points: vec![p(1.0, 0.2), p(4.0, 0.6)],
             source: String::new(),
         };
-        let (e, _) = t.predict("m", "s", 2.0, 0.0).unwrap();
+        let (e, _) = t.predict("m", "s", 2.0, 0.0, 0.2).unwrap();
         assert!((e - 0.4).abs() < 1e-12, "{e}");
-        assert_eq!(t.predict("m", "s", 0.5, 0.0), None);
-        assert_eq!(t.predict("m", "s", 4.5, 0.0), None);
-        assert_eq!(t.predict("m", "x", 2.0, 0.0), None);
+        assert_eq!(t.predict("m", "s", 0.5, 0.0, 0.2), None);
+        assert_eq!(t.predict("m", "s", 4.5, 0.0, 0.2), None);
+        assert_eq!(t.predict("m", "x", 2.0, 0.0, 0.2), None);
     }
 }

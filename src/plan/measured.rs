@@ -48,9 +48,10 @@ impl Accuracy for Measured {
         setting: &str,
         px_per_mm: f64,
         light_deg: f64,
+        shadow_mm: f64,
     ) -> Option<(f64, f64)> {
         self.model
-            .predict(self.asset, method, setting, px_per_mm, light_deg)
+            .predict(self.asset, method, setting, px_per_mm, light_deg, shadow_mm)
             .map(|p| (p.interior, p.silhouette))
     }
 }
@@ -69,9 +70,18 @@ mod tests {
                     .range(asset, r.method, r.setting)
                     .unwrap_or_else(|| panic!("{} {} not measured", r.method, r.setting));
                 let mid = (lo * hi).sqrt();
-                let (i, s) = m.predict(r.method, r.setting, mid, 60.0).unwrap();
+                let widest = m
+                    .model
+                    .widest_shadow_mm(asset, r.method, r.setting)
+                    .unwrap();
+                let (i, s) = m.predict(r.method, r.setting, mid, 60.0, widest).unwrap();
                 assert!(i.is_finite() && i >= 0.0 && s.is_finite() && s >= 0.0);
-                assert!(m.predict(r.method, r.setting, hi * 1.5, 60.0).is_none());
+                assert!(m
+                    .predict(r.method, r.setting, hi * 1.5, 60.0, widest)
+                    .is_none());
+                assert!(m
+                    .predict(r.method, r.setting, mid, 60.0, widest * 1.01)
+                    .is_none());
             }
         }
         assert_eq!(Measured::asset_of(None), Asset::Procedural);

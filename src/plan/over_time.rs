@@ -385,7 +385,14 @@ mod tests {
     /// predictions that cross back and forth by less than a 0.05 margin.
     struct Crossing;
     impl Accuracy for Crossing {
-        fn predict(&self, _m: &str, setting: &str, x: f64, _l: f64) -> Option<(f64, f64)> {
+        fn predict(
+            &self,
+            _m: &str,
+            setting: &str,
+            x: f64,
+            _l: f64,
+            _sh: f64,
+        ) -> Option<(f64, f64)> {
             let odd = ((x * 100.0).round() as i64) % 2 == 1;
             let e = match setting {
                 "steady" => 0.50,
@@ -403,6 +410,7 @@ mod tests {
             distance_heads: 4.0,
             px_per_mm,
             light_deg: 60.0,
+            shadow_mm: 0.2,
             skin_pixels: 1e4,
             region_pixels: 1e4,
             region_rects: 4.0,
@@ -471,11 +479,18 @@ mod tests {
         // a gain of 0.48: one switch, then held.
         struct Drop;
         impl Accuracy for Drop {
-            fn predict(&self, m: &str, s: &str, x: f64, l: f64) -> Option<(f64, f64)> {
+            fn predict(
+                &self,
+                m: &str,
+                s: &str,
+                x: f64,
+                l: f64,
+                sh: f64,
+            ) -> Option<(f64, f64)> {
                 if s == "steady" && x > 2.5 {
                     return None;
                 }
-                Crossing.predict(m, s, x, l)
+                Crossing.predict(m, s, x, l, sh)
             }
         }
         let frames: Vec<FrameInput> = (0..12)

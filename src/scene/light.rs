@@ -73,6 +73,17 @@ impl KeyLight {
 pub struct LightFrame {
     pub view_proj: Mat4,
     pub depth_range_units: f32,
+    /// Side of the square the shadow map covers, scene units.
+    pub extent_units: f32,
+}
+
+impl LightFrame {
+    /// Width of one shadow-map texel at any receiver (the projection is
+    /// orthographic), in millimetres: what a crowd's shadow map loses against
+    /// one head's (the accuracy model's third axis, docs/accuracy.md).
+    pub fn texel_mm(&self, shadow_size: u32, mm_per_unit: f32) -> f64 {
+        f64::from(self.extent_units) * f64::from(mm_per_unit) / f64::from(shadow_size.max(1))
+    }
 }
 
 /// Orthographic shadow projection for a directional light fitted to a bounding sphere:
@@ -98,6 +109,7 @@ pub fn shadow_frame(dir_to_light: Vec3, center: Vec3, radius: f32) -> LightFrame
     LightFrame {
         view_proj: proj * view,
         depth_range_units: 2.0 * r,
+        extent_units: 2.0 * r,
     }
 }
 
@@ -123,6 +135,14 @@ mod tests {
         assert!((light(0.0, 90.0).direction_to_light(f) - Vec3::Y).length() < 1e-6);
         let d = light(30.0, 45.0).direction_to_light(Vec3::new(1.0, 0.0, 0.0));
         assert!((d.length() - 1.0).abs() < 1e-6 && (d.y - 0.5f32.sqrt()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_texel_is_the_fitted_extent_over_the_size() {
+        let f = shadow_frame(Vec3::Y, Vec3::ZERO, 100.0);
+        // 1% margin on the radius: 202 units over 2048 texels, 2 mm a unit.
+        assert!((f.texel_mm(2048, 2.0) - 202.0 * 2.0 / 2048.0).abs() < 1e-4);
+        assert!((f.texel_mm(512, 2.0) / f.texel_mm(2048, 2.0) - 4.0).abs() < 1e-9);
     }
 
     #[test]

@@ -362,7 +362,14 @@ fn a_crowd_predicted_against_its_priced_frame() {
 /// dearer settings, measured over 0.3-8 px/mm.
 struct Smooth;
 impl Accuracy for Smooth {
-    fn predict(&self, method: &str, setting: &str, x: f64, _l: f64) -> Option<(f64, f64)> {
+    fn predict(
+        &self,
+        method: &str,
+        setting: &str,
+        x: f64,
+        _l: f64,
+        _sh: f64,
+    ) -> Option<(f64, f64)> {
         if !(0.3..=8.0).contains(&x) {
             return None;
         }
