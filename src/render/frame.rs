@@ -3,7 +3,8 @@
 //! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
 //! the stencil) -> each group's method's passes (one group in a single-method
 //! frame) and, in a frame of several, the merges (`merge.rs`) -> composite
-//! (diffuse after SSS + specular) -> Hable tone map.
+//! (diffuse after SSS + specular) -> Hable tone map -> the post chain's
+//! anti-aliasing stage (`crate::post`, `--aa`; none by default).
 //!
 //! Over 800 lines because every pass the frame itself records (shadow,
 //! geometry, composite, tone map, the character ids) reads the private
@@ -24,6 +25,7 @@ use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
 use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
 use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
+use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
 use crate::scene::framing::Framing;
 use crate::scene::light::LightFrame;
@@ -155,6 +157,8 @@ pub struct Frame {
     instance_set: vk::DescriptorSet,
     ids_instance_set: vk::DescriptorSet,
     screen_rect: Vec<vk::Rect2D>,
+    /// The stages after the tone map (`enable_post`; none with `--aa none`).
+    pub post: PostChain,
 }
 
 /// The heads of one group as the geometry pass draws them.
@@ -222,6 +226,7 @@ impl Frame {
             instance_set: vk::DescriptorSet::null(),
             ids_instance_set: vk::DescriptorSet::null(),
             screen_rect: scissors(&[full]),
+            post: PostChain::default(),
         };
         // Filled in by `build`: on an error, the guard frees what exists.
         let mut f = Guard::new(ctx, f);
@@ -424,6 +429,28 @@ impl Frame {
         self.write_instances(ctx)
     }
 
+    /// Declares the post chain's images and builds its stage for
+    /// `settings.aa` (before the usages are derived: its passes declare them).
+    pub fn enable_post(&mut self, ctx: &Context, res: &mut Resources) -> Result<()> {
+        let depth_stencil_format = res.format(self.targets.depth_stencil);
+        self.post = PostChain::new(
+            self.settings.aa,
+            &mut PostSetup {
+                ctx,
+                res,
+                input: self.targets.ldr,
+                depth_stencil_format,
+            },
+        )?;
+        Ok(())
+    }
+
+    /// The frame's output image: the anti-aliased frame, or the tone-mapped
+    /// one without a post stage.
+    pub fn output(&self) -> ImageId {
+        self.post.output().unwrap_or(self.targets.ldr)
+    }
+
     /// The frame's uniforms: camera, key light, shadow and transmittance parameters.
     fn uniforms(&self, scene: &Scene, transmittance: bool) -> FrameUniforms {
         let settings = &self.settings;
@@ -560,7 +587,12 @@ impl Frame {
                 self.pool
                     .write_set(ctx, &self.ids_pipeline, 0, &self.frame_binds(res)[..1])?;
         }
-        Ok(())
+        self.post.bind(&PostBind {
+            ctx,
+            res,
+            pool: &self.pool,
+            samplers: &self.samplers,
+        })
     }
 
     /// What group `g`'s passes are built against: its region and stencil code.
@@ -625,6 +657,7 @@ impl Frame {
         passes.extend(self.group_passes(groups, merge, res));
         passes.push(self.composite_pass(res, self.composite_source(groups)));
         passes.push(self.tonemap_pass(res));
+        passes.extend(self.post.passes(res));
         if let Some(ids) = self.character_ids {
             passes.push(self.character_ids_pass(ids));
         }
@@ -861,6 +894,7 @@ impl Frame {
         for o in &mut self.objects {
             o.destroy(ctx);
         }
+        self.post.destroy(ctx);
         self.beckmann.destroy(ctx);
         self.frame_ubo.destroy(ctx);
         self.instance_buffer.destroy(ctx);
