@@ -1,5 +1,5 @@
-//! The post chain after the composite: the tone map (still recorded by
-//! `render::frame`, the first stage), then the anti-aliasing stage `--aa`
+//! The post chain after the composite: the tone map (`tonemap`, every
+//! frame), then the anti-aliasing stage `--aa`
 //! picks (thesis ch. 9-10; issue 17). Each AA stage is a module with its
 //! declared images, pipelines and passes, like an SSS method (`crate::method`):
 //! it reads the tone-mapped LDR frame (gamma-space luma, as MLAA and FXAA
@@ -7,6 +7,7 @@
 //! output image. `--aa none` adds no image, pipeline or pass: the frame is the
 //! one it was before the chain existed, bit for bit.
 //!
+//! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
 //! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
 //!   weights, neighbourhood blending, both stencil-tested) and a copy.
 //! - `fxaa`: FXAA's quality preset, one pass.
@@ -15,6 +16,7 @@
 
 pub mod fxaa;
 pub mod mlaa;
+pub mod tonemap;
 
 use std::fmt;
 use std::str::FromStr;
@@ -90,7 +92,11 @@ impl FromStr for AaMode {
 pub struct PostSetup<'a> {
     pub ctx: &'a Context,
     pub res: &'a mut Resources,
-    /// The tone-mapped frame the stage reads.
+    /// The HDR composite the tone map reads.
+    pub hdr: ImageId,
+    /// The exposure the tone map applies (a factor on linear light).
+    pub exposure: f32,
+    /// The tone-mapped frame the anti-aliasing stage reads.
     pub input: ImageId,
     /// The frame's depth/stencil format (a stencil-culling stage's own
     /// stencil image takes it: the device renders and clears it).
@@ -118,24 +124,43 @@ pub trait AaStage {
     fn destroy(&mut self, ctx: &Context);
 }
 
-/// The chain after the tone map: no stage (`--aa none`) or one AA stage.
+/// The chain: the tone map, then no stage (`--aa none`) or one AA stage.
 #[derive(Default)]
 pub struct PostChain {
+    tonemap: tonemap::Tonemap,
     aa: Option<Box<dyn AaStage>>,
 }
 
 impl PostChain {
-    /// The stage `mode` names, its images declared and pipelines built.
+    /// The tone map and the stage `mode` names, images declared and
+    /// pipelines built. On an error, what was built is destroyed.
     pub fn new(mode: AaMode, s: &mut PostSetup) -> Result<Self> {
-        let aa: Option<Box<dyn AaStage>> = match mode {
+        let ctx = s.ctx;
+        let tm = tonemap::Tonemap::new(ctx, &*s.res, s.hdr, s.input, s.exposure)?;
+        let mut chain = crate::vk::guard::Guard::new(
+            ctx,
+            PostChain {
+                tonemap: tm,
+                aa: None,
+            },
+        );
+        chain.aa = match mode {
             AaMode::None => None,
             AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
             AaMode::Mlaa => Some(Box::new(mlaa::Mlaa::new(s)?)),
         };
-        Ok(PostChain { aa })
+        Ok(chain.keep())
     }
 
+    /// The tone map's pass, then the anti-aliasing stage's.
     pub fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
+        let mut passes = vec![self.tonemap.pass(res)];
+        passes.extend(self.aa_passes(res));
+        passes
+    }
+
+    /// The anti-aliasing stage's passes alone (none without one).
+    pub fn aa_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
         self.aa.as_ref().map(|a| a.passes(res)).unwrap_or_default()
     }
 
@@ -145,6 +170,7 @@ impl PostChain {
     }
 
     pub fn bind(&mut self, b: &PostBind) -> Result<()> {
+        self.tonemap.bind(b)?;
         match &mut self.aa {
             Some(a) => a.bind(b),
             None => Ok(()),
@@ -165,6 +191,13 @@ impl PostChain {
         if let Some(a) = &mut self.aa {
             a.destroy(ctx);
         }
+        self.tonemap.destroy(ctx);
+    }
+}
+
+impl crate::vk::guard::Destroy for PostChain {
+    fn destroy(&mut self, ctx: &Context) {
+        PostChain::destroy(self, ctx)
     }
 }
 

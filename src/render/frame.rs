@@ -19,7 +19,7 @@ use super::groups::{scissors, GroupMethod};
 use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
-use super::targets::{LDR_FORMAT, SHADOW_FORMAT};
+use super::targets::SHADOW_FORMAT;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
@@ -52,10 +52,7 @@ const SHADOW_BIAS_MM: f32 = 0.5;
 /// Slope-scaled depth bias of the shadow pass (in units of the depth slope):
 /// the usual 1.5 against acne on curved skin at grazing light.
 const SHADOW_SLOPE_BIAS: f32 = 1.5;
-/// Linear white point of Hable's filmic curve (his Uncharted 2 value).
-const WHITE_POINT: f32 = 11.2;
 const COMPOSITE_SHADER: &str = "composite.frag";
-const TONEMAP_SHADER: &str = "tonemap.frag";
 use crate::shader_constants::PCF_TRIPS;
 
 /// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
@@ -92,13 +89,6 @@ const IDS_SHADER: &str = "geometry_ids.frag";
 /// read per instance.
 const GEOMETRY_VERT: &str = "geometry_instanced.vert";
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct TonemapPush {
-    exposure: f32,
-    white_point: f32,
-}
-
 /// A full-screen post pass: what it reads (image, shader variable), what it writes.
 struct PostPass<'a, 'r> {
     name: &'r str,
@@ -107,7 +97,6 @@ struct PostPass<'a, 'r> {
     set: vk::DescriptorSet,
     reads: &'r [(ImageId, &'r str)],
     target: ImageId,
-    push: Option<TonemapPush>,
 }
 
 /// The frame's pipelines, uniforms, scene objects and placement.
@@ -126,7 +115,6 @@ pub struct Frame {
     shadow_pipeline: Pipeline,
     geometry_pipeline: Pipeline,
     composite_pipeline: Pipeline,
-    tonemap_pipeline: Pipeline,
     /// `--character-ids` only: the pass that writes each head's index + 1
     /// into `character_ids` after the frame (null otherwise).
     ids_pipeline: Pipeline,
@@ -134,7 +122,6 @@ pub struct Frame {
     pub character_ids: Option<ImageId>,
     frame_set: vk::DescriptorSet,
     composite_set: vk::DescriptorSet,
-    tonemap_set: vk::DescriptorSet,
     frame_ubo: Buffer,
     beckmann: Image,
     pub objects: Vec<GpuObject>,
@@ -204,13 +191,11 @@ impl Frame {
             shadow_pipeline: Pipeline::default(),
             geometry_pipeline: Pipeline::default(),
             composite_pipeline: Pipeline::default(),
-            tonemap_pipeline: Pipeline::default(),
             ids_pipeline: Pipeline::default(),
             ids_set: vk::DescriptorSet::null(),
             character_ids: None,
             frame_set: vk::DescriptorSet::null(),
             composite_set: vk::DescriptorSet::null(),
-            tonemap_set: vk::DescriptorSet::null(),
             frame_ubo: Buffer::default(),
             beckmann: Image::default(),
             objects: Vec::new(),
@@ -389,10 +374,6 @@ impl Frame {
             ctx,
             &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
         )?;
-        self.tonemap_pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc::fullscreen("tonemap", TONEMAP_SHADER, LDR_FORMAT),
-        )?;
         Ok(())
     }
 
@@ -429,8 +410,9 @@ impl Frame {
         self.write_instances(ctx)
     }
 
-    /// Declares the post chain's images and builds its stage for
-    /// `settings.aa` (before the usages are derived: its passes declare them).
+    /// Builds the post chain: the tone map, and the stage `settings.aa`
+    /// names with its images declared (before the usages are derived: its
+    /// passes declare them). Every frame needs it.
     pub fn enable_post(&mut self, ctx: &Context, res: &mut Resources) -> Result<()> {
         let depth_stencil_format = res.format(self.targets.depth_stencil);
         self.post = PostChain::new(
@@ -438,6 +420,8 @@ impl Frame {
             &mut PostSetup {
                 ctx,
                 res,
+                hdr: self.targets.hdr,
+                exposure: self.settings.exposure,
                 input: self.targets.ldr,
                 depth_stencil_format,
             },
@@ -576,12 +560,6 @@ impl Frame {
                 ("specularTex", Bind::Texture(res.view(t.specular))),
             ],
         )?;
-        self.tonemap_set = self.pool.write_set(
-            ctx,
-            &self.tonemap_pipeline,
-            0,
-            &[("hdrTex", Bind::Texture(res.view(t.hdr)))],
-        )?;
         if self.character_ids.is_some() {
             self.ids_set =
                 self.pool
@@ -656,7 +634,6 @@ impl Frame {
         let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
         passes.extend(self.group_passes(groups, merge, res));
         passes.push(self.composite_pass(res, self.composite_source(groups)));
-        passes.push(self.tonemap_pass(res));
         passes.extend(self.post.passes(res));
         if let Some(ids) = self.character_ids {
             passes.push(self.character_ids_pass(ids));
@@ -822,7 +799,6 @@ impl Frame {
             set,
             reads,
             target,
-            push,
         } = p;
         let work = ShaderWork {
             shader: shader.into(),
@@ -846,13 +822,7 @@ impl Frame {
         }
         pass.color(ColorTarget::new(target, Load::DontCare))
             .draws(Some(work), 1)
-            .record(move |pc: &PassContext| {
-                fullscreen(pc, pipeline, &[set], |c, cmd| {
-                    if let Some(p) = &push {
-                        pipeline.push(c, cmd, p);
-                    }
-                })
-            })
+            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
     }
 
     fn composite_pass<'a>(&'a self, res: &Resources, sss_output: ImageId) -> Pass<'a> {
@@ -866,26 +836,6 @@ impl Frame {
                 set: self.composite_set,
                 reads: &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
                 target: t.hdr,
-                push: None,
-            },
-        )
-    }
-
-    fn tonemap_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let t = self.targets;
-        self.fullscreen_pass(
-            res,
-            PostPass {
-                name: "tonemap",
-                pipeline: &self.tonemap_pipeline,
-                shader: TONEMAP_SHADER,
-                set: self.tonemap_set,
-                reads: &[(t.hdr, "hdrTex")],
-                target: t.ldr,
-                push: Some(TonemapPush {
-                    exposure: self.settings.exposure,
-                    white_point: WHITE_POINT,
-                }),
             },
         )
     }
@@ -902,7 +852,6 @@ impl Frame {
             &mut self.shadow_pipeline,
             &mut self.geometry_pipeline,
             &mut self.composite_pipeline,
-            &mut self.tonemap_pipeline,
             &mut self.ids_pipeline,
         ] {
             p.destroy(ctx);

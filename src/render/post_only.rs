@@ -8,10 +8,11 @@ use super::{submit_and_read, Renderer};
 use crate::graph::{ImageId, PassSample};
 
 impl Renderer<'_> {
-    /// Runs the post chain's passes and reads back the frame's output (linear
+    /// Runs the post chain's anti-aliasing passes (not the tone map, which
+    /// would overwrite the uploaded frame) and reads back the frame's output (linear
     /// float RGBA, decoded from sRGB) with each pass's samples.
     pub fn run_post_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
-        let passes = self.frame.post.passes(&self.resources);
+        let passes = self.frame.post.aa_passes(&self.resources);
         if passes.is_empty() {
             bail!("the post-only run needs an anti-aliasing stage (--aa)");
         }
