@@ -275,6 +275,9 @@ enum AaArg {
     /// Jimenez's MLAA (thesis ch. 9): luma edges writing the stencil, then
     /// blending weights and neighbourhood blending on edge pixels only.
     Mlaa,
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with local contrast
+    /// adaptation, diagonal patterns, accurate searches, sharp corners.
+    Smaa,
 }
 
 impl From<AaArg> for AaMode {
@@ -283,6 +286,7 @@ impl From<AaArg> for AaMode {
             AaArg::None => AaMode::None,
             AaArg::Fxaa => AaMode::Fxaa,
             AaArg::Mlaa => AaMode::Mlaa,
+            AaArg::Smaa => AaMode::Smaa,
         }
     }
 }

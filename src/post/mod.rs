@@ -10,12 +10,16 @@
 //! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
 //! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
 //!   weights, neighbourhood blending, both stencil-tested) and a copy.
+//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with
+//!   local contrast adaptation writing the stencil, blending weights
+//!   (stencil-tested: diagonals, accurate searches, corners), blending.
 //! - `fxaa`: FXAA's quality preset, one pass.
 //!
 //! The device-free parts (area texture, CPU references) live in `crate::aa`.
 
 pub mod fxaa;
 pub mod mlaa;
+pub mod smaa;
 pub mod tonemap;
 
 use std::fmt;
@@ -38,10 +42,12 @@ pub enum AaMode {
     Fxaa,
     /// Jimenez's MLAA (thesis ch. 9): three stencil-culled passes.
     Mlaa,
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset.
+    Smaa,
 }
 
 impl AaMode {
-    pub const ALL: [AaMode; 3] = [AaMode::None, AaMode::Fxaa, AaMode::Mlaa];
+    pub const ALL: [AaMode; 4] = [AaMode::None, AaMode::Fxaa, AaMode::Mlaa, AaMode::Smaa];
 
     /// The name `--aa` takes and reports print.
     pub fn name(self) -> &'static str {
@@ -49,6 +55,7 @@ impl AaMode {
             AaMode::None => "none",
             AaMode::Fxaa => "fxaa",
             AaMode::Mlaa => "mlaa",
+            AaMode::Smaa => "smaa",
         }
     }
 
@@ -59,6 +66,9 @@ impl AaMode {
             AaMode::Fxaa => "FXAA, quality preset: one full-screen pass on gamma luma",
             AaMode::Mlaa => {
                 "Jimenez's MLAA (thesis ch. 9): luma edges + stencil, blending weights, neighbourhood blending"
+            }
+            AaMode::Smaa => {
+                "SMAA 1x (thesis ch. 10.4), high preset: adapted luma edges + stencil, weights with diagonals and corners, blending"
             }
         }
     }
@@ -148,6 +158,7 @@ impl PostChain {
             AaMode::None => None,
             AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
             AaMode::Mlaa => Some(Box::new(mlaa::Mlaa::new(s)?)),
+            AaMode::Smaa => Some(Box::new(smaa::Smaa::new(s)?)),
         };
         Ok(chain.keep())
     }
@@ -212,7 +223,10 @@ mod tests {
             assert_eq!(m.name().to_uppercase().parse::<AaMode>().unwrap(), m);
         }
         let e = "smaa-t2x".parse::<AaMode>().unwrap_err().to_string();
-        assert!(e.contains("none, fxaa, mlaa") && !e.contains('\n'), "{e}");
+        assert!(
+            e.contains("none, fxaa, mlaa, smaa") && !e.contains('\n'),
+            "{e}"
+        );
         assert_eq!(AaMode::default(), AaMode::None);
     }
 }

@@ -7,7 +7,10 @@
 
 use crate::common;
 
-use dermis::aa::edges::{mlaa_luma_edges, Edgel, Edges, Image, MLAA_LUMA_THRESHOLD};
+use dermis::aa::edges::{
+    mlaa_luma_edges, smaa_luma_edges, Edgel, Edges, Image, LocalContrast, Preset,
+    MLAA_LUMA_THRESHOLD,
+};
 use dermis::aa::mlaa_area::MlaaAreaTex;
 use dermis::aa::mlaa_weights::{edge_pixels, top_line, weights, SEARCH_DISTANCE};
 use dermis::aa::revector;
@@ -55,6 +58,13 @@ impl Rng {
 /// whose luma difference lies within 1e-3 of the threshold are drawn again,
 /// so the f32 ulps of a GPU dot product cannot flip an edgel (no ties).
 fn blocks(w: usize, h: usize, seed: u64) -> Vec<u8> {
+    blocks_with(w, h, seed, false)
+}
+
+/// `blocks` for SMAA (`ratio_ties`): neither do two luma differences of the
+/// palette lie within 1e-3 of a factor 2 (the local contrast test `2 c >=
+/// c_max`), with a palette of 7.
+fn blocks_with(w: usize, h: usize, seed: u64, ratio_ties: bool) -> Vec<u8> {
     let mut rng = Rng(seed);
     let mut palette: Vec<[u8; 3]> = vec![[128, 128, 128]];
     let luma = |c: [u8; 3]| {
@@ -65,13 +75,32 @@ fn blocks(w: usize, h: usize, seed: u64) -> Vec<u8> {
             1.0,
         ])
     };
-    while palette.len() < 8 {
+    let deltas = |p: &[[u8; 3]]| -> Vec<f32> {
+        let mut d = vec![0.0];
+        for (i, a) in p.iter().enumerate() {
+            for b in &p[i + 1..] {
+                d.push((luma(*a) - luma(*b)).abs());
+            }
+        }
+        d
+    };
+    let size = if ratio_ties { 7 } else { 8 };
+    let mut tries = 0;
+    while palette.len() < size {
+        tries += 1;
+        assert!(tries < 1_000_000, "no palette without ties");
         let c = [0, 1, 2].map(|_| rng.below(256) as u8);
         let far = palette
             .iter()
             .all(|&p| ((luma(p) - luma(c)).abs() - MLAA_LUMA_THRESHOLD).abs() > 1e-3);
-        if far {
-            palette.push(c);
+        let mut with = palette.clone();
+        with.push(c);
+        let d = deltas(&with);
+        let no_ratio_tie = d
+            .iter()
+            .all(|&x| d.iter().all(|&y| x == y || (2.0 * x - y).abs() > 1e-3));
+        if far && (!ratio_ties || no_ratio_tie) {
+            palette = with;
         }
     }
     let mut px = vec![palette[0]; w * h];
@@ -419,7 +448,7 @@ fn fxaa_and_mlaa_lower_the_error_to_a_supersampled_edge() {
         })
         .collect();
     let base = rmse(&aliased_lin, &truth);
-    for mode in [AaMode::Fxaa, AaMode::Mlaa] {
+    for mode in [AaMode::Fxaa, AaMode::Mlaa, AaMode::Smaa] {
         let mut r = Renderer::new(&ctx, &egg_scene(), &settings(w as u32, h as u32, mode)).unwrap();
         r.upload_ldr(&aliased).unwrap();
         let (out, samples) = r.run_post_only().unwrap();
@@ -474,8 +503,182 @@ fn every_mode_renders_a_frame() {
         }
     }
     assert!(changed > 0, "MLAA changed no pixel of the egg's silhouette");
+    let (smaa, smaa_passes) = frame(AaMode::Smaa);
+    for p in ["smaa edges", "smaa weights", "smaa blend"] {
+        assert!(smaa_passes.iter().any(|n| n == p), "{p}: {smaa_passes:?}");
+    }
+    assert!(smaa.ldr != none.ldr, "SMAA changed nothing");
     let (fxaa, fxaa_passes) = frame(AaMode::Fxaa);
     assert!(fxaa_passes.iter().any(|n| n == "fxaa"));
     assert!(fxaa.ldr != none.ldr, "FXAA changed nothing");
     println!("MLAA changed {changed} of {} pixels", w * h);
+}
+
+/// A post-only SMAA run: the renderer (to read its images back), the output
+/// and the pass samples.
+type SmaaRun<'c> = (Renderer<'c>, Vec<[f32; 4]>, Vec<dermis::graph::PassSample>);
+
+fn run_smaa<'c>(ctx: &'c Context, w: usize, h: usize, rgba8: &[u8]) -> SmaaRun<'c> {
+    let mut r = Renderer::new(
+        ctx,
+        &egg_scene(),
+        &settings(w as u32, h as u32, AaMode::Smaa),
+    )
+    .unwrap();
+    r.upload_ldr(rgba8).unwrap();
+    let (out, samples) = r.run_post_only().unwrap();
+    (r, out, samples)
+}
+
+/// SMAA's edge pass against `aa::edges::smaa_luma_edges` (threshold 0.1,
+/// SMAA.hlsl's shared local-contrast maximum) exactly; its weights pass runs
+/// on the pixels with a thresholded left or top delta only (what pass 1
+/// keeps in the stencil before the adaptation), by samples passed.
+#[test]
+fn smaa_edges_equal_the_cpu_reference_and_the_stencil_culls_the_weights() {
+    let ctx = common::ctx();
+    let mut removed = 0;
+    // Vertical grey stripes whose steps differ enough that the local contrast
+    // test removes the weaker edgels beside the strong ones (no ties: every
+    // delta and twice every delta is far from 0.1 and from every other).
+    let stripes: Vec<u8> = (0..W * H)
+        .flat_map(|i| {
+            let v = [20u8, 60, 240, 130, 90][i % W % 5];
+            [v, v, v, 255]
+        })
+        .collect();
+    let images = [7, 1234, 99991]
+        .map(|seed| (seed, blocks_with(W, H, seed, true)))
+        .into_iter()
+        .chain([(0, stripes)]);
+    for (seed, rgba8) in images {
+        let (mut r, _, samples) = run_smaa(&ctx, W, H, &rgba8);
+        let px = gamma(&rgba8);
+        let img = Image::new(W, H, &px).unwrap();
+        let cpu = smaa_luma_edges(&img, Preset::High.threshold(), LocalContrast::Shared).unwrap();
+        let gpu = gpu_edges(&mut r, W, H);
+        for (i, (g, c)) in gpu.edgels.iter().zip(&cpu.edgels).enumerate() {
+            assert_eq!(g, c, "seed {seed}: edgels of pixel ({}, {})", i % W, i / W);
+        }
+        let thresholded = mlaa_luma_edges(&img, Preset::High.threshold()).unwrap();
+        let kept = thresholded
+            .edgels
+            .iter()
+            .filter(|e| e.left || e.top)
+            .count() as u64;
+        let adapted = cpu.edgels.iter().filter(|e| e.left || e.top).count();
+        for name in ["smaa edges", "smaa weights"] {
+            let p = samples.iter().find(|p| p.name == name).unwrap();
+            assert_eq!(p.samples_passed, kept, "seed {seed}: {name}");
+        }
+        let blend = samples.iter().find(|p| p.name == "smaa blend").unwrap();
+        assert_eq!(
+            blend.samples_passed,
+            (W * H) as u64,
+            "the blend runs everywhere"
+        );
+        println!("seed {seed}: {kept} pixels pass the threshold (samples passed of edges and weights), {adapted} keep an edgel after the local contrast test: GPU = CPU");
+        assert!(adapted as u64 <= kept && adapted > 60, "seed {seed}");
+        removed += kept - adapted as u64;
+    }
+    assert!(removed > 0, "the local contrast test removed no edgel");
+}
+
+/// A bilinear fetch of the SMAA area texture's bytes at texture coordinate
+/// `uv` (texel centres at i + 0.5, clamp to edge), as areas.
+fn area_bilinear(uv: [f32; 2]) -> [f32; 2] {
+    let (w, h) = (dermis::aa::smaa_area::WIDTH, dermis::aa::smaa_area::HEIGHT);
+    let rg = dermis::aa::smaa_area::area_tex_rg8();
+    let (fx, fy) = (uv[0] * w as f32 - 0.5, uv[1] * h as f32 - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - x0, fy - y0);
+    let at = |x: f32, y: f32, c: usize| {
+        let x = (x as isize).clamp(0, w as isize - 1) as usize;
+        let y = (y as isize).clamp(0, h as isize - 1) as usize;
+        rg[2 * (y * w + x) + c] as f32 / 255.0
+    };
+    [0, 1].map(|c| {
+        let top = at(x0, y0, c) * (1.0 - tx) + at(x0 + 1.0, y0, c) * tx;
+        let bottom = at(x0, y0 + 1.0, c) * (1.0 - tx) + at(x0 + 1.0, y0 + 1.0, c) * tx;
+        top * (1.0 - ty) + bottom * ty
+    })
+}
+
+/// A rising staircase of runs `n`: on an interior run every top edgel is a
+/// rising Z (crossing below at the left end, above at the right: e = 0.75,
+/// 0.25), with no diagonal (n >= 3) and no corner to round, so its SMAA
+/// weights are the area texture at `sqrt` of the distances to the run's ends
+/// (`smaa_area::ortho_texcoord`, bilinear): the GPU's within two 8-bit steps
+/// (lavapipe's filter weights are fixed point). This checks the searches'
+/// distances, the crossing edges and the table's orientation on Vulkan.
+#[test]
+fn smaa_weights_of_a_step_edge_are_the_area_texture_at_its_distances() {
+    let ctx = common::ctx();
+    let (w, h) = (96usize, 24usize);
+    for n in [3usize, 5, 8, 12] {
+        let rgba8: Vec<u8> = (0..w * h)
+            .flat_map(|i| {
+                let (x, y) = (i % w, i / w);
+                let v = if y + x / n >= 20 { 204 } else { 51 };
+                [v, v, v, 255]
+            })
+            .collect();
+        let (mut r, _, _) = run_smaa(&ctx, w, h, &rgba8);
+        let weights = gpu_weights(&mut r);
+        let k = 2;
+        let row = 20 - k;
+        let mut worst: f32 = 0.0;
+        let mut sum = 0.0;
+        for x in k * n..k * n + n {
+            let (l, rt) = ((x - k * n) as f32, (k * n + n - 1 - x) as f32);
+            let uv = dermis::aa::smaa_area::ortho_texcoord([l.sqrt(), rt.sqrt()], 0.75, 0.25, 0);
+            let want = area_bilinear(uv);
+            let t = weights[row * w + x];
+            for c in 0..2 {
+                worst = worst.max((t[c] as f32 / 255.0 - want[c]).abs());
+            }
+            sum += (t[0] as f64 + t[1] as f64) / 255.0;
+        }
+        println!(
+            "n {n}: worst |GPU - table| {:.4}, run weights sum {sum:.4} (the exact Z: n/4 = {:.4})",
+            worst,
+            n as f64 / 4.0
+        );
+        assert!(worst <= 2.0 / 255.0 + 1e-6, "n {n}: {worst}");
+    }
+}
+
+/// SMAA changes no pixel off its edges: a changed pixel has a non-zero
+/// weight on one of its four sides, which needs an edgel there.
+#[test]
+fn smaa_changes_no_pixel_away_from_an_edge() {
+    let ctx = common::ctx();
+    let rgba8 = blocks_with(W, H, 1234, true);
+    let (mut r, out, _) = run_smaa(&ctx, W, H, &rgba8);
+    let on_edge = edge_pixels(&gpu_edges(&mut r, W, H));
+    let input: Vec<[f32; 4]> = rgba8
+        .chunks_exact(4)
+        .map(|c| {
+            [
+                srgb_to_linear(c[0]),
+                srgb_to_linear(c[1]),
+                srgb_to_linear(c[2]),
+                c[3] as f32 / 255.0,
+            ]
+        })
+        .collect();
+    let mut changed = 0;
+    for (i, (o, x)) in out.iter().zip(&input).enumerate() {
+        if o != x {
+            changed += 1;
+            assert!(
+                on_edge[i],
+                "pixel ({}, {}) off every edge changed",
+                i % W,
+                i / W
+            );
+        }
+    }
+    println!("{changed} pixels changed, all on edges");
+    assert!(changed > 50, "{changed}");
 }

@@ -40,7 +40,7 @@ fn declared_fetches_are_what_the_shaders_fetch() {
         }
         // The post chain's stages, once (they follow every method alike).
         if std::ptr::eq(*m, METHODS[0]) {
-            for aa in [AaMode::Mlaa, AaMode::Fxaa] {
+            for aa in [AaMode::Mlaa, AaMode::Fxaa, AaMode::Smaa] {
                 let s = RenderSettings::study().with(m, &[]);
                 settings.push((format!("{} --aa {aa}", m.name), RenderSettings { aa, ..s }));
             }
