@@ -382,11 +382,20 @@ fn mlaa_changes_no_pixel_away_from_an_edge() {
 /// samples per pixel (the supersampled truth, linear light) and point-sampled
 /// at pixel centres (aliased).
 fn edge_scene(w: usize, h: usize) -> (Vec<u8>, Vec<[f32; 4]>) {
-    let inside = |x: f32, y: f32| {
+    sampled_scene(w, h, |x, y| {
         let line = y > 0.35 * x + 6.0 && x < 0.7 * w as f32;
         let (dx, dy) = (x - 0.75 * w as f32, y - 0.4 * h as f32);
         line || dx * dx + dy * dy < 14.0 * 14.0
-    };
+    })
+}
+
+/// White where `inside` holds on black: (point-sampled RGBA8, 16 x 16
+/// box-filtered linear truth).
+fn sampled_scene(
+    w: usize,
+    h: usize,
+    inside: impl Fn(f32, f32) -> bool,
+) -> (Vec<u8>, Vec<[f32; 4]>) {
     let s = 16;
     let mut aliased = Vec::new();
     let mut truth = Vec::new();
@@ -681,4 +690,59 @@ fn smaa_changes_no_pixel_away_from_an_edge() {
     }
     println!("{changed} pixels changed, all on edges");
     assert!(changed > 50, "{changed}");
+}
+
+/// A 45-degree staircase is a diagonal pattern for SMAA (ch. 10.4.2): every
+/// interior top edgel takes the diagonal half of the area table, pattern 0
+/// (both ends past the 8-step diagonal search), whose texels hold (64, 64):
+/// a quarter each way, where the orthogonal path would see one-pixel lines.
+/// The errors to the supersampled truth are printed, not asserted for SMAA:
+/// for this line (0.3 pixel below the steps' corners) the table's blend of the
+/// black pixel across, 0.25, overshoots its true 0.045 (docs/aa.md).
+#[test]
+fn smaa_takes_the_diagonal_path_on_45_degree_edges() {
+    let ctx = common::ctx();
+    let (w, h) = (96usize, 64usize);
+    let (aliased, truth) = sampled_scene(w, h, |x, y| {
+        let a = y > x - 20.3 && x < 60.0;
+        let b = y < 90.7 - x && x >= 60.0;
+        a || b
+    });
+    let lin = |rgba8: &[u8]| -> Vec<[f32; 4]> {
+        rgba8
+            .chunks_exact(4)
+            .map(|c| {
+                [
+                    srgb_to_linear(c[0]),
+                    srgb_to_linear(c[1]),
+                    srgb_to_linear(c[2]),
+                    1.0,
+                ]
+            })
+            .collect()
+    };
+    let base = rmse(&lin(&aliased), &truth);
+    let rg = dermis::aa::smaa_area::area_tex_rg8();
+    let (tx, ty) = dermis::aa::smaa_area::diag_texel(0, 7, 7, 0);
+    let t = 2 * (ty * dermis::aa::smaa_area::WIDTH + tx);
+    let table = [rg[t], rg[t + 1]];
+    assert_eq!(table, [64, 64]);
+    let mut errors = Vec::new();
+    for mode in [AaMode::Mlaa, AaMode::Smaa, AaMode::Fxaa] {
+        let mut r = Renderer::new(&ctx, &egg_scene(), &settings(w as u32, h as u32, mode)).unwrap();
+        r.upload_ldr(&aliased).unwrap();
+        let (out, _) = r.run_post_only().unwrap();
+        if mode == AaMode::Smaa {
+            let weights = gpu_weights(&mut r);
+            // The falling diagonal's top edgels, ten pixels from both its ends.
+            for x in 32..50 {
+                let y = x - 20;
+                assert_eq!(weights[y * w + x][..2], table, "({x}, {y})");
+            }
+        }
+        let e = rmse(&out, &truth);
+        println!("{mode} on 45-degree edges: RMSE {e:.4} against the aliased image's {base:.4} (ratio {:.3})", e / base);
+        errors.push(e);
+    }
+    assert!(errors[0] < base && errors[2] < base, "{errors:?} vs {base}");
 }
