@@ -19,8 +19,9 @@
 //    offset toward the neighbour (0.5 at the end, 0 at the middle of the
 //    span); a sub-pixel term (the pixel against its 3x3 low-pass) can raise
 //    it; one bilinear fetch at that offset is the result.
-layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, sRGB
+layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, sRGB: fetches decode
 layout(set = 0, binding = 1) uniform sampler linearClamp;
+layout(set = 0, binding = 2) uniform texture2D lumaTex;   // the same, its UNORM view: encoded values
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
@@ -34,29 +35,24 @@ const float STEP_LENGTH[STEPS] = float[](1.0, 1.5, 2.0, 4.0, 12.0);
 
 ivec2 lastTexel;
 
-vec4 texel(ivec2 p) {
-    return COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, clamp(p, ivec2(0), lastTexel), 0));
-}
-
 float lumaAtTexel(ivec2 p) {
-    return lumaOf(srgbEncode(texel(p).rgb));
+    ivec2 q = clamp(p, ivec2(0), lastTexel);
+    return lumaOf(COUNTED(SITE(0, 2, FK_POINT), texelFetch(lumaTex, q, 0)).rgb);
 }
 
-vec4 bilinear(vec2 pixel) {
-    vec2 uv = pixel / vec2(lastTexel + 1);
-    return COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorTex, linearClamp), uv, 0.0));
-}
-
+// Luma between texels: a bilinear fetch of the encoded values (FXAA filters
+// in gamma space).
 float lumaAt(vec2 pixel) {
-    return lumaOf(srgbEncode(bilinear(pixel).rgb));
+    vec2 uv = pixel / vec2(lastTexel + 1);
+    return lumaOf(COUNTED(SITE(0, 2, FK_BILINEAR), textureLod(sampler2D(lumaTex, linearClamp), uv, 0.0)).rgb);
 }
 
 void main() {
     COUNT_INVOCATION();
     lastTexel = textureSize(colorTex, 0) - 1;
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 colorM = texel(p);
-    float m = lumaOf(srgbEncode(colorM.rgb));
+    vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, p, 0));
+    float m = lumaAtTexel(p);
     float n = lumaAtTexel(p + ivec2(0, -1));
     float s = lumaAtTexel(p + ivec2(0, 1));
     float w = lumaAtTexel(p + ivec2(-1, 0));
@@ -130,5 +126,6 @@ void main() {
     bool good = ((nearerN ? endN : endP) < 0.0) != mBelow;
     float offset = good ? 0.5 - dist / span : 0.0;
     offset = max(offset, subpix);
-    outColor = bilinear(centre + offset * side * across);
+    vec2 uv = (centre + offset * side * across) / vec2(lastTexel + 1);
+    outColor = COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorTex, linearClamp), uv, 0.0));
 }

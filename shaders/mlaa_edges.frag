@@ -9,14 +9,14 @@
 // pixels passes 2 and 3 must run on. No early fragment tests: a discarded
 // fragment must not write the stencil. Reads clamp at the border (as
 // src/aa/edges.rs does), so a border pixel never has an edgel toward outside.
-layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, sRGB
+layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, its UNORM view: encoded values
 layout(push_constant) uniform Push { float threshold; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outEdges;
 
 float lumaAt(ivec2 p) {
     ivec2 q = clamp(p, ivec2(0), textureSize(colorTex, 0) - 1);
-    return lumaOf(srgbEncode(COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb));
+    return lumaOf(COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb);
 }
 
 void main() {

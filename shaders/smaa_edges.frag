@@ -11,14 +11,14 @@
 // src/aa/edges.rs's LocalContrast::Shared). A pixel with neither a left nor
 // a top edgel is discarded before the adaptation, so the stencil (REPLACE)
 // marks the pixels the blending-weight pass runs on. Reads clamp at the border.
-layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, sRGB
+layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, its UNORM view: encoded values
 layout(push_constant) uniform Push { float threshold; float adaptation; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outEdges;
 
 float lumaAt(ivec2 p) {
     ivec2 q = clamp(p, ivec2(0), textureSize(colorTex, 0) - 1);
-    return lumaOf(srgbEncode(COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb));
+    return lumaOf(COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb);
 }
 
 void main() {

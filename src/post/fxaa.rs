@@ -7,7 +7,7 @@ use ash::vk;
 
 use super::{AaStage, PostBind, PostSetup};
 use crate::graph::draw::fullscreen;
-use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, ImageDesc, ImageId, Load, Pass, PassContext, Resources};
 use crate::vk::context::Context;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
@@ -31,6 +31,8 @@ impl Fxaa {
         let extent = s.res.extent(s.input);
         let format = s.res.format(s.input);
         let output = s.res.declare(ImageDesc::new("fxaa output", extent, format));
+        // Luma reads the frame's encoded values through a UNORM view.
+        s.res.request_unorm_view(s.input);
         let pipeline =
             Pipeline::graphics(s.ctx, &GraphicsDesc::fullscreen("fxaa", SHADER, format))?;
         Ok(Fxaa {
@@ -43,24 +45,28 @@ impl Fxaa {
 }
 
 impl AaStage for Fxaa {
-    /// Every pixel fetches itself and its 4-neighbourhood; past the contrast
-    /// test also the corners, up to two bilinear fetches per search step and
-    /// the final one: bounds.
+    /// Every pixel fetches its colour, and the luma of itself and its
+    /// 4-neighbourhood; past the contrast test also the corners' luma, up to
+    /// two bilinear luma fetches per search step and the final colour fetch:
+    /// bounds.
     fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        let format = res.texel_format(self.input);
-        let f = |filter, count| Fetch {
-            texture: "colorTex".into(),
+        let f = |texture: &str, format, filter, count, exact| Fetch {
+            texture: texture.into(),
             format,
             filter,
             count,
-            exact: false,
+            exact,
             coherent: true,
         };
+        let (srgb, unorm) = (res.texel_format(self.input), Format::Rgba8Unorm);
+        let steps = f64::from(SEARCH_STEPS);
         let work = ShaderWork {
             shader: SHADER.into(),
             fetches: vec![
-                f(Filter::Point, 9.0),
-                f(Filter::Bilinear, 2.0 * f64::from(SEARCH_STEPS) + 1.0),
+                f("colorTex", srgb, Filter::Point, 1.0, true),
+                f("lumaTex", unorm, Filter::Point, 9.0, false),
+                f("lumaTex", unorm, Filter::Bilinear, 2.0 * steps, false),
+                f("colorTex", srgb, Filter::Bilinear, 1.0, false),
             ],
             alu: alu_estimate(SHADER, &[SEARCH_STEPS]),
             ..Default::default()
@@ -84,6 +90,7 @@ impl AaStage for Fxaa {
             0,
             &[
                 ("colorTex", Bind::Texture(b.res.view(self.input))),
+                ("lumaTex", Bind::Texture(b.res.unorm_view(self.input))),
                 ("linearClamp", Bind::Sampler(b.samplers.linear_clamp)),
             ],
         )?;

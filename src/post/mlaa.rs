@@ -89,6 +89,8 @@ impl Mlaa {
     pub fn new(s: &mut PostSetup) -> Result<Self> {
         let extent = s.res.extent(s.input);
         let ldr_format = s.res.format(s.input);
+        // Pass 1 reads the frame's encoded values (gamma luma) through a UNORM view.
+        s.res.request_unorm_view(s.input);
         let edges = s
             .res
             .declare(ImageDesc::new("mlaa edges", extent, TABLE_FORMAT));
@@ -176,10 +178,17 @@ impl Mlaa {
     }
 
     /// Pass 1: every pixel runs, edge pixels are written (colour and stencil).
-    fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+    fn edges_pass(&self) -> Pass<'_> {
         let work = ShaderWork {
             shader: EDGES_SHADER.into(),
-            fetches: vec![fetch(res, self.input, "colorTex", Filter::Point, 5.0, true)],
+            fetches: vec![Fetch {
+                texture: "colorTex".into(),
+                format: Format::Rgba8Unorm,
+                filter: Filter::Point,
+                count: 5.0,
+                exact: true,
+                coherent: true,
+            }],
             alu: alu_estimate(EDGES_SHADER, &[]),
             ..Default::default()
         };
@@ -340,7 +349,7 @@ fn fetch(
 impl AaStage for Mlaa {
     fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
         vec![
-            self.edges_pass(res),
+            self.edges_pass(),
             self.weights_pass(res),
             self.copy_pass(res),
             self.blend_pass(res),
@@ -358,7 +367,7 @@ impl AaStage for Mlaa {
                 ctx,
                 &self.edges_pipeline,
                 0,
-                &[("colorTex", Bind::Texture(res.view(self.input)))],
+                &[("colorTex", Bind::Texture(res.unorm_view(self.input)))],
             )?,
             b.pool.write_set(
                 ctx,

@@ -95,6 +95,8 @@ impl Smaa {
         let extent = s.res.extent(s.input);
         let ldr_format = s.res.format(s.input);
         let ds = s.depth_stencil_format;
+        // Pass 1 reads the frame's encoded values (gamma luma) through a UNORM view.
+        s.res.request_unorm_view(s.input);
         let edges = s
             .res
             .declare(ImageDesc::new("smaa edges", extent, TABLE_FORMAT));
@@ -183,17 +185,17 @@ impl Smaa {
 
     /// Pass 1: every pixel fetches itself, left and top; pixels kept also
     /// right, bottom and the two beyond left and top.
-    fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+    fn edges_pass(&self) -> Pass<'_> {
         let work = ShaderWork {
             shader: EDGES_SHADER.into(),
-            fetches: vec![fetch(
-                res,
-                self.input,
-                "colorTex",
-                Filter::Point,
-                7.0,
-                false,
-            )],
+            fetches: vec![Fetch {
+                texture: "colorTex".into(),
+                format: Format::Rgba8Unorm,
+                filter: Filter::Point,
+                count: 7.0,
+                exact: false,
+                coherent: true,
+            }],
             alu: alu_estimate(EDGES_SHADER, &[]),
             ..Default::default()
         };
@@ -302,7 +304,7 @@ fn fetch(
 impl AaStage for Smaa {
     fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
         vec![
-            self.edges_pass(res),
+            self.edges_pass(),
             self.weights_pass(res),
             self.blend_pass(res),
         ]
@@ -319,7 +321,7 @@ impl AaStage for Smaa {
                 ctx,
                 &self.edges_pipeline,
                 0,
-                &[("colorTex", Bind::Texture(res.view(self.input)))],
+                &[("colorTex", Bind::Texture(res.unorm_view(self.input)))],
             )?,
             b.pool.write_set(
                 ctx,
