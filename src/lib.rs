@@ -13,7 +13,8 @@
 //! shaders and their statistics, uploads, profiler) -> `graph` (declared images,
 //! passes with their role, work and accesses; barriers and usages derived, never
 //! written at call sites) -> `method` (the SSS methods, one module each behind
-//! one trait, and their registry) -> `render` (the frame around a method) ->
+//! one trait, and their registry; `post`, the anti-aliasing stages after the
+//! tone map) -> `render` (the frame around a method) ->
 //! `report`, `bench`, `run`, `output`, `trace`, `budget`, `plot` (report.json's
 //! schema and statistics, floors, runs, the file writers, the timeline, the
 //! console budget model, the chart writer) -> `eval` (ground-truth comparisons,
@@ -34,6 +35,7 @@ pub mod mix;
 pub mod output;
 pub mod plan;
 pub mod plot;
+pub mod post;
 pub mod reference;
 pub mod render;
 pub mod report;

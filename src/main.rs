@@ -22,6 +22,7 @@ use dermis::method::{
     OptKind,
 };
 use dermis::mix::plan_file::PlanFile;
+use dermis::post::AaMode;
 use dermis::render::settings::Assignment;
 use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
@@ -264,6 +265,32 @@ enum Command {
 // exhaustive matches (a variant added on either side fails to compile until
 // the other has it); the defaults are the library's, read back through `From`.
 
+/// `--aa`: the anti-aliasing after the tone map (`dermis::post`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AaArg {
+    /// None: the tone-mapped frame is the output.
+    None,
+    /// FXAA, quality preset: one full-screen pass.
+    Fxaa,
+    /// Jimenez's MLAA (thesis ch. 9): luma edges writing the stencil, then
+    /// blending weights and neighbourhood blending on edge pixels only.
+    Mlaa,
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with local contrast
+    /// adaptation, diagonal patterns, accurate searches, sharp corners.
+    Smaa,
+}
+
+impl From<AaArg> for AaMode {
+    fn from(a: AaArg) -> Self {
+        match a {
+            AaArg::None => AaMode::None,
+            AaArg::Fxaa => AaMode::Fxaa,
+            AaArg::Mlaa => AaMode::Mlaa,
+            AaArg::Smaa => AaMode::Smaa,
+        }
+    }
+}
+
 /// `--sss-region`: where the SSS passes run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum SssRegionArg {
@@ -502,6 +529,10 @@ struct Common {
     exposure: f32,
     #[arg(long, default_value_t = defaults().shadow_size)]
     shadow_size: u32,
+    /// Anti-aliasing of the tone-mapped frame (its passes are timed and priced like
+    /// every other pass).
+    #[arg(long, value_enum, ignore_case = true, default_value_t = AaArg::None)]
+    aa: AaArg,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -597,6 +628,7 @@ impl Common {
         s.ambient = self.ambient.unwrap_or(base.ambient);
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
+        s.aa = self.aa.into();
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)

@@ -58,6 +58,16 @@ pub const PCF_RADIUS: u32 = 1;
 /// Loop trips of that filter, per nested loop (the ALU estimate's input).
 pub const PCF_TRIPS: [u32; 2] = [2 * PCF_RADIUS + 1; 2];
 
+/// MLAA's distance searches (thesis ch. 9.4.1, Listing 9.3): bilinear
+/// fetches per direction, two pixels each, so lines are followed 8 pixels
+/// each way: the reach of the area texture (`aa::mlaa_area::MAX_DISTANCE`,
+/// the Xbox 360's `tfetch2D` offsets; `post::mlaa` checks the two agree).
+pub const MLAA_MAX_SEARCH_STEPS: u32 = 4;
+
+/// Distances per subtexture of MLAA's area texture (Listing 9.4's
+/// `NUM_DISTANCES`; `aa::mlaa_area::NUM_DISTANCES`, checked in `post::mlaa`).
+pub const MLAA_NUM_DISTANCES: u32 = 9;
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -122,6 +132,8 @@ pub fn glsl() -> String {
     def("TSD_MAX_ISLANDS", TSD_MAX_ISLANDS.to_string());
     def("PCF_RADIUS", PCF_RADIUS.to_string());
     def("PCF_TAPS", float((PCF_TRIPS[0] * PCF_TRIPS[1]) as f32));
+    def("MLAA_MAX_SEARCH_STEPS", MLAA_MAX_SEARCH_STEPS.to_string());
+    def("MLAA_NUM_DISTANCES", MLAA_NUM_DISTANCES.to_string());
     s.push_str("#endif\n");
     s
 }

@@ -6,6 +6,7 @@
 //!   the 16 patterns, the exact areas of L, Z and U shapes (ch. 9.2, 10.4.2).
 //! - `mlaa_area`: MLAA's 45 x 45 area texture, 5 x 5 subtextures of 9 x 9
 //!   (ch. 9.4.3, Listing 9.4).
+//! - `mlaa_weights`: the CPU mirror of MLAA's blending-weight pass (ch. 9.4).
 //! - `smaa_area`, `smaa_diag`: SMAA's 160 x 560 area texture, orthogonal
 //!   (quadratically compressed distances, 7 subpixel offsets) and diagonal
 //!   (5 offsets) halves, as `SMAA.hlsl` addresses it; R8G8 bytes, generated
@@ -23,6 +24,7 @@
 //! computes and what the GPU passes still need.
 pub mod edges;
 pub mod mlaa_area;
+pub mod mlaa_weights;
 pub mod revector;
 pub mod smaa_area;
 pub mod smaa_diag;

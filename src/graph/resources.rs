@@ -27,6 +27,9 @@ pub struct ImageDesc {
     pub extent: vk::Extent2D,
     pub format: vk::Format,
     pub levels: u32,
+    /// Also a view of level 0 as UNORM (an sRGB image read without its
+    /// decode: the post chain's edge tests work on the encoded values).
+    pub unorm_view: bool,
 }
 
 impl ImageDesc {
@@ -36,6 +39,7 @@ impl ImageDesc {
             extent,
             format,
             levels: 1,
+            unorm_view: false,
         }
     }
 
@@ -177,7 +181,15 @@ impl Resources {
             );
             let d = &s.desc;
             s.image = Some(
-                Image::with_levels(ctx, &d.name, d.extent, d.format, s.usage, d.levels)
+                Image::with_unorm_view(
+                    ctx,
+                    &d.name,
+                    d.extent,
+                    d.format,
+                    s.usage,
+                    d.levels,
+                    d.unorm_view,
+                )
                     .with_context(|| format!("creating the frame image '{}'", d.name))?,
             );
         }
@@ -236,6 +248,30 @@ impl Resources {
     /// The view of exactly the level `id` names.
     pub fn view(&self, id: ImageId) -> vk::ImageView {
         self.image(id).level_views[self.images[id.0].level as usize]
+    }
+
+    /// Asks for a UNORM view of an sRGB image declared earlier (before the
+    /// images are created: it is created mutable-format).
+    pub fn request_unorm_view(&mut self, id: ImageId) {
+        let slot = self.images[id.0].slot;
+        let s = &mut self.slots[slot];
+        assert!(
+            s.image.is_none(),
+            "image '{}': a UNORM view asked for after its creation",
+            s.desc.name
+        );
+        s.desc.unorm_view = true;
+    }
+
+    /// The UNORM view of an sRGB image ([`Resources::request_unorm_view`]);
+    /// a pass that binds one it did not ask for is a programmer error.
+    pub fn unorm_view(&self, id: ImageId) -> vk::ImageView {
+        self.image(id).unorm_view.unwrap_or_else(|| {
+            panic!(
+                "image '{}' has no UNORM view (request_unorm_view)",
+                self.name(id)
+            )
+        })
     }
 
     /// The mip level `id` names.

@@ -3,7 +3,8 @@
 //! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
 //! the stencil) -> each group's method's passes (one group in a single-method
 //! frame) and, in a frame of several, the merges (`merge.rs`) -> composite
-//! (diffuse after SSS + specular) -> Hable tone map.
+//! (diffuse after SSS + specular) -> Hable tone map -> the post chain's
+//! anti-aliasing stage (`crate::post`, `--aa`; none by default).
 //!
 //! Over 800 lines because every pass the frame itself records (shadow,
 //! geometry, composite, tone map, the character ids) reads the private
@@ -18,12 +19,13 @@ use super::groups::{scissors, GroupMethod};
 use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
-use super::targets::{LDR_FORMAT, SHADOW_FORMAT};
+use super::targets::SHADOW_FORMAT;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
 use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
 use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
+use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
 use crate::scene::framing::Framing;
 use crate::scene::light::LightFrame;
@@ -50,10 +52,7 @@ const SHADOW_BIAS_MM: f32 = 0.5;
 /// Slope-scaled depth bias of the shadow pass (in units of the depth slope):
 /// the usual 1.5 against acne on curved skin at grazing light.
 const SHADOW_SLOPE_BIAS: f32 = 1.5;
-/// Linear white point of Hable's filmic curve (his Uncharted 2 value).
-const WHITE_POINT: f32 = 11.2;
 const COMPOSITE_SHADER: &str = "composite.frag";
-const TONEMAP_SHADER: &str = "tonemap.frag";
 use crate::shader_constants::PCF_TRIPS;
 
 /// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
@@ -90,13 +89,6 @@ const IDS_SHADER: &str = "geometry_ids.frag";
 /// read per instance.
 const GEOMETRY_VERT: &str = "geometry_instanced.vert";
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct TonemapPush {
-    exposure: f32,
-    white_point: f32,
-}
-
 /// A full-screen post pass: what it reads (image, shader variable), what it writes.
 struct PostPass<'a, 'r> {
     name: &'r str,
@@ -105,7 +97,6 @@ struct PostPass<'a, 'r> {
     set: vk::DescriptorSet,
     reads: &'r [(ImageId, &'r str)],
     target: ImageId,
-    push: Option<TonemapPush>,
 }
 
 /// The frame's pipelines, uniforms, scene objects and placement.
@@ -124,7 +115,6 @@ pub struct Frame {
     shadow_pipeline: Pipeline,
     geometry_pipeline: Pipeline,
     composite_pipeline: Pipeline,
-    tonemap_pipeline: Pipeline,
     /// `--character-ids` only: the pass that writes each head's index + 1
     /// into `character_ids` after the frame (null otherwise).
     ids_pipeline: Pipeline,
@@ -132,7 +122,6 @@ pub struct Frame {
     pub character_ids: Option<ImageId>,
     frame_set: vk::DescriptorSet,
     composite_set: vk::DescriptorSet,
-    tonemap_set: vk::DescriptorSet,
     frame_ubo: Buffer,
     beckmann: Image,
     pub objects: Vec<GpuObject>,
@@ -155,6 +144,8 @@ pub struct Frame {
     instance_set: vk::DescriptorSet,
     ids_instance_set: vk::DescriptorSet,
     screen_rect: Vec<vk::Rect2D>,
+    /// The stages after the tone map (`enable_post`; none with `--aa none`).
+    pub post: PostChain,
 }
 
 /// The heads of one group as the geometry pass draws them.
@@ -200,13 +191,11 @@ impl Frame {
             shadow_pipeline: Pipeline::default(),
             geometry_pipeline: Pipeline::default(),
             composite_pipeline: Pipeline::default(),
-            tonemap_pipeline: Pipeline::default(),
             ids_pipeline: Pipeline::default(),
             ids_set: vk::DescriptorSet::null(),
             character_ids: None,
             frame_set: vk::DescriptorSet::null(),
             composite_set: vk::DescriptorSet::null(),
-            tonemap_set: vk::DescriptorSet::null(),
             frame_ubo: Buffer::default(),
             beckmann: Image::default(),
             objects: Vec::new(),
@@ -222,6 +211,7 @@ impl Frame {
             instance_set: vk::DescriptorSet::null(),
             ids_instance_set: vk::DescriptorSet::null(),
             screen_rect: scissors(&[full]),
+            post: PostChain::default(),
         };
         // Filled in by `build`: on an error, the guard frees what exists.
         let mut f = Guard::new(ctx, f);
@@ -384,10 +374,6 @@ impl Frame {
             ctx,
             &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
         )?;
-        self.tonemap_pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc::fullscreen("tonemap", TONEMAP_SHADER, LDR_FORMAT),
-        )?;
         Ok(())
     }
 
@@ -422,6 +408,31 @@ impl Frame {
         )?;
         self.character_ids = Some(ids);
         self.write_instances(ctx)
+    }
+
+    /// Builds the post chain: the tone map, and the stage `settings.aa`
+    /// names with its images declared (before the usages are derived: its
+    /// passes declare them). Every frame needs it.
+    pub fn enable_post(&mut self, ctx: &Context, res: &mut Resources) -> Result<()> {
+        let depth_stencil_format = res.format(self.targets.depth_stencil);
+        self.post = PostChain::new(
+            self.settings.aa,
+            &mut PostSetup {
+                ctx,
+                res,
+                hdr: self.targets.hdr,
+                exposure: self.settings.exposure,
+                input: self.targets.ldr,
+                depth_stencil_format,
+            },
+        )?;
+        Ok(())
+    }
+
+    /// The frame's output image: the anti-aliased frame, or the tone-mapped
+    /// one without a post stage.
+    pub fn output(&self) -> ImageId {
+        self.post.output().unwrap_or(self.targets.ldr)
     }
 
     /// The frame's uniforms: camera, key light, shadow and transmittance parameters.
@@ -549,18 +560,17 @@ impl Frame {
                 ("specularTex", Bind::Texture(res.view(t.specular))),
             ],
         )?;
-        self.tonemap_set = self.pool.write_set(
-            ctx,
-            &self.tonemap_pipeline,
-            0,
-            &[("hdrTex", Bind::Texture(res.view(t.hdr)))],
-        )?;
         if self.character_ids.is_some() {
             self.ids_set =
                 self.pool
                     .write_set(ctx, &self.ids_pipeline, 0, &self.frame_binds(res)[..1])?;
         }
-        Ok(())
+        self.post.bind(&PostBind {
+            ctx,
+            res,
+            pool: &self.pool,
+            samplers: &self.samplers,
+        })
     }
 
     /// What group `g`'s passes are built against: its region and stencil code.
@@ -624,7 +634,7 @@ impl Frame {
         let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
         passes.extend(self.group_passes(groups, merge, res));
         passes.push(self.composite_pass(res, self.composite_source(groups)));
-        passes.push(self.tonemap_pass(res));
+        passes.extend(self.post.passes(res));
         if let Some(ids) = self.character_ids {
             passes.push(self.character_ids_pass(ids));
         }
@@ -789,7 +799,6 @@ impl Frame {
             set,
             reads,
             target,
-            push,
         } = p;
         let work = ShaderWork {
             shader: shader.into(),
@@ -813,13 +822,7 @@ impl Frame {
         }
         pass.color(ColorTarget::new(target, Load::DontCare))
             .draws(Some(work), 1)
-            .record(move |pc: &PassContext| {
-                fullscreen(pc, pipeline, &[set], |c, cmd| {
-                    if let Some(p) = &push {
-                        pipeline.push(c, cmd, p);
-                    }
-                })
-            })
+            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
     }
 
     fn composite_pass<'a>(&'a self, res: &Resources, sss_output: ImageId) -> Pass<'a> {
@@ -833,26 +836,6 @@ impl Frame {
                 set: self.composite_set,
                 reads: &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
                 target: t.hdr,
-                push: None,
-            },
-        )
-    }
-
-    fn tonemap_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let t = self.targets;
-        self.fullscreen_pass(
-            res,
-            PostPass {
-                name: "tonemap",
-                pipeline: &self.tonemap_pipeline,
-                shader: TONEMAP_SHADER,
-                set: self.tonemap_set,
-                reads: &[(t.hdr, "hdrTex")],
-                target: t.ldr,
-                push: Some(TonemapPush {
-                    exposure: self.settings.exposure,
-                    white_point: WHITE_POINT,
-                }),
             },
         )
     }
@@ -861,6 +844,7 @@ impl Frame {
         for o in &mut self.objects {
             o.destroy(ctx);
         }
+        self.post.destroy(ctx);
         self.beckmann.destroy(ctx);
         self.frame_ubo.destroy(ctx);
         self.instance_buffer.destroy(ctx);
@@ -868,7 +852,6 @@ impl Frame {
             &mut self.shadow_pipeline,
             &mut self.geometry_pipeline,
             &mut self.composite_pipeline,
-            &mut self.tonemap_pipeline,
             &mut self.ids_pipeline,
         ] {
             p.destroy(ctx);

@@ -21,9 +21,9 @@ const UPLOAD_ACCESS: AccessKind = AccessKind::TransferWrite;
 /// How fills write the intermediates (whole contents, by a clear).
 pub const FILL_ACCESS: AccessKind = AccessKind::ClearWrite;
 
-/// The images `upload_sss_inputs` and `upload_normals` write.
+/// The images `upload_sss_inputs`, `upload_normals` and `upload_ldr` write.
 pub fn upload_accesses(t: &FrameTargets) -> Vec<(ImageId, AccessKind)> {
-    [t.diffuse, t.linear_depth, t.depth_stencil]
+    [t.diffuse, t.linear_depth, t.depth_stencil, t.ldr]
         .into_iter()
         .chain(t.normals)
         .map(|i| (i, UPLOAD_ACCESS))
@@ -188,6 +188,26 @@ impl Renderer<'_> {
                 bytemuck::cast_slice(normals_f16),
                 vec![(vk::ImageAspectFlags::COLOR, 0)],
             )],
+            extent,
+        )
+    }
+
+    /// Uploads a synthetic tone-mapped frame (tests of the post chain):
+    /// sRGB-encoded RGBA8, row-major, top row first.
+    pub fn upload_ldr(&mut self, rgba8: &[u8]) -> Result<()> {
+        let extent = self.frame.extent;
+        let want = extent.width as usize * extent.height as usize * 4;
+        if rgba8.len() != want {
+            bail!(
+                "a {}x{} frame needs {want} bytes, got {}",
+                extent.width,
+                extent.height,
+                rgba8.len()
+            );
+        }
+        let ldr = self.frame.targets.ldr;
+        self.upload(
+            vec![(ldr, rgba8, vec![(vk::ImageAspectFlags::COLOR, 0)])],
             extent,
         )
     }

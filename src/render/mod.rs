@@ -11,6 +11,7 @@ pub mod group_setup;
 pub mod groups;
 pub mod inputs;
 pub mod merge;
+pub mod post_only;
 pub mod readback;
 pub mod scene_gpu;
 pub mod settings;
@@ -203,6 +204,7 @@ impl<'c> Renderer<'c> {
         if let Some(ids) = ids {
             frame.enable_character_ids(ctx, &resources, ids)?;
         }
+        frame.enable_post(ctx, &mut resources)?;
         frame.set_skin_groups(
             ctx,
             specs
@@ -387,7 +389,7 @@ impl<'c> Renderer<'c> {
         // Everything a capture returns, read back in the frame's own submission.
         let t = &self.frame.targets;
         let mut finals = vec![
-            t.ldr,
+            self.frame.output(),
             self.frame.composite_source(&self.groups),
             t.linear_depth,
             t.hdr,

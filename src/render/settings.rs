@@ -7,6 +7,7 @@ use crate::method::region::{RegionMode, TILE_PX};
 use crate::method::{default_method, MethodEntry, MethodOptions};
 use crate::mix::assign::Rules;
 use crate::mix::plan_file::PlanFile;
+use crate::post::AaMode;
 use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
@@ -79,6 +80,9 @@ pub struct RenderSettings {
     pub ambient: f32,
     pub exposure: f32,
     pub shadow_size: u32,
+    /// Anti-aliasing after the tone map (`--aa`; `crate::post`). `None` leaves
+    /// the frame as it was before the post chain, bit for bit.
+    pub aa: AaMode,
 }
 
 /// The default view is a portrait (issue 15): the head alone in frame at
@@ -141,6 +145,7 @@ impl RenderSettings {
             ambient: 0.08,
             exposure: 2.0,
             shadow_size: 2048,
+            aa: AaMode::None,
         }
     }
 

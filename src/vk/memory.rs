@@ -31,6 +31,9 @@ pub struct Image {
     pub aspect: vk::ImageAspectFlags,
     /// A depth-only view of a depth/stencil image, for sampling.
     pub depth_view: Option<vk::ImageView>,
+    /// An sRGB image's level 0 read as UNORM (its encoded values, no
+    /// decode), made only when asked for (`with_unorm_view`).
+    pub unorm_view: Option<vk::ImageView>,
     pub name: String,
     allocation: Option<Allocation>,
 }
@@ -78,6 +81,60 @@ impl Image {
         Self::with_levels(ctx, name, extent, format, usage, 1)
     }
 
+    /// The UNORM format of the same texels as sRGB `format` (the one pair
+    /// dermis views both ways).
+    pub fn unorm_of(format: vk::Format) -> Option<vk::Format> {
+        match format {
+            vk::Format::R8G8B8A8_SRGB => Some(vk::Format::R8G8B8A8_UNORM),
+            _ => None,
+        }
+    }
+
+    /// An image with `levels` mip levels and, when `unorm_view`, created
+    /// mutable-format with a second view of level 0 as UNORM (its format must
+    /// be sRGB: [`Image::unorm_of`]).
+    pub fn with_unorm_view(
+        ctx: &Context,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        levels: u32,
+        unorm_view: bool,
+    ) -> Result<Self> {
+        if !unorm_view {
+            return Self::with_levels(ctx, name, extent, format, usage, levels);
+        }
+        let unorm = Self::unorm_of(format).with_context(|| {
+            format!("image '{name}': a UNORM view of {format:?} (not an sRGB format)")
+        })?;
+        let mut image = Guard::new(
+            ctx,
+            Self::create(ctx, name, extent, format, usage, levels, true)?,
+        );
+        ctx.creation_step(&format!("the UNORM view of image '{name}'"))?;
+        let view = unsafe {
+            ctx.device.create_image_view(
+                &vk::ImageViewCreateInfo::default()
+                    .image(image.raw)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(unorm)
+                    .subresource_range(
+                        vk::ImageSubresourceRange::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .level_count(1)
+                            .layer_count(1),
+                    ),
+                None,
+            )
+        }
+        .map_err(Error::from)
+        .with_context(|| format!("creating the UNORM view of image '{name}'"))?;
+        ctx.name(view, &format!("{name} unorm view"));
+        image.unorm_view = Some(view);
+        Ok(image.keep())
+    }
+
     /// An image with `levels` mip levels (each half the size of the previous).
     pub fn with_levels(
         ctx: &Context,
@@ -86,6 +143,18 @@ impl Image {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
         levels: u32,
+    ) -> Result<Self> {
+        Self::create(ctx, name, extent, format, usage, levels, false)
+    }
+
+    fn create(
+        ctx: &Context,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        levels: u32,
+        mutable_format: bool,
     ) -> Result<Self> {
         let levels = levels.max(1);
         let aspect = if is_depth_format(format) {
@@ -111,6 +180,11 @@ impl Image {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        let info = if mutable_format {
+            info.flags(vk::ImageCreateFlags::MUTABLE_FORMAT)
+        } else {
+            info
+        };
         ctx.creation_step(&format!("image '{name}'"))?;
         let raw = unsafe { ctx.device.create_image(&info, None) }
             .map_err(Error::from)
@@ -226,6 +300,9 @@ impl Image {
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             if let Some(v) = self.depth_view.take() {
+                ctx.device.destroy_image_view(v, None);
+            }
+            if let Some(v) = self.unorm_view.take() {
                 ctx.device.destroy_image_view(v, None);
             }
             if self.chain_view != self.view {

@@ -43,7 +43,8 @@ const LAYERS: &[&[&str]] = &[
     &["vk"],
     &["graph"],
     // mix: which method each character gets (it reads the registry).
-    &["method", "mix"],
+    // post: the anti-aliasing stages after the tone map (read by render).
+    &["method", "mix", "post"],
     &["render"],
     &[
         "report", "bench", "run", "output", "trace", "budget", "plot",
@@ -501,6 +502,14 @@ fn shaders_are_named_after_their_owner() {
         "tonemap",
         "probe",
     ];
+    // The post chain's stages (`src/post/`, one file each) and their shared include.
+    let post: Vec<String> = std::fs::read_dir(src().join("post"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "rs"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .map(|m| if m == "mod" { "post".to_string() } else { m })
+        .collect();
     // Includes whose facts several owners share.
     let shared = [
         "shader_constants",
@@ -521,6 +530,7 @@ fn shaders_are_named_after_their_owner() {
         assert!(
             methods.iter().any(|m| owned(m))
                 || frame.iter().any(|p| owned(p))
+                || post.iter().any(|p| owned(p))
                 || shared.contains(&stem),
             "shaders/{name} is named after no method, frame pass or shared include"
         );

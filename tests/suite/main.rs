@@ -21,6 +21,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod aa;
 mod accuracy;
 mod accuracy_model;
 mod budget_cli;

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 
 use dermis::graph::work::Work;
 use dermis::method::METHODS;
+use dermis::post::AaMode;
 use dermis::render::counting::{filter_kind, site};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
@@ -36,6 +37,13 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                 m.name.to_string(),
                 RenderSettings::study().with(m, &[("density", "2")]),
             ));
+        }
+        // The post chain's stages, once (they follow every method alike).
+        if std::ptr::eq(*m, METHODS[0]) {
+            for aa in [AaMode::Mlaa, AaMode::Fxaa, AaMode::Smaa] {
+                let s = RenderSettings::study().with(m, &[]);
+                settings.push((format!("{} --aa {aa}", m.name), RenderSettings { aa, ..s }));
+            }
         }
         for (label, s) in settings {
             let s = RenderSettings {

@@ -1,0 +1,232 @@
+//! The post chain after the composite: the tone map (`tonemap`, every
+//! frame), then the anti-aliasing stage `--aa`
+//! picks (thesis ch. 9-10; issue 17). Each AA stage is a module with its
+//! declared images, pipelines and passes, like an SSS method (`crate::method`):
+//! it reads the tone-mapped LDR frame (gamma-space luma, as MLAA and FXAA
+//! define their edges) and writes a new LDR target that becomes the frame's
+//! output image. `--aa none` adds no image, pipeline or pass: the frame is the
+//! one it was before the chain existed, bit for bit.
+//!
+//! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
+//! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
+//!   weights, neighbourhood blending, both stencil-tested) and a copy.
+//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with
+//!   local contrast adaptation writing the stencil, blending weights
+//!   (stencil-tested: diagonals, accurate searches, corners), blending.
+//! - `fxaa`: FXAA's quality preset, one pass.
+//!
+//! The device-free parts (area texture, CPU references) live in `crate::aa`.
+
+pub mod fxaa;
+pub mod mlaa;
+pub mod smaa;
+pub mod tonemap;
+
+use std::fmt;
+use std::str::FromStr;
+
+use anyhow::{bail, Result};
+use ash::vk;
+
+use crate::graph::{ImageId, Pass, Resources};
+use crate::vk::context::Context;
+use crate::vk::pipeline::{DescriptorPool, Samplers};
+
+/// Which anti-aliasing the frame gets after the tone map.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum AaMode {
+    /// None: the tone-mapped frame is the output (the frame before issue 17).
+    #[default]
+    None,
+    /// FXAA, quality preset: one pass.
+    Fxaa,
+    /// Jimenez's MLAA (thesis ch. 9): three stencil-culled passes.
+    Mlaa,
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset.
+    Smaa,
+}
+
+impl AaMode {
+    pub const ALL: [AaMode; 4] = [AaMode::None, AaMode::Fxaa, AaMode::Mlaa, AaMode::Smaa];
+
+    /// The name `--aa` takes and reports print.
+    pub fn name(self) -> &'static str {
+        match self {
+            AaMode::None => "none",
+            AaMode::Fxaa => "fxaa",
+            AaMode::Mlaa => "mlaa",
+            AaMode::Smaa => "smaa",
+        }
+    }
+
+    /// One line for `--help` and the docs.
+    pub fn summary(self) -> &'static str {
+        match self {
+            AaMode::None => "no anti-aliasing: the tone-mapped frame is the output",
+            AaMode::Fxaa => "FXAA, quality preset: one full-screen pass on gamma luma",
+            AaMode::Mlaa => {
+                "Jimenez's MLAA (thesis ch. 9): luma edges + stencil, blending weights, neighbourhood blending"
+            }
+            AaMode::Smaa => {
+                "SMAA 1x (thesis ch. 10.4), high preset: adapted luma edges + stencil, weights with diagonals and corners, blending"
+            }
+        }
+    }
+}
+
+impl fmt::Display for AaMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for AaMode {
+    type Err = anyhow::Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        match AaMode::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s))
+        {
+            Some(m) => Ok(m),
+            None => bail!(
+                "unknown anti-aliasing mode '{s}' (one of: {})",
+                AaMode::ALL.map(AaMode::name).join(", ")
+            ),
+        }
+    }
+}
+
+/// What a stage is built from (images are declared into `res` before they
+/// exist, as every frame image is).
+pub struct PostSetup<'a> {
+    pub ctx: &'a Context,
+    pub res: &'a mut Resources,
+    /// The HDR composite the tone map reads.
+    pub hdr: ImageId,
+    /// The exposure the tone map applies (a factor on linear light).
+    pub exposure: f32,
+    /// The tone-mapped frame the anti-aliasing stage reads.
+    pub input: ImageId,
+    /// The frame's depth/stencil format (a stencil-culling stage's own
+    /// stencil image takes it: the device renders and clears it).
+    pub depth_stencil_format: vk::Format,
+}
+
+/// What a stage's descriptor sets are written from, once the images exist.
+pub struct PostBind<'a> {
+    pub ctx: &'a Context,
+    pub res: &'a Resources,
+    pub pool: &'a DescriptorPool,
+    pub samplers: &'a Samplers,
+}
+
+/// One anti-aliasing stage of the chain.
+pub trait AaStage {
+    /// The stage's passes, in order, reading the tone-mapped frame.
+    fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>>;
+    /// The image the stage leaves the anti-aliased frame in (LDR, sRGB).
+    fn output(&self) -> ImageId;
+    /// Writes the descriptor sets that read frame images.
+    fn bind(&mut self, b: &PostBind) -> Result<()>;
+    /// The stage's images by name (tests read intermediates back).
+    fn images(&self) -> Vec<(&'static str, ImageId)>;
+    fn destroy(&mut self, ctx: &Context);
+}
+
+/// The chain: the tone map, then no stage (`--aa none`) or one AA stage.
+#[derive(Default)]
+pub struct PostChain {
+    tonemap: tonemap::Tonemap,
+    aa: Option<Box<dyn AaStage>>,
+}
+
+impl PostChain {
+    /// The tone map and the stage `mode` names, images declared and
+    /// pipelines built. On an error, what was built is destroyed.
+    pub fn new(mode: AaMode, s: &mut PostSetup) -> Result<Self> {
+        let ctx = s.ctx;
+        let tm = tonemap::Tonemap::new(ctx, &*s.res, s.hdr, s.input, s.exposure)?;
+        let mut chain = crate::vk::guard::Guard::new(
+            ctx,
+            PostChain {
+                tonemap: tm,
+                aa: None,
+            },
+        );
+        chain.aa = match mode {
+            AaMode::None => None,
+            AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
+            AaMode::Mlaa => Some(Box::new(mlaa::Mlaa::new(s)?)),
+            AaMode::Smaa => Some(Box::new(smaa::Smaa::new(s)?)),
+        };
+        Ok(chain.keep())
+    }
+
+    /// The tone map's pass, then the anti-aliasing stage's.
+    pub fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
+        let mut passes = vec![self.tonemap.pass(res)];
+        passes.extend(self.aa_passes(res));
+        passes
+    }
+
+    /// The anti-aliasing stage's passes alone (none without one).
+    pub fn aa_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
+        self.aa.as_ref().map(|a| a.passes(res)).unwrap_or_default()
+    }
+
+    /// The anti-aliased frame, `None` without a stage.
+    pub fn output(&self) -> Option<ImageId> {
+        self.aa.as_ref().map(|a| a.output())
+    }
+
+    pub fn bind(&mut self, b: &PostBind) -> Result<()> {
+        self.tonemap.bind(b)?;
+        match &mut self.aa {
+            Some(a) => a.bind(b),
+            None => Ok(()),
+        }
+    }
+
+    /// The stage's image named `name` (see [`AaStage::images`]).
+    pub fn image(&self, name: &str) -> Option<ImageId> {
+        self.aa
+            .as_ref()?
+            .images()
+            .into_iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, id)| id)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(a) = &mut self.aa {
+            a.destroy(ctx);
+        }
+        self.tonemap.destroy(ctx);
+    }
+}
+
+impl crate::vk::guard::Destroy for PostChain {
+    fn destroy(&mut self, ctx: &Context) {
+        PostChain::destroy(self, ctx)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn modes_parse_by_name_and_refuse_others_in_one_line() {
+        for m in AaMode::ALL {
+            assert_eq!(m.name().parse::<AaMode>().unwrap(), m);
+            assert_eq!(m.name().to_uppercase().parse::<AaMode>().unwrap(), m);
+        }
+        let e = "smaa-t2x".parse::<AaMode>().unwrap_err().to_string();
+        assert!(
+            e.contains("none, fxaa, mlaa, smaa") && !e.contains('\n'),
+            "{e}"
+        );
+        assert_eq!(AaMode::default(), AaMode::None);
+    }
+}
