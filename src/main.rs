@@ -141,6 +141,30 @@ enum Command {
         #[arg(long, default_value_t = 10)]
         frames: usize,
     },
+    /// Score every anti-aliasing mode against a supersampled frame (issue 17, docs/aa.md):
+    /// per view, the frame at FACTOR x FACTOR its size with the same camera and SSS method,
+    /// tone-mapped and box-filtered in display-linear light, against each --aa mode's frame
+    /// (relative RMSE and FLIP over the edge pixels and the whole frame). Writes
+    /// aa-eval.json, aa-eval.csv, chart.png/svg (AA ms against error) and per view the
+    /// reference, edge mask and frames as PNGs; prints the table.
+    AaEval {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, default_value = "out/aa-eval")]
+        out: PathBuf,
+        /// Views, comma-separated: head (the procedural face close and far; with --scene
+        /// PATH.glb also that scan), crowd (--heads procedural faces, 9 when --heads is 1)
+        /// and lines (builtin:lines, thin bars and a grid, at 1, 2 and 4 close-up distances).
+        #[arg(long, default_value = "head,crowd,lines")]
+        scenes: String,
+        /// Samples per pixel per axis of the reference (1..=8).
+        #[arg(long, default_value_t = dermis::eval::supersample::DEFAULT_FACTOR)]
+        factor: u32,
+        #[arg(long, default_value_t = 1)]
+        warmup: usize,
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+    },
     /// Price the frame on hardware budget profiles (profiles/*.toml): runs it on this
     /// device (lavapipe included) and again with the fetch-counting build, prints each
     /// pass's modelled ms, bound, eDRAM tiles and resolves, shares of the frame and of
@@ -440,7 +464,7 @@ struct Common {
     /// Enable the Khronos validation layer with synchronization validation; any message fails the run.
     #[arg(long)]
     validate: bool,
-    /// glTF/GLB scene, or builtin:face | builtin:egg (default: the embedded procedural face).
+    /// glTF/GLB scene, or builtin:face | builtin:egg | builtin:lines (default: the embedded procedural face).
     #[arg(long)]
     scene: Option<PathBuf>,
     #[arg(long)]
@@ -785,6 +809,14 @@ fn main_result() -> Result<()> {
             warmup,
             frames,
         } => eval(&common, &out, &scenes, warmup, frames)?,
+        Command::AaEval {
+            common,
+            out,
+            scenes,
+            factor,
+            warmup,
+            frames,
+        } => aa_eval(&common, &out, &scenes, factor, (warmup, frames))?,
         Command::Bench {
             common,
             report,
@@ -955,6 +987,63 @@ fn eval(common: &Common, out: &Path, scenes: &str, warmup: usize, frames: usize)
     Ok(())
 }
 
+/// `dermis aa-eval`: every AA mode against the supersampled frame.
+fn aa_eval(
+    common: &Common,
+    out: &Path,
+    scenes: &str,
+    factor: u32,
+    (warmup, frames): (usize, usize),
+) -> Result<()> {
+    use dermis::eval::{aa_eval, supersample};
+    dermis::run::check_frame_counts(warmup, frames)?;
+    let base = RenderSettings {
+        assignment: None,
+        ..common.settings()?
+    };
+    warn_foreign(&base);
+    // Checked against the device's limit too once it is open (`aa_eval::reference`).
+    supersample::check_supersampled(
+        base.width,
+        base.height,
+        factor,
+        dermis::scene::MAX_IMAGE_SIDE,
+    )?;
+    // A glTF --scene is the scan the head views add; a built-in one adds nothing.
+    let head = common
+        .scene
+        .as_deref()
+        .filter(|p| !p.to_str().is_some_and(|s| s.starts_with(BUILTIN)));
+    let crowd = if base.heads > 1 {
+        base.heads
+    } else {
+        aa_eval::DEFAULT_CROWD
+    };
+    let specs = aa_eval::scene_set(scenes, head, crowd, base.fovy_deg)?;
+    dermis::output::prepare_out_dir(out)?;
+    let ctx = common.context()?;
+    let opts = aa_eval::AaEvalOptions {
+        base,
+        factor,
+        warmup,
+        measured: frames,
+        progress: true,
+        images: Some(out.join("views")),
+    };
+    let result = aa_eval::sweep(&ctx, &specs, &opts).and_then(|rows| {
+        let files = aa_eval::write(&ctx, &rows, &specs, &opts, &command_line(), out)?;
+        Ok((rows, files))
+    });
+    let (rows, files) = ctx.finish_with(result)?;
+    print!("{}", aa_eval::table(&rows));
+    let names: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} and views/ in {}", names.join(", "), out.display());
+    Ok(())
+}
+
 /// `dermis bench`: many frames and the device ceilings, the report only.
 fn bench(
     common: &Common,
@@ -1081,6 +1170,9 @@ fn ignored_options(command: &str, m: &ArgMatches) -> Vec<String> {
         "budget" if given("compare_methods") => Some("--compare-methods prices every method"),
         _ => None,
     };
+    if command == "aa-eval" && given("aa") {
+        notes.push("--aa is ignored: aa-eval runs every mode".to_string());
+    }
     if let (Some(why), true) = (method_ignored, given("method")) {
         notes.push(format!("--method is ignored: {why}"));
     }

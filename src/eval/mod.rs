@@ -14,11 +14,16 @@
 //! - `accuracy_set`: the accuracy model's scene set (scales x lights on both
 //!   heads) and what it writes: the model's data, its chart and its
 //!   leave-one-scale-out error;
+//! - `supersample`: the anti-aliasing evaluation's supersampled reference
+//!   (the box filter in display-linear light), edge mask and scores;
+//! - `aa_eval`: `dermis aa-eval`, every AA mode against that reference;
 //! - `study`: `dermis eval` and `dermis compare`: scene sets, outputs, charts.
+pub mod aa_eval;
 pub mod accuracy_set;
 pub mod bands;
 pub mod chart;
 pub mod metrics;
 pub mod pareto;
 pub mod study;
+pub mod supersample;
 pub mod sweep;

@@ -11,6 +11,7 @@ pub mod gltf_source;
 pub mod head_measure;
 pub mod layout;
 pub mod light;
+pub mod lines;
 pub mod mesh;
 pub mod procedural;
 pub mod robust_bounds;
@@ -50,7 +51,7 @@ impl Scene {
 }
 
 /// The built-in scenes, by the name `--scene builtin:NAME` takes.
-pub const BUILTIN_SCENES: [&str; 2] = ["face", "egg"];
+pub const BUILTIN_SCENES: [&str; 3] = ["face", "egg", "lines"];
 
 /// The default scene: the procedural face (`face.rs`), no files needed.
 pub fn default_scene() -> Scene {
@@ -59,11 +60,13 @@ pub fn default_scene() -> Scene {
 
 /// A built-in scene by name (`face`, the default; `egg`, the first procedural
 /// head, kept so outputs before and after the default changed can be compared
-/// and the stability tests keep their calibrated scene).
+/// and the stability tests keep their calibrated scene; `lines`, thin bars
+/// and a grid on a card, the anti-aliasing evaluation's synthetic scene).
 pub fn builtin(name: &str) -> Result<Scene> {
     match name {
         "face" => Ok(face::face_scene()),
         "egg" => Ok(egg_scene()),
+        "lines" => Ok(lines::lines_scene()),
         other => bail!(
             "unknown built-in scene '{other}' (valid: {})",
             BUILTIN_SCENES.join(", ")
@@ -229,7 +232,7 @@ mod tests {
         assert!(builtin("pear")
             .unwrap_err()
             .to_string()
-            .contains("valid: face, egg"));
+            .contains("valid: face, egg, lines"));
         assert_eq!(default_scene().name, builtin("face").unwrap().name);
     }
 

@@ -57,6 +57,7 @@ const LAYERS: &[&[&str]] = &[
 /// Files above the pure core that must stay pure too (paths under `src/`).
 const PURE_FILES: &[&str] = &[
     "eval/metrics.rs",
+    "eval/supersample.rs",
     "budget/model.rs",
     "plan/cost.rs",
     "plan/character.rs",

@@ -22,6 +22,7 @@
 mod common;
 
 mod aa;
+mod aa_eval;
 mod accuracy;
 mod accuracy_model;
 mod budget_cli;
