@@ -51,6 +51,10 @@ pub struct Report {
     pub sss_region_pixels: Option<u64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sss_region_rects: Option<u64>,
+    /// The post chain's anti-aliasing (`--aa`, `post::AaMode::name`); `None`
+    /// without one (so a `--aa none` report is the one from before the chain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aa: Option<String>,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,

@@ -193,6 +193,7 @@ pub fn run(
         sss_region: Some(settings.sss_region),
         sss_region_pixels: Some(sss_region_pixels),
         sss_region_rects: Some(sss_region_rects),
+        aa: (settings.aa != crate::post::AaMode::None).then(|| settings.aa.name().to_string()),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -854,3 +854,69 @@ fn mlaa_blend_is_the_area_weighted_average_of_eq_9_1() {
         assert!(worst <= 2.5 / 255.0, "seed {seed}: {worst}");
     }
 }
+
+/// `dermis render --aa MODE` (validation on): the report names the mode and
+/// lists its passes, role `post`, timed and counted like every other pass;
+/// without `--aa` the report has no `aa` key; a mode it does not know is one
+/// error line.
+#[test]
+fn render_reports_the_mode_and_its_passes() {
+    let dir = std::env::temp_dir().join(format!("dermis-aa-{}", std::process::id()));
+    let render = |aa: Option<&str>, out: &std::path::Path| {
+        let mut c = common::dermis();
+        c.args([
+            "render",
+            "--validate",
+            "--device",
+            "llvmpipe",
+            "--width",
+            "64",
+        ])
+        .args(["--height", "48", "--frames", "2", "--warmup", "0", "--out"])
+        .arg(out);
+        if let Some(aa) = aa {
+            c.args(["--aa", aa]);
+        }
+        c.output().unwrap()
+    };
+    for (mode, passes) in [
+        (
+            "mlaa",
+            &["mlaa edges", "mlaa weights", "mlaa copy", "mlaa blend"][..],
+        ),
+        ("smaa", &["smaa edges", "smaa weights", "smaa blend"][..]),
+        ("fxaa", &["fxaa"][..]),
+    ] {
+        let out = dir.join(mode);
+        let o = render(Some(mode), &out);
+        assert!(
+            o.status.success(),
+            "{mode}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        assert_eq!(report["aa"], mode);
+        let listed: Vec<&serde_json::Value> = report["passes"].as_array().unwrap().iter().collect();
+        for p in passes {
+            let q = listed
+                .iter()
+                .find(|q| q["name"] == *p)
+                .unwrap_or_else(|| panic!("{mode}: no pass {p} in the report"));
+            assert_eq!(q["role"], "post", "{p}");
+        }
+    }
+    let out = dir.join("none");
+    assert!(render(None, &out).status.success());
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(report.get("aa").is_none());
+    let o = render(Some("smaa-t2x"), &dir.join("bad"));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("smaa-t2x"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
