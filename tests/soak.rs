@@ -10,10 +10,11 @@
 //! Default (the short soak of `cargo test`): 64x36, per method 20 warm-up
 //! frames, then 40 frames (the reference: 3 and 4, at 4 samples per mm^2); 4
 //! renders of 2 frames each in a row. Bounds: the highest resident memory so far
-//! grows at most QUARTER_BOUND_MIB in at least three of the four quarters of the
+//! grows at most QUARTER_BOUND_MIB in at least STEADY_QUARTERS of the four quarters of the
 //! frames and at most TOTAL_BOUND_MIB in all (a leak grows in every quarter; a driver cache or a
 //! new malloc arena of a rasteriser thread, once: lavapipe takes a 12-14 MiB step
-//! at a random frame in about one run of three); after the renders, at most
+//! at a random frame in about one run of three, and in some runs the allocator's
+//! first 2.5 MiB swing sets a high in another quarter); after the renders, at most
 //! TOTAL_BOUND_MIB above the value after the first; live allocations exactly
 //! equal; 0 objects created by the frame loop; 0 messages at teardown. A quarter
 //! of the short soak is 10 frames, so it fails on any leak of 100 KiB a frame or
@@ -39,6 +40,12 @@ use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 const QUARTER_BOUND_MIB: f64 = 1.0;
 /// Most growth over all the frames (and over the renders), in MiB.
 const TOTAL_BOUND_MIB: f64 = 24.0;
+/// Quarters (of four) that must stay within QUARTER_BOUND_MIB. Two one-off
+/// events can each set a high in a quarter of their own (the arena step and
+/// the first of the allocator's 2.5 MiB swings: seen together in 3 of 5 runs
+/// of one branch, 2026-12-02), while a leak sets one in all four, so two
+/// steady quarters still fail every leak the bound can see.
+const STEADY_QUARTERS: usize = 2;
 
 /// The soak's length: (frames a method, renders in a row). The short soak
 /// unless DERMIS_SOAK=1 asks for the long one; DERMIS_SOAK_FRAMES and
@@ -117,7 +124,7 @@ fn frames_and_renders_stay_flat() {
     let ctx = context();
     let mut failures = Vec::new();
     eprintln!(
-        "soak: 64x36, validation {}; RSS bounds: {QUARTER_BOUND_MIB} MiB in 3 of 4 quarters, {TOTAL_BOUND_MIB} MiB in all",
+        "soak: 64x36, validation {}; RSS bounds: {QUARTER_BOUND_MIB} MiB in {STEADY_QUARTERS} of 4 quarters, {TOTAL_BOUND_MIB} MiB in all",
         ctx.validation
     );
     eprintln!(
@@ -178,7 +185,7 @@ fn frames_and_renders_stay_flat() {
             made1 - made0,
             n as f64 / t.elapsed().as_secs_f64()
         );
-        if steady < 3 || growth > TOTAL_BOUND_MIB {
+        if steady < STEADY_QUARTERS || growth > TOTAL_BOUND_MIB {
             failures.push(format!(
                 "{method}: resident memory grew {growth:.1} MiB over {n} frames ({quarters:.2?} MiB by quarter)"
             ));
