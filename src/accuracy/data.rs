@@ -145,7 +145,9 @@ pub fn to_toml(header: &Header, rows: &[Row]) -> Result<String> {
     s.push_str(
         "# scale (px/mm at the head centre's depth) and key-light angle (degrees between the\n",
     );
-    s.push_str("# light and the direction to the camera) and shadow-map texel at the character (mm),\n");
+    s.push_str(
+        "# light and the direction to the camera) and shadow-map texel at the character (mm),\n",
+    );
     s.push_str("# measured against the ground truth.\n");
     s.push_str("# Regenerate (the `command` below; then copy the file here):\n");
     s.push_str(&format!("#   {}\n", header.command));

@@ -233,7 +233,10 @@ mod tests {
         let r = leave_one_shadow_out(&m);
         // The middle texel at both scales.
         assert_eq!(r[0].points, 2);
-        assert!(r[0].interior_max < 1e-12 && r[0].silhouette_max < 1e-12, "{r:?}");
+        assert!(
+            r[0].interior_max < 1e-12 && r[0].silhouette_max < 1e-12,
+            "{r:?}"
+        );
         // Two scales: no inner scale to leave out.
         assert_eq!(leave_one_scale_out(&m)[0].points, 0);
     }

@@ -520,7 +520,14 @@ mod tests {
         assert!((p(2f64.sqrt() * 2.0, 45.0).interior - (1.5 + 0.45)).abs() < 1e-12);
         // The procedural face has its own curve.
         let q = m
-            .predict(Asset::Procedural, "ssg", "4 Gaussians, LOD", 1.0, 30.0, FINE)
+            .predict(
+                Asset::Procedural,
+                "ssg",
+                "4 Gaussians, LOD",
+                1.0,
+                30.0,
+                FINE,
+            )
             .unwrap();
         assert!((q.interior - 10.3).abs() < 1e-12);
     }

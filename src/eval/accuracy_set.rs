@@ -281,7 +281,9 @@ mod tests {
         // the same in every view, and 4x as wide at 512.
         let sh = full[0].accuracy.as_ref().unwrap().shadow_mm;
         assert!(sh > 0.05 && sh < 0.5, "{sh}");
-        assert!(full.iter().all(|f| f.accuracy.as_ref().unwrap().shadow_mm == sh));
+        assert!(full
+            .iter()
+            .all(|f| f.accuracy.as_ref().unwrap().shadow_mm == sh));
         base.shadow_size = 512;
         let wide = accuracy_scenes(&[(Asset::Procedural, None)], &base).unwrap();
         let sw = wide[0].accuracy.as_ref().unwrap().shadow_mm;

@@ -190,7 +190,7 @@ impl Resources {
                     d.levels,
                     d.unorm_view,
                 )
-                    .with_context(|| format!("creating the frame image '{}'", d.name))?,
+                .with_context(|| format!("creating the frame image '{}'", d.name))?,
             );
         }
         Ok(())

@@ -479,14 +479,7 @@ mod tests {
         // a gain of 0.48: one switch, then held.
         struct Drop;
         impl Accuracy for Drop {
-            fn predict(
-                &self,
-                m: &str,
-                s: &str,
-                x: f64,
-                l: f64,
-                sh: f64,
-            ) -> Option<(f64, f64)> {
+            fn predict(&self, m: &str, s: &str, x: f64, l: f64, sh: f64) -> Option<(f64, f64)> {
                 if s == "steady" && x > 2.5 {
                     return None;
                 }
