@@ -23,7 +23,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::{AaStage, PostBind, PostSetup};
+use super::{fetch, rg8_as_rgba8, AaStage, PostBind, PostSetup};
 use crate::aa::edges::MLAA_LUMA_THRESHOLD;
 use crate::aa::mlaa_area::{MlaaAreaTex, AREA_SIZE, MAX_DISTANCE, NUM_DISTANCES};
 use crate::graph::draw::fullscreen;
@@ -78,11 +78,7 @@ pub struct Mlaa {
 
 /// The area texture as RGBA8 bytes: `MlaaAreaTex::rg8` in .rg, zeros in .ba.
 pub fn area_rgba8() -> Vec<u8> {
-    MlaaAreaTex::generate()
-        .rg8()
-        .chunks_exact(2)
-        .flat_map(|rg| [rg[0], rg[1], 0, 0])
-        .collect()
+    rg8_as_rgba8(&MlaaAreaTex::generate().rg8())
 }
 
 impl Mlaa {
@@ -325,24 +321,6 @@ impl Mlaa {
 
     fn stencil_test(&self) -> DepthStencil {
         DepthStencil::test_only(self.stencil).stencil_test(Some(STENCIL_EDGE))
-    }
-}
-
-fn fetch(
-    res: &Resources,
-    image: ImageId,
-    texture: &str,
-    filter: Filter,
-    count: f64,
-    exact: bool,
-) -> Fetch {
-    Fetch {
-        texture: texture.into(),
-        format: res.texel_format(image),
-        filter,
-        count,
-        exact,
-        coherent: true,
     }
 }
 

@@ -28,6 +28,7 @@ use std::str::FromStr;
 use anyhow::{bail, Result};
 use ash::vk;
 
+use crate::graph::work::{Fetch, Filter};
 use crate::graph::{ImageId, Pass, Resources};
 use crate::vk::context::Context;
 use crate::vk::pipeline::{DescriptorPool, Samplers};
@@ -210,6 +211,34 @@ impl crate::vk::guard::Destroy for PostChain {
     fn destroy(&mut self, ctx: &Context) {
         PostChain::destroy(self, ctx)
     }
+}
+
+/// A coherent fetch of `image` (its texel format from the resources) as a
+/// stage's declared work: what the AA passes' weight and blend shaders read.
+pub(crate) fn fetch(
+    res: &Resources,
+    image: ImageId,
+    texture: &str,
+    filter: Filter,
+    count: f64,
+    exact: bool,
+) -> Fetch {
+    Fetch {
+        texture: texture.into(),
+        format: res.texel_format(image),
+        filter,
+        count,
+        exact,
+        coherent: true,
+    }
+}
+
+/// Two-channel table bytes as RGBA8 texels (.rg; the work vocabulary has no
+/// RG8 format yet, docs/aa.md).
+pub(crate) fn rg8_as_rgba8(rg: &[u8]) -> Vec<u8> {
+    rg.chunks_exact(2)
+        .flat_map(|rg| [rg[0], rg[1], 0, 0])
+        .collect()
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::{AaStage, PostBind, PostSetup};
+use super::{fetch, rg8_as_rgba8, AaStage, PostBind, PostSetup};
 use crate::aa::edges::Preset;
 use crate::aa::{smaa_area, smaa_search};
 use crate::graph::draw::fullscreen;
@@ -75,10 +75,7 @@ pub struct Smaa {
 
 /// The area texture as RGBA8 bytes (its two channels in .rg).
 pub fn area_rgba8() -> Vec<u8> {
-    smaa_area::area_tex_rg8()
-        .chunks_exact(2)
-        .flat_map(|rg| [rg[0], rg[1], 0, 0])
-        .collect()
+    rg8_as_rgba8(smaa_area::area_tex_rg8())
 }
 
 /// The search texture as RGBA8 bytes (its channel in .r).
@@ -280,24 +277,6 @@ impl Smaa {
             .color(ColorTarget::new(self.output, Load::DontCare))
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
-    }
-}
-
-fn fetch(
-    res: &Resources,
-    image: ImageId,
-    texture: &str,
-    filter: Filter,
-    count: f64,
-    exact: bool,
-) -> Fetch {
-    Fetch {
-        texture: texture.into(),
-        format: res.texel_format(image),
-        filter,
-        count,
-        exact,
-        coherent: true,
     }
 }
 
