@@ -113,6 +113,48 @@ pub struct Fetch {
     /// texture cache misses; the budget model charges such fetches more).
     #[serde(default = "yes")]
     pub coherent: bool,
+    /// How far from their pixel an incoherent fetch's taps land (empty: not
+    /// declared, priced as the farthest). Rotated taps a pixel apart share
+    /// their bilinear texels with the neighbours' taps; taps several pixels
+    /// apart share nothing, so the cache misses grow with the radius
+    /// (`budget::units`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spread: Vec<Spread>,
+}
+
+/// `share` of a pass's invocations tap within about `radius_px` pixels of
+/// their own pixel (one character's kernel at its depth: a frame of several
+/// characters has one entry per character and ring).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Spread {
+    pub share: f64,
+    pub radius_px: f64,
+}
+
+impl Spread {
+    /// The same taps in at most one entry per quarter octave of radius (the
+    /// share-weighted mean radius of each): a crowd's hundreds of skin
+    /// clusters in a few entries, shares summing as before.
+    pub fn compact(spread: &[Spread]) -> Vec<Spread> {
+        let mut bins: Vec<(i32, f64, f64)> = Vec::new();
+        for s in spread.iter().filter(|s| s.share > 0.0 && s.radius_px > 0.0) {
+            let k = (4.0 * s.radius_px.log2()).floor() as i32;
+            match bins.iter_mut().find(|b| b.0 == k) {
+                Some(b) => {
+                    b.1 += s.share;
+                    b.2 += s.share * s.radius_px;
+                }
+                None => bins.push((k, s.share, s.share * s.radius_px)),
+            }
+        }
+        bins.sort_by_key(|b| b.0);
+        bins.into_iter()
+            .map(|(_, share, r)| Spread {
+                share,
+                radius_px: r / share,
+            })
+            .collect()
+    }
 }
 
 fn yes() -> bool {
@@ -251,6 +293,33 @@ mod tests {
     }
 
     #[test]
+    fn a_compact_spread_keeps_its_shares_and_mean_radius() {
+        let spread: Vec<Spread> = (0..200)
+            .map(|i| Spread {
+                share: 1.0 + (i % 7) as f64,
+                radius_px: 0.3 * 1.03f64.powi(i),
+            })
+            .collect();
+        let c = Spread::compact(&spread);
+        assert!(c.len() < 40, "{}", c.len());
+        let sum = |v: &[Spread], f: &dyn Fn(&Spread) -> f64| v.iter().map(f).sum::<f64>();
+        let share = |v: &[Spread]| sum(v, &|s| s.share);
+        let moment = |v: &[Spread]| sum(v, &|s| s.share * s.radius_px);
+        assert!((share(&c) - share(&spread)).abs() < 1e-9);
+        assert!((moment(&c) - moment(&spread)).abs() < 1e-9 * moment(&spread));
+        // Every entry stays within its quarter octave: no radius moves more
+        // than a factor 2^(1/4) from the taps it stands for.
+        for s in &spread {
+            let nearest = c
+                .iter()
+                .map(|x| (x.radius_px / s.radius_px).log2().abs())
+                .fold(f64::INFINITY, f64::min);
+            assert!(nearest <= 0.25 + 1e-9, "{}", s.radius_px);
+        }
+        assert!(Spread::compact(&[]).is_empty());
+    }
+
+    #[test]
     fn work_round_trips_through_json() {
         let w = Work::Raster {
             shader: Some(ShaderWork {
@@ -261,6 +330,7 @@ mod tests {
                     count: 16.0,
                     exact: true,
                     coherent: true,
+                    spread: Vec::new(),
                 }],
                 alu: 120.0,
                 ..Default::default()

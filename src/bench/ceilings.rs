@@ -284,6 +284,7 @@ impl<'p> Probe<'p> {
                 count: PROBE_TAPS as f64,
                 exact: true,
                 coherent: true,
+                spread: Vec::new(),
             }],
             None => Vec::new(),
         };

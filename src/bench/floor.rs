@@ -85,6 +85,7 @@ mod tests {
             count,
             exact: true,
             coherent: true,
+            spread: Vec::new(),
         }
     }
 

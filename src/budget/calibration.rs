@@ -92,8 +92,10 @@ pub fn priced_points() -> Result<(Vec<Priced>, Vec<String>)> {
 }
 
 /// Lower and upper bounds of the parameters (in `ModelParams::to_vec` order).
-pub const LO: [f64; N_PARAMS] = [0.1, 0.1, 0.1, 0.1, 0.1, 0.001, 0.1, 0.01, 0.01];
-pub const HI: [f64; N_PARAMS] = [10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 1000.0, 1000.0];
+pub const LO: [f64; N_PARAMS] = [0.1, 0.1, 0.1, 0.1, 0.1, 0.001, 0.1, 0.01, 0.01, 0.1];
+pub const HI: [f64; N_PARAMS] = [
+    10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 1000.0, 1000.0, 100.0,
+];
 /// Where every fit starts.
 const START: ModelParams = ModelParams {
     texture_scale: 1.0,
@@ -105,11 +107,15 @@ const START: ModelParams = ModelParams {
     incoherent_factor: 1.0,
     fixed_kpix_per_pass: 20.0,
     rect_kpix: 5.0,
+    incoherent_radius_px: 2.0,
 };
 
 /// Which parameters the peak-rate fit frees (`ModelParams::to_vec` order):
-/// all but `hiz_reject_scale`, `incoherent_factor` and `rect_kpix`.
-pub const PEAK_FREE: [bool; N_PARAMS] = [true, true, true, true, true, false, false, true, false];
+/// all but `hiz_reject_scale`, `incoherent_factor`, `rect_kpix` and
+/// `incoherent_radius_px`.
+pub const PEAK_FREE: [bool; N_PARAMS] = [
+    true, true, true, true, true, false, false, true, false, false,
+];
 const ALL_FREE: [bool; N_PARAMS] = [true; N_PARAMS];
 
 /// The start of the peak-rate fit: the structural parameters of `probed`.
@@ -118,6 +124,7 @@ fn peak_start(probed: &ModelParams) -> ModelParams {
         hiz_reject_scale: probed.hiz_reject_scale,
         incoherent_factor: probed.incoherent_factor,
         rect_kpix: probed.rect_kpix,
+        incoherent_radius_px: probed.incoherent_radius_px,
         ..START
     }
 }
@@ -532,6 +539,7 @@ mod tests {
             incoherent_factor: 1.0,
             fixed_kpix_per_pass: 30.0,
             rect_kpix: 4.0,
+            incoherent_radius_px: 2.0,
         };
         let (all, _) = priced_points().unwrap();
         let mut pts: Vec<Priced> = all

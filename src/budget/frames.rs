@@ -328,6 +328,7 @@ fn fetch(texture: &str, format: Format, filter: Filter, count: f64) -> Fetch {
         count,
         exact: true,
         coherent: true,
+        spread: Vec::new(),
     }
 }
 

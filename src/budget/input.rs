@@ -62,7 +62,8 @@ pub struct FrameInput {
 pub const RESCALE_RULE: &str = "a pass whose render area (draws) or first image (copies, \
 clears, dispatches) is the frame's size halved k >= 0 times follows the screen: its \
 fragments, samples, rasterised pixels, texels and invocations scale by the pixel ratio \
-(w'h')/(wh) and its sizes (hence its clears) by w'/w and h'/h; other passes (shadow maps, \
+(w'h')/(wh), its sizes (hence its clears) by w'/w and h'/h and its taps' spread radii by \
+h'/h; other passes (shadow maps, \
 LUTs) keep their counts; triangle and rectangle counts never scale";
 
 fn follows_screen(w: u32, h: u32, fw: u32, fh: u32) -> bool {
@@ -113,6 +114,16 @@ impl FrameInput {
                     Work::Compute { invocations, .. } => *invocations = n(*invocations),
                     Work::Copy { texels, .. } | Work::Clear { texels, .. } => *texels = n(*texels),
                 }
+                // A kernel's size on screen follows the view's height.
+                if let Work::Raster {
+                    shader: Some(s), ..
+                }
+                | Work::Compute { shader: s, .. } = &mut q.work
+                {
+                    for f in &mut s.fetches {
+                        f.spread.iter_mut().for_each(|x| x.radius_px *= sy);
+                    }
+                }
                 for i in &mut q.images {
                     if follows_screen(i.width, i.height, self.width, self.height) {
                         i.width = sz(i.width, sx);
@@ -148,6 +159,44 @@ mod tests {
             msaa: 1,
             clears: vec![],
         }
+    }
+
+    #[test]
+    fn spread_radii_follow_the_view_height() {
+        use crate::work::{Fetch, Filter, ShaderWork, Spread};
+        let mut p = PassInput::new("rings", PassRole::Sss, raster(1920, 1080));
+        if let Work::Raster { shader, .. } = &mut p.work {
+            *shader = Some(ShaderWork {
+                fetches: vec![Fetch {
+                    texture: "colorTex".into(),
+                    format: Format::Rgba16Float,
+                    filter: Filter::Bilinear,
+                    count: 12.0,
+                    exact: true,
+                    coherent: false,
+                    spread: vec![Spread {
+                        share: 1.0,
+                        radius_px: 9.0,
+                    }],
+                }],
+                ..Default::default()
+            });
+        }
+        let f = FrameInput {
+            label: "t".into(),
+            width: 1920,
+            height: 1080,
+            passes: vec![p],
+            provenance: vec![],
+        };
+        let g = f.rescaled(1280, 720);
+        let Work::Raster {
+            shader: Some(s), ..
+        } = &g.passes[0].work
+        else {
+            panic!("not a raster pass");
+        };
+        assert!((s.fetches[0].spread[0].radius_px - 6.0).abs() < 1e-12);
     }
 
     #[test]

@@ -228,6 +228,7 @@ mod tests {
                         count: taps,
                         exact: true,
                         coherent: true,
+                        spread: Vec::new(),
                     }],
                     alu: 4.0 * taps,
                     ..Default::default()
@@ -278,6 +279,70 @@ mod tests {
             );
             assert!((t[0].units.texture / one[0].units.texture - 2.0).abs() < 1e-9);
         }
+    }
+
+    /// `blur` with its taps incoherent, landing `spread` away.
+    fn rotated(spread: Vec<crate::work::Spread>) -> PassInput {
+        let mut p = blur(1_000_000, 16.0);
+        if let Work::Raster {
+            shader: Some(s), ..
+        } = &mut p.work
+        {
+            s.fetches[0].coherent = false;
+            s.fetches[0].spread = spread;
+        }
+        p
+    }
+
+    #[test]
+    fn incoherent_taps_cost_more_the_farther_they_land() {
+        use crate::work::Spread;
+        let p = prof("nvidia-h200");
+        let params = ParamSet::fitted().probed;
+        let at = |spread: Vec<Spread>| {
+            let u = price_units(&p, &frame(vec![rotated(spread)]));
+            u[0].units.scaled(&params).texture_incoherent
+        };
+        let coherent = price_units(&p, &frame(vec![blur(1_000_000, 16.0)]))[0]
+            .units
+            .scaled(&params)
+            .texture;
+        let one = |r: f64| {
+            at(vec![Spread {
+                share: 1.0,
+                radius_px: r,
+            }])
+        };
+        let undeclared = at(Vec::new());
+        // Within a texel of their pixel: nearly the coherent cost; far out:
+        // the full factor, as taps of no declared spread are priced.
+        assert!(
+            (one(0.125) / coherent - 1.0).abs() < 0.02,
+            "{}",
+            one(0.125) / coherent
+        );
+        assert!((one(128.0) / undeclared - 1.0).abs() < 0.01);
+        let radii = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+        for w in radii.windows(2) {
+            assert!(one(w[0]) < one(w[1]), "{w:?}");
+        }
+        // At the half radius: half the extra cost (between the bins around
+        // it, linear in log radius: within the shape's curvature).
+        let h = params.incoherent_radius_px;
+        let mid = coherent * params.incoherence(h);
+        assert!((one(h) / mid - 1.0).abs() < 0.05, "{} vs {mid}", one(h));
+        // Shares weigh: half the taps near, half far, is the mean of the two.
+        let both = at(vec![
+            Spread {
+                share: 0.5,
+                radius_px: 0.5,
+            },
+            Spread {
+                share: 0.5,
+                radius_px: 16.0,
+            },
+        ]);
+        assert!((both - (one(0.5) + one(16.0)) / 2.0).abs() < 1e-9 * both);
     }
 
     #[test]

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::budget::profile::RateSource;
 
 /// Number of free parameters.
-pub const N_PARAMS: usize = 9;
+pub const N_PARAMS: usize = 10;
 
 /// One set of the model's free parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -28,7 +28,8 @@ pub struct ModelParams {
     /// nothing (its triangle lies in front of every surface, so hierarchical
     /// Z rejects whole tiles: expected well under 1).
     pub hiz_reject_scale: f64,
-    /// Extra texture-time multiplier of incoherent (per-pixel rotated) taps.
+    /// Extra texture-time multiplier of incoherent (per-pixel rotated) taps
+    /// that land far apart (the asymptote of [`ModelParams::incoherence`]).
     pub incoherent_factor: f64,
     /// Fixed cost of every pass, in thousands of pixels at the profile's
     /// 32 bpp fill rate (pipeline ramp-up and drain, state changes).
@@ -36,6 +37,10 @@ pub struct ModelParams {
     /// Fixed cost of every rectangle of a copy (one copy region each), in the
     /// same unit.
     pub rect_kpix: f64,
+    /// Tap radius (pixels) at which incoherent taps pay half their extra
+    /// cost: rotated taps well inside it land in the texels their neighbours'
+    /// taps already brought into the cache.
+    pub incoherent_radius_px: f64,
 }
 
 impl ModelParams {
@@ -50,7 +55,19 @@ impl ModelParams {
         incoherent_factor: 1.0,
         fixed_kpix_per_pass: 0.0,
         rect_kpix: 0.0,
+        incoherent_radius_px: 1.0,
     };
+
+    /// The texture-time multiplier of incoherent taps landing `radius_px`
+    /// from their pixel: 1 (as coherent) for taps within a texel of it,
+    /// rising to `incoherent_factor` as the share of a tap's bilinear
+    /// texels its neighbours' taps do not share grows with the area the
+    /// rotated taps sweep, `r^2 / (r^2 + r_half^2)`.
+    pub fn incoherence(&self, radius_px: f64) -> f64 {
+        let r2 = radius_px * radius_px;
+        let h2 = self.incoherent_radius_px * self.incoherent_radius_px;
+        1.0 + (self.incoherent_factor - 1.0) * r2 / (r2 + h2)
+    }
 
     /// The parameters as a vector (for fitting) and back.
     pub fn to_vec(self) -> [f64; N_PARAMS] {
@@ -64,6 +81,7 @@ impl ModelParams {
             self.incoherent_factor,
             self.fixed_kpix_per_pass,
             self.rect_kpix,
+            self.incoherent_radius_px,
         ]
     }
 
@@ -78,6 +96,7 @@ impl ModelParams {
             incoherent_factor: v[6],
             fixed_kpix_per_pass: v[7],
             rect_kpix: v[8],
+            incoherent_radius_px: v[9],
         }
     }
 }
@@ -113,25 +132,48 @@ impl ParamSet {
 /// See [`ParamSet::fitted`].
 pub const FITTED: ParamSet = ParamSet {
     peak: ModelParams {
-        texture_scale: 1.18769,
-        alu_scale: 1.07544,
-        fill_scale: 1.91277,
-        memory_scale: 0.55179,
-        reject_scale: 1.65972,
-        hiz_reject_scale: 0.29789,
-        incoherent_factor: 1.40493,
-        fixed_kpix_per_pass: 20.72121,
-        rect_kpix: 29.63448,
+        texture_scale: 1.17542,
+        alu_scale: 1.08251,
+        fill_scale: 1.91362,
+        memory_scale: 0.55542,
+        reject_scale: 1.66443,
+        hiz_reject_scale: 0.29755,
+        incoherent_factor: 2.67270,
+        fixed_kpix_per_pass: 20.72504,
+        rect_kpix: 29.62749,
+        incoherent_radius_px: 8.18831,
     },
     probed: ModelParams {
-        texture_scale: 1.14326,
-        alu_scale: 0.98289,
-        fill_scale: 1.05804,
-        memory_scale: 1.00003,
-        reject_scale: 0.14368,
-        hiz_reject_scale: 0.29789,
-        incoherent_factor: 1.40493,
-        fixed_kpix_per_pass: 41.19397,
-        rect_kpix: 29.63448,
+        texture_scale: 1.14105,
+        alu_scale: 0.98099,
+        fill_scale: 1.05803,
+        memory_scale: 1.00010,
+        reject_scale: 0.15480,
+        hiz_reject_scale: 0.29755,
+        incoherent_factor: 2.67270,
+        fixed_kpix_per_pass: 41.30713,
+        rect_kpix: 29.62749,
+        incoherent_radius_px: 8.18831,
     },
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn incoherence_rises_from_one_to_the_factor() {
+        for p in [FITTED.peak, FITTED.probed] {
+            assert!((p.incoherence(0.0) - 1.0).abs() < 1e-12);
+            let half = p.incoherence(p.incoherent_radius_px);
+            assert!((half - (1.0 + p.incoherent_factor) / 2.0).abs() < 1e-12);
+            assert!((p.incoherence(1e6) - p.incoherent_factor).abs() < 1e-6);
+            let mut last = 1.0;
+            for r in [0.5, 1.0, 2.0, 4.0, 8.0, 16.0] {
+                let f = p.incoherence(r);
+                assert!(f > last, "not rising at {r}");
+                last = f;
+            }
+        }
+    }
+}

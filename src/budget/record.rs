@@ -248,6 +248,7 @@ mod tests {
             count,
             exact: false,
             coherent: true,
+            spread: Vec::new(),
         };
         ShaderWork {
             shader: "poisson.frag".into(),

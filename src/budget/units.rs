@@ -30,6 +30,24 @@ use crate::work::{
 const G: f64 = 1e9;
 const MS: f64 = 1e3;
 
+/// Bins of tap radius: half-octaves from 1/8 to 128 pixels.
+pub const SPREAD_BINS: usize = 21;
+
+/// The radius (pixels) of spread bin `b`.
+pub fn spread_bin_radius(b: usize) -> f64 {
+    0.125 * 2f64.powf(b as f64 / 2.0)
+}
+
+/// Adds `ms` of taps landing `radius_px` away to the two bins around it
+/// (linear in the radius's logarithm; clamped to the end bins).
+fn add_spread(bins: &mut [f64; SPREAD_BINS], radius_px: f64, ms: f64) {
+    let x = (2.0 * (radius_px.max(1e-9) / 0.125).log2()).clamp(0.0, (SPREAD_BINS - 1) as f64);
+    let i = (x.floor() as usize).min(SPREAD_BINS - 2);
+    let t = x - i as f64;
+    bins[i] += ms * (1.0 - t);
+    bins[i + 1] += ms * t;
+}
+
 /// Which unit bounds a pass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -49,8 +67,13 @@ pub enum Bound {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct UnitTimes {
     pub texture: f64,
-    /// Texture time of incoherent taps (scaled by `incoherent_factor` too).
+    /// Texture time of incoherent taps of no declared spread (scaled by
+    /// `incoherent_factor` too; after `scaled`, every incoherent tap's).
     pub texture_incoherent: f64,
+    /// Texture time of incoherent taps by how far they land from their pixel
+    /// (bin `b` at [`spread_bin_radius`]`(b)` pixels; scaled by
+    /// [`ModelParams::incoherence`] of its radius; 0 after `scaled`).
+    pub texture_incoherent_by_radius: [f64; SPREAD_BINS],
     pub alu: f64,
     pub fill: f64,
     pub memory: f64,
@@ -81,7 +104,15 @@ impl UnitTimes {
     pub fn scaled(&self, p: &ModelParams) -> UnitTimes {
         UnitTimes {
             texture: p.texture_scale * self.texture,
-            texture_incoherent: p.texture_scale * p.incoherent_factor * self.texture_incoherent,
+            texture_incoherent: p.texture_scale
+                * (p.incoherent_factor * self.texture_incoherent
+                    + (0..SPREAD_BINS)
+                        .map(|b| {
+                            self.texture_incoherent_by_radius[b]
+                                * p.incoherence(spread_bin_radius(b))
+                        })
+                        .sum::<f64>()),
+            texture_incoherent_by_radius: [0.0; SPREAD_BINS],
             alu: p.alu_scale * self.alu,
             fill: p.fill_scale * self.fill,
             memory: p.memory_scale * self.memory,
@@ -385,8 +416,14 @@ impl Pricing<'_> {
         for f in &s.fetches {
             if let (Some(r), Some(c)) = (rate, self.texel_cost(f.filter, f.format)) {
                 let ms = n * f.count * c / (r * G) * MS;
+                let shares: f64 = f.spread.iter().map(|s| s.share).sum();
                 if f.coherent {
                     self.u.texture += ms;
+                } else if shares > 0.0 {
+                    for s in &f.spread {
+                        let bins = &mut self.u.texture_incoherent_by_radius;
+                        add_spread(bins, s.radius_px, ms * s.share / shares);
+                    }
                 } else {
                     self.u.texture_incoherent += ms;
                 }

@@ -15,7 +15,7 @@ use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     SssMethod,
 };
-use crate::graph::work::{Fetch, Filter};
+use crate::graph::work::{Fetch, Filter, Spread};
 use crate::graph::{ImageId, Pass};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
@@ -75,6 +75,25 @@ impl Jittered {
     }
 }
 
+/// Where the ring taps land, per skin cluster `(share, view depth)`: half
+/// the taps on the mid ring, half on the wide one, each at its radius in
+/// pixels at the cluster's depth (the shader's `s / 3` pixels per mm, at
+/// full strength and no depth-gradient shrink), compacted.
+fn ring_spread(k: &JitteredKernel, stretch: &Stretch, depths: &[(f64, f32)]) -> Vec<Spread> {
+    let all: Vec<Spread> = depths
+        .iter()
+        .filter(|&&(_, d)| d > 0.0)
+        .flat_map(|&(share, depth)| {
+            let px_per_mm = f64::from(stretch.alpha / 3.0 / depth);
+            [k.mid_radius_mm, k.wide_radius_mm].map(|r| Spread {
+                share: share / 2.0,
+                radius_px: px_per_mm * f64::from(r),
+            })
+        })
+        .collect();
+    Spread::compact(&all)
+}
+
 impl SssMethod for Jittered {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
         let extent = f.extent;
@@ -95,9 +114,11 @@ impl SssMethod for Jittered {
         let fetches = vec![
             fetch(f.res, src, "colorTex", Filter::Point, 1.0),
             fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
-            // Rings rotated per pixel: neighbours share no texels.
+            // Rings rotated per pixel: neighbours share texels only where
+            // the rings are about a pixel wide on screen.
             Fetch {
                 coherent: false,
+                spread: ring_spread(&self.kernel, &self.stretch, f.depths),
                 ..fetch(f.res, src, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
             },
         ];
@@ -157,5 +178,36 @@ impl SssMethod for Jittered {
 
     fn as_any(&self) -> &dyn Any {
         self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::view::ViewScale;
+
+    #[test]
+    fn ring_taps_land_at_the_rings_radius_on_screen() {
+        // 720 rows, 20 degrees, a 230 mm head one unit tall: the view's own
+        // pixels per mm at each depth, times the ring radii.
+        let (h, fovy, mm) = (720, 20f32.to_radians(), 230.0);
+        let k = hable_kernel();
+        let stretch = Stretch::for_view(h, fovy, mm);
+        let view = ViewScale::new(h, fovy, mm);
+        let s = ring_spread(&k, &stretch, &[(0.25, 2.0), (0.75, 8.0)]);
+        let expect = [
+            (0.375, view.px_per_mm(8.0) * k.mid_radius_mm),
+            (0.375, view.px_per_mm(8.0) * k.wide_radius_mm),
+            (0.125, view.px_per_mm(2.0) * k.mid_radius_mm),
+            (0.125, view.px_per_mm(2.0) * k.wide_radius_mm),
+        ];
+        assert_eq!(s.len(), 4);
+        for (got, (share, r)) in s.iter().zip(expect) {
+            assert!((got.share - share).abs() < 1e-12);
+            assert!(
+                (got.radius_px / f64::from(r) - 1.0).abs() < 1e-5,
+                "{got:?} vs {r}"
+            );
+        }
     }
 }

@@ -173,6 +173,9 @@ pub struct FrameView<'a, 'r> {
     /// taps read from one (see `region.rs`): seed copies and stencil-tested draws
     /// are limited to them.
     pub region: &'a [vk::Rect2D],
+    /// Its characters' skin depths, `(share, view depth)` per skin cluster on
+    /// screen: how wide a kernel is on screen (declared work).
+    pub depths: &'a [(f64, f32)],
     /// One rectangle covering the screen.
     pub screen: &'a [vk::Rect2D],
     /// The stencil code of this instance's pixels (`mix::stencil_code` of its

@@ -38,6 +38,7 @@ pub fn fetch(res: &Resources, image: ImageId, texture: &str, filter: Filter, cou
         count,
         exact: true,
         coherent: true,
+        spread: Vec::new(),
     }
 }
 

@@ -50,7 +50,7 @@ use crate::budget::input::{FrameInput, PassInput};
 use crate::budget::model::{price_frame, Rescale};
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
-use crate::work::{PassRole, Work};
+use crate::work::{PassRole, Spread, Work};
 
 /// One stored frame of a setting: one character at a known scale.
 #[derive(Clone, Debug, PartialEq)]
@@ -481,6 +481,7 @@ impl SettingModel {
         };
         let xs = self.xs();
         let mut total = vec![0.0; sh.fetches.len()];
+        let mut spreads: Vec<Vec<Spread>> = vec![Vec::new(); sh.fetches.len()];
         let mut weight = 0.0;
         for l in loads {
             let w = l.skin_pixels
@@ -498,11 +499,27 @@ impl SettingModel {
             for (f, (x, y)) in total.iter_mut().zip(a.iter().zip(&b)) {
                 *f += w * lerp(*x, *y, t);
             }
+            // Where the taps land: the nearer sample's, its radii scaled to
+            // this character's px/mm (a kernel's size on screen is linear in it).
+            let near = if t < 0.5 { i } else { j };
+            if let Work::Raster {
+                shader: Some(s), ..
+            } = &self.samples[near].frame.passes[k].work
+            {
+                let scale = l.px_per_mm / xs[near];
+                for (out, f) in spreads.iter_mut().zip(&s.fetches) {
+                    out.extend(f.spread.iter().map(|x| Spread {
+                        share: w * x.share,
+                        radius_px: x.radius_px * scale,
+                    }));
+                }
+            }
             weight += w;
         }
         if weight > 0.0 {
-            for (f, t) in sh.fetches.iter_mut().zip(&total) {
+            for ((f, t), s) in sh.fetches.iter_mut().zip(&total).zip(&spreads) {
                 f.count = t / weight;
+                f.spread = Spread::compact(s);
             }
         }
     }

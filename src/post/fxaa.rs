@@ -57,6 +57,7 @@ impl AaStage for Fxaa {
             count,
             exact,
             coherent: true,
+            spread: Vec::new(),
         };
         let (srgb, unorm) = (res.texel_format(self.input), Format::Rgba8Unorm);
         let steps = f64::from(SEARCH_STEPS);

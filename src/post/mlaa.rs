@@ -184,6 +184,7 @@ impl Mlaa {
                 count: 5.0,
                 exact: true,
                 coherent: true,
+                spread: Vec::new(),
             }],
             alu: alu_estimate(EDGES_SHADER, &[]),
             ..Default::default()
@@ -244,6 +245,7 @@ impl Mlaa {
                     count: 2.0,
                     exact: false,
                     coherent: true,
+                    spread: Vec::new(),
                 },
             ],
             // Four searches (two per edgel), each loop at most `steps` trips.

@@ -230,6 +230,7 @@ pub(crate) fn fetch(
         count,
         exact,
         coherent: true,
+        spread: Vec::new(),
     }
 }
 

@@ -192,6 +192,7 @@ impl Smaa {
                 count: 7.0,
                 exact: false,
                 coherent: true,
+                spread: Vec::new(),
             }],
             alu: alu_estimate(EDGES_SHADER, &[]),
             ..Default::default()
@@ -236,6 +237,7 @@ impl Smaa {
             count,
             exact: false,
             coherent: true,
+            spread: Vec::new(),
         };
         let work = ShaderWork {
             shader: WEIGHTS_SHADER.into(),

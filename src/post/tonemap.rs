@@ -74,6 +74,7 @@ impl Tonemap {
                 count: 1.0,
                 exact: true,
                 coherent: true,
+                spread: Vec::new(),
             }],
             alu: alu_estimate(SHADER, &[]),
             ..Default::default()

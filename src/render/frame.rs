@@ -518,6 +518,20 @@ impl Frame {
         )
     }
 
+    /// Where the skin of the characters `instances` lies in depth
+    /// (`view::region::skin_depths`).
+    pub fn depths_for(&self, scene: &Scene, instances: &[Mat4]) -> Vec<(f64, f32)> {
+        let view = self.view_info();
+        let rv = RegionView {
+            view: self.camera.view(),
+            proj: self.camera.proj(view.aspect()),
+            near: self.camera.near,
+            width: self.extent.width,
+            height: self.extent.height,
+        };
+        crate::view::region::skin_depths(scene, instances, &rv)
+    }
+
     /// The groups' heads and codes the geometry pass draws (rewrites the
     /// instance buffer in group order).
     pub fn set_skin_groups(&mut self, ctx: &Context, groups: Vec<SkinGroup>) -> Result<()> {
@@ -580,6 +594,7 @@ impl Frame {
             res,
             extent: self.extent,
             region: &g.scissors,
+            depths: &g.depths,
             screen: &self.screen_rect,
             stencil: g.spec.stencil(),
         }
@@ -705,6 +720,7 @@ impl Frame {
             count: 1.0,
             exact,
             coherent: true,
+            spread: Vec::new(),
         };
         let shadow_format = res.texel_format(t.shadow);
         // Per fragment: the 3x3 PCF, the three material maps (the normal map
@@ -718,6 +734,7 @@ impl Frame {
                 count: 9.0,
                 exact: true,
                 coherent: true,
+                spread: Vec::new(),
             },
             rgba8("normalTex", false),
             rgba8("albedoTex", true),
@@ -728,6 +745,7 @@ impl Frame {
                 count: 1.0,
                 exact: false,
                 coherent: true,
+                spread: Vec::new(),
             },
             rgba8("specTex", true),
             Fetch {
@@ -737,6 +755,7 @@ impl Frame {
                 count: 1.0,
                 exact: false,
                 coherent: true,
+                spread: Vec::new(),
             },
         ];
         let work = ShaderWork {
@@ -811,6 +830,7 @@ impl Frame {
                     count: 1.0,
                     exact: true,
                     coherent: true,
+                    spread: Vec::new(),
                 })
                 .collect(),
             alu: alu_estimate(shader, &[]),

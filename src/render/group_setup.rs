@@ -59,6 +59,7 @@ pub fn build_groups(
             method: method?,
             region_px: Vec::new(),
             scissors: Vec::new(),
+            depths: Vec::new(),
         };
         // A group with no SSS records no pass: in a mix it has no region.
         let region = if mixed && g.is_none() {
@@ -67,6 +68,7 @@ pub fn build_groups(
             frame.region_for(scene, &*g.method, &g.instances)
         };
         g.set_region(region);
+        g.depths = frame.depths_for(scene, &g.instances);
         groups.push(g);
     }
     Ok(groups.keep())

@@ -152,6 +152,9 @@ pub struct GroupMethod {
     /// characters with its own reach. Set with [`GroupMethod::set_region`].
     pub region_px: Vec<PixelRect>,
     pub scissors: Vec<vk::Rect2D>,
+    /// Its skin's depths, `(share, view depth)` per skin cluster on screen
+    /// (`view::region::skin_depths`): how wide its kernels are on screen.
+    pub depths: Vec<(f64, f32)>,
 }
 
 /// The rectangles of a pixel region as scissors.

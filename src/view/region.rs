@@ -326,23 +326,63 @@ pub fn scene_region(
     tile: u32,
     reach: impl Fn(f32, &ReachScale) -> Option<f32>,
 ) -> Vec<PixelRect> {
-    let skin: Vec<&crate::scene::mesh::Object> = scene
-        .backdrop
-        .iter()
-        .chain(std::iter::once(&scene.head))
-        .filter(|o| o.material.skin)
-        .collect();
     let scale = ReachScale {
         height_px: v.height,
         tan_half_fovy,
         mm_per_unit: scene.mm_per_unit,
-        max_strength: skin
+        max_strength: skin_objects(scene)
             .iter()
             .map(|o| o.material.sss_strength)
             .fold(0.0, f32::max),
     };
-    // Skin objects are drawn once per character (see the geometry pass).
-    let boxes: Vec<Aabb> = skin
+    skin_region(
+        v,
+        skin_boxes(scene, instances),
+        |d| reach(d, &scale).unwrap_or(f32::INFINITY),
+        tile,
+    )
+}
+
+/// Where the skin of `instances` lies in depth: for each skin cluster on
+/// screen, its share of the clusters' on-screen area and its nearest view
+/// depth (what a method's per-pixel kernel size follows; clusters a face
+/// hides count too, so a share is an estimate, not a pixel count).
+pub fn skin_depths(
+    scene: &crate::scene::Scene,
+    instances: &[Mat4],
+    v: &RegionView,
+) -> Vec<(f64, f32)> {
+    let on_screen: Vec<(f64, f32)> = skin_boxes(scene, instances)
+        .iter()
+        .filter_map(|b| footprint(v, b))
+        .map(|f| {
+            (
+                f64::from(f.rect.width()) * f64::from(f.rect.height()),
+                f.nearest_depth,
+            )
+        })
+        .filter(|&(a, _)| a > 0.0)
+        .collect();
+    let total: f64 = on_screen.iter().map(|c| c.0).sum();
+    if total <= 0.0 {
+        return Vec::new();
+    }
+    on_screen.into_iter().map(|(a, d)| (a / total, d)).collect()
+}
+
+fn skin_objects(scene: &crate::scene::Scene) -> Vec<&crate::scene::mesh::Object> {
+    scene
+        .backdrop
+        .iter()
+        .chain(std::iter::once(&scene.head))
+        .filter(|o| o.material.skin)
+        .collect()
+}
+
+/// Every skin cluster's box, once per character (skin objects are drawn once
+/// per character: see the geometry pass).
+fn skin_boxes(scene: &crate::scene::Scene, instances: &[Mat4]) -> Vec<Aabb> {
+    skin_objects(scene)
         .iter()
         .flat_map(|o| {
             let clusters = cluster_bounds(&o.mesh, CLUSTER_CELLS);
@@ -350,13 +390,7 @@ pub fn scene_region(
                 .iter()
                 .flat_map(move |m| clusters.clone().into_iter().map(move |b| b.transformed(m)))
         })
-        .collect();
-    skin_region(
-        v,
-        boxes,
-        |d| reach(d, &scale).unwrap_or(f32::INFINITY),
-        tile,
-    )
+        .collect()
 }
 
 #[cfg(test)]

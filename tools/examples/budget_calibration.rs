@@ -28,8 +28,9 @@ fn main() -> Result<()> {
         format!(
             "ModelParams {{ texture_scale: {:.5}, alu_scale: {:.5}, fill_scale: {:.5}, \
              memory_scale: {:.5}, reject_scale: {:.5}, hiz_reject_scale: {:.5}, \
-             incoherent_factor: {:.5}, fixed_kpix_per_pass: {:.5}, rect_kpix: {:.5} }}",
-            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]
+             incoherent_factor: {:.5}, fixed_kpix_per_pass: {:.5}, rect_kpix: {:.5}, \
+             incoherent_radius_px: {:.5} }}",
+            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]
         )
     };
     println!(

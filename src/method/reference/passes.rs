@@ -346,5 +346,6 @@ fn material_fetch(texture: &str) -> Fetch {
         count: 1.0,
         exact: false,
         coherent: true,
+        spread: Vec::new(),
     }
 }

@@ -327,5 +327,6 @@ fn material_fetch(texture: &str, exact: bool) -> Fetch {
         exact,
         // Texels are shaded in the map's own order: neighbours fetch neighbours.
         coherent: true,
+        spread: Vec::new(),
     }
 }
