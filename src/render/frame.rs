@@ -501,13 +501,7 @@ impl Frame {
         if s.sss_region == RegionMode::Screen || method.reach_px(1.0, &probe).is_none() {
             return vec![full];
         }
-        let rv = RegionView {
-            view: self.camera.view(),
-            proj: self.camera.proj(view.aspect()),
-            near: self.camera.near,
-            width: self.extent.width,
-            height: self.extent.height,
-        };
+        let rv = self.region_view();
         scene_region(
             scene,
             instances,
@@ -521,15 +515,19 @@ impl Frame {
     /// Where the skin of the characters `instances` lies in depth
     /// (`view::region::skin_depths`).
     pub fn depths_for(&self, scene: &Scene, instances: &[Mat4]) -> Vec<(f64, f32)> {
+        crate::view::region::skin_depths(scene, instances, &self.region_view())
+    }
+
+    /// The camera as the region code projects with it.
+    fn region_view(&self) -> RegionView {
         let view = self.view_info();
-        let rv = RegionView {
+        RegionView {
             view: self.camera.view(),
             proj: self.camera.proj(view.aspect()),
             near: self.camera.near,
             width: self.extent.width,
             height: self.extent.height,
-        };
-        crate::view::region::skin_depths(scene, instances, &rv)
+        }
     }
 
     /// The groups' heads and codes the geometry pass draws (rewrites the
