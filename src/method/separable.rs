@@ -151,6 +151,19 @@ struct SssPush {
     follow_surface: i32,
 }
 
+/// How far the kernel's taps reach from a pixel at view depth `depth`: the
+/// widest offset at the strongest strength, as the shader scales it (the
+/// SSS region's margin; `plan::cli::characters` sizes the planner's regions
+/// with it too, so both draw the same rectangles).
+pub fn reach_px(kernel: &SeparableKernel, depth: f32, scale: &ReachScale) -> f32 {
+    let widest_mm = kernel
+        .samples
+        .iter()
+        .map(|s| s.offset_mm.abs())
+        .fold(0.0, f32::max);
+    widest_mm * scale.max_strength * scale.px_per_mm(depth) + BILINEAR_MARGIN_PX
+}
+
 pub struct Separable {
     pipeline: Pipeline,
     pub kernel: SeparableKernel,
@@ -263,15 +276,8 @@ impl SssMethod for Separable {
         self.diffuse
     }
 
-    /// The widest offset at the strongest strength, as the shader scales it.
     fn reach_px(&self, depth: f32, scale: &ReachScale) -> Option<f32> {
-        let widest_mm = self
-            .kernel
-            .samples
-            .iter()
-            .map(|s| s.offset_mm.abs())
-            .fold(0.0, f32::max);
-        Some(widest_mm * scale.max_strength * scale.px_per_mm(depth) + BILINEAR_MARGIN_PX)
+        Some(reach_px(&self.kernel, depth, scale))
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {

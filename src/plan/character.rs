@@ -45,6 +45,11 @@ pub struct CharacterInput {
     pub silhouette_share: f64,
     /// Screen rectangle of its skin `[x0, y0, x1, y1]` (pixels, half-open).
     pub screen_rect: [u32; 4],
+    /// The reference setting's SSS region of this character alone, as the
+    /// frame builds it (tiles, `[x0, y0, x1, y1]`; empty where unknown): a
+    /// group's region is the tile cover of its characters' (they overlap).
+    #[serde(skip)]
+    pub region_tiles: Vec<[u32; 4]>,
 }
 
 impl CharacterInput {
@@ -108,6 +113,7 @@ pub fn estimate(
                 region_rects: 0.0,
                 silhouette_share: CharacterInput::band_share(area, px_per_mm),
                 screen_rect: rect,
+                region_tiles: Vec::new(),
             }
         })
         .collect()

@@ -23,10 +23,10 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::character::CharacterInput;
-use super::choose::{plan, Accuracy, Ask, SettingCosts};
+use super::choose::{Accuracy, Ask, SettingCosts};
 use super::cli::{
-    atlas_mm, characters, load_models, plan_file, plan_frames_dir, reference_model, registered,
-    setting_costs, NODE_LIMIT,
+    atlas_mm, characters, load_models, plan_file, plan_frames_dir, plan_refilled, reference_model,
+    registered, setting_costs, NODE_LIMIT,
 };
 use super::cost::SettingModel;
 pub use super::truth::{render, truth_settings, with_method, CharacterScore, FrameError, Truth};
@@ -386,15 +386,22 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
             let (pname, budget) = (pname.as_str(), *budget);
             let c = &costs.iter().find(|(n, _)| n == pname).expect("priced").1;
             let t0 = Instant::now();
-            let p = plan(&Ask {
-                characters: &chars,
-                settings: c,
-                accuracy: o.accuracy,
-                budget_ms: budget,
-                previous: None,
-                switch_margin: 0.0,
-                node_limit: Some(NODE_LIMIT),
-            });
+            let prof = &profiles.iter().find(|(n, _)| n == pname).expect("loaded").1;
+            let p = plan_refilled(
+                &Ask {
+                    characters: &chars,
+                    settings: c,
+                    accuracy: o.accuracy,
+                    budget_ms: budget,
+                    previous: None,
+                    switch_margin: 0.0,
+                    node_limit: Some(NODE_LIMIT),
+                },
+                c,
+                &models,
+                prof,
+                (s.width, s.height, s.sss_region_tile),
+            );
             let solve_ms = t0.elapsed().as_secs_f64() * 1e3;
             let file: PlanFile = plan_file(pname, budget, &chars, c, &p, Vec::new())?;
             let mut ps = s.clone();

@@ -248,6 +248,7 @@ mod tests {
             region_rects: 0.0,
             silhouette_share: 0.1,
             screen_rect: [0; 4],
+            region_tiles: Vec::new(),
         }
     }
 

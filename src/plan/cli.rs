@@ -356,7 +356,50 @@ pub fn characters(
         c.region_pixels = r;
         c.region_rects = if c.skin_pixels > 0.0 { n.max(1.0) } else { 0.0 };
     }
+    for (c, tiles) in cs.iter_mut().zip(reference_regions(scene, s, &framing)) {
+        c.region_tiles = tiles.iter().map(|r| [r.x0, r.y0, r.x1, r.y1]).collect();
+    }
     cs
+}
+
+/// Each character's region alone as the frame builds it for the reference
+/// setting (separable at its defaults: its kernel's reach, the frame's tiles),
+/// so a group's region can be the cover of its characters' (`cost::Overlap`).
+/// Empty where the frame draws no region (`--sss-region screen`) or the
+/// reference is another method.
+fn reference_regions(
+    scene: &Scene,
+    s: &RenderSettings,
+    framing: &crate::scene::framing::Framing,
+) -> Vec<Vec<crate::view::region::PixelRect>> {
+    use crate::method::separable;
+    use crate::view::region::{instance_regions, RegionMode, RegionView};
+    let none = || vec![Vec::new(); framing.instances.len()];
+    let d = RenderSettings::default();
+    if s.sss_region == RegionMode::Screen || d.method.name != "separable" {
+        return none();
+    }
+    let Ok(kernel) = separable::Config::parse(&d.method.opts(&d.options))
+        .and_then(|c| crate::skin::kernel::SeparableKernel::build(c.params, c.samples))
+    else {
+        return none();
+    };
+    let cam = framing.camera;
+    let rv = RegionView {
+        view: cam.view(),
+        proj: cam.proj(s.width as f32 / s.height as f32),
+        near: cam.near,
+        width: s.width,
+        height: s.height,
+    };
+    instance_regions(
+        scene,
+        &framing.instances,
+        &rv,
+        (cam.fovy_rad / 2.0).tan(),
+        s.sss_region_tile,
+        |depth, scale| separable::reach_px(&kernel, depth, scale),
+    )
 }
 
 /// Every setting's costs for `chars` on the profile.
@@ -393,6 +436,100 @@ pub fn setting_costs(
         .collect()
 }
 
+/// A plan's groups priced as the frame draws them: each group's characters'
+/// regions merged (`cost::Overlap`: one tile cover, fewer rectangles than
+/// their sum), each group one `price_frame`. The solver's additive parts count
+/// every character's region whole, an upper bound; this is the plan's
+/// prediction. Each row's part is scaled so that the rows and the groups'
+/// fixed costs still sum to it.
+pub fn price_merged(
+    p: &mut Plan,
+    chars: &[CharacterInput],
+    costs: &[SettingCosts],
+    models: &[SettingModel],
+    prof: &Profile,
+    (width, height, tile): (u32, u32, u32),
+) {
+    let cm = CostModel {
+        profile: prof,
+        params: ParamSet::fitted(),
+        width,
+        height,
+    };
+    let mut total = 0.0;
+    for (g, fixed) in p.groups.clone() {
+        let members: Vec<usize> = (0..p.rows.len())
+            .filter(|&i| p.rows[i].setting == Some(g))
+            .collect();
+        let additive: f64 = members.iter().map(|&i| p.rows[i].part_ms).sum::<f64>() + fixed;
+        let model = models
+            .iter()
+            .find(|m| m.method == costs[g].method && m.setting == costs[g].setting);
+        let regions: Vec<&[[u32; 4]]> = members
+            .iter()
+            .map(|&i| chars[i].region_tiles.as_slice())
+            .collect();
+        let overlap = super::cost::Overlap::of(&regions, width, height, tile);
+        let loads: Vec<_> = members.iter().map(|&i| super::load_of(&chars[i])).collect();
+        let merged = model
+            .and_then(|m| m.group_ms(prof, &cm.params, &overlap.apply(&loads), width, height))
+            .unwrap_or(additive);
+        let parts = additive - fixed;
+        let k = if parts > 0.0 {
+            ((merged - fixed) / parts).max(0.0)
+        } else {
+            1.0
+        };
+        for &i in &members {
+            p.rows[i].part_ms *= k;
+        }
+        total += merged;
+    }
+    p.solution.cost_ms = total;
+}
+
+/// Plans, prices the plan as the frame draws it (`price_merged`) and, while
+/// that leaves budget unused, plans again with the solver's budget stretched
+/// by the additive over merged cost of the last plan, keeping a stretched
+/// plan only where its merged cost fits the budget and its error is lower
+/// (at most `REFILL_ROUNDS` rounds). The solver's optimality and bound are
+/// those of the additive problem at the budget it was given.
+pub fn plan_refilled(
+    ask: &Ask,
+    costs: &[SettingCosts],
+    models: &[SettingModel],
+    prof: &Profile,
+    size: (u32, u32, u32),
+) -> Plan {
+    let priced = |budget: f64| {
+        let mut p = plan(&Ask {
+            budget_ms: budget,
+            previous: ask.previous.clone(),
+            ..*ask
+        });
+        let additive = p.solution.cost_ms;
+        price_merged(&mut p, ask.characters, costs, models, prof, size);
+        (p, additive)
+    };
+    let (mut best, mut additive) = priced(ask.budget_ms);
+    let mut merged = best.solution.cost_ms;
+    for _ in 0..REFILL_ROUNDS {
+        if merged <= 0.0 || additive <= merged * (1.0 + 1e-6) {
+            break;
+        }
+        let (p, a) = priced(ask.budget_ms * additive / merged);
+        if p.solution.cost_ms > ask.budget_ms + 1e-9 || p.solution.error >= best.solution.error {
+            break;
+        }
+        (additive, merged) = (a, p.solution.cost_ms);
+        best = p;
+    }
+    best
+}
+
+/// Rounds of `plan_refilled` (each a solve and a pricing of its groups).
+pub const REFILL_ROUNDS: usize = 4;
+
 /// Node limit of the branch and bound in `dermis plan` (beyond it the plan
 /// is the best found and the bound says how far from optimal it can be).
 pub const NODE_LIMIT: u64 = 20_000;
@@ -418,15 +555,21 @@ pub fn run(
         atlas_mm(scene),
     );
     let t1 = Instant::now();
-    let p = plan(&Ask {
-        characters: &chars,
-        settings: &costs,
-        accuracy,
-        budget_ms: args.budget_ms,
-        previous: None,
-        switch_margin: 0.0,
-        node_limit: Some(NODE_LIMIT),
-    });
+    let p = plan_refilled(
+        &Ask {
+            characters: &chars,
+            settings: &costs,
+            accuracy,
+            budget_ms: args.budget_ms,
+            previous: None,
+            switch_margin: 0.0,
+            node_limit: Some(NODE_LIMIT),
+        },
+        &costs,
+        &models,
+        &args.profile,
+        (settings.width, settings.height, settings.sss_region_tile),
+    );
     let t2 = Instant::now();
     notes.extend(plan_notes(&p, accuracy_source));
     notes.push(format!(

@@ -416,6 +416,7 @@ mod tests {
             region_rects: 4.0,
             silhouette_share: 0.1,
             screen_rect: [0, 0, 100, 100],
+            region_tiles: Vec::new(),
         };
         let s = |setting: &str| SettingCosts {
             method: "m".into(),

@@ -343,6 +343,44 @@ pub fn scene_region(
     )
 }
 
+/// The region of each character alone (`scene_region` of one instance at a
+/// time, the clusters computed once): what the planner unions per group
+/// (`plan::cost::GroupRegion`), since characters' regions overlap and merge
+/// into fewer rectangles than their sum.
+pub fn instance_regions(
+    scene: &crate::scene::Scene,
+    instances: &[Mat4],
+    v: &RegionView,
+    tan_half_fovy: f32,
+    tile: u32,
+    reach: impl Fn(f32, &ReachScale) -> f32,
+) -> Vec<Vec<PixelRect>> {
+    let scale = ReachScale {
+        height_px: v.height,
+        tan_half_fovy,
+        mm_per_unit: scene.mm_per_unit,
+        max_strength: skin_objects(scene)
+            .iter()
+            .map(|o| o.material.sss_strength)
+            .fold(0.0, f32::max),
+    };
+    let clusters: Vec<Aabb> = skin_objects(scene)
+        .iter()
+        .flat_map(|o| cluster_bounds(&o.mesh, CLUSTER_CELLS))
+        .collect();
+    instances
+        .iter()
+        .map(|m| {
+            skin_region(
+                v,
+                clusters.iter().map(|b| b.transformed(m)),
+                |d| reach(d, &scale),
+                tile,
+            )
+        })
+        .collect()
+}
+
 /// Where the skin of `instances` lies in depth: for each skin cluster on
 /// screen, its share of the clusters' on-screen area and its nearest view
 /// depth (what a method's per-pixel kernel size follows; clusters a face
