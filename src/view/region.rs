@@ -315,6 +315,19 @@ pub fn cluster_bounds(mesh: &Mesh, cells: u32) -> Vec<Aabb> {
 /// boxes per head, projected once per renderer.
 pub const CLUSTER_CELLS: u32 = 8;
 
+/// The scale a method's reach is measured in for `scene` seen through `v`.
+fn reach_scale(scene: &crate::scene::Scene, v: &RegionView, tan_half_fovy: f32) -> ReachScale {
+    ReachScale {
+        height_px: v.height,
+        tan_half_fovy,
+        mm_per_unit: scene.mm_per_unit,
+        max_strength: skin_objects(scene)
+            .iter()
+            .map(|o| o.material.sss_strength)
+            .fold(0.0, f32::max),
+    }
+}
+
 /// The SSS region of a method in a scene: every skin object's triangle
 /// clusters, once per character (`instances`), widened by `reach` (the
 /// method's reach in pixels at a depth; `None`: the whole screen).
@@ -326,15 +339,7 @@ pub fn scene_region(
     tile: u32,
     reach: impl Fn(f32, &ReachScale) -> Option<f32>,
 ) -> Vec<PixelRect> {
-    let scale = ReachScale {
-        height_px: v.height,
-        tan_half_fovy,
-        mm_per_unit: scene.mm_per_unit,
-        max_strength: skin_objects(scene)
-            .iter()
-            .map(|o| o.material.sss_strength)
-            .fold(0.0, f32::max),
-    };
+    let scale = reach_scale(scene, v, tan_half_fovy);
     skin_region(
         v,
         skin_boxes(scene, instances),
@@ -345,7 +350,7 @@ pub fn scene_region(
 
 /// The region of each character alone (`scene_region` of one instance at a
 /// time, the clusters computed once): what the planner unions per group
-/// (`plan::cost::GroupRegion`), since characters' regions overlap and merge
+/// (`plan::cost::Overlap`), since characters' regions overlap and merge
 /// into fewer rectangles than their sum.
 pub fn instance_regions(
     scene: &crate::scene::Scene,
@@ -355,15 +360,7 @@ pub fn instance_regions(
     tile: u32,
     reach: impl Fn(f32, &ReachScale) -> f32,
 ) -> Vec<Vec<PixelRect>> {
-    let scale = ReachScale {
-        height_px: v.height,
-        tan_half_fovy,
-        mm_per_unit: scene.mm_per_unit,
-        max_strength: skin_objects(scene)
-            .iter()
-            .map(|o| o.material.sss_strength)
-            .fold(0.0, f32::max),
-    };
+    let scale = reach_scale(scene, v, tan_half_fovy);
     let clusters: Vec<Aabb> = skin_objects(scene)
         .iter()
         .flat_map(|o| cluster_bounds(&o.mesh, CLUSTER_CELLS))
