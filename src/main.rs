@@ -22,7 +22,7 @@ use dermis::method::{
     OptKind,
 };
 use dermis::mix::plan_file::PlanFile;
-use dermis::post::AaMode;
+use dermis::post::{AaMode, EdgeSource};
 use dermis::render::settings::Assignment;
 use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
@@ -315,6 +315,27 @@ impl From<AaArg> for AaMode {
     }
 }
 
+/// `--aa-edges`: what MLAA's or SMAA's first pass finds edges in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AaEdgesArg {
+    /// Luma of the gamma-encoded colour (both modes' default).
+    Luma,
+    /// The frame's linear view depth, 10 mm threshold (MLAA only: thesis ch. 9.3).
+    Depth,
+    /// The largest R, G or B difference (SMAA only: ch. 10.4.1).
+    Color,
+}
+
+impl From<AaEdgesArg> for EdgeSource {
+    fn from(a: AaEdgesArg) -> Self {
+        match a {
+            AaEdgesArg::Luma => EdgeSource::Luma,
+            AaEdgesArg::Depth => EdgeSource::Depth,
+            AaEdgesArg::Color => EdgeSource::Color,
+        }
+    }
+}
+
 /// `--sss-region`: where the SSS passes run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum SssRegionArg {
@@ -557,6 +578,14 @@ struct Common {
     /// every other pass).
     #[arg(long, value_enum, ignore_case = true, default_value_t = AaArg::None)]
     aa: AaArg,
+    /// Bloom on the HDR composite before the tone map: a 4-level Gaussian pyramid
+    /// mixed in at 10 % (docs/aa.md, "Bloom"); off by default.
+    #[arg(long)]
+    bloom: bool,
+    /// What MLAA's or SMAA's edge pass reads [default: luma]; an error with another
+    /// --aa.
+    #[arg(long, value_enum, ignore_case = true)]
+    aa_edges: Option<AaEdgesArg>,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -653,6 +682,8 @@ impl Common {
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
         s.aa = self.aa.into();
+        s.post.bloom = self.bloom;
+        s.post.aa_edges = self.aa_edges.map(Into::into);
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)

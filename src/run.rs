@@ -194,6 +194,8 @@ pub fn run(
         sss_region_pixels: Some(sss_region_pixels),
         sss_region_rects: Some(sss_region_rects),
         aa: (settings.aa != crate::post::AaMode::None).then(|| settings.aa.name().to_string()),
+        bloom: settings.post.bloom,
+        aa_edges: settings.post.aa_edges.map(|e| e.name().to_string()),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -109,6 +109,17 @@ pub fn luma(c: [f32; 4]) -> f32 {
 /// ch. 9.3.1).
 pub const MLAA_LUMA_THRESHOLD: f32 = 0.1;
 
+/// MLAA's depth threshold, in millimetres of linear view depth (ch. 9.3:
+/// the thesis gives none; it "varies with resolution"). One centimetre:
+/// above the step between neighbouring pixels of one surface up to 87
+/// degrees from the view at the portrait's pixels of about 0.4 mm (a head of
+/// some 240 mm over 580 of 720 rows; 0.4 / tan 3 deg = 7.6 mm), below the depth steps where a face occludes
+/// itself (the nose's side over the cheek, the ear, the chin over the neck:
+/// 15 mm and more) and far below a silhouette against the background. The
+/// depth pass compares linear depth, so the threshold is a length whatever
+/// the distance (a projected depth's steps shrink with the square of it).
+pub const MLAA_DEPTH_THRESHOLD_MM: f32 = 10.0;
+
 /// SMAA's quality presets (`SMAA.hlsl`, ANCHORS.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {

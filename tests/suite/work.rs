@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 
 use dermis::graph::work::Work;
 use dermis::method::METHODS;
-use dermis::post::AaMode;
+use dermis::post::{AaMode, EdgeSource};
 use dermis::render::counting::{filter_kind, site};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
@@ -44,6 +44,13 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                 let s = RenderSettings::study().with(m, &[]);
                 settings.push((format!("{} --aa {aa}", m.name), RenderSettings { aa, ..s }));
             }
+            let mut s = RenderSettings::study().with(m, &[]);
+            s.post.bloom = true;
+            settings.push((format!("{} --bloom", m.name), s));
+            let mut s = RenderSettings::study().with(m, &[]);
+            s.aa = AaMode::Mlaa;
+            s.post.aa_edges = Some(EdgeSource::Depth);
+            settings.push((format!("{} --aa mlaa --aa-edges depth", m.name), s));
         }
         for (label, s) in settings {
             let s = RenderSettings {
