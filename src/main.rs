@@ -13,6 +13,7 @@ use clap::{
     Arg, ArgAction, ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum,
 };
 
+use dermis::aa::edges::Preset as SmaaPreset;
 use dermis::budget::run::BudgetOptions;
 use dermis::budget::Rescale;
 use dermis::eval::{study, sweep};
@@ -299,8 +300,8 @@ enum AaArg {
     /// Jimenez's MLAA (thesis ch. 9): luma edges writing the stencil, then
     /// blending weights and neighbourhood blending on edge pixels only.
     Mlaa,
-    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with local contrast
-    /// adaptation, diagonal patterns, accurate searches, sharp corners.
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), --smaa-preset (default high): edges with
+    /// local contrast adaptation, diagonal patterns, accurate searches, sharp corners.
     Smaa,
 }
 
@@ -332,6 +333,30 @@ impl From<AaEdgesArg> for EdgeSource {
             AaEdgesArg::Luma => EdgeSource::Luma,
             AaEdgesArg::Depth => EdgeSource::Depth,
             AaEdgesArg::Color => EdgeSource::Color,
+        }
+    }
+}
+
+/// `--smaa-preset`: SMAA's quality preset (SMAA.hlsl's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum SmaaPresetArg {
+    /// Threshold 0.15, 4 search steps, no diagonals or corners.
+    Low,
+    /// Threshold 0.1, 8 search steps, no diagonals or corners.
+    Medium,
+    /// Threshold 0.1, 16 search steps, diagonals 8, corner rounding 25 %.
+    High,
+    /// Threshold 0.05, 32 search steps, diagonals 16, corner rounding 25 %.
+    Ultra,
+}
+
+impl From<SmaaPresetArg> for SmaaPreset {
+    fn from(a: SmaaPresetArg) -> Self {
+        match a {
+            SmaaPresetArg::Low => SmaaPreset::Low,
+            SmaaPresetArg::Medium => SmaaPreset::Medium,
+            SmaaPresetArg::High => SmaaPreset::High,
+            SmaaPresetArg::Ultra => SmaaPreset::Ultra,
         }
     }
 }
@@ -586,6 +611,9 @@ struct Common {
     /// --aa.
     #[arg(long, value_enum, ignore_case = true)]
     aa_edges: Option<AaEdgesArg>,
+    /// SMAA's quality preset [default: high]; an error without --aa smaa.
+    #[arg(long, value_enum, ignore_case = true)]
+    smaa_preset: Option<SmaaPresetArg>,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -684,6 +712,7 @@ impl Common {
         s.aa = self.aa.into();
         s.post.bloom = self.bloom;
         s.post.aa_edges = self.aa_edges.map(Into::into);
+        s.post.smaa_preset = self.smaa_preset.map(Into::into);
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)

@@ -62,6 +62,9 @@ pub struct Report {
     /// (`post::EdgeSource::name`); absent otherwise (luma).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aa_edges: Option<String>,
+    /// SMAA's preset when `--smaa-preset` named one (`Preset::name`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smaa_preset: Option<String>,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,

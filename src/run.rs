@@ -196,6 +196,7 @@ pub fn run(
         aa: (settings.aa != crate::post::AaMode::None).then(|| settings.aa.name().to_string()),
         bloom: settings.post.bloom,
         aa_edges: settings.post.aa_edges.map(|e| e.name().to_string()),
+        smaa_preset: settings.post.smaa_preset.map(|p| p.name().to_string()),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -14,7 +14,7 @@
 //! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
 //! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
 //!   weights, neighbourhood blending, both stencil-tested) and a copy.
-//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with
+//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
 //!   local contrast adaptation writing the stencil, blending weights
 //!   (stencil-tested: diagonals, accurate searches, corners), blending.
 //! - `fxaa`: FXAA's quality preset, one pass.
@@ -34,6 +34,7 @@ use std::str::FromStr;
 use anyhow::{bail, Result};
 use ash::vk;
 
+use crate::aa::edges::Preset;
 use crate::graph::work::{Fetch, Filter};
 use crate::graph::{ImageId, Pass, Resources};
 use crate::vk::context::Context;
@@ -75,7 +76,7 @@ impl AaMode {
                 "Jimenez's MLAA (thesis ch. 9): luma edges + stencil, blending weights, neighbourhood blending"
             }
             AaMode::Smaa => {
-                "SMAA 1x (thesis ch. 10.4), high preset: adapted luma edges + stencil, weights with diagonals and corners, blending"
+                "SMAA 1x (thesis ch. 10.4), --smaa-preset (default high): adapted luma or colour edges + stencil, weights with diagonals and corners, blending"
             }
         }
     }
@@ -154,6 +155,9 @@ pub struct PostOptions {
     /// Where MLAA or SMAA find edges (`--aa-edges`); `None`: luma, and a
     /// report that does not name it.
     pub aa_edges: Option<EdgeSource>,
+    /// SMAA's preset (`--smaa-preset`); `None`: high, and a report that does
+    /// not name it.
+    pub smaa_preset: Option<Preset>,
 }
 
 impl PostOptions {
@@ -162,8 +166,19 @@ impl PostOptions {
         self.aa_edges.unwrap_or_default()
     }
 
+    /// SMAA's preset.
+    pub fn smaa_preset(&self) -> Preset {
+        self.smaa_preset.unwrap_or(smaa::DEFAULT_PRESET)
+    }
+
     /// Refuses, in one line, an option that `aa` does not use.
     pub fn check(&self, aa: AaMode) -> Result<()> {
+        if let (Some(p), false) = (self.smaa_preset, aa == AaMode::Smaa) {
+            bail!(
+                "--smaa-preset {} applies to --aa smaa, not to --aa {aa}",
+                p.name()
+            );
+        }
         if let Some(e) = self.aa_edges {
             if !e.modes().contains(&aa) {
                 bail!(
@@ -369,6 +384,14 @@ mod tests {
             ..PostOptions::default()
         };
         assert!(PostOptions::default().check(AaMode::Fxaa).is_ok());
+        let low = PostOptions {
+            smaa_preset: Some(Preset::Low),
+            ..PostOptions::default()
+        };
+        assert!(low.check(AaMode::Smaa).is_ok());
+        let e = low.check(AaMode::Mlaa).unwrap_err().to_string();
+        assert!(e.contains("--smaa-preset low") && e.contains("mlaa"), "{e}");
+        assert_eq!(PostOptions::default().smaa_preset(), Preset::High);
         assert_eq!(PostOptions::default().edges(), EdgeSource::Luma);
         for (e, ok) in [
             (EdgeSource::Luma, [false, false, true, true]),

@@ -8,6 +8,7 @@ use crate::common;
 
 use std::collections::BTreeMap;
 
+use dermis::aa::edges::Preset;
 use dermis::graph::work::Work;
 use dermis::method::METHODS;
 use dermis::post::{AaMode, EdgeSource};
@@ -51,6 +52,16 @@ fn declared_fetches_are_what_the_shaders_fetch() {
             s.aa = AaMode::Mlaa;
             s.post.aa_edges = Some(EdgeSource::Depth);
             settings.push((format!("{} --aa mlaa --aa-edges depth", m.name), s));
+            for (preset, edges) in [
+                (Preset::Low, EdgeSource::Luma),
+                (Preset::Ultra, EdgeSource::Color),
+            ] {
+                let mut s = RenderSettings::study().with(m, &[]);
+                s.aa = AaMode::Smaa;
+                s.post.aa_edges = Some(edges);
+                s.post.smaa_preset = Some(preset);
+                settings.push((format!("{} --aa smaa {preset:?} {edges}", m.name), s));
+            }
         }
         for (label, s) in settings {
             let s = RenderSettings {
