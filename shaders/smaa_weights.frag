@@ -3,7 +3,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "fetch_count.glsl"
 // SMAA 1x pass 2 (thesis ch. 10.4.2; the structure of SMAA.hlsl's
-// SMAABlendingWeightCalculationPS, high preset, written here in pixel units):
+// SMAABlendingWeightCalculationPS, its preset's steps and switches pushed by
+// src/post/smaa.rs, written here in pixel units):
 // per top edgel, first the diagonal patterns (two diagonal searches each way,
 // their crossing edges, the diagonal half of the area texture); if none, the
 // horizontal line: searches of four edgels per bilinear fetch (at -0.25,
@@ -21,10 +22,16 @@ layout(set = 0, binding = 3) uniform sampler linearClamp;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outWeights;
 
-// The high preset.
-const int MAX_SEARCH_STEPS = 16;
-const int MAX_SEARCH_STEPS_DIAG = 8;
-const float CORNER_ROUNDING = 0.25;
+// The preset (aa::edges::Preset): orthogonal search steps (16 at high),
+// diagonal ones (8; 0: no diagonal patterns, low and medium), the corner
+// rounding (0.25) and whether corners are detected at all (not at low and
+// medium).
+layout(push_constant) uniform Push {
+    int maxSearchSteps;
+    int maxSearchStepsDiag;
+    float cornerRounding;
+    int corners;
+} pc;
 // The area texture's layout (src/aa/smaa_area.rs).
 const float AREA_MAX_DISTANCE = 16.0;
 const float AREA_MAX_DISTANCE_DIAG = 20.0;
@@ -118,7 +125,7 @@ vec4 decodeDiag4(vec4 e) {
 vec2 searchDiag1(vec2 centre, vec2 dir, out vec2 e) {
     vec4 c = vec4(centre, -1.0, 1.0);
     e = vec2(0.0);
-    while (c.z < float(MAX_SEARCH_STEPS_DIAG - 1) && c.w > 0.9) {
+    while (c.z < float(pc.maxSearchStepsDiag - 1) && c.w > 0.9) {
         c.xyz += vec3(dir, 1.0);
         e = edgesAt(c.xy);
         c.w = dot(e, vec2(0.5));
@@ -130,7 +137,7 @@ vec2 searchDiag2(vec2 centre, vec2 dir, out vec2 e) {
     vec4 c = vec4(centre, -1.0, 1.0);
     c.x += 0.25;
     e = vec2(0.0);
-    while (c.z < float(MAX_SEARCH_STEPS_DIAG - 1) && c.w > 0.9) {
+    while (c.z < float(pc.maxSearchStepsDiag - 1) && c.w > 0.9) {
         c.xyz += vec3(dir, 1.0);
         e = decodeDiag(edgesAt(c.xy));
         c.w = dot(e, vec2(0.5));
@@ -185,7 +192,7 @@ vec2 diagWeights(vec2 centre, vec2 e) {
 // line's end on one side, that side's blend is rounded down by 1 - r.
 vec2 horizontalCorners(vec2 weights, vec4 ends, vec2 d) {
     vec2 leftRight = step(d.xy, d.yx);
-    vec2 rounding = (1.0 - CORNER_ROUNDING) * leftRight;
+    vec2 rounding = (1.0 - pc.cornerRounding) * leftRight;
     rounding /= leftRight.x + leftRight.y;
     vec2 factor = vec2(1.0);
     factor.x -= rounding.x * edgesAt(ends.xy + vec2(0.0, 1.0)).r;
@@ -197,7 +204,7 @@ vec2 horizontalCorners(vec2 weights, vec4 ends, vec2 d) {
 
 vec2 verticalCorners(vec2 weights, vec4 ends, vec2 d) {
     vec2 leftRight = step(d.xy, d.yx);
-    vec2 rounding = (1.0 - CORNER_ROUNDING) * leftRight;
+    vec2 rounding = (1.0 - pc.cornerRounding) * leftRight;
     rounding /= leftRight.x + leftRight.y;
     vec2 factor = vec2(1.0);
     factor.x -= rounding.x * edgesAt(ends.xy + vec2(1.0, 0.0)).g;
@@ -214,9 +221,11 @@ void main() {
     vec2 centre = vec2(p) + 0.5;
     vec2 e = COUNTED(SITE(0, 0, FK_POINT), texelFetch(edgesTex, p, 0)).rg;
     vec4 weights = vec4(0.0);
-    float reach = 2.0 * float(MAX_SEARCH_STEPS);
+    float reach = 2.0 * float(pc.maxSearchSteps);
     if (e.g > 0.0) {  // edge at north
-        weights.rg = diagWeights(centre, e);
+        if (pc.maxSearchStepsDiag > 0) {
+            weights.rg = diagWeights(centre, e);
+        }
         if (weights.r == -weights.g) {  // no diagonal: both zero
             vec2 start = centre + vec2(-0.25, -0.125);
             float left = searchXLeft(start, start.x - reach);
@@ -226,7 +235,9 @@ void main() {
             float e2 = edgesAt(vec2(right + 1.0, centre.y - 0.25)).r;
             vec2 d = abs(round(vec2(left, right) - centre.x));
             weights.rg = area(sqrt(d), e1, e2);
-            weights.rg = horizontalCorners(weights.rg, vec4(left, centre.y, right, centre.y), d);
+            if (pc.corners != 0) {
+                weights.rg = horizontalCorners(weights.rg, vec4(left, centre.y, right, centre.y), d);
+            }
         } else {
             e.r = 0.0;  // a diagonal was found: skip the vertical line
         }
@@ -240,7 +251,9 @@ void main() {
         float e2 = edgesAt(vec2(centre.x - 0.25, down + 1.0)).g;
         vec2 d = abs(round(vec2(up, down) - centre.y));
         weights.ba = area(sqrt(d), e1, e2);
-        weights.ba = verticalCorners(weights.ba, vec4(centre.x, up, centre.x, down), d);
+        if (pc.corners != 0) {
+            weights.ba = verticalCorners(weights.ba, vec4(centre.x, up, centre.x, down), d);
+        }
     }
     outWeights = weights;
 }

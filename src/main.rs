@@ -13,6 +13,7 @@ use clap::{
     Arg, ArgAction, ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum,
 };
 
+use dermis::aa::edges::Preset as SmaaPreset;
 use dermis::budget::run::BudgetOptions;
 use dermis::budget::Rescale;
 use dermis::eval::{study, sweep};
@@ -22,7 +23,7 @@ use dermis::method::{
     OptKind,
 };
 use dermis::mix::plan_file::PlanFile;
-use dermis::post::AaMode;
+use dermis::post::{AaMode, EdgeSource};
 use dermis::render::settings::Assignment;
 use dermis::render::RenderSettings;
 use dermis::run::{bench_run, header, render_to_dir, RunOptions};
@@ -299,8 +300,8 @@ enum AaArg {
     /// Jimenez's MLAA (thesis ch. 9): luma edges writing the stencil, then
     /// blending weights and neighbourhood blending on edge pixels only.
     Mlaa,
-    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with local contrast
-    /// adaptation, diagonal patterns, accurate searches, sharp corners.
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), --smaa-preset (default high): edges with
+    /// local contrast adaptation, diagonal patterns, accurate searches, sharp corners.
     Smaa,
 }
 
@@ -311,6 +312,51 @@ impl From<AaArg> for AaMode {
             AaArg::Fxaa => AaMode::Fxaa,
             AaArg::Mlaa => AaMode::Mlaa,
             AaArg::Smaa => AaMode::Smaa,
+        }
+    }
+}
+
+/// `--aa-edges`: what MLAA's or SMAA's first pass finds edges in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum AaEdgesArg {
+    /// Luma of the gamma-encoded colour (both modes' default).
+    Luma,
+    /// The frame's linear view depth, 10 mm threshold (MLAA only: thesis ch. 9.3).
+    Depth,
+    /// The largest R, G or B difference (SMAA only: ch. 10.4.1).
+    Color,
+}
+
+impl From<AaEdgesArg> for EdgeSource {
+    fn from(a: AaEdgesArg) -> Self {
+        match a {
+            AaEdgesArg::Luma => EdgeSource::Luma,
+            AaEdgesArg::Depth => EdgeSource::Depth,
+            AaEdgesArg::Color => EdgeSource::Color,
+        }
+    }
+}
+
+/// `--smaa-preset`: SMAA's quality preset (SMAA.hlsl's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum SmaaPresetArg {
+    /// Threshold 0.15, 4 search steps, no diagonals or corners.
+    Low,
+    /// Threshold 0.1, 8 search steps, no diagonals or corners.
+    Medium,
+    /// Threshold 0.1, 16 search steps, diagonals 8, corner rounding 25 %.
+    High,
+    /// Threshold 0.05, 32 search steps, diagonals 16, corner rounding 25 %.
+    Ultra,
+}
+
+impl From<SmaaPresetArg> for SmaaPreset {
+    fn from(a: SmaaPresetArg) -> Self {
+        match a {
+            SmaaPresetArg::Low => SmaaPreset::Low,
+            SmaaPresetArg::Medium => SmaaPreset::Medium,
+            SmaaPresetArg::High => SmaaPreset::High,
+            SmaaPresetArg::Ultra => SmaaPreset::Ultra,
         }
     }
 }
@@ -557,6 +603,17 @@ struct Common {
     /// every other pass).
     #[arg(long, value_enum, ignore_case = true, default_value_t = AaArg::None)]
     aa: AaArg,
+    /// Bloom on the HDR composite before the tone map: a 4-level Gaussian pyramid
+    /// mixed in at 10 % (docs/aa.md, "Bloom"); off by default.
+    #[arg(long)]
+    bloom: bool,
+    /// What MLAA's or SMAA's edge pass reads [default: luma]; an error with another
+    /// --aa.
+    #[arg(long, value_enum, ignore_case = true)]
+    aa_edges: Option<AaEdgesArg>,
+    /// SMAA's quality preset [default: high]; an error without --aa smaa.
+    #[arg(long, value_enum, ignore_case = true)]
+    smaa_preset: Option<SmaaPresetArg>,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -653,6 +710,9 @@ impl Common {
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
         s.aa = self.aa.into();
+        s.post.bloom = self.bloom;
+        s.post.aa_edges = self.aa_edges.map(Into::into);
+        s.post.smaa_preset = self.smaa_preset.map(Into::into);
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)

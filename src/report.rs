@@ -55,6 +55,16 @@ pub struct Report {
     /// without one (so a `--aa none` report is the one from before the chain).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aa: Option<String>,
+    /// The bloom before the tone map (`--bloom`); absent without it.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub bloom: bool,
+    /// MLAA's or SMAA's edge source when `--aa-edges` named one
+    /// (`post::EdgeSource::name`); absent otherwise (luma).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aa_edges: Option<String>,
+    /// SMAA's preset when `--smaa-preset` named one (`Preset::name`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smaa_preset: Option<String>,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,

@@ -68,6 +68,15 @@ pub const MLAA_MAX_SEARCH_STEPS: u32 = 4;
 /// `NUM_DISTANCES`; `aa::mlaa_area::NUM_DISTANCES`, checked in `post::mlaa`).
 pub const MLAA_NUM_DISTANCES: u32 = 9;
 
+/// Levels of the bloom's pyramid (`post::bloom_pyramid` says why four):
+/// half, quarter, eighth and sixteenth resolution, one texture binding each in
+/// bloom_combine.frag.
+pub const BLOOM_LEVELS: usize = 4;
+
+/// Half width in texels of the bloom's Gaussian blur per level: taps
+/// -R..=R, so 3 sigma of its one-texel Gaussian (`post::bloom_pyramid`).
+pub const BLOOM_BLUR_RADIUS: u32 = 3;
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -134,6 +143,8 @@ pub fn glsl() -> String {
     def("PCF_TAPS", float((PCF_TRIPS[0] * PCF_TRIPS[1]) as f32));
     def("MLAA_MAX_SEARCH_STEPS", MLAA_MAX_SEARCH_STEPS.to_string());
     def("MLAA_NUM_DISTANCES", MLAA_NUM_DISTANCES.to_string());
+    def("BLOOM_LEVELS", BLOOM_LEVELS.to_string());
+    def("BLOOM_BLUR_RADIUS", BLOOM_BLUR_RADIUS.to_string());
     s.push_str("#endif\n");
     s
 }

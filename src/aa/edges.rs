@@ -109,8 +109,21 @@ pub fn luma(c: [f32; 4]) -> f32 {
 /// ch. 9.3.1).
 pub const MLAA_LUMA_THRESHOLD: f32 = 0.1;
 
-/// SMAA's quality presets (`SMAA.hlsl`, ANCHORS.md).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// MLAA's depth threshold, in millimetres of linear view depth (ch. 9.3:
+/// the thesis gives none; it "varies with resolution"). One centimetre:
+/// above the step between neighbouring pixels of one surface up to 87
+/// degrees from the view at the portrait's pixels of about 0.4 mm (a head of
+/// some 240 mm over 580 of 720 rows; 0.4 / tan 3 deg = 7.6 mm), below the depth steps where a face occludes
+/// itself (the nose's side over the cheek, the ear, the chin over the neck:
+/// 15 mm and more) and far below a silhouette against the background. The
+/// depth pass compares linear depth, so the threshold is a length whatever
+/// the distance (a projected depth's steps shrink with the square of it).
+pub const MLAA_DEPTH_THRESHOLD_MM: f32 = 10.0;
+
+/// SMAA's quality presets (`SMAA.hlsl`, ANCHORS.md): low (threshold 0.15,
+/// 4 search steps, no diagonals or corners), medium (0.1, 8), high (0.1, 16,
+/// diagonals 8, corner rounding 25 %), ultra (0.05, 32, 16, 25 %).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Preset {
     Low,
     Medium,
@@ -119,6 +132,48 @@ pub enum Preset {
 }
 
 impl Preset {
+    pub const ALL: [Preset; 4] = [Preset::Low, Preset::Medium, Preset::High, Preset::Ultra];
+
+    /// The name `--smaa-preset` takes and reports print.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Low => "low",
+            Preset::Medium => "medium",
+            Preset::High => "high",
+            Preset::Ultra => "ultra",
+        }
+    }
+
+    /// Bilinear fetches per orthogonal search (`SMAA_MAX_SEARCH_STEPS`; two
+    /// pixels each).
+    pub fn search_steps(self) -> u32 {
+        match self {
+            Preset::Low => 4,
+            Preset::Medium => 8,
+            Preset::High => 16,
+            Preset::Ultra => 32,
+        }
+    }
+
+    /// Steps per diagonal search (`SMAA_MAX_SEARCH_STEPS_DIAG`); `None`: the
+    /// preset has no diagonal patterns (`SMAA_DISABLE_DIAG_DETECTION`).
+    pub fn diag_search_steps(self) -> Option<u32> {
+        match self {
+            Preset::Low | Preset::Medium => None,
+            Preset::High => Some(8),
+            Preset::Ultra => Some(16),
+        }
+    }
+
+    /// The corner rounding (`SMAA_CORNER_ROUNDING` / 100); `None`: no
+    /// corner detection (`SMAA_DISABLE_CORNER_DETECTION`).
+    pub fn corner_rounding(self) -> Option<f32> {
+        match self {
+            Preset::Low | Preset::Medium => None,
+            Preset::High | Preset::Ultra => Some(0.25),
+        }
+    }
+
     /// The colour / luma threshold.
     pub fn threshold(self) -> f32 {
         match self {

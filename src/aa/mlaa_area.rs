@@ -18,6 +18,28 @@ pub const AREA_SIZE: usize = NUM_DISTANCES * 5;
 /// the Xbox 360's `tfetch2D` offsets end at -8 / 7.5).
 pub const MAX_DISTANCE: usize = NUM_DISTANCES - 1;
 
+/// The Xbox 360's `tfetch2D` offsets, in pixels from the fetch's own
+/// coordinate (ch. 9.4.1: "limited to offsets of -8 and 7.5, which
+/// constrains the maximum distance that can be searched"; past eight pixels
+/// the hardware is used less efficiently). The lower end, 8 pixels, is
+/// MLAA's search reach: `MAX_DISTANCE`, `post::mlaa::SEARCH_DISTANCE`,
+/// `shader_constants::MLAA_MAX_SEARCH_STEPS` (2 pixels per bilinear fetch)
+/// and the budget's `frames::MLAA_MAX_SEARCH_TAPS` follow from it.
+pub const XBOX360_TFETCH2D_MIN_OFFSET_PX: i32 = -8;
+/// The upper end, 7.5 pixels, in half pixels (15): a search step lands on a
+/// half pixel between two edgels, so 7.5 is the last one within reach.
+pub const XBOX360_TFETCH2D_MAX_OFFSET_HALF_PX: i32 = 15;
+/// Channels of MLAA's edges target on the Xbox 360 (ch. 9.6, Table 9.2's
+/// note: the framework could not create two-channel 8-bit targets, so the
+/// edges took four). This port's edges target is four-channel too
+/// (`post::mlaa`), so the budget prices the Xbox 360's footprint.
+pub const XBOX360_EDGES_TARGET_CHANNELS: usize = 4;
+
+// The reach is the Xbox 360's: 8 pixels back, and 7.5 + 0.5 (the pixel's
+// own half) forward.
+const _: () = assert!(MAX_DISTANCE as i32 == -XBOX360_TFETCH2D_MIN_OFFSET_PX);
+const _: () = assert!(MAX_DISTANCE as i32 == (XBOX360_TFETCH2D_MAX_OFFSET_HALF_PX + 1) / 2);
+
 /// The area texture: `AREA_SIZE`^2 texels, row-major, row 0 first, two
 /// channels each (own pixel, opposite pixel; see `revector`'s frame).
 #[derive(Clone, Debug, PartialEq)]

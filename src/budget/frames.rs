@@ -332,6 +332,18 @@ fn fetch(texture: &str, format: Format, filter: Filter, count: f64) -> Fetch {
     }
 }
 
+/// The most bilinear search fetches MLAA's weights pass makes per edge pixel:
+/// two edgels, two searches each, each reaching the Xbox 360's `tfetch2D`
+/// offset of 8 pixels (`aa::mlaa_area::XBOX360_TFETCH2D_MIN_OFFSET_PX`, ch.
+/// 9.4.1) at two pixels per fetch: 16. `mlaa_frame` charges at most this.
+pub const MLAA_MAX_SEARCH_TAPS: f64 =
+    (2 * 2 * (-crate::aa::mlaa_area::XBOX360_TFETCH2D_MIN_OFFSET_PX / 2)) as f64;
+
+// The port's searches (`post::mlaa`'s declared bound) reach as far.
+const _: () = assert!(
+    4 * crate::shader_constants::MLAA_MAX_SEARCH_STEPS as i32 == MLAA_MAX_SEARCH_TAPS as i32
+);
+
 /// One MLAA draw: `shader` into an RGBA8 target, with `ds`, clearing `clears`.
 fn mlaa_draw(w: u32, h: u32, shader: ShaderWork, ds: DepthStencilUse, clears: Vec<Format>) -> Work {
     Work::Raster {
@@ -355,8 +367,12 @@ fn mlaa_draw(w: u32, h: u32, shader: ShaderWork, ds: DepthStencilUse, clears: Ve
 /// only (stencil). `edge_share` of the pixels are edges (an assumption: the
 /// thesis gives no count); the weights pass searches `search_taps` bilinear
 /// taps on average (its loops stop at the edge's end) plus 2 area-texture and
-/// 1 edge fetch; blending makes 3 point and 4 bilinear fetches.
+/// 1 edge fetch; blending makes 3 point and 4 bilinear fetches. The search
+/// taps are capped at [`MLAA_MAX_SEARCH_TAPS`] (the Xbox 360's reach), and
+/// the edges target has the Xbox 360's four channels
+/// (`aa::mlaa_area::XBOX360_EDGES_TARGET_CHANNELS`: RGBA8).
 pub fn mlaa_frame(w: u32, h: u32, edge_share: f64, search_taps: f64) -> FrameInput {
+    let search_taps = search_taps.clamp(0.0, MLAA_MAX_SEARCH_TAPS);
     let px = u64::from(w) * u64::from(h);
     let edges = (px as f64 * edge_share).round() as u64;
     let d24 = Format::D24UnormS8Uint;
@@ -471,6 +487,36 @@ mod tests {
             .all(|p| p.fragments == 0 && p.rasterized_pixels == Some(1920 * 1080)));
         let six = six_gaussians(&f);
         assert_eq!(six.passes.len(), f.passes.len() + 10);
+    }
+
+    // Ch. 9.4.1's Xbox 360 facts as the first-principles frame uses them: no
+    // more search taps than the tfetch2D reach allows, whatever the caller
+    // asks, and a four-channel (one byte each) edges target.
+    #[test]
+    fn mlaa_frames_search_no_further_than_the_xbox_360_reaches() {
+        assert_eq!(MLAA_MAX_SEARCH_TAPS, 16.0);
+        for (asked, charged) in [(8.0, 8.0), (40.0, MLAA_MAX_SEARCH_TAPS)] {
+            let f = mlaa_frame(1280, 720, 0.1, asked);
+            let Work::Raster {
+                shader: Some(s), ..
+            } = &f.passes[1].work
+            else {
+                panic!("the weights pass is a draw")
+            };
+            let taps: f64 = s
+                .fetches
+                .iter()
+                .filter(|f| f.filter == Filter::Bilinear)
+                .map(|f| f.count)
+                .sum();
+            assert_eq!(taps, charged, "asked {asked}");
+        }
+        let f = mlaa_frame(1280, 720, 0.1, 8.0);
+        let edges = f.passes[0].images.iter().find(|i| i.image == "edges");
+        assert_eq!(
+            edges.map(|e| e.format.bytes_per_texel() as usize),
+            Some(crate::aa::mlaa_area::XBOX360_EDGES_TARGET_CHANNELS)
+        );
     }
 
     #[test]

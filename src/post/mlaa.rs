@@ -2,7 +2,9 @@
 //! tone-mapped frame and a copy:
 //!
 //! 1. `mlaa edges` (ch. 9.3.1, Listing 9.1): Eq. 9.2 luma of the gamma-encoded
-//!    colour, threshold 0.1, left and top edgels into an RGBA8 edges target
+//!    colour, threshold 0.1 (or, with `--aa-edges depth`, the frame's linear
+//!    view depth, threshold `MLAA_DEPTH_THRESHOLD_MM`: ch. 9.3), left and top
+//!    edgels into an RGBA8 edges target
 //!    cleared every frame; pixels with no edge on any of their four sides are
 //!    discarded, so the stencil (cleared to 0, REPLACE 1) marks edge pixels.
 //! 2. `mlaa weights` (ch. 9.4, Listings 9.2-9.4): stencil EQUAL 1, early
@@ -16,15 +18,15 @@
 //!
 //! Targets: edges and weights RGBA8 unorm (the work vocabulary names no
 //! two-channel format; the Xbox 360 used a four-channel edges target too,
-//! ch. 9.6), the area texture RGBA8 unorm (its two channels in .rg), the
+//! ch. 9.6: `aa::mlaa_area::XBOX360_EDGES_TARGET_CHANNELS`), the area texture RGBA8 unorm (its two channels in .rg), the
 //! stencil in the frame's depth/stencil format, the output sRGB like the
 //! tone-mapped frame.
 
 use anyhow::Result;
 use ash::vk;
 
-use super::{fetch, rg8_as_rgba8, AaStage, PostBind, PostSetup};
-use crate::aa::edges::MLAA_LUMA_THRESHOLD;
+use super::{fetch, rg8_as_rgba8, AaStage, EdgeSource, PostBind, PostSetup};
+use crate::aa::edges::{MLAA_DEPTH_THRESHOLD_MM, MLAA_LUMA_THRESHOLD};
 use crate::aa::mlaa_area::{MlaaAreaTex, AREA_SIZE, MAX_DISTANCE, NUM_DISTANCES};
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
@@ -41,6 +43,7 @@ use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
 
 pub const EDGES_SHADER: &str = "mlaa_edges.frag";
+pub const EDGES_DEPTH_SHADER: &str = "mlaa_edges_depth.frag";
 pub const WEIGHTS_SHADER: &str = "mlaa_weights.frag";
 pub const BLEND_SHADER: &str = "mlaa_blend.frag";
 /// Edges, weights and the area texture: plain unorm, never sRGB (bevy's SMAA
@@ -55,6 +58,18 @@ pub const SEARCH_DISTANCE: usize = 2 * MLAA_MAX_SEARCH_STEPS as usize;
 const _: () = assert!(MLAA_NUM_DISTANCES as usize == NUM_DISTANCES);
 const _: () = assert!(SEARCH_DISTANCE == MAX_DISTANCE);
 const _: () = assert!(MLAA_MAX_SEARCH_STEPS as usize == crate::aa::mlaa_weights::MAX_SEARCH_STEPS);
+// The reach is the Xbox 360's tfetch2D offset (ch. 9.4.1; the constant's doc).
+const _: () =
+    assert!(SEARCH_DISTANCE as i32 == -crate::aa::mlaa_area::XBOX360_TFETCH2D_MIN_OFFSET_PX);
+// The edges target has the Xbox 360's four channels (TABLE_FORMAT is RGBA8).
+const _: () = assert!(crate::aa::mlaa_area::XBOX360_EDGES_TARGET_CHANNELS == 4);
+
+/// The depth pass's threshold in scene units: `MLAA_DEPTH_THRESHOLD_MM` over
+/// the scene's millimetres per unit (what the pass pushes; tests compare
+/// with the CPU reference at the same f32).
+pub fn depth_threshold(mm_per_unit: f32) -> f32 {
+    MLAA_DEPTH_THRESHOLD_MM / mm_per_unit
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -69,6 +84,10 @@ pub struct Mlaa {
     blend_pipeline: Pipeline,
     area: Image,
     input: ImageId,
+    /// What pass 1 reads: the frame's UNORM view (luma) or its linear depth.
+    source: EdgeSource,
+    depth: ImageId,
+    threshold: f32,
     edges: ImageId,
     weights: ImageId,
     stencil: ImageId,
@@ -85,8 +104,15 @@ impl Mlaa {
     pub fn new(s: &mut PostSetup) -> Result<Self> {
         let extent = s.res.extent(s.input);
         let ldr_format = s.res.format(s.input);
-        // Pass 1 reads the frame's encoded values (gamma luma) through a UNORM view.
-        s.res.request_unorm_view(s.input);
+        let source = s.options.edges();
+        let (edges_shader, threshold) = match source {
+            EdgeSource::Depth => (EDGES_DEPTH_SHADER, depth_threshold(s.mm_per_unit)),
+            _ => {
+                // Pass 1 reads the frame's encoded values (gamma luma) through a UNORM view.
+                s.res.request_unorm_view(s.input);
+                (EDGES_SHADER, MLAA_LUMA_THRESHOLD)
+            }
+        };
         let edges = s
             .res
             .declare(ImageDesc::new("mlaa edges", extent, TABLE_FORMAT));
@@ -131,7 +157,7 @@ impl Mlaa {
             ctx,
             Pipeline::graphics(
                 ctx,
-                &with_stencil("mlaa edges", EDGES_SHADER, TABLE_FORMAT, write),
+                &with_stencil("mlaa edges", edges_shader, TABLE_FORMAT, write),
             )?,
         );
         let p2 = Guard::new(
@@ -165,6 +191,9 @@ impl Mlaa {
             blend_pipeline: p3.keep(),
             area,
             input: s.input,
+            source,
+            depth: s.linear_depth,
+            threshold,
             edges,
             weights,
             stencil,
@@ -174,24 +203,33 @@ impl Mlaa {
     }
 
     /// Pass 1: every pixel runs, edge pixels are written (colour and stencil).
-    fn edges_pass(&self) -> Pass<'_> {
+    fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+        let (shader, read, texture, format) = match self.source {
+            EdgeSource::Depth => (
+                EDGES_DEPTH_SHADER,
+                self.depth,
+                "depthTex",
+                res.texel_format(self.depth),
+            ),
+            _ => (EDGES_SHADER, self.input, "colorTex", Format::Rgba8Unorm),
+        };
         let work = ShaderWork {
-            shader: EDGES_SHADER.into(),
+            shader: shader.into(),
             fetches: vec![Fetch {
-                texture: "colorTex".into(),
-                format: Format::Rgba8Unorm,
+                texture: texture.into(),
+                format,
                 filter: Filter::Point,
                 count: 5.0,
                 exact: true,
                 coherent: true,
                 spread: Vec::new(),
             }],
-            alu: alu_estimate(EDGES_SHADER, &[]),
+            alu: alu_estimate(shader, &[]),
             ..Default::default()
         };
-        let (pipeline, set) = (&self.edges_pipeline, self.sets[0]);
+        let (pipeline, set, threshold) = (&self.edges_pipeline, self.sets[0], self.threshold);
         Pass::new("mlaa edges", PassRole::Post)
-            .sampled(self.input)
+            .sampled(read)
             .color(ColorTarget::new(self.edges, Load::Clear([0.0; 4])))
             .depth_stencil(
                 DepthStencil::cleared(self.stencil, 1.0)
@@ -209,13 +247,7 @@ impl Mlaa {
                             STENCIL_EDGE,
                         )
                     };
-                    pipeline.push(
-                        c,
-                        cmd,
-                        &EdgesPush {
-                            threshold: MLAA_LUMA_THRESHOLD,
-                        },
-                    );
+                    pipeline.push(c, cmd, &EdgesPush { threshold });
                 })
             })
     }
@@ -329,7 +361,7 @@ impl Mlaa {
 impl AaStage for Mlaa {
     fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
         vec![
-            self.edges_pass(),
+            self.edges_pass(res),
             self.weights_pass(res),
             self.copy_pass(res),
             self.blend_pass(res),
@@ -342,13 +374,13 @@ impl AaStage for Mlaa {
 
     fn bind(&mut self, b: &PostBind) -> Result<()> {
         let (ctx, res, linear) = (b.ctx, b.res, b.samplers.linear_clamp);
+        let edges_bind = match self.source {
+            EdgeSource::Depth => ("depthTex", Bind::Texture(res.view(self.depth))),
+            _ => ("colorTex", Bind::Texture(res.unorm_view(self.input))),
+        };
         self.sets = [
-            b.pool.write_set(
-                ctx,
-                &self.edges_pipeline,
-                0,
-                &[("colorTex", Bind::Texture(res.unorm_view(self.input)))],
-            )?,
+            b.pool
+                .write_set(ctx, &self.edges_pipeline, 0, &[edges_bind])?,
             b.pool.write_set(
                 ctx,
                 &self.weights_pipeline,

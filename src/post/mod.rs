@@ -1,22 +1,28 @@
-//! The post chain after the composite: the tone map (`tonemap`, every
+//! The post chain after the composite: the bloom (`bloom`, with `--bloom`)
+//! on the HDR composite, the tone map (`tonemap`, every
 //! frame), then the anti-aliasing stage `--aa`
 //! picks (thesis ch. 9-10; issue 17). Each AA stage is a module with its
 //! declared images, pipelines and passes, like an SSS method (`crate::method`):
 //! it reads the tone-mapped LDR frame (gamma-space luma, as MLAA and FXAA
 //! define their edges) and writes a new LDR target that becomes the frame's
 //! output image. `--aa none` adds no image, pipeline or pass: the frame is the
-//! one it was before the chain existed, bit for bit.
+//! one it was before the chain existed, bit for bit; so does a frame without
+//! `--bloom`.
 //!
+//! - `bloom`: a Gaussian pyramid on the HDR composite before the tone map
+//!   (thesis ch. 3.1, 11.1); its numbers in `bloom_pyramid` (pure).
 //! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
 //! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
 //!   weights, neighbourhood blending, both stencil-tested) and a copy.
-//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset: edges with
+//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
 //!   local contrast adaptation writing the stencil, blending weights
 //!   (stencil-tested: diagonals, accurate searches, corners), blending.
 //! - `fxaa`: FXAA's quality preset, one pass.
 //!
 //! The device-free parts (area texture, CPU references) live in `crate::aa`.
 
+pub mod bloom;
+pub mod bloom_pyramid;
 pub mod fxaa;
 pub mod mlaa;
 pub mod smaa;
@@ -28,6 +34,7 @@ use std::str::FromStr;
 use anyhow::{bail, Result};
 use ash::vk;
 
+use crate::aa::edges::Preset;
 use crate::graph::work::{Fetch, Filter};
 use crate::graph::{ImageId, Pass, Resources};
 use crate::vk::context::Context;
@@ -69,7 +76,7 @@ impl AaMode {
                 "Jimenez's MLAA (thesis ch. 9): luma edges + stencil, blending weights, neighbourhood blending"
             }
             AaMode::Smaa => {
-                "SMAA 1x (thesis ch. 10.4), high preset: adapted luma edges + stencil, weights with diagonals and corners, blending"
+                "SMAA 1x (thesis ch. 10.4), --smaa-preset (default high): adapted luma or colour edges + stencil, weights with diagonals and corners, blending"
             }
         }
     }
@@ -98,6 +105,96 @@ impl FromStr for AaMode {
     }
 }
 
+/// What MLAA's and SMAA's first pass finds edges in (`--aa-edges`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum EdgeSource {
+    /// Eq. 9.2's luma of the gamma-encoded colour (ch. 9.3.1, 10.4.1): the
+    /// default of both.
+    #[default]
+    Luma,
+    /// MLAA's depth variant (ch. 9.3, Listing 9.1): the frame's linear view
+    /// depth, threshold `aa::edges::MLAA_DEPTH_THRESHOLD_MM`.
+    Depth,
+    /// SMAA's colour variant (ch. 10.4.1): the largest of the R, G, B deltas.
+    Color,
+}
+
+impl EdgeSource {
+    pub const ALL: [EdgeSource; 3] = [EdgeSource::Luma, EdgeSource::Depth, EdgeSource::Color];
+
+    /// The name `--aa-edges` takes and reports print.
+    pub fn name(self) -> &'static str {
+        match self {
+            EdgeSource::Luma => "luma",
+            EdgeSource::Depth => "depth",
+            EdgeSource::Color => "color",
+        }
+    }
+
+    /// The AA modes that offer it.
+    fn modes(self) -> &'static [AaMode] {
+        match self {
+            EdgeSource::Luma => &[AaMode::Mlaa, AaMode::Smaa],
+            EdgeSource::Depth => &[AaMode::Mlaa],
+            EdgeSource::Color => &[AaMode::Smaa],
+        }
+    }
+}
+
+impl fmt::Display for EdgeSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The post chain's options besides `--aa` (`RenderSettings::post`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct PostOptions {
+    /// The bloom on the HDR composite (`--bloom`; off: no bloom image, pipeline or pass).
+    pub bloom: bool,
+    /// Where MLAA or SMAA find edges (`--aa-edges`); `None`: luma, and a
+    /// report that does not name it.
+    pub aa_edges: Option<EdgeSource>,
+    /// SMAA's preset (`--smaa-preset`); `None`: high, and a report that does
+    /// not name it.
+    pub smaa_preset: Option<Preset>,
+}
+
+impl PostOptions {
+    /// The edge source the stage uses.
+    pub fn edges(&self) -> EdgeSource {
+        self.aa_edges.unwrap_or_default()
+    }
+
+    /// SMAA's preset.
+    pub fn smaa_preset(&self) -> Preset {
+        self.smaa_preset.unwrap_or(smaa::DEFAULT_PRESET)
+    }
+
+    /// Refuses, in one line, an option that `aa` does not use.
+    pub fn check(&self, aa: AaMode) -> Result<()> {
+        if let (Some(p), false) = (self.smaa_preset, aa == AaMode::Smaa) {
+            bail!(
+                "--smaa-preset {} applies to --aa smaa, not to --aa {aa}",
+                p.name()
+            );
+        }
+        if let Some(e) = self.aa_edges {
+            if !e.modes().contains(&aa) {
+                bail!(
+                    "--aa-edges {e} applies to --aa {}, not to --aa {aa}",
+                    e.modes()
+                        .iter()
+                        .map(|m| m.name())
+                        .collect::<Vec<_>>()
+                        .join(" or ")
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
 /// What a stage is built from (images are declared into `res` before they
 /// exist, as every frame image is).
 pub struct PostSetup<'a> {
@@ -112,6 +209,12 @@ pub struct PostSetup<'a> {
     /// The frame's depth/stencil format (a stencil-culling stage's own
     /// stencil image takes it: the device renders and clears it).
     pub depth_stencil_format: vk::Format,
+    /// The chain's options besides the AA mode.
+    pub options: PostOptions,
+    /// The frame's linear view depth (scene units): MLAA's depth edges read it.
+    pub linear_depth: ImageId,
+    /// Millimetres per scene unit (the depth threshold is in millimetres).
+    pub mm_per_unit: f32,
 }
 
 /// What a stage's descriptor sets are written from, once the images exist.
@@ -135,26 +238,28 @@ pub trait AaStage {
     fn destroy(&mut self, ctx: &Context);
 }
 
-/// The chain: the tone map, then no stage (`--aa none`) or one AA stage.
+/// The chain: the bloom (with `--bloom`), the tone map, then no stage
+/// (`--aa none`) or one AA stage.
 #[derive(Default)]
 pub struct PostChain {
+    bloom: Option<bloom::Bloom>,
     tonemap: tonemap::Tonemap,
     aa: Option<Box<dyn AaStage>>,
 }
 
 impl PostChain {
-    /// The tone map and the stage `mode` names, images declared and
-    /// pipelines built. On an error, what was built is destroyed.
+    /// The bloom if asked for, the tone map and the stage `mode` names,
+    /// images declared and pipelines built. On an error, what was built is
+    /// destroyed.
     pub fn new(mode: AaMode, s: &mut PostSetup) -> Result<Self> {
         let ctx = s.ctx;
-        let tm = tonemap::Tonemap::new(ctx, &*s.res, s.hdr, s.input, s.exposure)?;
-        let mut chain = crate::vk::guard::Guard::new(
-            ctx,
-            PostChain {
-                tonemap: tm,
-                aa: None,
-            },
-        );
+        let mut chain = crate::vk::guard::Guard::new(ctx, PostChain::default());
+        if s.options.bloom {
+            chain.bloom = Some(bloom::Bloom::new(ctx, s.res, s.hdr)?);
+        }
+        // The tone map reads the bloomed composite when there is one.
+        let hdr = chain.bloom.as_ref().map_or(s.hdr, bloom::Bloom::output);
+        chain.tonemap = tonemap::Tonemap::new(ctx, &*s.res, hdr, s.input, s.exposure)?;
         chain.aa = match mode {
             AaMode::None => None,
             AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
@@ -164,11 +269,31 @@ impl PostChain {
         Ok(chain.keep())
     }
 
-    /// The tone map's pass, then the anti-aliasing stage's.
+    /// The bloom's passes, the tone map's, then the anti-aliasing stage's.
     pub fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        let mut passes = vec![self.tonemap.pass(res)];
+        let mut passes = self.bloom_passes(res);
+        passes.push(self.tonemap.pass(res));
         passes.extend(self.aa_passes(res));
         passes
+    }
+
+    /// The bloom's passes alone (none without `--bloom`).
+    pub fn bloom_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
+        self.bloom
+            .as_ref()
+            .map(|b| b.passes(res))
+            .unwrap_or_default()
+    }
+
+    /// The bloom's image named `name` (`bloom::Bloom::images`), `None`
+    /// without `--bloom`.
+    pub fn bloom_image(&self, name: &str) -> Option<ImageId> {
+        self.bloom
+            .as_ref()?
+            .images()
+            .into_iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, id)| id)
     }
 
     /// The anti-aliasing stage's passes alone (none without one).
@@ -182,6 +307,9 @@ impl PostChain {
     }
 
     pub fn bind(&mut self, b: &PostBind) -> Result<()> {
+        if let Some(bloom) = &mut self.bloom {
+            bloom.bind(b)?;
+        }
         self.tonemap.bind(b)?;
         match &mut self.aa {
             Some(a) => a.bind(b),
@@ -204,6 +332,9 @@ impl PostChain {
             a.destroy(ctx);
         }
         self.tonemap.destroy(ctx);
+        if let Some(b) = &mut self.bloom {
+            b.destroy(ctx);
+        }
     }
 }
 
@@ -245,6 +376,38 @@ pub(crate) fn rg8_as_rgba8(rg: &[u8]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn edge_sources_apply_to_their_modes_only() {
+        let with = |e| PostOptions {
+            aa_edges: Some(e),
+            ..PostOptions::default()
+        };
+        assert!(PostOptions::default().check(AaMode::Fxaa).is_ok());
+        let low = PostOptions {
+            smaa_preset: Some(Preset::Low),
+            ..PostOptions::default()
+        };
+        assert!(low.check(AaMode::Smaa).is_ok());
+        let e = low.check(AaMode::Mlaa).unwrap_err().to_string();
+        assert!(e.contains("--smaa-preset low") && e.contains("mlaa"), "{e}");
+        assert_eq!(PostOptions::default().smaa_preset(), Preset::High);
+        assert_eq!(PostOptions::default().edges(), EdgeSource::Luma);
+        for (e, ok) in [
+            (EdgeSource::Luma, [false, false, true, true]),
+            (EdgeSource::Depth, [false, false, true, false]),
+            (EdgeSource::Color, [false, false, false, true]),
+        ] {
+            for (m, ok) in AaMode::ALL.into_iter().zip(ok) {
+                let r = with(e).check(m);
+                assert_eq!(r.is_ok(), ok, "{e} with {m}");
+                if let Err(err) = r {
+                    let err = err.to_string();
+                    assert!(err.contains(e.name()) && !err.contains('\n'), "{err}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn modes_parse_by_name_and_refuse_others_in_one_line() {

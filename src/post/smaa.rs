@@ -1,14 +1,17 @@
-//! SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset, as a post stage: three
-//! passes on the tone-mapped frame.
+//! SMAA 1x (thesis ch. 10.4.1-10.4.2) as a post stage, the preset
+//! `--smaa-preset` names (default high), three passes on the tone-mapped
+//! frame.
 //!
-//! 1. `smaa edges` (ch. 10.4.1, Eq. 10.1): gamma luma, threshold 0.1, local
+//! 1. `smaa edges` (ch. 10.4.1, Eq. 10.1): gamma luma (or, with `--aa-edges
+//!    color`, the largest R, G or B difference), the preset's threshold, local
 //!    contrast adaptation (factor 2, SMAA.hlsl's shared maximum:
 //!    `aa::edges::LocalContrast::Shared`); pixels with neither a left nor a
 //!    top edgel are discarded, so the stencil marks the pixels pass 2 runs on.
 //! 2. `smaa weights` (ch. 10.4.2): stencil EQUAL 1, early tests: diagonal
 //!    patterns, accurate distance searches (four edgels per bilinear fetch,
 //!    decoded by the search texture), crossing edges, the orthogonal areas at
-//!    `sqrt(d)`, sharp corners (rounding 25 %).
+//!    `sqrt(d)`, sharp corners (rounding 25 %); the preset sets the search
+//!    steps and switches diagonals and corners off (low, medium).
 //! 3. `smaa blend`: every pixel, the larger of its horizontal and vertical
 //!    weight pairs, two bilinear fetches.
 //!
@@ -20,7 +23,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::{fetch, rg8_as_rgba8, AaStage, PostBind, PostSetup};
+use super::{fetch, rg8_as_rgba8, AaStage, EdgeSource, PostBind, PostSetup};
 use crate::aa::edges::Preset;
 use crate::aa::{smaa_area, smaa_search};
 use crate::graph::draw::fullscreen;
@@ -36,20 +39,55 @@ use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
 
 pub const EDGES_SHADER: &str = "smaa_edges.frag";
+pub const EDGES_COLOR_SHADER: &str = "smaa_edges_color.frag";
 pub const WEIGHTS_SHADER: &str = "smaa_weights.frag";
 pub const BLEND_SHADER: &str = "smaa_blend.frag";
 const TABLE_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// The stencil value of a pixel with an edgel.
 pub const STENCIL_EDGE: u32 = 1;
-/// The preset this stage runs (its threshold; the shader holds its search
-/// steps, 16 orthogonal and 8 diagonal, and its corner rounding, 25 %).
-pub const PRESET: Preset = Preset::High;
+/// The preset without `--smaa-preset` (what the stage ran before presets).
+pub const DEFAULT_PRESET: Preset = Preset::High;
 /// SMAA's local contrast adaptation factor (an edgel survives if its delta
 /// is at least the largest around it over this).
 pub const LOCAL_CONTRAST_FACTOR: f32 = 2.0;
-/// The shader's search loops, in the order they are reached: four diagonal
-/// (8 steps), then left, right, up and down (16 steps).
-const LOOP_TRIPS: [u32; 8] = [8, 8, 8, 8, 16, 16, 16, 16];
+/// The weights shader's search loops, in the order they are reached: four
+/// diagonal (the preset's diagonal steps, none without diagonals), then
+/// left, right, up and down (its orthogonal steps).
+fn loop_trips(p: Preset) -> [u32; 8] {
+    let (d, s) = (p.diag_search_steps().unwrap_or(0), p.search_steps());
+    [d, d, d, d, s, s, s, s]
+}
+
+/// The bound on the weights pass's bilinear edge fetches per pixel: the top
+/// edgel's diagonal searches (4 x steps, 6 crossing and test fetches) where
+/// the preset has them, the four orthogonal searches of both edgels (4 x
+/// steps), their 4 crossing fetches and, with corners, 8 corner fetches
+/// (114 at high).
+pub fn weights_bilinear_bound(p: Preset) -> f64 {
+    let diag = p.diag_search_steps().map_or(0, |d| 4 * d + 6);
+    let corners = if p.corner_rounding().is_some() { 8 } else { 0 };
+    f64::from(diag + 4 * p.search_steps() + 4 + corners)
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct WeightsPush {
+    max_search_steps: i32,
+    max_search_steps_diag: i32,
+    corner_rounding: f32,
+    corners: i32,
+}
+
+impl WeightsPush {
+    fn of(p: Preset) -> Self {
+        WeightsPush {
+            max_search_steps: p.search_steps() as i32,
+            max_search_steps_diag: p.diag_search_steps().unwrap_or(0) as i32,
+            corner_rounding: p.corner_rounding().unwrap_or(0.0),
+            corners: i32::from(p.corner_rounding().is_some()),
+        }
+    }
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -66,6 +104,9 @@ pub struct Smaa {
     area: Image,
     search: Image,
     input: ImageId,
+    preset: Preset,
+    /// Luma or colour edges (`--aa-edges`).
+    color: bool,
     edges: ImageId,
     weights: ImageId,
     stencil: ImageId,
@@ -92,7 +133,15 @@ impl Smaa {
         let extent = s.res.extent(s.input);
         let ldr_format = s.res.format(s.input);
         let ds = s.depth_stencil_format;
-        // Pass 1 reads the frame's encoded values (gamma luma) through a UNORM view.
+        let preset = s.options.smaa_preset();
+        let color = s.options.edges() == EdgeSource::Color;
+        let edges_shader = if color {
+            EDGES_COLOR_SHADER
+        } else {
+            EDGES_SHADER
+        };
+        // Pass 1 reads the frame's encoded values (gamma luma, or colour)
+        // through a UNORM view.
         s.res.request_unorm_view(s.input);
         let edges = s
             .res
@@ -129,7 +178,7 @@ impl Smaa {
         let ctx = s.ctx;
         let p1 = Guard::new(
             ctx,
-            Pipeline::graphics(ctx, &with_stencil("smaa edges", EDGES_SHADER, write))?,
+            Pipeline::graphics(ctx, &with_stencil("smaa edges", edges_shader, write))?,
         );
         let p2 = Guard::new(
             ctx,
@@ -172,6 +221,8 @@ impl Smaa {
             area: area.keep(),
             search,
             input: s.input,
+            preset,
+            color,
             edges,
             weights,
             stencil,
@@ -183,8 +234,13 @@ impl Smaa {
     /// Pass 1: every pixel fetches itself, left and top; pixels kept also
     /// right, bottom and the two beyond left and top.
     fn edges_pass(&self) -> Pass<'_> {
+        let shader = if self.color {
+            EDGES_COLOR_SHADER
+        } else {
+            EDGES_SHADER
+        };
         let work = ShaderWork {
-            shader: EDGES_SHADER.into(),
+            shader: shader.into(),
             fetches: vec![Fetch {
                 texture: "colorTex".into(),
                 format: Format::Rgba8Unorm,
@@ -194,10 +250,11 @@ impl Smaa {
                 coherent: true,
                 spread: Vec::new(),
             }],
-            alu: alu_estimate(EDGES_SHADER, &[]),
+            alu: alu_estimate(shader, &[]),
             ..Default::default()
         };
         let (pipeline, set) = (&self.edges_pipeline, self.sets[0]);
+        let threshold = self.preset.threshold();
         Pass::new("smaa edges", PassRole::Post)
             .sampled(self.input)
             .color(ColorTarget::new(self.edges, Load::Clear([0.0; 4])))
@@ -218,7 +275,7 @@ impl Smaa {
                         )
                     };
                     let push = EdgesPush {
-                        threshold: PRESET.threshold(),
+                        threshold,
                         adaptation: LOCAL_CONTRAST_FACTOR,
                     };
                     pipeline.push(c, cmd, &push);
@@ -243,20 +300,30 @@ impl Smaa {
             shader: WEIGHTS_SHADER.into(),
             fetches: vec![
                 fetch(res, self.edges, "edgesTex", Filter::Point, 1.0, true),
-                fetch(res, self.edges, "edgesTex", Filter::Bilinear, 114.0, false),
+                fetch(
+                    res,
+                    self.edges,
+                    "edgesTex",
+                    Filter::Bilinear,
+                    weights_bilinear_bound(self.preset),
+                    false,
+                ),
                 table("areaTex", Filter::Bilinear, 4.0),
                 table("searchTex", Filter::Point, 4.0),
             ],
-            alu: alu_estimate(WEIGHTS_SHADER, &LOOP_TRIPS),
+            alu: alu_estimate(WEIGHTS_SHADER, &loop_trips(self.preset)),
             ..Default::default()
         };
         let (pipeline, set) = (&self.weights_pipeline, self.sets[1]);
+        let push = WeightsPush::of(self.preset);
         Pass::new("smaa weights", PassRole::Post)
             .sampled(self.edges)
             .color(ColorTarget::new(self.weights, Load::Clear([0.0; 4])))
             .depth_stencil(DepthStencil::test_only(self.stencil).stencil_test(Some(STENCIL_EDGE)))
             .draws(Some(work), 1)
-            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
+            .record(move |pc: &PassContext| {
+                fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &push))
+            })
     }
 
     /// Pass 3, every pixel: three weight texels, then two bilinear colour
@@ -354,6 +421,28 @@ impl AaStage for Smaa {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // The high preset's bound is the one declared before presets (114), and
+    // the presets' bounds rise with their steps.
+    #[test]
+    fn the_weights_bound_follows_the_preset() {
+        assert_eq!(weights_bilinear_bound(DEFAULT_PRESET), 114.0);
+        assert_eq!(loop_trips(DEFAULT_PRESET), [8, 8, 8, 8, 16, 16, 16, 16]);
+        assert_eq!(weights_bilinear_bound(Preset::Low), 20.0);
+        assert_eq!(weights_bilinear_bound(Preset::Medium), 36.0);
+        assert_eq!(weights_bilinear_bound(Preset::Ultra), 210.0);
+        let p = WeightsPush::of(Preset::High);
+        assert_eq!(
+            (p.max_search_steps, p.max_search_steps_diag, p.corners),
+            (16, 8, 1)
+        );
+        assert_eq!(p.corner_rounding, 0.25);
+        let p = WeightsPush::of(Preset::Low);
+        assert_eq!(
+            (p.max_search_steps, p.max_search_steps_diag, p.corners),
+            (4, 0, 0)
+        );
+    }
 
     #[test]
     fn the_tables_upload_their_channels_first() {

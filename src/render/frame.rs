@@ -424,6 +424,9 @@ impl Frame {
                 exposure: self.settings.exposure,
                 input: self.targets.ldr,
                 depth_stencil_format,
+                options: self.settings.post,
+                linear_depth: self.targets.linear_depth,
+                mm_per_unit: self.mm_per_unit,
             },
         )?;
         Ok(())

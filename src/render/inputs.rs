@@ -21,9 +21,9 @@ const UPLOAD_ACCESS: AccessKind = AccessKind::TransferWrite;
 /// How fills write the intermediates (whole contents, by a clear).
 pub const FILL_ACCESS: AccessKind = AccessKind::ClearWrite;
 
-/// The images `upload_sss_inputs`, `upload_normals` and `upload_ldr` write.
+/// The images `upload_sss_inputs`, `upload_normals`, `upload_hdr` and `upload_ldr` write.
 pub fn upload_accesses(t: &FrameTargets) -> Vec<(ImageId, AccessKind)> {
-    [t.diffuse, t.linear_depth, t.depth_stencil, t.ldr]
+    [t.diffuse, t.linear_depth, t.depth_stencil, t.hdr, t.ldr]
         .into_iter()
         .chain(t.normals)
         .map(|i| (i, UPLOAD_ACCESS))
@@ -186,6 +186,30 @@ impl Renderer<'_> {
             vec![(
                 id,
                 bytemuck::cast_slice(normals_f16),
+                vec![(vk::ImageAspectFlags::COLOR, 0)],
+            )],
+            extent,
+        )
+    }
+
+    /// Uploads a synthetic HDR composite (tests of the bloom): RGBA f16
+    /// bits, row-major, top row first.
+    pub fn upload_hdr(&mut self, rgba_f16: &[u16]) -> Result<()> {
+        let extent = self.frame.extent;
+        let want = extent.width as usize * extent.height as usize * 4;
+        if rgba_f16.len() != want {
+            bail!(
+                "a {}x{} composite needs {want} half floats, got {}",
+                extent.width,
+                extent.height,
+                rgba_f16.len()
+            );
+        }
+        let hdr = self.frame.targets.hdr;
+        self.upload(
+            vec![(
+                hdr,
+                bytemuck::cast_slice(rgba_f16),
                 vec![(vk::ImageAspectFlags::COLOR, 0)],
             )],
             extent,

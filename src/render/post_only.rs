@@ -28,6 +28,25 @@ impl Renderer<'_> {
         )
     }
 
+    /// Runs the bloom's passes alone on whatever the HDR composite holds
+    /// (`Renderer::upload_hdr` puts a synthetic image there) and reads back
+    /// the bloomed composite with each pass's samples.
+    pub fn run_bloom_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
+        let passes = self.frame.post.bloom_passes(&self.resources);
+        let Some(output) = self.frame.post.bloom_image("bloomed") else {
+            bail!("the bloom-only run needs --bloom");
+        };
+        submit_and_read(
+            self.ctx,
+            &self.submit,
+            &mut self.resources,
+            output,
+            passes,
+            true,
+            "during the bloom-only run",
+        )
+    }
+
     /// The post stage's image `name` (see `post::AaStage::images`).
     pub fn post_image(&self, name: &str) -> Result<ImageId> {
         match self.frame.post.image(name) {

@@ -7,7 +7,7 @@ use crate::method::region::{RegionMode, TILE_PX};
 use crate::method::{default_method, MethodEntry, MethodOptions};
 use crate::mix::assign::Rules;
 use crate::mix::plan_file::PlanFile;
-use crate::post::AaMode;
+use crate::post::{AaMode, PostOptions};
 use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
@@ -83,6 +83,9 @@ pub struct RenderSettings {
     /// Anti-aliasing after the tone map (`--aa`; `crate::post`). `None` leaves
     /// the frame as it was before the post chain, bit for bit.
     pub aa: AaMode,
+    /// The post chain's other options (`--bloom`; `crate::post::PostOptions`).
+    /// The default adds nothing to the frame.
+    pub post: PostOptions,
 }
 
 /// The default view is a portrait (issue 15): the head alone in frame at
@@ -146,6 +149,7 @@ impl RenderSettings {
             exposure: 2.0,
             shadow_size: 2048,
             aa: AaMode::None,
+            post: PostOptions::default(),
         }
     }
 
@@ -224,6 +228,7 @@ impl RenderSettings {
                 self.walk_heads
             );
         }
+        self.post.check(self.aa)?;
         check_fovy(self.fovy_deg)?;
         self.light.validate()?;
         if !self.ambient.is_finite() || !(0.0..=MAX_AMBIENT).contains(&self.ambient) {

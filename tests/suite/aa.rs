@@ -28,7 +28,7 @@ use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::vk::context::Context;
 
-fn settings(w: u32, h: u32, aa: AaMode) -> RenderSettings {
+pub(crate) fn settings(w: u32, h: u32, aa: AaMode) -> RenderSettings {
     RenderSettings {
         width: w,
         height: h,
@@ -39,7 +39,7 @@ fn settings(w: u32, h: u32, aa: AaMode) -> RenderSettings {
 }
 
 /// An sRGB-encoded RGBA8 frame as the gamma-space floats the CPU references read.
-fn gamma(rgba8: &[u8]) -> Vec<[f32; 4]> {
+pub(crate) fn gamma(rgba8: &[u8]) -> Vec<[f32; 4]> {
     rgba8
         .chunks_exact(4)
         .map(|c| [0, 1, 2, 3].map(|i| c[i] as f32 / 255.0))
@@ -47,16 +47,16 @@ fn gamma(rgba8: &[u8]) -> Vec<[f32; 4]> {
 }
 
 /// A deterministic generator (xorshift), so the images repeat.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
         self.0
     }
-    fn below(&mut self, n: u64) -> u64 {
+    pub(crate) fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
 }
@@ -72,7 +72,7 @@ fn blocks(w: usize, h: usize, seed: u64) -> Vec<u8> {
 /// `blocks` for SMAA (`ratio_ties`): neither do two luma differences of the
 /// palette lie within 1e-3 of a factor 2 (the local contrast test `2 c >=
 /// c_max`), with a palette of 7.
-fn blocks_with(w: usize, h: usize, seed: u64, ratio_ties: bool) -> Vec<u8> {
+pub(crate) fn blocks_with(w: usize, h: usize, seed: u64, ratio_ties: bool) -> Vec<u8> {
     let mut rng = Rng(seed);
     let mut palette: Vec<[u8; 3]> = vec![[128, 128, 128]];
     let luma = |c: [u8; 3]| {
@@ -140,7 +140,7 @@ fn blocks_with(w: usize, h: usize, seed: u64, ratio_ties: bool) -> Vec<u8> {
 }
 
 /// The GPU's edges texture as `Edges` (.r left, .g top).
-fn gpu_edges(r: &mut Renderer, w: usize, h: usize) -> Edges {
+pub(crate) fn gpu_edges(r: &mut Renderer, w: usize, h: usize) -> Edges {
     let id = r.post_image("edges").unwrap();
     let tex = r.read_back(id).unwrap();
     Edges {

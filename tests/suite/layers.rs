@@ -58,6 +58,7 @@ const LAYERS: &[&[&str]] = &[
 const PURE_FILES: &[&str] = &[
     "eval/metrics.rs",
     "eval/supersample.rs",
+    "post/bloom_pyramid.rs",
     "budget/model.rs",
     "plan/cost.rs",
     "plan/character.rs",

@@ -22,9 +22,11 @@
 mod common;
 
 mod aa;
+mod aa_edges;
 mod aa_eval;
 mod accuracy;
 mod accuracy_model;
+mod bloom;
 mod budget_cli;
 mod harness;
 mod mix;

@@ -8,9 +8,10 @@ use crate::common;
 
 use std::collections::BTreeMap;
 
+use dermis::aa::edges::Preset;
 use dermis::graph::work::Work;
 use dermis::method::METHODS;
-use dermis::post::AaMode;
+use dermis::post::{AaMode, EdgeSource};
 use dermis::render::counting::{filter_kind, site};
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
@@ -43,6 +44,23 @@ fn declared_fetches_are_what_the_shaders_fetch() {
             for aa in [AaMode::Mlaa, AaMode::Fxaa, AaMode::Smaa] {
                 let s = RenderSettings::study().with(m, &[]);
                 settings.push((format!("{} --aa {aa}", m.name), RenderSettings { aa, ..s }));
+            }
+            let mut s = RenderSettings::study().with(m, &[]);
+            s.post.bloom = true;
+            settings.push((format!("{} --bloom", m.name), s));
+            let mut s = RenderSettings::study().with(m, &[]);
+            s.aa = AaMode::Mlaa;
+            s.post.aa_edges = Some(EdgeSource::Depth);
+            settings.push((format!("{} --aa mlaa --aa-edges depth", m.name), s));
+            for (preset, edges) in [
+                (Preset::Low, EdgeSource::Luma),
+                (Preset::Ultra, EdgeSource::Color),
+            ] {
+                let mut s = RenderSettings::study().with(m, &[]);
+                s.aa = AaMode::Smaa;
+                s.post.aa_edges = Some(edges);
+                s.post.smaa_preset = Some(preset);
+                settings.push((format!("{} --aa smaa {preset:?} {edges}", m.name), s));
             }
         }
         for (label, s) in settings {
