@@ -557,6 +557,10 @@ struct Common {
     /// every other pass).
     #[arg(long, value_enum, ignore_case = true, default_value_t = AaArg::None)]
     aa: AaArg,
+    /// Multisampling of the geometry pass: 1, 2, 4 or 8 samples per pixel, resolved
+    /// before the SSS passes (1: none; the device must support the count).
+    #[arg(long, default_value_t = defaults().msaa)]
+    msaa: u32,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -653,6 +657,7 @@ impl Common {
         s.exposure = self.exposure;
         s.shadow_size = self.shadow_size;
         s.aa = self.aa.into();
+        s.msaa = self.msaa;
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)

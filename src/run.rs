@@ -194,6 +194,7 @@ pub fn run(
         sss_region_pixels: Some(sss_region_pixels),
         sss_region_rects: Some(sss_region_rects),
         aa: (settings.aa != crate::post::AaMode::None).then(|| settings.aa.name().to_string()),
+        msaa: (settings.msaa > 1).then_some(settings.msaa),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

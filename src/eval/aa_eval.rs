@@ -173,6 +173,8 @@ pub fn reference(
         height: h,
         sss_region_tile: (settings.sss_region_tile * n).min(1024),
         aa: AaMode::None,
+        // The reference is supersampled, not multisampled.
+        msaa: 1,
         ..settings.clone()
     };
     let out = run(

@@ -29,6 +29,9 @@ pub struct ColorTarget {
     /// Its contents outlive the pass whatever the load op (a character's map a
     /// later frame may keep): its barrier never discards them.
     pub persistent: bool,
+    /// A multisampled target's single-sample image, which the pass resolves
+    /// it into (the average of its samples) when it ends (`--msaa`).
+    pub resolve: Option<ImageId>,
 }
 
 impl ColorTarget {
@@ -38,6 +41,15 @@ impl ColorTarget {
             load,
             blend: false,
             persistent: false,
+            resolve: None,
+        }
+    }
+
+    /// Resolved into `single` when the pass ends (see [`ColorTarget::resolve`]).
+    pub fn resolved_into(self, single: ImageId) -> Self {
+        ColorTarget {
+            resolve: Some(single),
+            ..self
         }
     }
 
@@ -83,6 +95,10 @@ pub struct DepthStencil {
     pub stencil_ref: Option<u32>,
     /// Draws write stencil (their reference is set per draw by the closure).
     pub stencil_write: bool,
+    /// A multisampled attachment's single-sample image, which the pass
+    /// resolves depth and stencil into, both from sample 0, when it ends
+    /// (`--msaa`; docs/aa.md, "MSAA with the SSS pipeline").
+    pub resolve: Option<ImageId>,
 }
 
 impl DepthStencil {
@@ -95,6 +111,15 @@ impl DepthStencil {
             depth_write: true,
             stencil_ref: None,
             stencil_write: false,
+            resolve: None,
+        }
+    }
+
+    /// Resolved into `single` when the pass ends (see [`DepthStencil::resolve`]).
+    pub fn resolved_into(self, single: ImageId) -> Self {
+        DepthStencil {
+            resolve: Some(single),
+            ..self
         }
     }
 
@@ -108,6 +133,7 @@ impl DepthStencil {
             depth_write: false,
             stencil_ref: None,
             stencil_write: false,
+            resolve: None,
         }
     }
 

@@ -142,6 +142,8 @@ impl<'a> Pass<'a> {
                     | AccessKind::ColorAttachmentLoadWrite
                     | AccessKind::DepthStencilWrite
                     | AccessKind::DepthStencilReadOnly
+                    | AccessKind::ColorResolveWrite
+                    | AccessKind::DepthStencilResolveWrite
             ),
             "pass '{}' declares an attachment with image(): use color() or depth_stencil()",
             self.name
@@ -176,6 +178,9 @@ impl<'a> Pass<'a> {
     /// A colour attachment (attachment index: the order of these calls).
     pub fn color(mut self, target: ColorTarget) -> Self {
         self.images.push((target.image, target.access()));
+        if let Some(single) = target.resolve {
+            self.images.push((single, AccessKind::ColorResolveWrite));
+        }
         self.raster().colors.push(target);
         self
     }
@@ -183,6 +188,15 @@ impl<'a> Pass<'a> {
     /// The depth/stencil attachment.
     pub fn depth_stencil(mut self, ds: DepthStencil) -> Self {
         self.images.push((ds.image, ds.access()));
+        if let Some(single) = ds.resolve {
+            assert!(
+                ds.clear.is_some(),
+                "pass '{}' resolves a depth/stencil attachment it does not write",
+                self.name
+            );
+            self.images
+                .push((single, AccessKind::DepthStencilResolveWrite));
+        }
         let r = self.raster();
         assert!(r.depth.is_none(), "one depth/stencil attachment per pass");
         assert!(
@@ -325,7 +339,14 @@ impl<'a> Pass<'a> {
                     width,
                     height,
                     triangles,
-                    msaa: 1,
+                    // The attachments' samples per pixel (one count for all:
+                    // Vulkan renders every attachment of a pass at one).
+                    msaa: r
+                        .colors
+                        .first()
+                        .map(|c| c.image)
+                        .or(r.depth.map(|d| d.image))
+                        .map_or(1, |id| res.samples(id)),
                     clears,
                 }
             }
@@ -387,20 +408,39 @@ fn begin_rendering(
                 Load::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
                 Load::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
             };
-            vk::RenderingAttachmentInfo::default()
+            let att = vk::RenderingAttachmentInfo::default()
                 .image_view(pc.view(c.image))
                 .image_layout(pc.layout(c.image))
                 .load_op(op)
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue {
                     color: vk::ClearColorValue { float32: clear },
-                })
+                });
+            // Every colour format dermis renders is float or UNORM, so the
+            // resolve is the average of the samples (the box filter MSAA is).
+            match c.resolve {
+                Some(single) => att
+                    .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                    .resolve_image_view(pc.view(single))
+                    .resolve_image_layout(pc.layout(single)),
+                None => att,
+            }
         })
         .collect();
     let ds_att = depth.map(|d| {
         let att = vk::RenderingAttachmentInfo::default()
             .image_view(pc.view(d.image))
             .image_layout(pc.layout(d.image));
+        // Depth and stencil both from sample 0: the one mode every device
+        // has for both (VK_KHR_depth_stencil_resolve), and one surface's
+        // depth and group code together (docs/aa.md).
+        let att = match d.resolve {
+            Some(single) => att
+                .resolve_mode(vk::ResolveModeFlags::SAMPLE_ZERO)
+                .resolve_image_view(pc.view(single))
+                .resolve_image_layout(pc.layout(single)),
+            None => att,
+        };
         match d.clear {
             Some((depth, stencil)) => att
                 .load_op(vk::AttachmentLoadOp::CLEAR)

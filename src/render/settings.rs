@@ -83,6 +83,30 @@ pub struct RenderSettings {
     /// Anti-aliasing after the tone map (`--aa`; `crate::post`). `None` leaves
     /// the frame as it was before the post chain, bit for bit.
     pub aa: AaMode,
+    /// Samples per pixel of the geometry pass (`--msaa`: 1, 2, 4 or 8),
+    /// resolved before the SSS passes (docs/aa.md, "MSAA with the SSS
+    /// pipeline"). 1 is the frame as it was before, bit for bit.
+    pub msaa: u32,
+}
+
+/// The sample counts `--msaa` takes.
+pub const MSAA_COUNTS: [u32; 4] = [1, 2, 4, 8];
+
+/// Refuses a sample count `--msaa` does not take, and a method that cannot
+/// run multisampled (`MethodEntry::no_msaa`), in one line.
+pub fn check_msaa(msaa: u32, method: Option<&MethodEntry>) -> Result<()> {
+    if !MSAA_COUNTS.contains(&msaa) {
+        bail!("--msaa must be 1, 2, 4 or 8 samples per pixel, got {msaa}");
+    }
+    if let (true, Some(method)) = (msaa > 1, method) {
+        if let Some(why) = method.no_msaa {
+            bail!(
+                "method {} cannot run with --msaa {msaa}: {why}",
+                method.name
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The default view is a portrait (issue 15): the head alone in frame at
@@ -146,6 +170,7 @@ impl RenderSettings {
             exposure: 2.0,
             shadow_size: 2048,
             aa: AaMode::None,
+            msaa: 1,
         }
     }
 
@@ -186,6 +211,15 @@ impl RenderSettings {
         }
         (self.method.check)(&self.method.opts(&self.options))
             .with_context(|| format!("method {}", self.method.name))?;
+        // A frame of several is checked per group once its methods are known
+        // (`render::groups::group_specs`).
+        check_msaa(self.msaa, self.assignment.is_none().then_some(self.method))?;
+        if self.msaa > 1 && self.character_ids {
+            bail!(
+                "--character-ids cannot run with --msaa {}: its pass redraws the heads depth-EQUAL against the frame's depth, which is resolved from sample 0",
+                self.msaa
+            );
+        }
         // An option of another method is ignored (the CLI says so), but its
         // value must still be one it would accept: no NaN slips through unread.
         for m in crate::method::METHODS {

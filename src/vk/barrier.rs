@@ -29,6 +29,15 @@ pub enum AccessKind {
     ColorAttachmentLoadWrite,
     /// Depth/stencil attachment cleared and written (depth test + write, stencil replace).
     DepthStencilWrite,
+    /// Single-sample colour image written by the multisample resolve at the
+    /// end of a render pass (`--msaa`): the colour-attachment row, named apart
+    /// so reports and the budget tell a resolve from a draw.
+    ColorResolveWrite,
+    /// Single-sample depth/stencil image written by the multisample resolve at
+    /// the end of a render pass (`--msaa`): resolves of depth/stencil happen in
+    /// the colour-attachment-output stage with colour-attachment writes (the
+    /// spec's "Multisample Resolve Operations"), in the attachment layout.
+    DepthStencilResolveWrite,
     /// Depth/stencil attachment loaded for testing only (depth test or stencil test,
     /// no writes): read-only layout, so it could also be sampled at the same time.
     DepthStencilReadOnly,
@@ -102,6 +111,16 @@ impl AccessKind {
                 A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
                 L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
             ),
+            AccessKind::ColorResolveWrite => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            AccessKind::DepthStencilResolveWrite => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+            ),
             AccessKind::DepthStencilReadOnly => (
                 S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
                 A::DEPTH_STENCIL_ATTACHMENT_READ,
@@ -173,6 +192,8 @@ impl AccessKind {
             AccessKind::ColorAttachmentWrite
                 | AccessKind::ColorAttachmentLoadWrite
                 | AccessKind::DepthStencilWrite
+                | AccessKind::DepthStencilResolveWrite
+                | AccessKind::ColorResolveWrite
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::ComputeStorageReadWrite
                 | AccessKind::FragmentStorageReadWrite
@@ -190,6 +211,8 @@ impl AccessKind {
             self,
             AccessKind::ColorAttachmentWrite
                 | AccessKind::DepthStencilWrite
+                | AccessKind::DepthStencilResolveWrite
+                | AccessKind::ColorResolveWrite
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::TransferWrite
                 | AccessKind::ClearWrite
@@ -201,12 +224,12 @@ impl AccessKind {
     pub fn image_usage(self) -> vk::ImageUsageFlags {
         type U = vk::ImageUsageFlags;
         match self {
-            AccessKind::ColorAttachmentWrite | AccessKind::ColorAttachmentLoadWrite => {
-                U::COLOR_ATTACHMENT
-            }
-            AccessKind::DepthStencilWrite | AccessKind::DepthStencilReadOnly => {
-                U::DEPTH_STENCIL_ATTACHMENT
-            }
+            AccessKind::ColorAttachmentWrite
+            | AccessKind::ColorAttachmentLoadWrite
+            | AccessKind::ColorResolveWrite => U::COLOR_ATTACHMENT,
+            AccessKind::DepthStencilWrite
+            | AccessKind::DepthStencilResolveWrite
+            | AccessKind::DepthStencilReadOnly => U::DEPTH_STENCIL_ATTACHMENT,
             AccessKind::FragmentSampledRead
             | AccessKind::ComputeSampledRead
             | AccessKind::AnyShaderSampledRead => U::SAMPLED,
@@ -382,7 +405,9 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 21] = [
+    const ALL: [AccessKind; 23] = [
+        AccessKind::ColorResolveWrite,
+        AccessKind::DepthStencilResolveWrite,
         AccessKind::FragmentStorageReadWrite,
         AccessKind::ClearWrite,
         AccessKind::ComputeStorageReadWrite,

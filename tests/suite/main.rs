@@ -28,6 +28,7 @@ mod accuracy_model;
 mod budget_cli;
 mod harness;
 mod mix;
+mod msaa;
 mod plan;
 mod plan_motion;
 mod reference;
