@@ -715,6 +715,65 @@ mod tests {
             .is_none());
     }
 
+    // `--msaa`: a multisampled pass declares its resolve targets as resolve
+    // writes (their barriers and usages), its work at the attachments'
+    // samples, and its reports name the resolved images as resolve targets.
+    #[test]
+    fn a_multisampled_pass_resolves_and_declares_its_samples() {
+        let mut res = Resources::default();
+        let extent = vk::Extent2D {
+            width: 8,
+            height: 4,
+        };
+        let ms = |res: &mut Resources, name: &str, f| {
+            res.declare(ImageDesc::new(name, extent, f).with_samples(4))
+        };
+        let c4 = ms(&mut res, "c 4x", vk::Format::R16G16B16A16_SFLOAT);
+        let d4 = ms(&mut res, "d 4x", vk::Format::D32_SFLOAT_S8_UINT);
+        let c = image(&mut res, "c", 8, 4, vk::Format::R16G16B16A16_SFLOAT);
+        let d = image(&mut res, "d", 8, 4, vk::Format::D32_SFLOAT_S8_UINT);
+        let p = Pass::new("p", PassRole::Geometry)
+            .color(ColorTarget::new(c4, Load::Clear([0.0; 4])).resolved_into(c))
+            .depth_stencil(DepthStencil::cleared(d4, 1.0).resolved_into(d))
+            .draws(None, 2);
+        type A = AccessKind;
+        assert_eq!(
+            p.images,
+            vec![
+                (c4, A::ColorAttachmentWrite),
+                (c, A::ColorResolveWrite),
+                (d4, A::DepthStencilWrite),
+                (d, A::DepthStencilResolveWrite),
+            ]
+        );
+        assert!(matches!(
+            p.declared_work(&res),
+            Some(Work::Raster {
+                msaa: 4,
+                width: 8,
+                height: 4,
+                ..
+            })
+        ));
+        let kinds: Vec<_> = res.image_uses(&p.images).iter().map(|u| u.kind).collect();
+        use crate::work::ImageUseKind as K;
+        assert_eq!(
+            kinds,
+            vec![
+                K::ColorTarget,
+                K::ResolveTarget,
+                K::DepthTarget,
+                K::ResolveTarget
+            ]
+        );
+        // The 4x images count four samples a texel.
+        assert_eq!(res.declared_bytes(), 8 * 4 * (8 * 4 + 8 * 4 + 8 + 8));
+        res.allow(&p.images);
+        assert!(res
+            .usage(d)
+            .contains(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT));
+    }
+
     #[test]
     #[should_panic(expected = "use color() or depth_stencil()")]
     fn attachments_cannot_be_declared_without_their_load_op() {

@@ -180,14 +180,7 @@ impl<'c> Renderer<'c> {
         let mixed = specs.len() > 1;
         // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
-        let targets = targets::declare(
-            ctx,
-            &mut resources,
-            extent,
-            settings.shadow_size,
-            needs,
-            settings.msaa,
-        )?;
+        let targets = targets::declare(ctx, &mut resources, settings, needs)?;
         let ids = settings.character_ids.then(|| {
             resources.declare(crate::graph::ImageDesc::new(
                 "character ids",
@@ -475,32 +468,6 @@ impl<'c> Renderer<'c> {
             "while reading back an image",
         )
         .map(|(img, _)| img)
-    }
-
-    /// Reads the stencil of the frame's (single-sample) depth/stencil target
-    /// back, one byte a pixel, after a frame: each pixel's group code as the
-    /// SSS passes test it (with `--msaa`, the resolve's sample 0).
-    pub fn read_stencil(&mut self) -> Result<Vec<u8>> {
-        let id = self.frame.targets.depth_stencil;
-        let mut plan = ReadbackPlan::single_stencil(id);
-        let (ctx, submit) = (self.ctx, &self.submit);
-        let done = plan
-            .interleave(ctx, &mut self.resources, Vec::new())
-            .and_then(|p| {
-                submit_passes(
-                    ctx,
-                    submit,
-                    &mut self.resources,
-                    &p,
-                    false,
-                    "while reading back the stencil",
-                )
-            });
-        if let Err(e) = done {
-            plan.discard(ctx, &mut self.resources);
-            return Err(e);
-        }
-        plan.finish_bytes(ctx, &mut self.resources)
     }
 
     /// The depth-buffer value of a surface at linear view depth `d` (this camera).

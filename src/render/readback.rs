@@ -351,6 +351,35 @@ impl ReadbackPlan {
     }
 }
 
+// Beside the plan it uses (render/mod.rs stays small).
+impl super::Renderer<'_> {
+    /// Reads the stencil of the frame's (single-sample) depth/stencil target
+    /// back, one byte a pixel, after a frame: each pixel's group code as the
+    /// SSS passes test it (with `--msaa`, the resolve's sample 0).
+    pub fn read_stencil(&mut self) -> Result<Vec<u8>> {
+        let id = self.frame.targets.depth_stencil;
+        let mut plan = ReadbackPlan::single_stencil(id);
+        let (ctx, submit) = (self.ctx, &self.submit);
+        let done = plan
+            .interleave(ctx, &mut self.resources, Vec::new())
+            .and_then(|p| {
+                super::submit_passes(
+                    ctx,
+                    submit,
+                    &mut self.resources,
+                    &p,
+                    false,
+                    "while reading back the stencil",
+                )
+            });
+        if let Err(e) = done {
+            plan.discard(ctx, &mut self.resources);
+            return Err(e);
+        }
+        plan.finish_bytes(ctx, &mut self.resources)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

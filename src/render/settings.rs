@@ -281,7 +281,7 @@ impl RenderSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::method::lookup;
+    use crate::method::{default_method, lookup};
 
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
@@ -322,6 +322,37 @@ mod tests {
         let mut b = s.clone();
         b.light.intensity = f32::NAN;
         assert!(b.validate(16384).is_err());
+    }
+
+    // `--msaa` takes 1, 2, 4 or 8; the methods that cannot run multisampled
+    // say so in one line naming themselves, the others pass.
+    #[test]
+    fn msaa_counts_and_the_methods_that_refuse_it() {
+        for n in MSAA_COUNTS {
+            check_msaa(n, Some(default_method())).unwrap();
+        }
+        for n in [0, 3, 16] {
+            let e = check_msaa(n, None).unwrap_err().to_string();
+            assert!(
+                e.contains("1, 2, 4 or 8") && e.contains(&n.to_string()),
+                "{e}"
+            );
+        }
+        for m in crate::method::METHODS {
+            check_msaa(1, Some(m)).unwrap();
+            match (m.no_msaa, check_msaa(4, Some(m))) {
+                (None, r) => r.unwrap(),
+                (Some(_), r) => {
+                    let e = r.unwrap_err().to_string();
+                    assert!(e.contains(m.name) && !e.contains('\n'), "{e}");
+                }
+            }
+        }
+        let mut s = RenderSettings::default();
+        s.msaa = 4;
+        s.validate(16384).unwrap();
+        s.character_ids = true;
+        assert!(s.validate(16384).is_err());
     }
 
     // Issue 11: every number has an upper bound too; huge values gave black

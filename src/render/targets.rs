@@ -4,6 +4,7 @@
 use anyhow::{bail, Result};
 use ash::vk;
 
+use super::settings::RenderSettings;
 use crate::graph::{ImageDesc, Resources};
 use crate::method::{FrameTargets, MsaaTargets, Needs};
 use crate::vk::context::Context;
@@ -69,16 +70,19 @@ pub fn check_msaa(ctx: &Context, samples: u32, formats: &[(vk::Format, bool)]) -
     Ok(())
 }
 
-/// Declares the frame's targets at `extent` with what `needs` asks for, and
-/// with `msaa` > 1 the geometry pass's multisampled attachments.
+/// Declares the frame's targets at the settings' size with what `needs` asks
+/// for, and with `--msaa` > 1 the geometry pass's multisampled attachments.
 pub fn declare(
     ctx: &Context,
     res: &mut Resources,
-    extent: vk::Extent2D,
-    shadow_size: u32,
+    settings: &RenderSettings,
     needs: Needs,
-    msaa: u32,
 ) -> Result<FrameTargets> {
+    let extent = vk::Extent2D {
+        width: settings.width,
+        height: settings.height,
+    };
+    let (shadow_size, msaa) = (settings.shadow_size, settings.msaa);
     if !ctx.format_supports(
         LINEAR_DEPTH_FORMAT,
         vk::FormatFeatureFlags::COLOR_ATTACHMENT

@@ -606,6 +606,30 @@ mod tests {
         assert_eq!(b.new_layout, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
     }
 
+    // `--msaa`: the single-sample depth/stencil the geometry pass resolves
+    // into is written in the colour-attachment-output stage (the spec's
+    // resolve operations), then stencil-tested by the SSS passes.
+    #[test]
+    fn depth_resolve_then_stencil_test() {
+        let b = image_after(
+            &[AccessKind::DepthStencilResolveWrite],
+            AccessKind::DepthStencilReadOnly,
+        )
+        .unwrap();
+        assert_eq!(b.src_stage, S::COLOR_ATTACHMENT_OUTPUT);
+        assert_eq!(b.src_access, A::COLOR_ATTACHMENT_WRITE);
+        assert_eq!(b.dst_access, A::DEPTH_STENCIL_ATTACHMENT_READ);
+        assert_eq!(b.old_layout, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+        assert_eq!(b.new_layout, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let c = image_after(
+            &[AccessKind::ColorResolveWrite],
+            AccessKind::FragmentSampledRead,
+        )
+        .unwrap();
+        assert_eq!(c.src_access, A::COLOR_ATTACHMENT_WRITE);
+        assert_eq!(c.new_layout, L::SHADER_READ_ONLY_OPTIMAL);
+    }
+
     // "Copy to a buffer, then read it on the host"; reads of a never-written
     // buffer and the first write of a fresh one need nothing.
     #[test]
