@@ -348,8 +348,10 @@ mod tests {
                 }
             }
         }
-        let mut s = RenderSettings::default();
-        s.msaa = 4;
+        let mut s = RenderSettings {
+            msaa: 4,
+            ..RenderSettings::default()
+        };
         s.validate(16384).unwrap();
         s.character_ids = true;
         assert!(s.validate(16384).is_err());
