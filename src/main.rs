@@ -1178,6 +1178,11 @@ fn ignored_options(command: &str, m: &ArgMatches) -> Vec<String> {
     if command == "aa-eval" && given("aa") {
         notes.push("--aa is ignored: aa-eval runs every mode".to_string());
     }
+    if command == "aa-eval" && given("msaa") {
+        notes.push(
+            "--msaa is ignored: aa-eval scores every MSAA count the device renders".to_string(),
+        );
+    }
     if let (Some(why), true) = (method_ignored, given("method")) {
         notes.push(format!("--method is ignored: {why}"));
     }
