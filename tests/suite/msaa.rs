@@ -333,3 +333,41 @@ fn render_reports_and_budget_prices_the_multisampled_geometry_pass() {
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("--msaa must be 1, 2, 4 or 8"), "{stderr}");
 }
+
+/// The 4x frame tears down clean, also when its set-up fails: the set-up is
+/// made to fail at each of its creation steps in turn (the multisampled
+/// images and the multisampled geometry pipeline among them), each failure
+/// is one error line and frees its memory at once, and after a clean frame
+/// the device is destroyed with nothing left.
+#[test]
+fn every_failed_4x_set_up_step_tears_down_clean() {
+    let scene = egg_scene();
+    let ctx = common::ctx();
+    let s = egg(48, 32, MSAA);
+    let live =
+        |ctx: &dermis::vk::context::Context| ctx.allocator().generate_report().allocations.len();
+    let base = live(&ctx);
+    let before = ctx.creations();
+    drop(Renderer::new(&ctx, &scene, &s).unwrap());
+    let steps = ctx.creations() - before;
+    for k in 0..steps {
+        ctx.fail_creation_after(Some(k));
+        let e = match Renderer::new(&ctx, &scene, &s) {
+            Ok(_) => panic!("step {k} of {steps} did not fail"),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            e.contains("injected failure") && !e.contains('\n'),
+            "step {k}: {e}"
+        );
+        assert_eq!(live(&ctx), base, "step {k} ({e}) left memory allocated");
+    }
+    ctx.fail_creation_after(None);
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    r.capture(false).unwrap();
+    r.read_stencil().unwrap();
+    drop(r);
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("teardown after {steps} failures: {e:#}"));
+    println!("{MSAA}x: {steps} creation steps failed in turn, clean");
+}
