@@ -19,8 +19,10 @@ pub enum Load {
     Clear([f32; 4]),
 }
 
-/// A colour attachment: its image, its load op (the store op is always STORE:
-/// every colour a pass draws is read later), and whether the draws blend into it.
+/// A colour attachment: its image, its load op (the store op is STORE: every
+/// colour a pass draws is read later; DONT_CARE for a multisampled target the
+/// pass resolves, whose samples nothing reads), and whether the draws blend
+/// into it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ColorTarget {
     pub image: ImageId,

@@ -391,6 +391,18 @@ impl PassSample {
     }
 }
 
+/// The store op of a written attachment: STORE (every image a pass draws is
+/// read later), but DONT_CARE for a multisampled one that the pass resolves:
+/// nothing reads its samples after the resolve, which happens before the
+/// store, so a tiler need not write them out.
+fn store_op(resolved: bool) -> vk::AttachmentStoreOp {
+    if resolved {
+        vk::AttachmentStoreOp::DONT_CARE
+    } else {
+        vk::AttachmentStoreOp::STORE
+    }
+}
+
 /// Begins dynamic rendering of `colors` and `depth` over `area` from the
 /// origin, views and layouts from the pass's declared accesses, and sets
 /// viewport, scissor and the stencil reference the declaration names.
@@ -412,7 +424,7 @@ fn begin_rendering(
                 .image_view(pc.view(c.image))
                 .image_layout(pc.layout(c.image))
                 .load_op(op)
-                .store_op(vk::AttachmentStoreOp::STORE)
+                .store_op(store_op(c.resolve.is_some()))
                 .clear_value(vk::ClearValue {
                     color: vk::ClearColorValue { float32: clear },
                 });
@@ -444,7 +456,7 @@ fn begin_rendering(
         match d.clear {
             Some((depth, stencil)) => att
                 .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
+                .store_op(store_op(d.resolve.is_some()))
                 .clear_value(vk::ClearValue {
                     depth_stencil: vk::ClearDepthStencilValue { depth, stencil },
                 }),
