@@ -11,6 +11,10 @@
 //! [`Pass::declared_work`] fills the declared work's colour writes, clears,
 //! depth/stencil use, extent and invocations. No record closure chooses a load
 //! op or begins rendering, and no pass types a clear twice.
+//!
+//! Over 800 lines because 225 of them are the unit tests of the declaration
+//! and the executor (multisampled passes and their resolves among them),
+//! which read best beside the code they pin down.
 
 use ash::vk;
 
