@@ -614,6 +614,10 @@ struct Common {
     /// SMAA's quality preset [default: high]; an error without --aa smaa.
     #[arg(long, value_enum, ignore_case = true)]
     smaa_preset: Option<SmaaPresetArg>,
+    /// Multisampling of the geometry pass: 1, 2, 4 or 8 samples per pixel, resolved
+    /// before the SSS passes (1: none; the device must support the count).
+    #[arg(long, default_value_t = defaults().msaa)]
+    msaa: u32,
 }
 
 /// The options every registered method declares, one flag each, added from the
@@ -713,6 +717,7 @@ impl Common {
         s.post.bloom = self.bloom;
         s.post.aa_edges = self.aa_edges.map(Into::into);
         s.post.smaa_preset = self.smaa_preset.map(Into::into);
+        s.msaa = self.msaa;
         // Checked again against the device limits once a device is open.
         s.validate(u32::MAX)?;
         Ok(s)
@@ -1232,6 +1237,11 @@ fn ignored_options(command: &str, m: &ArgMatches) -> Vec<String> {
     };
     if command == "aa-eval" && given("aa") {
         notes.push("--aa is ignored: aa-eval runs every mode".to_string());
+    }
+    if command == "aa-eval" && given("msaa") {
+        notes.push(
+            "--msaa is ignored: aa-eval scores every MSAA count the device renders".to_string(),
+        );
     }
     if let (Some(why), true) = (method_ignored, given("method")) {
         notes.push(format!("--method is ignored: {why}"));

@@ -65,6 +65,10 @@ pub struct Report {
     /// SMAA's preset when `--smaa-preset` named one (`Preset::name`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub smaa_preset: Option<String>,
+    /// Samples per pixel of the geometry pass (`--msaa`) when more than one;
+    /// `None` at 1x (so a 1x report is the one from before `--msaa`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub msaa: Option<u32>,
     pub scene: String,
     pub mm_per_unit: f32,
     pub heads: u32,

@@ -197,6 +197,7 @@ pub fn run(
         bloom: settings.post.bloom,
         aa_edges: settings.post.aa_edges.map(|e| e.name().to_string()),
         smaa_preset: settings.post.smaa_preset.map(|p| p.name().to_string()),
+        msaa: (settings.msaa > 1).then_some(settings.msaa),
         scene: scene.name.clone(),
         mm_per_unit,
         heads: settings.heads,

@@ -255,6 +255,9 @@ pub enum ImageUseKind {
     DepthTarget,
     /// Depth/stencil attachment tested only.
     DepthTest,
+    /// Single-sample image a multisampled pass resolves into at its end
+    /// (`--msaa`): every pixel written once from its samples.
+    ResolveTarget,
     /// Storage image or buffer, read and/or written by a shader.
     Storage,
     CopySource,

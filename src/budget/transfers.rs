@@ -25,7 +25,10 @@ const MS: f64 = 1e3;
 fn writes(kind: ImageUseKind) -> bool {
     matches!(
         kind,
-        ImageUseKind::ColorTarget | ImageUseKind::ColorTargetLoad | ImageUseKind::DepthTarget
+        ImageUseKind::ColorTarget
+            | ImageUseKind::ColorTargetLoad
+            | ImageUseKind::DepthTarget
+            | ImageUseKind::ResolveTarget
     )
 }
 

@@ -517,6 +517,7 @@ impl Pricing<'_> {
                 target_bytes.push(b);
             }
         }
+        self.resolves(p, msaa);
         self.rejection(p, shader.is_some() && !color.is_empty(), msaa);
         let st = self.edram_tiles(*width, *height, msaa, &target_bytes);
         let mut geo_factor = splits as f64;
@@ -569,6 +570,27 @@ impl Pricing<'_> {
             }
         }
         target_bytes
+    }
+
+    /// A multisampled pass's resolves into its single-sample images (`--msaa`)
+    /// off eDRAM: each reads its `msaa` samples and writes one texel per pixel
+    /// through memory. On eDRAM the resolve is the copy out of eDRAM a later
+    /// read forces (`transfers`), at the resolved size, as on Xenos.
+    fn resolves(&mut self, p: &PassInput, msaa: u32) {
+        if self.prof.edram.is_some() {
+            return;
+        }
+        for iu in p
+            .images
+            .iter()
+            .filter(|i| i.kind == ImageUseKind::ResolveTarget)
+        {
+            let Some(f) = self.target_format(iu.format, false) else {
+                continue;
+            };
+            let texels = f64::from(iu.width) * f64::from(iu.height);
+            self.mem_bytes += texels * f64::from(f.bytes()) * f64::from(msaa + 1);
+        }
     }
 
     /// Depth/stencil traffic (a depth-only pass is bound by its Z writes);

@@ -23,6 +23,7 @@ use super::supersample::{box_filter_srgb8, check_supersampled, edge_mask, score,
 use super::{chart, pareto};
 use crate::output::{write_json, write_rgba8_png};
 use crate::post::AaMode;
+use crate::render::settings::{check_msaa, MSAA_COUNTS};
 use crate::render::RenderSettings;
 use crate::run::{run, RunOptions};
 use crate::scene::camera::Camera;
@@ -150,12 +151,32 @@ pub struct AaRow {
 /// Each pass of a frame: its name and median GPU ms.
 pub type PassTimes = Vec<(String, f64)>;
 /// One mode's frame of a view: `(mode, sRGB8 frame, AA ms, frame ms)`.
-pub type ModeFrame = (AaMode, Vec<u8>, f64, f64);
+pub type ModeFrame = (String, Vec<u8>, f64, f64);
+
+/// The label of the row of `--msaa n` (with `--aa none`).
+pub fn msaa_label(n: u32) -> String {
+    format!("msaa{n}x")
+}
+
+/// The MSAA counts above 1 scored beside the post modes: those the device
+/// renders and the settings' method accepts (none in a frame of several,
+/// whose groups are checked only once they are known).
+pub fn msaa_counts(ctx: &Context, settings: &RenderSettings) -> Vec<u32> {
+    if settings.assignment.is_some() {
+        return Vec::new();
+    }
+    MSAA_COUNTS
+        .into_iter()
+        .filter(|&n| n > 1 && ctx.facts.framebuffer_sample_counts.contains(&n))
+        .filter(|&n| check_msaa(n, Some(settings.method)).is_ok())
+        .collect()
+}
 
 /// The filtered reference of one view and the 1x frames of every mode.
 pub struct ViewFrames {
     pub reference: Vec<u8>,
-    /// `(mode, sRGB8 frame, AA ms, frame ms)`, in `AaMode::ALL` order.
+    /// `(mode, sRGB8 frame, AA ms, frame ms)`, in `AaMode::ALL` order, then
+    /// the MSAA rows (`mode_frames`).
     pub modes: Vec<ModeFrame>,
 }
 
@@ -173,6 +194,8 @@ pub fn reference(
         height: h,
         sss_region_tile: (settings.sss_region_tile * n).min(1024),
         aa: AaMode::None,
+        // The reference is supersampled, not multisampled.
+        msaa: 1,
         ..settings.clone()
     };
     let out = run(
@@ -231,25 +254,49 @@ pub fn mode_frame(
 }
 
 /// Every mode's frame of one view, in `AaMode::ALL` order (`none` first, whose
-/// passes the others' AA ms are told from): `(mode, sRGB8, AA ms, frame ms)`.
-/// `on_mode` is called before each mode's run and `done` after it.
+/// passes the others' AA ms are told from), then one frame per count of
+/// [`msaa_counts`] with `--aa none`: `(label, sRGB8, AA ms, frame ms)`. An
+/// MSAA row's AA ms is its frame's median GPU ms over `none`'s (the overhead
+/// Table 10.1 gives for MSAA; 0 when the measurement noise makes it
+/// negative). `on_mode` is called with each label before its run and `done`
+/// after it.
 pub fn mode_frames(
     ctx: &Context,
     scene: &Scene,
     settings: &RenderSettings,
     (warmup, measured): (usize, usize),
-    on_mode: &dyn Fn(AaMode),
+    on_mode: &dyn Fn(&str),
     done: &dyn Fn(),
 ) -> Result<Vec<ModeFrame>> {
+    // The post modes run on the single-sample frame; MSAA has rows of its own.
+    let settings = &RenderSettings {
+        msaa: 1,
+        ..settings.clone()
+    };
     let mut none_passes: PassTimes = Vec::new();
+    let mut none_ms = 0.0;
     let mut out = Vec::new();
     for mode in AaMode::ALL {
-        on_mode(mode);
+        on_mode(mode.name());
         let (frame, passes, frame_ms) = mode_frame(ctx, scene, settings, mode, warmup, measured)?;
         if mode == AaMode::None {
             none_passes = passes.clone();
+            none_ms = frame_ms;
         }
-        out.push((mode, frame, aa_pass_ms(&passes, &none_passes), frame_ms));
+        let aa = aa_pass_ms(&passes, &none_passes);
+        out.push((mode.name().to_string(), frame, aa, frame_ms));
+        done();
+    }
+    for n in msaa_counts(ctx, settings) {
+        let label = msaa_label(n);
+        on_mode(&label);
+        let s = RenderSettings {
+            msaa: n,
+            ..settings.clone()
+        };
+        let (frame, _, frame_ms) = mode_frame(ctx, scene, &s, AaMode::None, warmup, measured)
+            .with_context(|| format!("--msaa {n}"))?;
+        out.push((label, frame, (frame_ms - none_ms).max(0.0), frame_ms));
         done();
     }
     Ok(out)
@@ -266,17 +313,17 @@ pub fn score_view(
     let none = f
         .modes
         .iter()
-        .find(|m| m.0 == AaMode::None)
+        .find(|m| m.0 == AaMode::None.name())
         .context("the no-AA frame")?;
     let mask = edge_mask(&f.reference, &none.1)?;
     let edges = mask.iter().filter(|&&m| m).count();
     let mut rows = Vec::new();
     for (mode, frame, aa, frame_ms) in &f.modes {
         let error = score(frame, &f.reference, &mask, width, height)
-            .with_context(|| format!("scoring --aa {mode} on '{name}'"))?;
+            .with_context(|| format!("scoring {mode} on '{name}'"))?;
         rows.push(AaRow {
             scene: name.to_string(),
-            mode: mode.name().to_string(),
+            mode: mode.clone(),
             aa_ms: *aa,
             frame_ms: *frame_ms,
             edge_pixels: edges,
@@ -307,7 +354,7 @@ fn slug(name: &str) -> String {
 
 /// Runs the set; one row per (view, mode).
 pub fn sweep(ctx: &Context, scenes: &[AaScene], o: &AaEvalOptions) -> Result<Vec<AaRow>> {
-    let per_view = 1 + AaMode::ALL.len() as u64;
+    let per_view = 1 + (AaMode::ALL.len() + msaa_counts(ctx, &o.base).len()) as u64;
     let bar = o.progress.then(|| {
         let b = indicatif::ProgressBar::new(scenes.len() as u64 * per_view);
         b.set_style(
@@ -344,7 +391,7 @@ pub fn sweep(ctx: &Context, scenes: &[AaScene], o: &AaEvalOptions) -> Result<Vec
             &scene,
             &s,
             (o.warmup, o.measured),
-            &|mode| step(format!("{}: --aa {mode}", v.name)),
+            &|mode| step(format!("{}: {mode}", v.name)),
             &tick,
         )
         .with_context(|| format!("on '{}'", v.name))?;

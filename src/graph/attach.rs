@@ -19,8 +19,10 @@ pub enum Load {
     Clear([f32; 4]),
 }
 
-/// A colour attachment: its image, its load op (the store op is always STORE:
-/// every colour a pass draws is read later), and whether the draws blend into it.
+/// A colour attachment: its image, its load op (the store op is STORE: every
+/// colour a pass draws is read later; DONT_CARE for a multisampled target the
+/// pass resolves, whose samples nothing reads), and whether the draws blend
+/// into it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ColorTarget {
     pub image: ImageId,
@@ -29,6 +31,9 @@ pub struct ColorTarget {
     /// Its contents outlive the pass whatever the load op (a character's map a
     /// later frame may keep): its barrier never discards them.
     pub persistent: bool,
+    /// A multisampled target's single-sample image, which the pass resolves
+    /// it into (the average of its samples) when it ends (`--msaa`).
+    pub resolve: Option<ImageId>,
 }
 
 impl ColorTarget {
@@ -38,6 +43,15 @@ impl ColorTarget {
             load,
             blend: false,
             persistent: false,
+            resolve: None,
+        }
+    }
+
+    /// Resolved into `single` when the pass ends (see [`ColorTarget::resolve`]).
+    pub fn resolved_into(self, single: ImageId) -> Self {
+        ColorTarget {
+            resolve: Some(single),
+            ..self
         }
     }
 
@@ -83,6 +97,10 @@ pub struct DepthStencil {
     pub stencil_ref: Option<u32>,
     /// Draws write stencil (their reference is set per draw by the closure).
     pub stencil_write: bool,
+    /// A multisampled attachment's single-sample image, which the pass
+    /// resolves depth and stencil into, both from sample 0, when it ends
+    /// (`--msaa`; docs/aa.md, "MSAA with the SSS pipeline").
+    pub resolve: Option<ImageId>,
 }
 
 impl DepthStencil {
@@ -95,6 +113,15 @@ impl DepthStencil {
             depth_write: true,
             stencil_ref: None,
             stencil_write: false,
+            resolve: None,
+        }
+    }
+
+    /// Resolved into `single` when the pass ends (see [`DepthStencil::resolve`]).
+    pub fn resolved_into(self, single: ImageId) -> Self {
+        DepthStencil {
+            resolve: Some(single),
+            ..self
         }
     }
 
@@ -108,6 +135,7 @@ impl DepthStencil {
             depth_write: false,
             stencil_ref: None,
             stencil_write: false,
+            resolve: None,
         }
     }
 

@@ -30,6 +30,10 @@ pub struct ImageDesc {
     /// Also a view of level 0 as UNORM (an sRGB image read without its
     /// decode: the post chain's edge tests work on the encoded values).
     pub unorm_view: bool,
+    /// Samples per pixel (1 but for the multisampled geometry pass's
+    /// attachments, `--msaa`; such an image has one level and is resolved,
+    /// never sampled or copied).
+    pub samples: u32,
 }
 
 impl ImageDesc {
@@ -40,7 +44,14 @@ impl ImageDesc {
             format,
             levels: 1,
             unorm_view: false,
+            samples: 1,
         }
+    }
+
+    /// `samples` samples per pixel (see [`ImageDesc::samples`]).
+    pub fn with_samples(mut self, samples: u32) -> Self {
+        self.samples = samples.max(1);
+        self
     }
 
     pub fn with_levels(mut self, levels: u32) -> Self {
@@ -180,7 +191,9 @@ impl Resources {
                 s.desc.name
             );
             let d = &s.desc;
-            s.image = Some(
+            let image = if d.samples > 1 {
+                Image::multisampled(ctx, &d.name, d.extent, d.format, s.usage, d.samples)
+            } else {
                 Image::with_unorm_view(
                     ctx,
                     &d.name,
@@ -190,8 +203,9 @@ impl Resources {
                     d.levels,
                     d.unorm_view,
                 )
-                .with_context(|| format!("creating the frame image '{}'", d.name))?,
-            );
+            };
+            s.image =
+                Some(image.with_context(|| format!("creating the frame image '{}'", d.name))?);
         }
         Ok(())
     }
@@ -207,7 +221,8 @@ impl Resources {
                     0 => 8,
                     b => b as u64,
                 };
-                let level0 = d.extent.width as u64 * d.extent.height as u64 * texel;
+                let level0 =
+                    d.extent.width as u64 * d.extent.height as u64 * texel * d.samples as u64;
                 // A full chain adds a third.
                 if d.levels > 1 {
                     level0 + level0 / 3
@@ -287,6 +302,11 @@ impl Resources {
         self.slot(id).desc.format
     }
 
+    /// Samples per pixel of `id`'s image.
+    pub fn samples(&self, id: ImageId) -> u32 {
+        self.slot(id).desc.samples
+    }
+
     /// The format of `id` as pass declarations and reports name it.
     pub fn texel_format(&self, id: ImageId) -> Format {
         self.slot(id).texel
@@ -354,6 +374,9 @@ impl Resources {
                     AccessKind::ColorAttachmentLoadWrite => ImageUseKind::ColorTargetLoad,
                     AccessKind::DepthStencilWrite => ImageUseKind::DepthTarget,
                     AccessKind::DepthStencilReadOnly => ImageUseKind::DepthTest,
+                    AccessKind::ColorResolveWrite | AccessKind::DepthStencilResolveWrite => {
+                        ImageUseKind::ResolveTarget
+                    }
                     AccessKind::FragmentSampledRead
                     | AccessKind::ComputeSampledRead
                     | AccessKind::AnyShaderSampledRead => ImageUseKind::Sampled,

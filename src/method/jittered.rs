@@ -40,6 +40,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     needs: |_, _| Needs::PLAIN,
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Jittered::new(s)?)),
+    no_msaa: None,
 };
 
 pub struct Jittered {

@@ -75,6 +75,23 @@ pub struct FrameTargets {
     pub depth_stencil: ImageId,
     pub hdr: ImageId,
     pub ldr: ImageId,
+    /// With `--msaa N` (N > 1): the geometry pass's multisampled attachments,
+    /// resolved into the single-sample targets above when it ends, so every
+    /// method reads what it reads at 1x.
+    pub multisampled: Option<MsaaTargets>,
+}
+
+/// The geometry pass's attachments at `samples` samples per pixel, one per
+/// single-sample target it resolves into (docs/aa.md, "MSAA with the SSS
+/// pipeline").
+#[derive(Clone, Copy, Debug)]
+pub struct MsaaTargets {
+    pub samples: u32,
+    pub diffuse: ImageId,
+    pub specular: ImageId,
+    pub linear_depth: ImageId,
+    pub normals: Option<ImageId>,
+    pub depth_stencil: ImageId,
 }
 
 /// What a method needs the frame to provide, known before anything is built.
@@ -250,6 +267,9 @@ pub struct MethodEntry {
     /// Parses and checks the options before any device opens.
     pub check: fn(&Opts) -> Result<()>,
     pub build: fn(&mut MethodSetup) -> Result<Box<dyn SssMethod>>,
+    /// Why the method cannot run on a multisampled frame (`--msaa` > 1), in
+    /// one line; `None`: it reads the resolved targets like any 1x frame.
+    pub no_msaa: Option<&'static str>,
 }
 
 impl MethodEntry {

@@ -28,6 +28,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
             diffuse: s.targets.diffuse,
         }))
     },
+    no_msaa: None,
 };
 
 pub struct NoSss {

@@ -53,6 +53,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     },
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Poisson::new(s)?)),
+    no_msaa: None,
 };
 
 /// Levels for a target of `extent` (every level at least one texel).

@@ -97,6 +97,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Separable::new(s)?)),
+    no_msaa: None,
 };
 
 /// The method's options, parsed.

@@ -79,6 +79,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Ssg::new(s)?)),
+    no_msaa: None,
 };
 
 /// How non-skin pixels are kept out of the SSS passes.

@@ -340,7 +340,10 @@ impl Frame {
                 .chain(targets.normals)
                 .map(|t| res.format(t))
                 .collect();
-        self.geometry_pipeline = Pipeline::graphics(
+        // At `--msaa N` it rasterises N samples a pixel into the
+        // multisampled attachments (shading stays once a pixel).
+        let samples = targets.multisampled.map_or(1, |m| m.samples);
+        self.geometry_pipeline = Pipeline::graphics_multisampled(
             ctx,
             &GraphicsDesc {
                 name: "geometry".into(),
@@ -369,6 +372,7 @@ impl Frame {
                 depth_bias: None,
                 blend: Blend::None,
             },
+            samples,
         )?;
         self.composite_pipeline = Pipeline::graphics(
             ctx,
@@ -769,16 +773,32 @@ impl Frame {
         // no surface reads as "in front". Declared in the order the dumps number
         // them: the three targets, depth and stencil, then the normals a method
         // asked for (attachment order: the colours in the order given).
-        let clear = |c: ImageId, v: [f32; 4]| ColorTarget::new(c, Load::Clear(v));
+        // With `--msaa` each target is drawn multisampled and resolved into
+        // the single-sample one the methods read: colours (and linear depth:
+        // the thesis' average of the subsamples' depths, ch. 6.3) averaged,
+        // depth and stencil from sample 0 (docs/aa.md).
+        let ms = t.multisampled;
+        let clear = |c: ImageId, multi: Option<ImageId>, v: [f32; 4]| match multi {
+            Some(m) => ColorTarget::new(m, Load::Clear(v)).resolved_into(c),
+            None => ColorTarget::new(c, Load::Clear(v)),
+        };
+        let depth = match ms {
+            Some(m) => DepthStencil::cleared(m.depth_stencil, 1.0).resolved_into(t.depth_stencil),
+            None => DepthStencil::cleared(t.depth_stencil, 1.0),
+        };
         let mut pass = Pass::new("geometry", PassRole::Geometry)
             .sampled(t.shadow)
-            .color(clear(t.diffuse, [0.0; 4]))
-            .color(clear(t.specular, [0.0; 4]))
-            .color(clear(t.linear_depth, [self.camera.far, 0.0, 0.0, 0.0]))
+            .color(clear(t.diffuse, ms.map(|m| m.diffuse), [0.0; 4]))
+            .color(clear(t.specular, ms.map(|m| m.specular), [0.0; 4]))
+            .color(clear(
+                t.linear_depth,
+                ms.map(|m| m.linear_depth),
+                [self.camera.far, 0.0, 0.0, 0.0],
+            ))
             // Every drawn pixel gets its object's skin bit (the reference is set per draw).
-            .depth_stencil(DepthStencil::cleared(t.depth_stencil, 1.0).stencil_write(true));
+            .depth_stencil(depth.stencil_write(true));
         if let Some(n) = t.normals {
-            pass = pass.color(clear(n, [0.0; 4]));
+            pass = pass.color(clear(n, ms.and_then(|m| m.normals), [0.0; 4]));
         }
         pass.draws(Some(work), self.triangles(false))
             .record(move |pc: &PassContext| {

@@ -105,6 +105,7 @@ pub fn group_specs(scene: &Scene, settings: &RenderSettings) -> Result<Vec<Group
     for g in mix.groups()? {
         let entry = g.choice.entry()?;
         let options = g.choice.method_options();
+        super::settings::check_msaa(settings.msaa, Some(entry))?;
         // ssg's shader branch shades every pixel whose alpha marks skin, the
         // other groups' too: only the stencil keeps a group to its pixels.
         if entry.name == "ssg"

@@ -180,7 +180,7 @@ impl<'c> Renderer<'c> {
         let mixed = specs.len() > 1;
         // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
-        let targets = targets::declare(ctx, &mut resources, extent, settings.shadow_size, needs)?;
+        let targets = targets::declare(ctx, &mut resources, settings, needs)?;
         let ids = settings.character_ids.then(|| {
             resources.declare(crate::graph::ImageDesc::new(
                 "character ids",

@@ -41,6 +41,9 @@ pub struct ReadbackPlan {
     dumped: usize,
     /// Buffer count of the graph before this plan added its own, restored at the end.
     buffers_before: usize,
+    /// Depth/stencil images are read back as their stencil aspect (one byte
+    /// a texel) instead of their depth.
+    stencil: bool,
 }
 
 /// Label prefix of the readback passes (a label only: they are found by role).
@@ -128,6 +131,15 @@ impl ReadbackPlan {
             pending: Vec::new(),
             dumped: 0,
             buffers_before: 0,
+            stencil: false,
+        }
+    }
+
+    /// The stencil of one depth/stencil image, read after all passes.
+    pub fn single_stencil(image: ImageId) -> Self {
+        ReadbackPlan {
+            stencil: true,
+            ..Self::single(image)
         }
     }
 
@@ -149,11 +161,19 @@ impl ReadbackPlan {
         pass: &str,
         id: ImageId,
     ) -> Result<Option<Pass<'a>>> {
-        // Mip levels above 0 are tracked as their own resources but not dumped.
-        if res.level_of(id) > 0 {
+        // Mip levels above 0 are tracked as their own resources but not
+        // dumped, and a multisampled image cannot be copied to a buffer: its
+        // resolved image is dumped in its place.
+        if res.level_of(id) > 0 || res.samples(id) > 1 {
             return Ok(None);
         }
-        let Some((bpt, aspect)) = copy_format(res.format(id)) else {
+        let format = res.format(id);
+        let copied = if self.stencil && crate::vk::memory::has_stencil(format) {
+            Some((1, vk::ImageAspectFlags::STENCIL))
+        } else {
+            copy_format(format)
+        };
+        let Some((bpt, aspect)) = copied else {
             return Ok(None);
         };
         let extent = res.extent(id);
@@ -310,6 +330,14 @@ impl ReadbackPlan {
         to_rgba_f32(*format, bytes)
     }
 
+    /// After the fence: the bytes of the one image read back (a stencil
+    /// plan's: one byte a texel, rows top to bottom).
+    pub fn finish_bytes(self, ctx: &Context, res: &mut Resources) -> Result<Vec<u8>> {
+        let (mut finals, _) = self.finish(ctx, res)?;
+        anyhow::ensure!(!finals.is_empty(), "nothing was read back");
+        Ok(finals.swap_remove(0).1)
+    }
+
     /// Frees the readback buffers of a plan whose submission failed.
     pub fn discard(mut self, ctx: &Context, res: &mut Resources) {
         self.release(ctx, res);
@@ -320,6 +348,35 @@ impl ReadbackPlan {
             p.buffer.destroy(ctx);
         }
         res.truncate_buffers(self.buffers_before);
+    }
+}
+
+// Beside the plan it uses (render/mod.rs stays small).
+impl super::Renderer<'_> {
+    /// Reads the stencil of the frame's (single-sample) depth/stencil target
+    /// back, one byte a pixel, after a frame: each pixel's group code as the
+    /// SSS passes test it (with `--msaa`, the resolve's sample 0).
+    pub fn read_stencil(&mut self) -> Result<Vec<u8>> {
+        let id = self.frame.targets.depth_stencil;
+        let mut plan = ReadbackPlan::single_stencil(id);
+        let (ctx, submit) = (self.ctx, &self.submit);
+        let done = plan
+            .interleave(ctx, &mut self.resources, Vec::new())
+            .and_then(|p| {
+                super::submit_passes(
+                    ctx,
+                    submit,
+                    &mut self.resources,
+                    &p,
+                    false,
+                    "while reading back the stencil",
+                )
+            });
+        if let Err(e) = done {
+            plan.discard(ctx, &mut self.resources);
+            return Err(e);
+        }
+        plan.finish_bytes(ctx, &mut self.resources)
     }
 }
 

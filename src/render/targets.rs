@@ -4,8 +4,9 @@
 use anyhow::{bail, Result};
 use ash::vk;
 
+use super::settings::RenderSettings;
 use crate::graph::{ImageDesc, Resources};
-use crate::method::{FrameTargets, Needs};
+use crate::method::{FrameTargets, MsaaTargets, Needs};
 use crate::vk::context::Context;
 
 /// Diffuse and specular light, the intermediates and the HDR composite.
@@ -36,14 +37,52 @@ pub fn depth_stencil_format(ctx: &Context) -> Result<vk::Format> {
     )
 }
 
-/// Declares the frame's targets at `extent` with what `needs` asks for.
+/// Refuses `samples` samples per pixel (`--msaa`) when the device cannot
+/// render them into every attachment of the geometry pass, in one line that
+/// names the counts it can.
+pub fn check_msaa(ctx: &Context, samples: u32, formats: &[(vk::Format, bool)]) -> Result<()> {
+    let f = &ctx.facts;
+    let counts: Vec<String> = f
+        .framebuffer_sample_counts
+        .iter()
+        .map(|n| format!("{n}x"))
+        .collect();
+    if !f.framebuffer_sample_counts.contains(&samples) {
+        bail!(
+            "device '{}' cannot render {samples}x MSAA: its framebuffers take {} samples per pixel",
+            f.name,
+            counts.join(", ")
+        );
+    }
+    for &(format, depth) in formats {
+        let usage = if depth {
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+        } else {
+            vk::ImageUsageFlags::COLOR_ATTACHMENT
+        };
+        if !ctx.format_supports_samples(format, usage, samples) {
+            bail!(
+                "device '{}' cannot render {samples}x MSAA into {format:?} (a geometry-pass target)",
+                f.name
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Declares the frame's targets at the settings' size with what `needs` asks
+/// for, and with `--msaa` > 1 the geometry pass's multisampled attachments.
 pub fn declare(
     ctx: &Context,
     res: &mut Resources,
-    extent: vk::Extent2D,
-    shadow_size: u32,
+    settings: &RenderSettings,
     needs: Needs,
 ) -> Result<FrameTargets> {
+    let extent = vk::Extent2D {
+        width: settings.width,
+        height: settings.height,
+    };
+    let (shadow_size, msaa) = (settings.shadow_size, settings.msaa);
     if !ctx.format_supports(
         LINEAR_DEPTH_FORMAT,
         vk::FormatFeatureFlags::COLOR_ATTACHMENT
@@ -67,14 +106,45 @@ pub fn declare(
         width: shadow_size,
         height: shadow_size,
     };
+    // In the order of the 1x frame before `--msaa` (shadow, specular, depth).
+    let shadow = res.declare(ImageDesc::new("shadow map", shadow_extent, SHADOW_FORMAT));
+    let specular = res.declare(ImageDesc::new("specular", extent, DIFFUSE_FORMAT));
+    let depth_stencil = res.declare(ImageDesc::new("depth stencil", extent, ds_format));
+    let multisampled = if msaa > 1 {
+        check_msaa(
+            ctx,
+            msaa,
+            &[
+                (DIFFUSE_FORMAT, false),
+                (LINEAR_DEPTH_FORMAT, false),
+                (ds_format, true),
+            ],
+        )?;
+        let mut ms = |name: &str, format| {
+            res.declare(
+                ImageDesc::new(&format!("{name} {msaa}x"), extent, format).with_samples(msaa),
+            )
+        };
+        Some(MsaaTargets {
+            samples: msaa,
+            diffuse: ms("diffuse", DIFFUSE_FORMAT),
+            specular: ms("specular", DIFFUSE_FORMAT),
+            linear_depth: ms("linear depth", LINEAR_DEPTH_FORMAT),
+            normals: normals.map(|_| ms("normals", DIFFUSE_FORMAT)),
+            depth_stencil: ms("depth stencil", ds_format),
+        })
+    } else {
+        None
+    };
     Ok(FrameTargets {
-        shadow: res.declare(ImageDesc::new("shadow map", shadow_extent, SHADOW_FORMAT)),
+        shadow,
         diffuse,
-        specular: res.declare(ImageDesc::new("specular", extent, DIFFUSE_FORMAT)),
+        specular,
         linear_depth,
         normals,
-        depth_stencil: res.declare(ImageDesc::new("depth stencil", extent, ds_format)),
+        depth_stencil,
         hdr: res.declare(ImageDesc::new("hdr", extent, DIFFUSE_FORMAT)),
         ldr: res.declare(ImageDesc::new("ldr", extent, LDR_FORMAT)),
+        multisampled,
     })
 }

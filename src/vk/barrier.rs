@@ -29,6 +29,15 @@ pub enum AccessKind {
     ColorAttachmentLoadWrite,
     /// Depth/stencil attachment cleared and written (depth test + write, stencil replace).
     DepthStencilWrite,
+    /// Single-sample colour image written by the multisample resolve at the
+    /// end of a render pass (`--msaa`): the colour-attachment row, named apart
+    /// so reports and the budget tell a resolve from a draw.
+    ColorResolveWrite,
+    /// Single-sample depth/stencil image written by the multisample resolve at
+    /// the end of a render pass (`--msaa`): resolves of depth/stencil happen in
+    /// the colour-attachment-output stage with colour-attachment writes (the
+    /// spec's "Multisample Resolve Operations"), in the attachment layout.
+    DepthStencilResolveWrite,
     /// Depth/stencil attachment loaded for testing only (depth test or stencil test,
     /// no writes): read-only layout, so it could also be sampled at the same time.
     DepthStencilReadOnly,
@@ -102,6 +111,16 @@ impl AccessKind {
                 A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
                 L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
             ),
+            AccessKind::ColorResolveWrite => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            AccessKind::DepthStencilResolveWrite => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+            ),
             AccessKind::DepthStencilReadOnly => (
                 S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
                 A::DEPTH_STENCIL_ATTACHMENT_READ,
@@ -173,6 +192,8 @@ impl AccessKind {
             AccessKind::ColorAttachmentWrite
                 | AccessKind::ColorAttachmentLoadWrite
                 | AccessKind::DepthStencilWrite
+                | AccessKind::DepthStencilResolveWrite
+                | AccessKind::ColorResolveWrite
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::ComputeStorageReadWrite
                 | AccessKind::FragmentStorageReadWrite
@@ -190,6 +211,8 @@ impl AccessKind {
             self,
             AccessKind::ColorAttachmentWrite
                 | AccessKind::DepthStencilWrite
+                | AccessKind::DepthStencilResolveWrite
+                | AccessKind::ColorResolveWrite
                 | AccessKind::ComputeStorageWrite
                 | AccessKind::TransferWrite
                 | AccessKind::ClearWrite
@@ -201,12 +224,12 @@ impl AccessKind {
     pub fn image_usage(self) -> vk::ImageUsageFlags {
         type U = vk::ImageUsageFlags;
         match self {
-            AccessKind::ColorAttachmentWrite | AccessKind::ColorAttachmentLoadWrite => {
-                U::COLOR_ATTACHMENT
-            }
-            AccessKind::DepthStencilWrite | AccessKind::DepthStencilReadOnly => {
-                U::DEPTH_STENCIL_ATTACHMENT
-            }
+            AccessKind::ColorAttachmentWrite
+            | AccessKind::ColorAttachmentLoadWrite
+            | AccessKind::ColorResolveWrite => U::COLOR_ATTACHMENT,
+            AccessKind::DepthStencilWrite
+            | AccessKind::DepthStencilResolveWrite
+            | AccessKind::DepthStencilReadOnly => U::DEPTH_STENCIL_ATTACHMENT,
             AccessKind::FragmentSampledRead
             | AccessKind::ComputeSampledRead
             | AccessKind::AnyShaderSampledRead => U::SAMPLED,
@@ -382,7 +405,9 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 21] = [
+    const ALL: [AccessKind; 23] = [
+        AccessKind::ColorResolveWrite,
+        AccessKind::DepthStencilResolveWrite,
         AccessKind::FragmentStorageReadWrite,
         AccessKind::ClearWrite,
         AccessKind::ComputeStorageReadWrite,
@@ -579,6 +604,30 @@ mod tests {
         assert_eq!(b.src_access, A::DEPTH_STENCIL_ATTACHMENT_WRITE);
         assert_eq!(b.dst_access, A::DEPTH_STENCIL_ATTACHMENT_READ);
         assert_eq!(b.new_layout, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+    }
+
+    // `--msaa`: the single-sample depth/stencil the geometry pass resolves
+    // into is written in the colour-attachment-output stage (the spec's
+    // resolve operations), then stencil-tested by the SSS passes.
+    #[test]
+    fn depth_resolve_then_stencil_test() {
+        let b = image_after(
+            &[AccessKind::DepthStencilResolveWrite],
+            AccessKind::DepthStencilReadOnly,
+        )
+        .unwrap();
+        assert_eq!(b.src_stage, S::COLOR_ATTACHMENT_OUTPUT);
+        assert_eq!(b.src_access, A::COLOR_ATTACHMENT_WRITE);
+        assert_eq!(b.dst_access, A::DEPTH_STENCIL_ATTACHMENT_READ);
+        assert_eq!(b.old_layout, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+        assert_eq!(b.new_layout, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let c = image_after(
+            &[AccessKind::ColorResolveWrite],
+            AccessKind::FragmentSampledRead,
+        )
+        .unwrap();
+        assert_eq!(c.src_access, A::COLOR_ATTACHMENT_WRITE);
+        assert_eq!(c.new_layout, L::SHADER_READ_ONLY_OPTIMAL);
     }
 
     // "Copy to a buffer, then read it on the host"; reads of a never-written

@@ -68,6 +68,14 @@ pub struct DeviceFacts {
     /// Whether shaders may write clip distances (enabled when present:
     /// texture-space diffusion clips its unwrapped meshes with them).
     pub shader_clip_distance: bool,
+    /// Samples per pixel a render target may have (`--msaa`): the counts in
+    /// the colour, depth and stencil framebuffer sample-count limits alike,
+    /// ascending (1 always).
+    pub framebuffer_sample_counts: Vec<u32>,
+    /// The depth and stencil resolve modes of VK_KHR_depth_stencil_resolve
+    /// (core in 1.2; SAMPLE_ZERO is required of both).
+    pub depth_resolve_modes: vk::ResolveModeFlags,
+    pub stencil_resolve_modes: vk::ResolveModeFlags,
 }
 
 /// Validation messages collected by the debug messenger. Any message is an error:
@@ -341,7 +349,10 @@ impl Context {
             );
         }
         let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver_props);
+        let mut resolve_props = vk::PhysicalDeviceDepthStencilResolveProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut driver_props)
+            .push_next(&mut resolve_props);
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
         let driver = format!(
             "{} {}",
@@ -449,6 +460,18 @@ impl Context {
             },
             fragment_stores_and_atomics: features.fragment_stores_and_atomics == vk::TRUE,
             shader_clip_distance: features.shader_clip_distance == vk::TRUE,
+            framebuffer_sample_counts: {
+                let l = &props.limits;
+                let both = l.framebuffer_color_sample_counts
+                    & l.framebuffer_depth_sample_counts
+                    & l.framebuffer_stencil_sample_counts;
+                [1u32, 2, 4, 8, 16, 32, 64]
+                    .into_iter()
+                    .filter(|&n| both.as_raw() & n != 0)
+                    .collect()
+            },
+            depth_resolve_modes: resolve_props.supported_depth_resolve_modes,
+            stencil_resolve_modes: resolve_props.supported_stencil_resolve_modes,
         };
 
         // Everything is made: the context owns (and tears down) it from here.
@@ -654,6 +677,28 @@ impl Context {
                 .get_physical_device_format_properties(self.physical, format)
         };
         p.optimal_tiling_features.contains(features)
+    }
+
+    /// Whether an optimal-tiling 2D image of `format` with `usage` may have
+    /// `samples` samples per pixel (the format's own limit, below the
+    /// framebuffer's).
+    pub fn format_supports_samples(
+        &self,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        samples: u32,
+    ) -> bool {
+        let p = unsafe {
+            self.instance.get_physical_device_image_format_properties(
+                self.physical,
+                format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                usage,
+                vk::ImageCreateFlags::empty(),
+            )
+        };
+        p.is_ok_and(|p| p.sample_counts.as_raw() & samples != 0)
     }
 
     pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {

@@ -70,6 +70,18 @@ pub fn bytes_per_texel(f: vk::Format) -> usize {
     }
 }
 
+/// The Vulkan sample-count flag of `n` samples per pixel (1, 2, 4 or 8:
+/// what `--msaa` takes).
+pub fn sample_count(n: u32) -> Result<vk::SampleCountFlags> {
+    Ok(match n {
+        1 => vk::SampleCountFlags::TYPE_1,
+        2 => vk::SampleCountFlags::TYPE_2,
+        4 => vk::SampleCountFlags::TYPE_4,
+        8 => vk::SampleCountFlags::TYPE_8,
+        _ => anyhow::bail!("{n} samples per pixel: dermis multisamples at 1, 2, 4 or 8"),
+    })
+}
+
 impl Image {
     pub fn new(
         ctx: &Context,
@@ -110,7 +122,7 @@ impl Image {
         })?;
         let mut image = Guard::new(
             ctx,
-            Self::create(ctx, name, extent, format, usage, levels, true)?,
+            Self::create(ctx, name, extent, format, usage, levels, true, 1)?,
         );
         ctx.creation_step(&format!("the UNORM view of image '{name}'"))?;
         let view = unsafe {
@@ -144,9 +156,25 @@ impl Image {
         usage: vk::ImageUsageFlags,
         levels: u32,
     ) -> Result<Self> {
-        Self::create(ctx, name, extent, format, usage, levels, false)
+        Self::create(ctx, name, extent, format, usage, levels, false, 1)
     }
 
+    /// A single-level image of `samples` samples per pixel (the multisampled
+    /// geometry pass's attachments, resolved at the end of the pass; never
+    /// sampled nor copied: `vkCmdCopyImageToBuffer` takes one sample only).
+    pub fn multisampled(
+        ctx: &Context,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        samples: u32,
+    ) -> Result<Self> {
+        Self::create(ctx, name, extent, format, usage, 1, false, samples)
+    }
+
+    // Every fact of a VkImageCreateInfo dermis varies, one argument each.
+    #[allow(clippy::too_many_arguments)]
     fn create(
         ctx: &Context,
         name: &str,
@@ -155,6 +183,7 @@ impl Image {
         usage: vk::ImageUsageFlags,
         levels: u32,
         mutable_format: bool,
+        samples: u32,
     ) -> Result<Self> {
         let levels = levels.max(1);
         let aspect = if is_depth_format(format) {
@@ -176,7 +205,7 @@ impl Image {
             })
             .mip_levels(levels)
             .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(sample_count(samples)?)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);

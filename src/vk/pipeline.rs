@@ -176,6 +176,13 @@ fn make_layout(
 
 impl Pipeline {
     pub fn graphics(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
+        Self::graphics_multisampled(ctx, d, 1)
+    }
+
+    /// A graphics pipeline that rasterises `samples` samples per pixel (the
+    /// multisampled geometry pass, `--msaa`; 1 is [`Pipeline::graphics`]).
+    /// Shading stays per pixel: no sample shading.
+    pub fn graphics_multisampled(ctx: &Context, d: &GraphicsDesc, samples: u32) -> Result<Self> {
         let frag = d.frag.map(|f| variant(ctx, f));
         let mut stages_names = vec![d.vert];
         if let Some(f) = &frag {
@@ -198,7 +205,7 @@ impl Pipeline {
                 ..Default::default()
             },
         );
-        p.build_graphics(ctx, d, frag.as_deref())?;
+        p.build_graphics(ctx, d, frag.as_deref(), samples)?;
         Ok(p.keep())
     }
 
@@ -210,6 +217,7 @@ impl Pipeline {
         ctx: &Context,
         d: &GraphicsDesc,
         frag: Option<&str>,
+        samples: u32,
     ) -> Result<()> {
         let layout = self.layout;
         // The modules go when this returns: the pipeline does not need them.
@@ -274,7 +282,7 @@ impl Pipeline {
                 .depth_bias_slope_factor(slope);
         }
         let ms = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+            .rasterization_samples(crate::vk::memory::sample_count(samples)?);
         let mut ds = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(d.depth_test)
             .depth_write_enable(d.depth_write)

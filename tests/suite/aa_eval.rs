@@ -226,20 +226,48 @@ fn aa_eval_command_writes_its_files_and_guards_the_size() {
     );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("aa-eval.json")).unwrap()).unwrap();
-    assert_eq!(
-        json["rows"].as_array().unwrap().len(),
-        3 * AaMode::ALL.len()
-    );
+    // A row per view and post mode, and per MSAA count the device renders
+    // (lavapipe: 4x), scored beside them.
+    let counts: Vec<u32> = common::ctx()
+        .facts
+        .framebuffer_sample_counts
+        .iter()
+        .copied()
+        .filter(|&n| (2..=8).contains(&n))
+        .collect();
+    let per_view = AaMode::ALL.len() + counts.len();
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3 * per_view);
+    for n in &counts {
+        let label = dermis::eval::aa_eval::msaa_label(*n);
+        let msaa: Vec<_> = rows.iter().filter(|r| r["mode"] == label).collect();
+        assert_eq!(msaa.len(), 3, "{label} rows");
+        // MSAA lowers the edge error on every lines view (the margin the
+        // post modes are held to).
+        for r in msaa {
+            assert!(r["rmse_edges_vs_none"].as_f64().unwrap() < 0.9, "{r}");
+        }
+    }
     assert_eq!(json["factor"], 4);
     let csv = std::fs::read_to_string(out.join("aa-eval.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 1 + 3 * AaMode::ALL.len());
+    assert_eq!(csv.lines().count(), 1 + 3 * per_view);
+    let msaa_png = counts.first().map(|&n| {
+        format!(
+            "views/lines-1x/{}.png",
+            dermis::eval::aa_eval::msaa_label(n)
+        )
+    });
     for f in [
         "chart.png",
         "chart.svg",
         "views/lines-1x/reference.png",
         "views/lines-1x/edges.png",
-    ] {
-        assert!(out.join(f).is_file(), "{f} missing");
+    ]
+    .into_iter()
+    .map(String::from)
+    .chain(msaa_png)
+    {
+        assert!(out.join(&f).is_file(), "{f} missing");
     }
     let _ = std::fs::remove_dir_all(&out);
     // Refused before a device opens, in one line.

@@ -30,6 +30,7 @@ mod bloom;
 mod budget_cli;
 mod harness;
 mod mix;
+mod msaa;
 mod plan;
 mod plan_motion;
 mod reference;

@@ -62,6 +62,13 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                 s.post.smaa_preset = Some(preset);
                 settings.push((format!("{} --aa smaa {preset:?} {edges}", m.name), s));
             }
+            // The multisampled geometry pass shades once a pixel: its
+            // declared fetches hold at 4x too (lavapipe's one count above 1).
+            let s = RenderSettings::study().with(m, &[]);
+            settings.push((
+                format!("{} --msaa 4", m.name),
+                RenderSettings { msaa: 4, ..s },
+            ));
         }
         for (label, s) in settings {
             let s = RenderSettings {

@@ -163,6 +163,9 @@ const OPT_OPTIONS: &[OptSpec] = &[
     },
 ];
 
+/// Why neither tsd entry runs with `--msaa` (docs/aa.md).
+const NO_MSAA: Option<&str> = Some("texture-space diffusion shades in a second mesh pass, drawn depth-EQUAL against the frame's depth: with --msaa that depth is resolved from sample 0 and no single-sample redraw matches it (and the pass itself would alias)");
+
 pub static ENTRY: MethodEntry = MethodEntry {
     name: "tsd",
     aliases: &["texture-space"],
@@ -183,6 +186,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o, false).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, false)?)),
+    no_msaa: NO_MSAA,
 };
 
 pub static OPT_ENTRY: MethodEntry = MethodEntry {
@@ -205,6 +209,7 @@ pub static OPT_ENTRY: MethodEntry = MethodEntry {
     needs: |_, _| Needs::PLAIN,
     check: |o| Config::parse(o, true).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, true)?)),
+    no_msaa: NO_MSAA,
 };
 
 /// How culled texels are skipped (thesis section 3.2).
