@@ -190,8 +190,16 @@ pub struct CaseRow {
     pub uniform_fitting: usize,
     /// Skin-SSS ms measured on this device (median over the timed frames),
     /// and of that the merges (the mixed frame's own overhead).
+    /// The plan's frame is timed twice, before and after its parts
+    /// (`measured_sss_runs_ms`), and the lower median is kept: a transient
+    /// only ever slows a run down (the 2026-12-02 H200 re-check timed one
+    /// plan at 1.73x the same assignment's time in the call before, its
+    /// parts alone unchanged: docs/perf/h200-msaa/README.md).
     pub measured_sss_ms: Option<f64>,
     pub measured_merge_ms: Option<f64>,
+    /// Both timings of the plan's frame, in the order they ran.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measured_sss_runs_ms: Vec<f64>,
     /// Each group's skin-SSS ms timed alone (its characters with its method,
     /// every other character with none): the parts the mixed frame is made
     /// of. The mixed frame's own overhead is `measured_sss_ms` minus their sum.
@@ -285,6 +293,12 @@ fn time_sss(ctx: &Context, scene: &Scene, s: &RenderSettings, n: usize) -> Resul
         crate::report::median_of_sorted(v) + 0.0
     };
     Ok((med(&mut sss), med(&mut merge)))
+}
+
+/// The run with the lower skin-SSS median, with its merges: of two timings
+/// of one frame, the one a transient (clocks, another process) did not slow.
+fn lower_run(runs: &[(f64, f64)]) -> Option<(f64, f64)> {
+    runs.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 /// A setting's modelled cost for every character with it: its fixed cost and
@@ -456,20 +470,22 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
                 }
             }
             let timed = o.timed_frames > 0 && pname == o.timed_profile;
-            let (measured_sss_ms, measured_merge_ms) = if timed {
-                let (a, b) = time_sss(ctx, o.scene, &ps, o.timed_frames)?;
-                (Some(a), Some(b))
-            } else {
-                (None, None)
-            };
+            let mut runs: Vec<(f64, f64)> = Vec::new();
             let mut parts_sss_ms = Vec::new();
             if timed {
+                runs.push(time_sss(ctx, o.scene, &ps, o.timed_frames)?);
                 for (label, alone) in group_parts(&file) {
                     let mut gs = s.clone();
                     gs.assignment = Some(Assignment::Plan(alone));
                     parts_sss_ms.push((label, time_sss(ctx, o.scene, &gs, o.timed_frames)?.0));
                 }
+                runs.push(time_sss(ctx, o.scene, &ps, o.timed_frames)?);
             }
+            let measured_sss_runs_ms: Vec<f64> = runs.iter().map(|r| r.0).collect();
+            let (measured_sss_ms, measured_merge_ms) = match lower_run(&runs) {
+                Some((a, b)) => (Some(a), Some(b)),
+                None => (None, None),
+            };
             let mut groups: Vec<String> = Vec::new();
             for a in &file.assignments {
                 let l = match (a.method.as_str(), &a.setting) {
@@ -496,6 +512,7 @@ pub fn run(ctx: &Context, o: &CheckOptions) -> Result<CheckReport> {
                 uniform_fitting: fitting,
                 measured_sss_ms,
                 measured_merge_ms,
+                measured_sss_runs_ms,
                 parts_sss_ms,
                 characters: case_chars,
             });
@@ -655,6 +672,7 @@ mod tests {
             uniform_fitting: 1,
             measured_sss_ms: Some(0.55),
             measured_merge_ms: Some(0.01),
+            measured_sss_runs_ms: vec![0.55, 0.56],
             parts_sss_ms: vec![],
             characters: vec![],
         }
@@ -667,5 +685,15 @@ mod tests {
         assert!((s.mean_abs_prediction_error - 0.05).abs() < 1e-12);
         assert!((s.max_abs_prediction_error - 0.1).abs() < 1e-12);
         assert_eq!(s.h200_measured_over_predicted.len(), 3);
+    }
+
+    #[test]
+    fn of_two_timings_the_lower_is_kept_with_its_merges() {
+        assert_eq!(lower_run(&[]), None);
+        assert_eq!(
+            lower_run(&[(0.352, 0.0), (0.209, 0.001)]),
+            Some((0.209, 0.001))
+        );
+        assert_eq!(lower_run(&[(0.20, 0.02), (0.21, 0.0)]), Some((0.20, 0.02)));
     }
 }
