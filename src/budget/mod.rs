@@ -13,7 +13,7 @@
 //! the implementations the sources timed, first-principles frames),
 //! [`points`] (the published and benchmark points), [`calibration`] (fit,
 //! held-out scores), [`porting`] (docs/budget.md's tables), [`table`] (the
-//! printed table).
+//! printed table), [`table91`] (thesis Table 9.1 as data and its games' line).
 //!
 //! With a device: [`run`] (`dermis budget`: run, count fetches, price, print,
 //! write) and [`chart`] (the stacked-bar chart).
@@ -31,6 +31,7 @@ pub mod profile;
 pub mod record;
 pub mod run;
 pub mod table;
+pub mod table91;
 pub mod transfers;
 pub mod units;
 

@@ -26,7 +26,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::budget::input::{FrameInput, PassInput};
-use crate::graph::work::{Filter, ShaderWork, Work};
+use crate::graph::work::{Filter, PassRole, ShaderWork, Work};
 use crate::report::{PassReport, Report};
 
 /// The fragments rule (module docs), for reports.
@@ -138,10 +138,14 @@ fn fragments(
 }
 
 /// Pixels a pass's triangles cover before its early tests, for passes that
-/// test without writing depth (the stencil-masked SSS passes): the SSS
-/// region's pixels when it draws one triangle per rectangle of the region,
-/// else its whole render area. `None` for passes that reject nothing early.
-fn rasterized(rec: &Report, work: &Work) -> Option<u64> {
+/// test without writing depth (the stencil-masked SSS passes, the
+/// stencil-culled AA passes): for an SSS pass, the SSS region's pixels when it
+/// draws one triangle per rectangle of the region; else its whole render
+/// area. Only SSS passes draw the region: a post pass's one full-screen
+/// triangle beside a one-rectangle region is the whole screen (it was taken
+/// for the region once, and the Xbox 360's MLAA resolves priced at a fifth).
+/// `None` for passes that reject nothing early.
+fn rasterized(rec: &Report, role: PassRole, work: &Work) -> Option<u64> {
     let Work::Raster {
         depth_stencil: Some(ds),
         width,
@@ -156,8 +160,8 @@ fn rasterized(rec: &Report, work: &Work) -> Option<u64> {
         return None;
     }
     let area = u64::from(*width) * u64::from(*height);
-    match (rec.sss_region_pixels, rec.sss_region_rects) {
-        (Some(px), Some(rects)) if rects == *triangles => Some(px),
+    match (role, rec.sss_region_pixels, rec.sss_region_rects) {
+        (PassRole::Sss, Some(px), Some(rects)) if rects == *triangles => Some(px),
         _ => Some(area),
     }
 }
@@ -192,7 +196,7 @@ pub fn frame_from_record(
         let mut q = PassInput::new(&p.name, role, work);
         q.fragments = fragments(p, &q.work, counting, c);
         q.samples_passed = p.samples_passed;
-        q.rasterized_pixels = rasterized(rec, &q.work);
+        q.rasterized_pixels = rasterized(rec, role, &q.work);
         q.images = p.images.clone();
         q.measured_ms = Some(p.gpu_ms.median);
         if let Some(c) = c {
@@ -373,6 +377,27 @@ mod tests {
         assert_eq!(s.fetches[1].count, 10.0);
         assert_eq!(lp.passes[1].measured_ms, Some(0.5));
         assert!(lp.provenance[1].contains("counted"));
+    }
+
+    #[test]
+    fn a_post_pass_beside_a_one_rectangle_region_covers_the_screen() {
+        let mut r = record("llvmpipe");
+        r.sss_region_rects = Some(1);
+        let one_triangle = |w: &mut Work| {
+            if let Work::Raster { triangles, .. } = w {
+                *triangles = 1;
+            }
+        };
+        one_triangle(r.passes[1].work.as_mut().unwrap());
+        let mut post = r.passes[1].clone();
+        post.name = "mlaa weights".into();
+        post.role = Some(PassRole::Post);
+        r.passes.push(post);
+        let f = frame_from_record(&r, None, "t").unwrap();
+        // The SSS pass draws the region's one rectangle; MLAA's full-screen
+        // triangle covers the 100 x 50 screen.
+        assert_eq!(f.passes[1].rasterized_pixels, Some(2000));
+        assert_eq!(f.passes[2].rasterized_pixels, Some(5000));
     }
 
     #[test]
