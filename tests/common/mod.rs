@@ -225,3 +225,44 @@ fn sanitize(name: &str) -> String {
         })
         .collect()
 }
+
+/// The gpu-allocator allocations `ctx` holds now.
+pub fn live_allocations(ctx: &Context) -> usize {
+    ctx.allocator().generate_report().allocations.len()
+}
+
+/// Makes the renderer's set-up for `settings` fail at each of its creation
+/// steps in turn (`Context::fail_creation_after`): every failure must be one
+/// error line naming the injected failure and must free its memory at once.
+/// Leaves failure injection off; returns the number of steps. `what` names the
+/// case in the messages.
+pub fn fail_each_creation_step(
+    ctx: &Context,
+    scene: &dermis::scene::Scene,
+    settings: &dermis::render::RenderSettings,
+    what: &str,
+) -> usize {
+    use dermis::render::Renderer;
+    let base = live_allocations(ctx);
+    let before = ctx.creations();
+    drop(Renderer::new(ctx, scene, settings).expect("a clean set-up"));
+    let steps = ctx.creations() - before;
+    for k in 0..steps {
+        ctx.fail_creation_after(Some(k));
+        let e = match Renderer::new(ctx, scene, settings) {
+            Ok(_) => panic!("{what}: step {k} of {steps} did not fail"),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(
+            e.contains("injected failure") && !e.contains('\n'),
+            "{what} step {k}: {e}"
+        );
+        assert_eq!(
+            live_allocations(ctx),
+            base,
+            "{what} step {k} ({e}) left memory allocated"
+        );
+    }
+    ctx.fail_creation_after(None);
+    steps
+}

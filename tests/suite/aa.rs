@@ -755,10 +755,6 @@ fn smaa_takes_the_diagonal_path_on_45_degree_edges() {
     assert!(errors[0] < base && errors[2] < base, "{errors:?} vs {base}");
 }
 
-fn live_allocations(ctx: &Context) -> usize {
-    ctx.allocator().generate_report().allocations.len()
-}
-
 /// Every anti-aliasing stage tears down clean, also when its set-up fails:
 /// the renderer's set-up is made to fail at each of its creation steps in
 /// turn (`Context::fail_creation_after`, as tests/teardown.rs does for the
@@ -771,27 +767,7 @@ fn every_stage_and_every_failed_stage_set_up_tear_down_clean() {
     for mode in [AaMode::Fxaa, AaMode::Mlaa, AaMode::Smaa] {
         let ctx = common::ctx();
         let s = settings(64, 36, mode);
-        let base = live_allocations(&ctx);
-        let before = ctx.creations();
-        drop(Renderer::new(&ctx, &scene, &s).unwrap());
-        let steps = ctx.creations() - before;
-        for k in 0..steps {
-            ctx.fail_creation_after(Some(k));
-            let e = match Renderer::new(&ctx, &scene, &s) {
-                Ok(_) => panic!("{mode}: step {k} of {steps} did not fail"),
-                Err(e) => format!("{e:#}"),
-            };
-            assert!(
-                e.contains("injected failure") && !e.contains('\n'),
-                "{mode} step {k}: {e}"
-            );
-            assert_eq!(
-                live_allocations(&ctx),
-                base,
-                "{mode} step {k} ({e}) left memory allocated"
-            );
-        }
-        ctx.fail_creation_after(None);
+        let steps = common::fail_each_creation_step(&ctx, &scene, &s, &mode.to_string());
         let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
         r.capture(false).unwrap();
         drop(r);

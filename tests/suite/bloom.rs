@@ -292,10 +292,6 @@ fn render_reports_the_bloom_passes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn live_allocations(ctx: &Context) -> usize {
-    ctx.allocator().generate_report().allocations.len()
-}
-
 /// The bloom's set-up fails cleanly at each of its creation steps in turn
 /// (`Context::fail_creation_after`, as for the AA stages): one error line,
 /// its memory freed at once, and the device destroyed with nothing left
@@ -305,23 +301,7 @@ fn every_failed_bloom_set_up_tears_down_clean() {
     let scene = egg_scene();
     let ctx = common::ctx();
     let s = settings(64, 36, true);
-    let base = live_allocations(&ctx);
-    let before = ctx.creations();
-    drop(Renderer::new(&ctx, &scene, &s).unwrap());
-    let steps = ctx.creations() - before;
-    for k in 0..steps {
-        ctx.fail_creation_after(Some(k));
-        let e = match Renderer::new(&ctx, &scene, &s) {
-            Ok(_) => panic!("step {k} of {steps} did not fail"),
-            Err(e) => format!("{e:#}"),
-        };
-        assert!(
-            e.contains("injected failure") && !e.contains('\n'),
-            "step {k}: {e}"
-        );
-        assert_eq!(live_allocations(&ctx), base, "step {k} ({e}) left memory");
-    }
-    ctx.fail_creation_after(None);
+    let steps = common::fail_each_creation_step(&ctx, &scene, &s, "--bloom");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     r.capture(false).unwrap();
     drop(r);

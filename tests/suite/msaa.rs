@@ -344,25 +344,7 @@ fn every_failed_4x_set_up_step_tears_down_clean() {
     let scene = egg_scene();
     let ctx = common::ctx();
     let s = egg(48, 32, MSAA);
-    let live =
-        |ctx: &dermis::vk::context::Context| ctx.allocator().generate_report().allocations.len();
-    let base = live(&ctx);
-    let before = ctx.creations();
-    drop(Renderer::new(&ctx, &scene, &s).unwrap());
-    let steps = ctx.creations() - before;
-    for k in 0..steps {
-        ctx.fail_creation_after(Some(k));
-        let e = match Renderer::new(&ctx, &scene, &s) {
-            Ok(_) => panic!("step {k} of {steps} did not fail"),
-            Err(e) => format!("{e:#}"),
-        };
-        assert!(
-            e.contains("injected failure") && !e.contains('\n'),
-            "step {k}: {e}"
-        );
-        assert_eq!(live(&ctx), base, "step {k} ({e}) left memory allocated");
-    }
-    ctx.fail_creation_after(None);
+    let steps = common::fail_each_creation_step(&ctx, &scene, &s, "--msaa 4");
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     r.capture(false).unwrap();
     r.read_stencil().unwrap();
