@@ -532,6 +532,16 @@ fn plan_check_scores_plans_against_the_ground_truth() {
         }
         let timed = c.profile == "nvidia-h200";
         assert_eq!(c.measured_sss_ms.is_some(), timed);
+        // The plan's frame is timed before and after its parts; the lower is kept.
+        assert_eq!(c.measured_sss_runs_ms.len(), if timed { 2 } else { 0 });
+        if let Some(m) = c.measured_sss_ms {
+            let low = c
+                .measured_sss_runs_ms
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(m, low, "{c:?}");
+        }
         let groups = c.plan_groups.iter().filter(|g| *g != "none").count();
         assert_eq!(
             c.parts_sss_ms.len(),
