@@ -16,7 +16,7 @@ use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
 use crate::scene::framing::Framing;
-use crate::scene::Scene;
+use crate::scene::{HeadSize, Scene};
 use crate::view::ViewScale;
 
 /// Width of the eval's silhouette band on the skin, mm (`eval::bands`).
@@ -65,8 +65,9 @@ impl CharacterInput {
     }
 }
 
-/// The geometric estimate of one character (region fields left at 0: the
-/// cost model fills them from its reference frames).
+/// The geometric estimate of every character (region fields left at 0: the
+/// cost model fills them from its reference frames), its skin counted by the
+/// exact rasterisation.
 pub fn estimate(
     scene: &Scene,
     framing: &Framing,
@@ -75,32 +76,68 @@ pub fn estimate(
     light_dir: Vec3,
     shadow_size: u32,
 ) -> Vec<CharacterInput> {
-    let shadow_mm = framing.light.texel_mm(shadow_size, scene.mm_per_unit);
     let cam = framing.camera;
-    let aspect = width as f32 / height as f32;
-    let view = cam.view();
-    let vp = cam.view_proj(aspect);
-    let scale = ViewScale::new(height, cam.fovy_rad, scene.mm_per_unit);
-    let head_h = scene.head_height_units();
-    let centre = scene.head_center();
-    let mesh = &scene.head.mesh;
+    let vp = cam.view_proj(width as f32 / height as f32);
     let visible = if scene.head.material.skin {
-        rasterise(mesh, &framing.instances, &vp, cam.eye, width, height)
+        rasterise(
+            &scene.head.mesh,
+            &framing.instances,
+            &vp,
+            cam.eye,
+            width,
+            height,
+        )
     } else {
         vec![(0.0, [0; 4]); framing.instances.len()]
     };
+    let view = FrameView {
+        framing,
+        width,
+        height,
+        light_dir,
+        shadow_size,
+    };
+    from_visible(scene, &scene.head_size(), &view, &visible)
+}
+
+/// The frame an estimate is made for.
+pub struct FrameView<'a> {
+    pub framing: &'a Framing,
+    pub width: u32,
+    pub height: u32,
+    pub light_dir: Vec3,
+    pub shadow_size: u32,
+}
+
+/// Every character of `v` given its visible skin pixels and screen rectangle
+/// (`visible`, in the frame's order: the exact rasterisation's or
+/// `skin_patches`'), `size` the scene's head measures.
+pub fn from_visible(
+    scene: &Scene,
+    size: &HeadSize,
+    v: &FrameView,
+    visible: &[(f64, [u32; 4])],
+) -> Vec<CharacterInput> {
+    let framing = v.framing;
+    let shadow_mm = framing.light.texel_mm(v.shadow_size, scene.mm_per_unit);
+    let cam = framing.camera;
+    let view = cam.view();
+    let scale = ViewScale::new(v.height, cam.fovy_rad, scene.mm_per_unit);
+    let head_h = size.height;
+    let centre = size.centre;
+    let light_dir = v.light_dir.normalize_or_zero();
     framing
         .instances
         .iter()
+        .zip(visible)
         .enumerate()
-        .map(|(index, m)| {
+        .map(|(index, (m, &(area, rect)))| {
             let c = m.transform_point3(centre);
             let depth = -view.transform_point3(c).z;
             let to_eye = (cam.eye - c).normalize_or_zero();
-            let light_deg = f64::from(to_eye.dot(light_dir.normalize_or_zero()).clamp(-1.0, 1.0))
+            let light_deg = f64::from(to_eye.dot(light_dir).clamp(-1.0, 1.0))
                 .acos()
                 .to_degrees();
-            let (area, rect) = visible[index];
             let px_per_mm = f64::from(scale.px_per_mm(depth.max(1e-6)));
             CharacterInput {
                 index,

@@ -95,28 +95,6 @@ pub fn reference_model(models: &[SettingModel]) -> Result<&SettingModel> {
         .context("the reference setting has no stored frames")
 }
 
-/// One frame's planner inputs: its characters estimated and every setting
-/// priced for them on `profile`, each step timed.
-pub fn frame_input(
-    scene: &Scene,
-    s: &RenderSettings,
-    models: &[SettingModel],
-    reference: &SettingModel,
-    profile: &Profile,
-    atlas: f64,
-) -> super::over_time::FrameInput {
-    let t = Instant::now();
-    let chars = characters(scene, s, reference);
-    let t1 = Instant::now();
-    let costs = setting_costs(models, &chars, profile, s.width, s.height, atlas);
-    super::over_time::FrameInput {
-        characters: chars,
-        costs,
-        inputs_ms: t.elapsed().as_secs_f64() * 1e3,
-        costs_ms: t1.elapsed().as_secs_f64() * 1e3,
-    }
-}
-
 /// The reference setting: the default method at its default options.
 pub fn reference_setting() -> Result<(String, String)> {
     let d = RenderSettings::default();
@@ -351,15 +329,26 @@ pub fn characters(
         shot.light_dir,
         s.shadow_size,
     );
-    for c in &mut cs {
-        let (r, n) = reference.region_of(c.px_per_mm, c.skin_pixels);
-        c.region_pixels = r;
-        c.region_rects = if c.skin_pixels > 0.0 { n.max(1.0) } else { 0.0 };
+    with_regions(&mut cs, reference, reference_regions(scene, s, &framing));
+    cs
+}
+
+/// Each character's reference region: its pixels and rectangles from the
+/// reference setting's stored frames (`price_grid::reference_load`), its
+/// tiles as the frame builds them (`tiles`, in the frame's order).
+pub fn with_regions(
+    cs: &mut [CharacterInput],
+    reference: &SettingModel,
+    tiles: Vec<Vec<crate::view::region::PixelRect>>,
+) {
+    for c in cs.iter_mut() {
+        let l = super::price_grid::reference_load(reference, c.px_per_mm, c.skin_pixels);
+        c.region_pixels = l.region_pixels;
+        c.region_rects = l.region_rects;
     }
-    for (c, tiles) in cs.iter_mut().zip(reference_regions(scene, s, &framing)) {
+    for (c, tiles) in cs.iter_mut().zip(tiles) {
         c.region_tiles = tiles.iter().map(|r| [r.x0, r.y0, r.x1, r.y1]).collect();
     }
-    cs
 }
 
 /// Each character's region alone as the frame builds it for the reference
@@ -367,7 +356,7 @@ pub fn characters(
 /// so a group's region can be the cover of its characters' (`cost::Overlap`).
 /// Empty where the frame draws no region (`--sss-region screen`) or the
 /// reference is another method.
-fn reference_regions(
+pub fn reference_regions(
     scene: &Scene,
     s: &RenderSettings,
     framing: &crate::scene::framing::Framing,

@@ -301,7 +301,9 @@ impl SettingModel {
         lerp(r(i), r(j), t)
     }
 
-    fn nearest(&self, x: f64) -> usize {
+    /// The stored frame nearest `x` px/mm (in ln x): the one a group's frame
+    /// takes its passes' shapes from, so a part jumps where it changes.
+    pub fn nearest(&self, x: f64) -> usize {
         let (i, j, t) = bracket(&self.xs(), x);
         if t < 0.5 {
             i
@@ -329,11 +331,25 @@ impl SettingModel {
     /// The frame of a group of characters with this setting at `width` x
     /// `height` (see the module docs).
     pub fn group_frame(&self, loads: &[CharacterLoad], width: u32, height: u32) -> FrameInput {
+        self.group_frame_near(loads, width, height, None)
+    }
+
+    /// [`SettingModel::group_frame`] with every pass shaped on stored frame
+    /// `near` instead of the one nearest each character (`None`: nearest):
+    /// a part priced this way is smooth in px/mm, which `price_grid`
+    /// interpolates.
+    pub fn group_frame_near(
+        &self,
+        loads: &[CharacterLoad],
+        width: u32,
+        height: u32,
+        near: Option<usize>,
+    ) -> FrameInput {
         let mid = loads.iter().map(|l| l.px_per_mm).fold(f64::NAN, f64::max);
-        let base_i = if mid.is_finite() {
-            self.nearest(mid)
-        } else {
-            0
+        let base_i = match near {
+            Some(n) => n.min(self.samples.len() - 1),
+            None if mid.is_finite() => self.nearest(mid),
+            None => 0,
         };
         let base = self.samples[base_i].frame.rescaled(width, height);
         let mut passes = Vec::with_capacity(base.passes.len());
@@ -349,7 +365,7 @@ impl SettingModel {
                         .unwrap_or(self.kinds.len());
                     for l in loads {
                         for j in k..end {
-                            passes.push(self.own_pass(j, l));
+                            passes.push(self.own_pass(j, l, near));
                         }
                     }
                     k = end;
@@ -382,7 +398,7 @@ impl SettingModel {
                     if shade != Per::Fixed {
                         q.fragments = n(sum(shade, &|p| p.fragments as f64));
                         q.samples_passed = n(sum(shade, &|p| p.samples_passed as f64));
-                        self.mix_fetches(k, &mut q, loads);
+                        self.mix_fetches(k, &mut q, loads, near);
                     }
                     if raster != Per::Fixed {
                         q.rasterized_pixels =
@@ -444,13 +460,17 @@ impl SettingModel {
 
     /// Pass `k` of one character (texture space): the nearest frame's pass
     /// with its counts interpolated at the character's scale.
-    fn own_pass(&self, k: usize, l: &CharacterLoad) -> PassInput {
+    fn own_pass(&self, k: usize, l: &CharacterLoad, near: Option<usize>) -> PassInput {
         let (i, j, t) = bracket(&self.xs(), l.px_per_mm);
         let (a, b) = (
             &self.samples[i].frame.passes[k],
             &self.samples[j].frame.passes[k],
         );
-        let mut q = self.samples[self.nearest(l.px_per_mm)].frame.passes[k].clone();
+        let shape = near.map_or_else(
+            || self.nearest(l.px_per_mm),
+            |n| n.min(self.samples.len() - 1),
+        );
+        let mut q = self.samples[shape].frame.passes[k].clone();
         let n = |x: u64, y: u64| lerp(x as f64, y as f64, t).round().max(0.0) as u64;
         q.fragments = n(a.fragments, b.fragments);
         q.samples_passed = n(a.samples_passed, b.samples_passed);
@@ -464,7 +484,13 @@ impl SettingModel {
 
     /// A shared pass's fetches per invocation: each character's (interpolated
     /// at its scale) weighted by the fragments it shades.
-    fn mix_fetches(&self, k: usize, q: &mut PassInput, loads: &[CharacterLoad]) {
+    fn mix_fetches(
+        &self,
+        k: usize,
+        q: &mut PassInput,
+        loads: &[CharacterLoad],
+        forced: Option<usize>,
+    ) {
         let fetches = |p: &PassInput| -> Vec<f64> {
             match &p.work {
                 Work::Raster {
@@ -501,7 +527,7 @@ impl SettingModel {
             }
             // Where the taps land: the nearer sample's, its radii scaled to
             // this character's px/mm (a kernel's size on screen is linear in it).
-            let near = if t < 0.5 { i } else { j };
+            let near = forced.map_or(if t < 0.5 { i } else { j }, |n| n.min(xs.len() - 1));
             if let Work::Raster {
                 shader: Some(s), ..
             } = &self.samples[near].frame.passes[k].work
@@ -534,7 +560,20 @@ impl SettingModel {
         width: u32,
         height: u32,
     ) -> Option<f64> {
-        let f = self.group_frame(loads, width, height);
+        self.group_ms_near(prof, params, loads, width, height, None)
+    }
+
+    /// [`SettingModel::group_ms`] of [`SettingModel::group_frame_near`].
+    pub fn group_ms_near(
+        &self,
+        prof: &Profile,
+        params: &ParamSet,
+        loads: &[CharacterLoad],
+        width: u32,
+        height: u32,
+        near: Option<usize>,
+    ) -> Option<f64> {
+        let f = self.group_frame_near(loads, width, height, near);
         let b = price_frame(prof, &f, params, Rescale::AsRun);
         let unpriced = b
             .passes
@@ -663,6 +702,26 @@ impl CostModel<'_> {
             std::slice::from_ref(l),
             self.width,
             self.height,
+        )?;
+        Some((one - fixed_ms).max(0.0))
+    }
+
+    /// [`CostModel::part_ms`] with the passes shaped on stored frame `near`
+    /// (see [`SettingModel::group_frame_near`]).
+    pub fn part_ms_near(
+        &self,
+        s: &SettingModel,
+        fixed_ms: f64,
+        l: &CharacterLoad,
+        near: usize,
+    ) -> Option<f64> {
+        let one = s.group_ms_near(
+            self.profile,
+            &self.params,
+            std::slice::from_ref(l),
+            self.width,
+            self.height,
+            Some(near),
         )?;
         Some((one - fixed_ms).max(0.0))
     }

@@ -14,8 +14,10 @@
 //! scoring frames with [`truth`]. docs/plan.md says how it works.
 //! Over time (issue 16 item 6, docs/plan-over-time.md): [`over_time`]
 //! (pure: the walking crowd re-planned with hysteresis, switches and their
-//! measure) and, with a device, [`motion`] (`dermis plan-motion`) and its
-//! chart [`motion_chart`].
+//! measure), the per-frame inputs [`frame_inputs`] (the characters from
+//! [`skin_patches`] and their costs from [`price_grid`], both pure) and, with
+//! a device, [`motion`] (`dermis plan-motion`) and its chart
+//! [`motion_chart`].
 
 pub mod character;
 pub mod check;
@@ -24,11 +26,14 @@ pub mod choose;
 pub mod cli;
 pub mod cost;
 pub mod dolly;
+pub mod frame_inputs;
 pub mod measured;
 pub mod motion;
 pub mod motion_chart;
 pub mod over_time;
 pub mod picture;
+pub mod price_grid;
+pub mod skin_patches;
 pub mod solve;
 pub mod truth;
 

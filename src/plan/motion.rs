@@ -17,9 +17,8 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::choose::Accuracy;
-use super::cli::{
-    atlas_mm, frame_input, load_models, plan_file, plan_frames_dir, reference_model, NODE_LIMIT,
-};
+use super::cli::{load_models, plan_file, plan_frames_dir, reference_model, NODE_LIMIT};
+use super::frame_inputs::FrameInputs;
 use super::motion_chart::Line;
 use super::over_time::{
     changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, FramePlan, Pop,
@@ -147,7 +146,6 @@ type Previous = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>);
 fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInput>)> {
     let (models, _) = load_models(&plan_frames_dir())?;
     let reference = reference_model(&models)?;
-    let atlas = atlas_mm(o.scene);
     let frame_settings: Vec<RenderSettings> = (0..o.walk.frames)
         .map(|k| {
             let mut s = o.base.clone();
@@ -157,10 +155,19 @@ fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInpu
             s
         })
         .collect();
-    let inputs: Vec<FrameInput> = frame_settings
-        .iter()
-        .map(|s| frame_input(o.scene, s, &models, reference, &o.profile, atlas))
-        .collect();
+    // Per frame the fast inputs (the skin patches and the price grid),
+    // what a game re-planning every frame would run.
+    let mut per_frame = FrameInputs::new(
+        o.scene,
+        &models,
+        reference,
+        &o.profile,
+        o.base.width,
+        o.base.height,
+    );
+    // Every scale priced once, before the first frame (a game's load).
+    per_frame.fill_scene();
+    let inputs: Vec<FrameInput> = frame_settings.iter().map(|s| per_frame.frame(s)).collect();
     Ok((frame_settings, inputs))
 }
 

@@ -50,8 +50,14 @@ pub struct Framing {
 /// that head, and the far plane reaches its last row. Grid: the camera pulls
 /// back until the whole grid fills the old framing.
 pub fn frame(scene: &Scene, shot: &Shot) -> Framing {
-    let head_height = scene.head_height_units();
-    let center = scene.head_center();
+    frame_sized(scene, shot, &scene.head_size())
+}
+
+/// [`frame`] with the head's measures given (`Scene::head_size` of the same
+/// scene): what re-framing every frame calls, the mesh measured once.
+pub fn frame_sized(scene: &Scene, shot: &Shot, size: &crate::scene::HeadSize) -> Framing {
+    let head_height = size.height;
+    let center = size.centre;
     let local = scene.head_bounds;
     let heads = shot.heads.max(1);
     let (instances, mut camera) = match shot.layout {

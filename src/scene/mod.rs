@@ -41,13 +41,29 @@ impl Scene {
     /// Measured from the mesh on every call (a few milliseconds on a large scan): keep
     /// the result if you need it per frame.
     pub fn head_height_units(&self) -> f32 {
-        head_measure::framed_part(&self.head.mesh, self.forward).1
+        self.head_size().height
     }
 
     /// Centre of the head from the chin up (not of a scan's shoulders): the camera target.
     pub fn head_center(&self) -> Vec3 {
-        head_measure::framed_part(&self.head.mesh, self.forward).0
+        self.head_size().centre
     }
+
+    /// Both measures in one pass over the mesh (a few milliseconds on a large
+    /// scan): what a caller framing the same scene every frame keeps.
+    pub fn head_size(&self) -> HeadSize {
+        let (centre, height) = head_measure::framed_part(&self.head.mesh, self.forward);
+        HeadSize { centre, height }
+    }
+}
+
+/// Where a scene's head is and how tall (`Scene::head_size`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadSize {
+    /// Centre of the head from the chin up, scene units.
+    pub centre: Vec3,
+    /// Chin-to-crown extent, scene units.
+    pub height: f32,
 }
 
 /// The built-in scenes, by the name `--scene builtin:NAME` takes.

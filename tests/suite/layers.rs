@@ -67,6 +67,8 @@ const PURE_FILES: &[&str] = &[
     "plan/solve.rs",
     "plan/dolly.rs",
     "plan/over_time.rs",
+    "plan/skin_patches.rs",
+    "plan/price_grid.rs",
 ];
 
 /// What no pure file may name: the Vulkan bindings, and the crate's device
