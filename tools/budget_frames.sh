@@ -9,8 +9,12 @@
 #               directory of new-format bench reports of that matrix)
 #   porting/    docs/budget.md's frames: the head at 1280x720, 1/3/5 characters, close/mid/far,
 #               every real-time method (h{N}_{shot}_{method}.json)
+#   msaa/       the configurations of docs/perf/h200-msaa (the scan's portrait at 720p and
+#               1080p, 16 heads at 4 head heights at 720p; at 1x, with MLAA at 720p, SMAA 1x at 1080p): their
+#               counted fetches for tools/examples/msaa_score.rs (the H200's reports hold the
+#               counts of every sample count, lavapipe renders 1x and 4x only)
 #
-#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix porting (default: all)
+#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix porting msaa (default: all)
 #
 # BIN defaults to target/release/dermis. Existing frames are kept (delete to redo).
 set -uo pipefail
@@ -19,7 +23,7 @@ shift || true
 ASSET=${ASSET:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 D=profiles/frames
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting)
+[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting msaa)
 
 # frame DIR NAME dermis-budget-args...: one frame on lavapipe.
 frame() {
@@ -137,12 +141,40 @@ porting() {
   done
 }
 
+# docs/perf/h200-msaa/aa.sh's views (the default portrait view, not --view study).
+msaa() {
+  mkdir -p "$D/msaa"
+  local name args
+  for spec in "portrait-1280x720|--width 1280 --height 720" \
+      "portrait-1920x1080|--width 1920 --height 1080" \
+      "crowd16-1280x720|--width 1280 --height 720 --heads 16 --distance 4" \
+      "portrait-1280x720-mlaa|--width 1280 --height 720 --aa mlaa" \
+      "portrait-1920x1080-smaa|--width 1920 --height 1080 --aa smaa" \
+      "crowd16-1280x720-mlaa|--width 1280 --height 720 --heads 16 --distance 4 --aa mlaa"; do
+    name=${spec%%|*}
+    read -r -a args <<< "${spec#*|}"
+    local target="$D/msaa/$name.json"
+    [ -e "$target" ] && continue
+    local tmp
+    tmp=$(mktemp -d)
+    if "$BIN" budget --device llvmpipe --as-run --profile nvidia-h200 --warmup 0 --frames 1 \
+        --scene "$ASSET" "${args[@]}" --out "$tmp" > "$tmp/log.txt" 2>&1; then
+      cp "$tmp/frames/separable.json" "$target"
+      echo "ok: msaa/$name"
+    else
+      echo "FAILED: msaa/$name: $(tail -1 "$tmp/log.txt")" >&2
+    fi
+    rm -rf "$tmp"
+  done
+}
+
 for p in "${parts[@]}"; do
   case $p in
     published) published ;;
     h100) h100 ;;
     matrix) matrix ;;
     porting) porting ;;
-    *) echo "unknown part '$p' (valid: published h100 matrix porting)" >&2; exit 2 ;;
+    msaa) msaa ;;
+    *) echo "unknown part '$p' (valid: published h100 matrix porting msaa)" >&2; exit 2 ;;
   esac
 done

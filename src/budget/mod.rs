@@ -6,7 +6,7 @@
 //! Pure (no device): [`profile`] (hardware profiles, `profiles/*.toml`, strict
 //! parsing), [`input`] (the model's input and the rescaling rule), [`record`]
 //! (a run's report read back, the fragments and fetch-count rules), [`edram`]
-//! (tiles, resolves), [`units`] (unit times of a pass and the combining rule),
+//! (tiles, resolves), [`msaa`] (MSAA colour and Z compression), [`units`] (unit times of a pass and the combining rule),
 //! [`transfers`] (eDRAM resolves and restores over a frame), [`params`] (the
 //! fitted parameters), [`model`] (the priced frame), [`frames`] (stored
 //! frames, the pairing of bench reports with them, the transformations into
@@ -24,6 +24,7 @@ pub mod edram;
 pub mod frames;
 pub mod input;
 pub mod model;
+pub mod msaa;
 pub mod params;
 pub mod points;
 pub mod porting;

@@ -467,6 +467,103 @@ mod tests {
         assert!(u[0].unpriced.is_empty());
     }
 
+    /// A 1920 x 1080 pass writing one RGBA8 target at `msaa` samples: every
+    /// pixel covered, `partial` of them by two fragments.
+    fn multisampled(msaa: u32, partial: u64) -> PassInput {
+        let px = 1920 * 1080;
+        let mut p = blur(px + partial, 0.0);
+        if let Work::Raster {
+            shader,
+            color,
+            msaa: m,
+            width,
+            height,
+            ..
+        } = &mut p.work
+        {
+            *shader = None;
+            color[0].format = Format::Rgba8Unorm;
+            *m = msaa;
+            (*width, *height) = (1920, 1080);
+        }
+        p.samples_passed = px * u64::from(msaa);
+        p
+    }
+
+    #[test]
+    fn compressed_msaa_pays_its_samples_only_where_edges_cross_pixels() {
+        let px = 1920.0 * 1080.0;
+        let units = |prof: &str, msaa, partial| {
+            price_units(&self::prof(prof), &frame(vec![multisampled(msaa, partial)]))[0].units
+        };
+        // GTX 470 (GF100: compressed pixels at the pixel rate, 24.3 G/s;
+        // uncompressed samples at 24.3 G samples/s; 133.9 GB/s).
+        let one = units("geforce-gtx-470", 1, 0);
+        let flat = units("geforce-gtx-470", 8, 0);
+        assert!((one.fill - px / 24.3e9 * 1e3).abs() < 1e-12);
+        assert!((flat.fill - one.fill).abs() < 1e-12, "no edge: 8x at 1x's cost");
+        assert!((flat.memory - one.memory).abs() < 1e-12);
+        let e = 200_000.0;
+        let edged = units("geforce-gtx-470", 8, 200_000);
+        let want_fill = ((px - e) / 24.3e9 + e * 8.0 / 24.3e9) * 1e3;
+        assert!((edged.fill - want_fill).abs() < 1e-12, "{} {want_fill}", edged.fill);
+        let stored = px * (1.0 + e / px * 7.0);
+        assert!((edged.memory - stored * 4.0 / 133.9e9 * 1e3).abs() < 1e-12);
+        // 9800 GTX+ (G92: 47.2 G samples/s through the ROPs whatever the
+        // compression): 4x costs 1x's pixel slots, 8x twice them.
+        let g1 = units("geforce-9800-gtx-plus", 1, 0);
+        let g4 = units("geforce-9800-gtx-plus", 4, 0);
+        let g8 = units("geforce-9800-gtx-plus", 8, 0);
+        assert!((g4.fill - g1.fill).abs() < 1e-12);
+        assert!((g8.fill / g1.fill - 2.0).abs() < 1e-9);
+        // Without compression (the Steam Deck's profile) every sample is
+        // stored: memory grows with the count.
+        let d1 = units("steam-deck", 1, 0);
+        let d4 = units("steam-deck", 4, 0);
+        assert!((d4.memory / d1.memory - 4.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn depth_traffic_counts_each_sample_once() {
+        // samples_passed already counts samples: at 4x a D32S8 target is
+        // read and written once per sample, not per sample squared.
+        let p = prof("steam-deck");
+        let mut g = multisampled(4, 0);
+        if let Work::Raster { depth_stencil, .. } = &mut g.work {
+            *depth_stencil = Some(crate::work::DepthStencilUse {
+                format: Format::D32FloatS8Uint,
+                depth_test: true,
+                depth_write: true,
+                stencil_test: false,
+                stencil_write: false,
+            });
+        }
+        let with = price_units(&p, &frame(vec![g]))[0].units.memory;
+        let without = price_units(&p, &frame(vec![multisampled(4, 0)]))[0].units.memory;
+        let samples = 1920.0 * 1080.0 * 4.0;
+        let want = samples * 5.0 * 2.0 / 88.0e9 * 1e3;
+        assert!((with - without - want).abs() < 1e-12, "{} vs {want}", with - without);
+    }
+
+    #[test]
+    fn fast_depth_clears_cost_nothing() {
+        let cleared = |prof: &str, f: Format| {
+            let mut c = blur(0, 0.0);
+            if let Work::Raster { clears, .. } = &mut c.work {
+                *clears = vec![f];
+            }
+            price_units(&self::prof(prof), &frame(vec![c]))[0].units
+        };
+        // NVIDIA's fast Z clear (the GeForce profiles): no fill, no bytes.
+        let z = cleared("geforce-9800-gtx-plus", Format::D32FloatS8Uint);
+        assert_eq!((z.clear, z.memory), (0.0, 0.0));
+        // A colour clear still writes every pixel at the fill rate.
+        let c = cleared("geforce-9800-gtx-plus", Format::Rgba8Unorm);
+        assert!((c.clear - 1280.0 * 720.0 / 11.8e9 * 1e3).abs() < 1e-12);
+        // A profile without it pays the depth clear at its Z rate.
+        assert!(cleared("steam-deck", Format::D32FloatS8Uint).clear > 0.0);
+    }
+
     #[test]
     fn missing_numbers_leave_the_pass_unpriced_and_named() {
         // The H100 profile has no MSAA rate: a 4x pass cannot be priced there.

@@ -318,12 +318,38 @@ pub struct Raster {
     pub triangles_gtris: Quantity,
     /// Depth/stencil-only samples per second (Z-only passes, early rejection).
     pub z_only_gsamples: Quantity,
-    /// Colour samples written per second with MSAA on.
+    /// Colour samples written per second with MSAA on, at 32 bpp (wider
+    /// formats at the ratio of their fill rate to RGBA8's); with compression,
+    /// the rate of the samples that are stored uncompressed.
     pub msaa_gsamples: Quantity,
+    /// What MSAA colour and Z compression saves ([`MsaaCompression`]).
+    pub msaa_compression: MsaaCompression,
+    /// Depth/stencil clears set per-tile state instead of writing every
+    /// sample (NVIDIA's "Fast Z-Clear"): they cost no fill and no bandwidth.
+    pub fast_depth_clear: bool,
     /// Most colour targets one pass may write.
     pub max_color_targets: u32,
     /// Most samples per pixel.
     pub max_msaa: u32,
+}
+
+/// What a GPU's lossless MSAA compression saves. MSAA shades once per pixel,
+/// so the samples of a pixel one fragment covers whole hold one colour and
+/// one depth plane: compression stores them once. A pixel that triangle edges
+/// cross holds samples of two or more fragments and is stored whole
+/// (`budget::msaa`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MsaaCompression {
+    /// Every sample is written, stored and resolved (eDRAM, or no source).
+    None,
+    /// Fully covered pixels are stored (colour and Z) and resolved as one
+    /// sample; the ROPs still process every sample at `msaa_gsamples`.
+    Storage,
+    /// As `Storage`, and a fully covered pixel also passes the ROPs as one
+    /// pixel (at the fill rate): only partly covered pixels cost their
+    /// samples at `msaa_gsamples`.
+    StorageAndRop,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

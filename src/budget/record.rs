@@ -229,6 +229,17 @@ pub fn frame_from_record(
     } else {
         "fetches: as declared (upper bounds where a shader branches)".into()
     });
+    let multisampled = passes
+        .iter()
+        .any(|p| matches!(p.work, Work::Raster { msaa, .. } if msaa > 1));
+    if multisampled && counting == FragmentCounting::BeforeEarlyTests {
+        provenance.push(
+            "msaa: this driver's counts give no partly covered pixel (fragments are the samples \
+             passed / samples per pixel), so MSAA compression is priced as if no triangle edge \
+             crossed a pixel: a lower bound (budget::msaa)"
+                .into(),
+        );
+    }
     Ok(FrameInput {
         label: label.to_string(),
         width: rec.width,

@@ -21,8 +21,11 @@ use serde::Serialize;
 
 use crate::budget::edram;
 use crate::budget::input::PassInput;
+use crate::budget::msaa::{self, Coverage};
 use crate::budget::params::ModelParams;
-use crate::budget::profile::{kebab, FormatCaps, FormatClass, Profile, Quantity, TargetFormat};
+use crate::budget::profile::{
+    kebab, FormatCaps, FormatClass, MsaaCompression, Profile, Quantity, TargetFormat,
+};
 use crate::work::{
     ColorWrite, DepthStencilUse, Filter, Format, ImageUseKind, PassRole, ShaderWork, Work,
 };
@@ -454,8 +457,10 @@ impl Pricing<'_> {
         }
     }
 
-    /// Load-op clears: in eDRAM at its internal rate, elsewhere at the
-    /// format's fill rate (and through memory).
+    /// Load-op clears of `texels` each: in eDRAM at its internal rate,
+    /// elsewhere at the format's fill rate (and through memory), except a
+    /// depth/stencil clear on a profile with fast depth clears (it sets
+    /// per-tile state and writes no sample: `raster.fast_depth_clear`).
     fn clears(&mut self, formats: &[Format], texels: f64) {
         for &f in formats {
             let bytes = texels * f64::from(f.bytes_per_texel());
@@ -466,6 +471,10 @@ impl Pricing<'_> {
                     }
                 }
                 None => {
+                    let depth = TargetFormat::from_work(f).class() == FormatClass::Depth;
+                    if depth && self.prof.raster.fast_depth_clear {
+                        continue;
+                    }
                     let t = self.target_format(f, false);
                     if let Some(r) = t.and_then(|t| self.fill_rate(t, false)) {
                         self.u.clear += texels / (r * G) * MS;
@@ -473,6 +482,16 @@ impl Pricing<'_> {
                     self.mem_bytes += bytes;
                 }
             }
+        }
+    }
+
+    /// The MSAA compression that applies to this pass: the profile's off
+    /// eDRAM (eDRAM holds every sample at its internal rate), none at 1x.
+    fn compression(&self, msaa: u32) -> MsaaCompression {
+        if msaa > 1 && self.prof.edram.is_none() {
+            self.prof.raster.msaa_compression
+        } else {
+            MsaaCompression::None
         }
     }
 
@@ -492,8 +511,8 @@ impl Pricing<'_> {
         };
         let n = p.fragments as f64;
         let msaa = (*msaa).max(1);
-        let samples = f64::from(*width) * f64::from(*height) * f64::from(msaa);
-        self.clears(clears, samples);
+        let pixels = f64::from(*width) * f64::from(*height);
+        self.clears(clears, msaa::cleared_texels(pixels, msaa, self.compression(msaa)));
         if let Some(s) = shader {
             self.shader_terms(s, n, false);
         }
@@ -511,7 +530,7 @@ impl Pricing<'_> {
                 color.len()
             ));
         }
-        let mut target_bytes = self.color_writes(color, n, msaa);
+        let mut target_bytes = self.color_writes(color, p, msaa);
         if let Some(ds) = depth_stencil {
             if let Some(b) = self.depth_writes(ds, p, n, msaa, color.is_empty()) {
                 target_bytes.push(b);
@@ -538,22 +557,35 @@ impl Pricing<'_> {
     }
 
     /// Fill time of the colour writes (MRTs one after another; at MSAA the
-    /// larger of pixel and sample time); returns each target's bytes.
-    fn color_writes(&mut self, color: &[ColorWrite], n: f64, msaa: u32) -> Vec<u32> {
+    /// larger of pixel and sample time, or under compression the ROP time of
+    /// `msaa::rop_seconds`); returns each target's bytes.
+    fn color_writes(&mut self, color: &[ColorWrite], p: &PassInput, msaa: u32) -> Vec<u32> {
+        let n = p.fragments as f64;
+        let comp = self.compression(msaa);
+        let cov = Coverage::of(n, p.samples_passed as f64, msaa);
         let mut target_bytes = Vec::new();
         for cw in color {
             let Some(f) = self.target_format(cw.format, cw.blend) else {
                 continue;
             };
             target_bytes.push(f.bytes());
-            let mut t = self.fill_rate(f, cw.blend).map(|r| n / (r * G) * MS);
+            let rate = self.fill_rate(f, cw.blend);
+            let mut t = rate.map(|r| n / (r * G) * MS);
             if msaa > 1 {
                 let q = self.prof.raster.msaa_gsamples;
-                let ms = self
-                    .need("raster.msaa_gsamples", q)
-                    .map(|r| n * f64::from(msaa) / (r * G) * MS);
-                t = match (t, ms) {
-                    (Some(a), Some(b)) => Some(a.max(b)),
+                let s = self.need("raster.msaa_gsamples", q);
+                let caps = self.prof.caps(TargetFormat::Rgba8Unorm);
+                let rgba8 = caps.and_then(|c| c.fill_gpix.value());
+                t = match (rate, s, comp) {
+                    (Some(r), Some(s), MsaaCompression::None) => {
+                        Some((n / r).max(n * f64::from(msaa) / s) / G * MS)
+                    }
+                    // The per-sample rate is the 32 bpp one: wider formats
+                    // pass the ROPs at their fill rate's share of RGBA8's.
+                    (Some(r), Some(s), c) => {
+                        let s = s * r / rgba8.unwrap_or(r);
+                        Some(msaa::rop_seconds(&cov, msaa, c, r * G, s * G) * MS)
+                    }
                     _ => None,
                 };
             }
@@ -566,20 +598,25 @@ impl Pricing<'_> {
             }
             if self.prof.edram.is_none() {
                 let rw = if cw.blend { 2.0 } else { 1.0 };
-                self.mem_bytes += n * f64::from(msaa) * f64::from(f.bytes()) * rw;
+                let stored = msaa::colour_samples(n, &cov, msaa, comp);
+                self.mem_bytes += stored * f64::from(f.bytes()) * rw;
             }
         }
         target_bytes
     }
 
     /// A multisampled pass's resolves into its single-sample images (`--msaa`)
-    /// off eDRAM: each reads its `msaa` samples and writes one texel per pixel
-    /// through memory. On eDRAM the resolve is the copy out of eDRAM a later
-    /// read forces (`transfers`), at the resolved size, as on Xenos.
+    /// off eDRAM: each reads the samples its pixels store (all `msaa` of them,
+    /// or under compression one per whole pixel: `msaa::stored_samples_per_pixel`)
+    /// and writes one texel per pixel through memory. On eDRAM the resolve is
+    /// the copy out of eDRAM a later read forces (`transfers`), at the resolved
+    /// size, as on Xenos.
     fn resolves(&mut self, p: &PassInput, msaa: u32) {
         if self.prof.edram.is_some() {
             return;
         }
+        let share = Coverage::of(p.fragments as f64, p.samples_passed as f64, msaa).partial_share();
+        let read = msaa::stored_samples_per_pixel(share, msaa, self.compression(msaa));
         for iu in p
             .images
             .iter()
@@ -589,7 +626,7 @@ impl Pricing<'_> {
                 continue;
             };
             let texels = f64::from(iu.width) * f64::from(iu.height);
-            self.mem_bytes += texels * f64::from(f.bytes()) * f64::from(msaa + 1);
+            self.mem_bytes += texels * f64::from(f.bytes()) * (read + 1.0);
         }
     }
 
@@ -608,12 +645,13 @@ impl Pricing<'_> {
         if self.prof.edram.is_none() {
             let rw = f64::from(u8::from(ds.depth_test || ds.stencil_test))
                 + f64::from(u8::from(ds.depth_write || ds.stencil_write));
-            self.mem_bytes += n.max(passed) * f64::from(msaa) * f64::from(f.bytes()) * rw;
+            let stored = msaa::depth_samples(n, passed, msaa, self.compression(msaa));
+            self.mem_bytes += stored * f64::from(f.bytes()) * rw;
         }
         if depth_only {
             let q = self.prof.raster.z_only_gsamples;
             if let Some(z) = self.need("raster.z_only_gsamples", q) {
-                self.u.fill += passed * f64::from(msaa) / (z * G) * MS;
+                self.u.fill += passed / (z * G) * MS;
             }
         }
         Some(f.bytes())

@@ -60,6 +60,7 @@ const PURE_FILES: &[&str] = &[
     "eval/supersample.rs",
     "post/bloom_pyramid.rs",
     "budget/model.rs",
+    "budget/msaa.rs",
     "budget/table91.rs",
     "plan/cost.rs",
     "plan/character.rs",
