@@ -501,12 +501,19 @@ mod tests {
         let one = units("geforce-gtx-470", 1, 0);
         let flat = units("geforce-gtx-470", 8, 0);
         assert!((one.fill - px / 24.3e9 * 1e3).abs() < 1e-12);
-        assert!((flat.fill - one.fill).abs() < 1e-12, "no edge: 8x at 1x's cost");
+        assert!(
+            (flat.fill - one.fill).abs() < 1e-12,
+            "no edge: 8x at 1x's cost"
+        );
         assert!((flat.memory - one.memory).abs() < 1e-12);
         let e = 200_000.0;
         let edged = units("geforce-gtx-470", 8, 200_000);
         let want_fill = ((px - e) / 24.3e9 + e * 8.0 / 24.3e9) * 1e3;
-        assert!((edged.fill - want_fill).abs() < 1e-12, "{} {want_fill}", edged.fill);
+        assert!(
+            (edged.fill - want_fill).abs() < 1e-12,
+            "{} {want_fill}",
+            edged.fill
+        );
         let stored = px * (1.0 + e / px * 7.0);
         assert!((edged.memory - stored * 4.0 / 133.9e9 * 1e3).abs() < 1e-12);
         // 9800 GTX+ (G92: 47.2 G samples/s through the ROPs whatever the
@@ -539,10 +546,16 @@ mod tests {
             });
         }
         let with = price_units(&p, &frame(vec![g]))[0].units.memory;
-        let without = price_units(&p, &frame(vec![multisampled(4, 0)]))[0].units.memory;
+        let without = price_units(&p, &frame(vec![multisampled(4, 0)]))[0]
+            .units
+            .memory;
         let samples = 1920.0 * 1080.0 * 4.0;
         let want = samples * 5.0 * 2.0 / 88.0e9 * 1e3;
-        assert!((with - without - want).abs() < 1e-12, "{} vs {want}", with - without);
+        assert!(
+            (with - without - want).abs() < 1e-12,
+            "{} vs {want}",
+            with - without
+        );
     }
 
     #[test]

@@ -230,7 +230,10 @@ mod tests {
         };
         for c in [Storage, StorageAndRop] {
             for n in [2, 4, 8] {
-                let (a, b) = (rop_seconds(&more, n, c, px, sm), rop_seconds(&p, n, c, px, sm));
+                let (a, b) = (
+                    rop_seconds(&more, n, c, px, sm),
+                    rop_seconds(&p, n, c, px, sm),
+                );
                 assert!(a >= b * (1.0 - 1e-12), "{c:?} {n}x: {a} < {b}");
             }
         }

@@ -512,7 +512,10 @@ impl Pricing<'_> {
         let n = p.fragments as f64;
         let msaa = (*msaa).max(1);
         let pixels = f64::from(*width) * f64::from(*height);
-        self.clears(clears, msaa::cleared_texels(pixels, msaa, self.compression(msaa)));
+        self.clears(
+            clears,
+            msaa::cleared_texels(pixels, msaa, self.compression(msaa)),
+        );
         if let Some(s) = shader {
             self.shader_terms(s, n, false);
         }

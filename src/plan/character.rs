@@ -138,7 +138,14 @@ pub fn from_visible(
             let light_deg = f64::from(to_eye.dot(light_dir).clamp(-1.0, 1.0))
                 .acos()
                 .to_degrees();
-            let px_per_mm = f64::from(scale.px_per_mm(depth.max(1e-6)));
+            // Behind the eye (a camera passing through the crowd) a character
+            // has no scale on screen: 0, which the planner's rules read as
+            // under a pixel.
+            let px_per_mm = if depth > 0.0 {
+                f64::from(scale.px_per_mm(depth))
+            } else {
+                0.0
+            };
             CharacterInput {
                 index,
                 distance_heads: f64::from(cam.eye.distance(c) / head_h),

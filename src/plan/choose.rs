@@ -69,6 +69,10 @@ pub struct SettingCosts {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Excluded {
+    /// No skin pixel on screen (hidden behind others or off screen): its
+    /// passes would change no pixel, and with no weight in the objective a
+    /// setting would only flip at will from frame to frame.
+    NoSkinOnScreen,
     UnderAPixel,
     TexelOverNarrowReach,
     OutsideMeasuredRange,
@@ -132,7 +136,9 @@ pub fn plan(a: &Ask) -> Plan {
         let mut pred = vec![None; a.settings.len()];
         let mut ex = Vec::new();
         for (si, s) in a.settings.iter().enumerate() {
-            let why = if under_a_pixel(c.px_per_mm) {
+            let why = if c.skin_pixels <= 0.0 {
+                Some(Excluded::NoSkinOnScreen)
+            } else if under_a_pixel(c.px_per_mm) {
                 Some(Excluded::UnderAPixel)
             } else if s.texel_mm[ci].is_some_and(|t| t > narrow_reach_mm()) {
                 Some(Excluded::TexelOverNarrowReach)

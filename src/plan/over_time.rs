@@ -159,19 +159,20 @@ pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
     let mut out: Vec<FramePlan> = Vec::with_capacity(frames.len());
     for (k, f) in frames.iter().enumerate() {
         let costs = planning_costs(frames, k, r.look_ahead);
-        let previous = out
-            .last()
-            .filter(|_| r.switch_margin > 0.0)
-            .map(|last: &FramePlan| {
-                (0..f.characters.len())
-                    .map(|c| {
-                        let l = last.labels.get(c).cloned().flatten()?;
-                        costs
-                            .iter()
-                            .position(|s| s.method == l.0 && s.setting == l.1)
-                    })
-                    .collect::<Vec<Option<usize>>>()
-            });
+        // The first frame takes every setting on from none: with a margin
+        // it too keeps the margin's share of the budget free, so the frames
+        // after it do not drop what it took on as soon as the crowd nears.
+        let previous = (r.switch_margin > 0.0).then(|| match out.last() {
+            Some(last) => (0..f.characters.len())
+                .map(|c| {
+                    let l = last.labels.get(c).cloned().flatten()?;
+                    costs
+                        .iter()
+                        .position(|s| s.method == l.0 && s.setting == l.1)
+                })
+                .collect::<Vec<Option<usize>>>(),
+            None => vec![None; f.characters.len()],
+        });
         let ask = Ask {
             characters: &f.characters,
             settings: &costs,

@@ -54,6 +54,14 @@ pub const SELF_DEPTH_CELLS: f32 = 2.0;
 /// The most patches a character is estimated with.
 pub const MAX_PATCHES: usize = 6000;
 
+/// A character whose visible skin is under this share of its facing skin on
+/// screen counts as hidden: a sliver peeking past a nearer character is
+/// below what the occlusion buffer resolves (a hidden character was counted
+/// at 108 pixels where the exact count is 0), and a count that comes and goes
+/// from frame to frame made the re-planned crowd give such a character a
+/// setting and take it back every few frames (docs/plan-over-time.md).
+pub const MIN_VISIBLE_SHARE: f64 = 0.05;
+
 /// Pixels per side of a texel of the occlusion buffer.
 pub const OCCLUSION_TEXEL_PX: u32 = 2;
 
@@ -179,6 +187,8 @@ impl SkinPatches {
         // Facing, on-screen patches: (character, x, y, depth, pixels).
         let mut seen: Vec<(u32, f32, f32, f32, f32)> = Vec::new();
         let mut looked = vec![0usize; instances.len()];
+        // Each character's facing skin on screen before occlusion.
+        let mut facing_px = vec![0.0f64; instances.len()];
         let f2 = v.focal_px * v.focal_px;
         let ts = t as f32;
         for (k, m) in instances.iter().enumerate() {
@@ -230,6 +240,7 @@ impl SkinPatches {
                         }
                     }
                 }
+                facing_px[k] += f64::from(pixels);
                 seen.push((k as u32, x, y, z - SELF_DEPTH_CELLS * cell, pixels));
             }
         }
@@ -265,7 +276,19 @@ impl SkinPatches {
         }
         out.into_iter()
             .zip(looked)
-            .map(|((pixels, r), patches)| PatchEstimate {
+            .zip(facing_px)
+            .map(|(((pixels, r), patches), facing)| (pixels, r, patches, facing))
+            // A character left with a sliver of its skin is at the occlusion
+            // buffer's grain: counted as hidden (see `MIN_VISIBLE_SHARE`).
+            .map(|(pixels, r, patches, facing)| {
+                let pixels = if pixels < MIN_VISIBLE_SHARE * facing {
+                    0.0
+                } else {
+                    pixels
+                };
+                (pixels, r, patches)
+            })
+            .map(|(pixels, r, patches)| PatchEstimate {
                 pixels,
                 rect: if pixels > 0.0 {
                     [

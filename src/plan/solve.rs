@@ -30,7 +30,14 @@
 //! option other than a character's previous one has `switch_margin` times
 //! the character's weight added to its error, so a character switches only
 //! when the switch gains more than the margin (the objective reported is the
-//! error without the margin).
+//! error without the margin); and a setting other than its previous one
+//! (none excepted: dropping frees time) must fit with `switch_margin` times
+//! the budget left over, so what a frame takes on is not taken back the next
+//! frame because every character's part grew a little (the crowd walking
+//! nearer) or an estimate moved (the cost reported is without the reserve).
+//! Without the reserve, a 16-character walk filled its last percent of
+//! budget with a small character and dropped it the frame after, three
+//! times over five frames (docs/plan-over-time.md).
 
 use serde::Serialize;
 
@@ -274,13 +281,20 @@ pub fn solve(p: &Problem) -> Solution {
                 .iter()
                 .filter(|o| o.cost_ms.is_finite() && o.error.is_finite())
                 .map(|o| {
-                    let switch = match &p.previous {
-                        Some(prev) if prev.get(c).copied().flatten() != o.setting => {
-                            p.switch_margin * w
-                        }
-                        _ => 0.0,
+                    let switched = matches!(
+                        &p.previous,
+                        Some(prev) if prev.get(c).copied().flatten() != o.setting
+                    );
+                    let (switch, reserve) = if switched {
+                        (p.switch_margin * w, p.switch_margin * p.budget_ms)
+                    } else {
+                        (0.0, 0.0)
                     };
-                    (o.setting, o.cost_ms.max(0.0), o.error * w + switch)
+                    (
+                        o.setting,
+                        o.cost_ms.max(0.0) + reserve,
+                        o.error * w + switch,
+                    )
                 })
                 .collect();
             if !o.iter().any(|x| x.0.is_none()) {
@@ -495,6 +509,52 @@ mod tests {
         assert!(!s.optimal);
         assert!(s.cost_ms <= p.budget_ms + 1e-9);
         assert!(s.lower_bound.unwrap() <= s.error + 1e-9);
+    }
+
+    #[test]
+    fn a_new_setting_must_leave_the_margin_of_the_budget_free() {
+        // One character whose only setting costs 0.99 of a 1 ms budget.
+        let p = Problem {
+            weights: vec![1.0],
+            options: vec![vec![
+                Opt {
+                    setting: None,
+                    cost_ms: 0.0,
+                    error: 1.0,
+                },
+                Opt {
+                    setting: Some(0),
+                    cost_ms: 0.99,
+                    error: 0.5,
+                },
+            ]],
+            fixed_ms: vec![0.0],
+            budget_ms: 1.0,
+            previous: None,
+            switch_margin: 0.02,
+            node_limit: None,
+        };
+        // Planned afresh it fits.
+        assert_eq!(solve(&p).choice, vec![Some(0)]);
+        // Taken on from none it must leave 2% of the budget: 0.99 + 0.02 > 1.
+        let from_none = Problem {
+            previous: Some(vec![None]),
+            ..p.clone()
+        };
+        assert_eq!(solve(&from_none).choice, vec![None]);
+        // Kept, it costs what it costs, reported without the reserve.
+        let kept = solve(&Problem {
+            previous: Some(vec![Some(0)]),
+            ..p.clone()
+        });
+        assert_eq!(kept.choice, vec![Some(0)]);
+        assert!((kept.cost_ms - 0.99).abs() < 1e-12, "{}", kept.cost_ms);
+        // With room to spare it is taken on.
+        let cheaper = Problem {
+            budget_ms: 1.05,
+            ..from_none
+        };
+        assert_eq!(solve(&cheaper).choice, vec![Some(0)]);
     }
 
     #[test]

@@ -100,7 +100,10 @@ fn overheads(
         let f = frame(dir, &format!("{base}-msaa{n}"))?;
         let b = price(prof, &f, rescale);
         if !b.unpriced_passes.is_empty() {
-            println!("| {base} | {p} | {n}x: unpriced ({}) |", b.unpriced_passes.join("; "));
+            println!(
+                "| {base} | {p} | {n}x: unpriced ({}) |",
+                b.unpriced_passes.join("; ")
+            );
             continue;
         }
         let (_, share) = geometry_share(&f).unwrap_or((n, 0.0));
@@ -115,7 +118,8 @@ fn overheads(
         // (as if the GPU compressed whole tiles only and every tile held an edge).
         let mut plain = prof.clone();
         plain.raster.msaa_compression = MsaaCompression::None;
-        let upper = price(&plain, &f, rescale).total_ms - price(&plain, &frame(dir, &format!("{base}-msaa1"))?, rescale).total_ms;
+        let upper = price(&plain, &f, rescale).total_ms
+            - price(&plain, &frame(dir, &format!("{base}-msaa1"))?, rescale).total_ms;
         let vs = published(n)
             .map(|m| format!("{m:.2} ({:.2}x)", over / m))
             .unwrap_or_else(|| "-".into());
@@ -153,23 +157,69 @@ fn main() -> Result<()> {
     println!("|---|---|---|---|---|---|---|---|");
     let t101 = |n: u32| TABLE_10_1.iter().find(|t| t.0 == n).map(|t| t.1);
     let ch9 = |n: u32| (n == 8).then_some(CH9_8X_MS);
-    overheads(&dir, "portrait-1920x1080", &[2, 4, 8], &gtx470, Rescale::AsRun, &t101)?;
+    overheads(
+        &dir,
+        "portrait-1920x1080",
+        &[2, 4, 8],
+        &gtx470,
+        Rescale::AsRun,
+        &t101,
+    )?;
     // The crowd ran at 720p only: priced at 1080p by the rescaling rule.
-    overheads(&dir, "crowd16-1280x720", &[4, 8], &gtx470, Rescale::ToProfile, &t101)?;
-    overheads(&dir, "portrait-1280x720", &[2, 4, 8], &g92, Rescale::AsRun, &ch9)?;
-    overheads(&dir, "crowd16-1280x720", &[4, 8], &g92, Rescale::AsRun, &ch9)?;
+    overheads(
+        &dir,
+        "crowd16-1280x720",
+        &[4, 8],
+        &gtx470,
+        Rescale::ToProfile,
+        &t101,
+    )?;
+    overheads(
+        &dir,
+        "portrait-1280x720",
+        &[2, 4, 8],
+        &g92,
+        Rescale::AsRun,
+        &ch9,
+    )?;
+    overheads(
+        &dir,
+        "crowd16-1280x720",
+        &[4, 8],
+        &g92,
+        Rescale::AsRun,
+        &ch9,
+    )?;
     println!();
     println!("| frame | profile | MLAA ms (edges + weights + blend) | 8x MSAA overhead ms (without compression) | 8x MSAA / MLAA (without compression) | published |");
     println!("|---|---|---|---|---|---|");
     for base in ["portrait-1280x720", "crowd16-1280x720"] {
-        let one = price(&g92, &frame(&dir, &format!("{base}-msaa1"))?, Rescale::AsRun);
-        let eight = price(&g92, &frame(&dir, &format!("{base}-msaa8"))?, Rescale::AsRun);
+        let one = price(
+            &g92,
+            &frame(&dir, &format!("{base}-msaa1"))?,
+            Rescale::AsRun,
+        );
+        let eight = price(
+            &g92,
+            &frame(&dir, &format!("{base}-msaa8"))?,
+            Rescale::AsRun,
+        );
         let mlaa = price(&g92, &frame(&dir, &format!("{base}-mlaa"))?, Rescale::AsRun);
         let over = eight.total_ms - one.total_ms;
         let mut plain = g92.clone();
         plain.raster.msaa_compression = MsaaCompression::None;
-        let upper = price(&plain, &frame(&dir, &format!("{base}-msaa8"))?, Rescale::AsRun).total_ms
-            - price(&plain, &frame(&dir, &format!("{base}-msaa1"))?, Rescale::AsRun).total_ms;
+        let upper = price(
+            &plain,
+            &frame(&dir, &format!("{base}-msaa8"))?,
+            Rescale::AsRun,
+        )
+        .total_ms
+            - price(
+                &plain,
+                &frame(&dir, &format!("{base}-msaa1"))?,
+                Rescale::AsRun,
+            )
+            .total_ms;
         match passes_ms(&mlaa, &MLAA_PASSES) {
             Some(m) => println!(
                 "| {base} | {} | {m:.3} | {over:.3} ({upper:.3}) | **{:.2}x** ({:.2}x) | {CH9_SPEEDUP:.2}x (8x MSAA {CH9_8X_MS} ms, MLAA 0.44 ms) |",
@@ -180,7 +230,11 @@ fn main() -> Result<()> {
             None => println!("| {base} | {} | unpriced | {over:.3} | - | - |", g92.profile.name),
         }
     }
-    let smaa = price(&gtx470, &frame(&dir, "portrait-1920x1080-smaa")?, Rescale::AsRun);
+    let smaa = price(
+        &gtx470,
+        &frame(&dir, "portrait-1920x1080-smaa")?,
+        Rescale::AsRun,
+    );
     let s = passes_ms(&smaa, &SMAA_PASSES).context("SMAA unpriced on the GTX 470")?;
     println!();
     println!(
