@@ -290,6 +290,32 @@ pub struct Alu {
     /// Peak rate reachable by compute dispatches (`"unknown"` where the GPU
     /// has no compute path).
     pub compute_gflops: Quantity,
+    /// How the ALUs issue ([`Alu::issue`]): instructions per second, 1e9, of a
+    /// GPU whose ALUs issue whole vector instructions (Xenos: a vec4 and a
+    /// scalar slot per ALU per clock; RSX: two vec4 units per pixel pipe).
+    /// One shader instruction takes an issue slot whatever its width, so a
+    /// vec3 multiply leaves a vec4 ALU's fourth lane (and its scalar slot)
+    /// idle, and `gflops`, which counts every lane, overstates the rate.
+    /// Absent on SIMT GPUs (G80 on), whose lanes each run one scalar
+    /// instruction a clock.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vector_ginstr: Option<Quantity>,
+}
+
+/// How a profile's shader instructions are issued (see [`Alu::vector_ginstr`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AluIssue {
+    /// One lane-instruction per lane per clock: `gflops / 2` of them a
+    /// second (a multiply-add counts two flops).
+    Lanes,
+    /// Whole vector instructions at this many 1e9 a second.
+    Vector(Quantity),
+}
+
+impl Alu {
+    pub fn issue(&self) -> AluIssue {
+        self.vector_ginstr.map_or(AluIssue::Lanes, AluIssue::Vector)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -529,6 +555,24 @@ impl Profile {
         }
         q("alu.gflops", self.alu.gflops)?;
         q("alu.compute_gflops", self.alu.compute_gflops)?;
+        if let Some(v) = self.alu.vector_ginstr {
+            q("alu.vector_ginstr", v)?;
+            // An instruction fills at least one lane: a vector-issue rate above
+            // the lanes' (gflops / 2) contradicts the profile's own gflops.
+            let top = match v {
+                Quantity::Param { max, .. } => Some(max),
+                other => other.value(),
+            };
+            if let (Some(top), Some(g)) = (top, self.alu.gflops.value()) {
+                if top > g / 2.0 {
+                    bail!(
+                        "field `alu.vector_ginstr`: {top} G instructions/s is more than \
+                         alu.gflops / 2 = {} G lane-instructions/s",
+                        g / 2.0
+                    );
+                }
+            }
+        }
         let t = &self.texture;
         q("texture.bilinear_gtexels", t.bilinear_gtexels)?;
         q("texture.point_cost", t.point_cost)?;
@@ -716,6 +760,60 @@ mod tests {
         );
         let e = err_of(&t);
         assert!(e.contains("edram.resolve_gbps"), "{e}");
+    }
+
+    /// The Xbox 360's profile with its `vector_ginstr` line replaced.
+    fn with_issue(line: &str) -> String {
+        let t = xbox_text();
+        let start = t.find("vector_ginstr =").unwrap();
+        let end = start + t[start..].find('\n').unwrap();
+        format!("{}{line}{}", &t[..start], &t[end..])
+    }
+
+    #[test]
+    fn vector_issue_is_read_where_given_and_lanes_elsewhere() {
+        let x = Profile::load("xbox360").unwrap();
+        assert_eq!(
+            x.alu.issue(),
+            AluIssue::Vector(Quantity::Param {
+                value: 24.0,
+                min: 24.0,
+                max: 48.0
+            })
+        );
+        assert_eq!(
+            Profile::load("geforce-9800-gtx-plus").unwrap().alu.issue(),
+            AluIssue::Lanes
+        );
+        // Absent (SIMT), a plain number and "unknown" all parse.
+        let p = Profile::parse(&with_issue(""), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Lanes);
+        let p = Profile::parse(&with_issue("vector_ginstr = 30.0"), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Vector(Quantity::Known(30.0)));
+        let p = Profile::parse(&with_issue("vector_ginstr = \"unknown\""), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Vector(Quantity::Unknown));
+    }
+
+    #[test]
+    fn a_bad_issue_rate_is_one_line_naming_it() {
+        let e = err_of(&with_issue("vector_ginstr = \"fast\""));
+        assert!(e.contains("[alu]") && e.contains("fast"), "{e}");
+        let e = err_of(&with_issue("vector_ginstr = -24.0"));
+        assert!(e.contains("alu.vector_ginstr"), "{e}");
+        let e = err_of(&with_issue("vector_ginstrs = 24.0"));
+        assert!(e.contains("vector_ginstrs"), "{e}");
+        // More instructions than lanes (240 GFLOPS: 120 G lane-instructions).
+        let e = err_of(&with_issue(
+            "vector_ginstr = { value = 24.0, min = 24.0, max = 121.0 }",
+        ));
+        assert!(e.contains("alu.vector_ginstr") && e.contains("120"), "{e}");
+        let e = err_of(&with_issue(
+            "vector_ginstr = { value = 50.0, min = 24.0, max = 48.0 }",
+        ));
+        assert!(
+            e.contains("alu.vector_ginstr") && e.contains("outside"),
+            "{e}"
+        );
     }
 
     #[test]
