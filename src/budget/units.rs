@@ -14,7 +14,7 @@
 //! the shader (rejection, set-up) or after it (resolves) adds. The `k`s,
 //! `f_inc` and the fixed costs are [`ModelParams`], fitted by `calibration`.
 //! The ALU unit is instructions over the profile's issue rate
-//! ([`crate::budget::profile::Alu::vector_ginstr`]: lane-instructions on SIMT
+//! ([`crate::budget::profile::Alu::ginstr`]: lane-instructions on SIMT
 //! GPUs, whole vector instructions on Xenos and RSX).
 //! (A p-norm of the unit times in place of their maximum, p fitted, gained
 //! 1 point of median error on the H100 and destabilised the published fit:
@@ -27,7 +27,7 @@ use crate::budget::input::PassInput;
 use crate::budget::msaa::{self, Coverage};
 use crate::budget::params::ModelParams;
 use crate::budget::profile::{
-    kebab, AluIssue, FormatCaps, FormatClass, MsaaCompression, Profile, Quantity, TargetFormat,
+    kebab, FormatCaps, FormatClass, MsaaCompression, Profile, Quantity, TargetFormat,
 };
 use crate::work::{
     ColorWrite, DepthStencilUse, Filter, Format, ImageUseKind, PassRole, ShaderWork, Work,
@@ -446,35 +446,11 @@ impl Pricing<'_> {
             }
         }
         self.u.memory += n * (s.storage_read_bytes + s.storage_write_bytes);
-        if let Some(rate) = self.alu_ginstr(compute) {
-            self.u.alu = n * s.alu / (rate * G) * MS;
-        }
-    }
-
-    /// Shader instructions (`ShaderWork::alu`: SPIR-V arithmetic, a vector
-    /// instruction counted once) executed per second, 1e9: on SIMT lanes one
-    /// per lane per clock, `gflops / 2` (peak GFLOPS count a multiply-add as
-    /// two); on vector-issue ALUs the profile's `alu.vector_ginstr`, whatever
-    /// each instruction's width (a compute dispatch at the compute path's
-    /// share of the peak).
-    fn alu_ginstr(&mut self, compute: bool) -> Option<f64> {
-        let alu = &self.prof.alu;
-        let (frag_gflops, comp_gflops, issue) = (alu.gflops, alu.compute_gflops, alu.issue());
-        let gflops = if compute {
-            self.need("alu.compute_gflops", comp_gflops)?
-        } else {
-            self.need("alu.gflops", frag_gflops)?
-        };
-        match issue {
-            AluIssue::Lanes => Some(gflops / 2.0),
-            AluIssue::Vector(q) => {
-                let v = self.need("alu.vector_ginstr", q)?;
-                if compute {
-                    let g = self.need("alu.gflops", frag_gflops)?;
-                    Some(v * gflops / g)
-                } else {
-                    Some(v)
-                }
+        // Instructions over the profile's issue rate (`Alu::ginstr`).
+        match self.prof.alu.ginstr(compute) {
+            Ok(rate) => self.u.alu = n * s.alu / (rate * G) * MS,
+            Err(missing) => {
+                self.need(missing, Quantity::Unknown);
             }
         }
     }
