@@ -569,7 +569,12 @@ mod tests {
         let start = peak_start(&probed);
         let of = |p: &ModelParams| objective(&refs, p, &start, &PEAK_FREE);
         let (multi, one) = (fit_peak(&refs, start), fit_from(&refs, start, PEAK_FREE));
-        assert!(of(&multi) <= of(&one) + 1e-9, "{} > {}", of(&multi), of(&one));
+        assert!(
+            of(&multi) <= of(&one) + 1e-9,
+            "{} > {}",
+            of(&multi),
+            of(&one)
+        );
     }
 
     #[test]
