@@ -4,7 +4,7 @@
 //! of a run, calibrated against published timings and bench reports.
 //!
 //! Pure (no device): [`profile`] (hardware profiles, `profiles/*.toml`, strict
-//! parsing), [`input`] (the model's input and the rescaling rule), [`record`]
+//! parsing), [`format`] (the formats profiles name, substitutes), [`input`] (the model's input and the rescaling rule), [`record`]
 //! (a run's report read back, the fragments and fetch-count rules), [`edram`]
 //! (tiles, resolves), [`msaa`] (MSAA colour and Z compression), [`units`] (unit times of a pass and the combining rule),
 //! [`transfers`] (eDRAM resolves and restores over a frame), [`params`] (the
@@ -21,6 +21,7 @@
 pub mod calibration;
 pub mod chart;
 pub mod edram;
+pub mod format;
 pub mod frames;
 pub mod input;
 pub mod model;

@@ -207,6 +207,7 @@ pub fn price_frame(
 mod tests {
     use super::*;
     use crate::budget::input::PassInput;
+    use crate::budget::profile::Quantity;
     use crate::work::{
         ColorWrite, Fetch, Filter, Format, ImageUse, ImageUseKind, ShaderWork, Work,
     };
@@ -624,7 +625,83 @@ mod tests {
         );
         assert!(b.unpriced_passes.is_empty());
         assert_eq!(b.passes[0].substitutions[0].wanted, "compute");
-        // 240 instructions x 1M at 120 G instructions/s (240 GFLOPS): 2 ms.
-        assert!((b.passes[0].terms_ms.alu - 2.0).abs() < 1e-9);
+        // 240 instructions x 1M at Xenos' 24 G vector instructions/s: 10 ms.
+        assert!((b.passes[0].terms_ms.alu - 10.0).abs() < 1e-9);
+    }
+
+    /// `n` fragments of a shader of `k` arithmetic instructions, nothing else.
+    fn alu_only(n: u64, k: f64) -> PassInput {
+        let mut p = blur(n, 0.0);
+        if let Work::Raster {
+            shader: Some(s), ..
+        } = &mut p.work
+        {
+            s.fetches.clear();
+            s.alu = k;
+        }
+        p
+    }
+
+    #[test]
+    fn vector_issue_prices_an_instruction_per_alu_clock() {
+        let alu =
+            |prof: &Profile, n, k| price_units(prof, &frame(vec![alu_only(n, k)]))[0].units.alu;
+        let (n, k) = (921_600u64, 177.0);
+        let ms = |rate_g: f64| n as f64 * k / (rate_g * 1e9) * 1e3;
+        // Xenos: 48 ALUs x 0.5 GHz, one instruction a clock whatever its width.
+        let xbox = prof("xbox360");
+        assert!(
+            (alu(&xbox, n, k) - ms(24.0)).abs() < 1e-12,
+            "{}",
+            alu(&xbox, n, k)
+        );
+        // RSX: 24 pipes x 2 vec4 units x 0.5 GHz.
+        assert!((alu(&prof("ps3"), n, k) - ms(24.0)).abs() < 1e-12);
+        // SIMT lanes are unchanged: gflops / 2 (9800 GTX+: 470 GFLOPS).
+        let g92 = prof("geforce-9800-gtx-plus");
+        assert!(g92.alu.vector_ginstr.is_none());
+        assert!((alu(&g92, n, k) - ms(235.0)).abs() < 1e-12);
+        // The pairing bound: at the parameter's max the time halves.
+        let mut paired = xbox.clone();
+        paired.alu.vector_ginstr = Some(Quantity::Known(48.0));
+        assert!((alu(&paired, n, k) - ms(24.0) / 2.0).abs() < 1e-12);
+        // The old lane rule would have charged a fifth of it.
+        let mut lanes = xbox.clone();
+        lanes.alu.vector_ginstr = None;
+        assert!((alu(&lanes, n, k) - ms(120.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn vector_issue_of_a_compute_path_scales_with_its_share_of_the_peak() {
+        // A vector-issue GPU whose compute dispatches reach half the pixel
+        // shaders' flops issues half the instructions.
+        let mut p = prof("xbox360");
+        p.alu.compute_gflops = Quantity::Known(120.0);
+        let c = PassInput::new(
+            "gather",
+            PassRole::Sss,
+            Work::Compute {
+                shader: ShaderWork {
+                    alu: 240.0,
+                    ..Default::default()
+                },
+                invocations: 1_000_000,
+            },
+        );
+        let u = price_units(&p, &frame(vec![c]));
+        assert!(u[0].substitutions.is_empty());
+        assert!(
+            (u[0].units.alu - 240e6 / 12e9 * 1e3).abs() < 1e-12,
+            "{}",
+            u[0].units.alu
+        );
+    }
+
+    #[test]
+    fn an_unknown_issue_rate_leaves_alu_passes_unpriced() {
+        let mut p = prof("xbox360");
+        p.alu.vector_ginstr = Some(Quantity::Unknown);
+        let u = price_units(&p, &frame(vec![alu_only(1000, 10.0)]));
+        assert_eq!(u[0].unpriced, vec!["alu.vector_ginstr".to_string()]);
     }
 }

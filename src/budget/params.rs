@@ -132,14 +132,14 @@ impl ParamSet {
 /// See [`ParamSet::fitted`].
 pub const FITTED: ParamSet = ParamSet {
     peak: ModelParams {
-        texture_scale: 1.17233,
-        alu_scale: 1.07966,
-        fill_scale: 1.96595,
-        memory_scale: 0.55396,
-        reject_scale: 1.66372,
+        texture_scale: 1.16682,
+        alu_scale: 1.07458,
+        fill_scale: 1.96421,
+        memory_scale: 0.55136,
+        reject_scale: 1.66102,
         hiz_reject_scale: 0.29755,
         incoherent_factor: 2.67270,
-        fixed_kpix_per_pass: 20.59063,
+        fixed_kpix_per_pass: 20.11136,
         rect_kpix: 29.62749,
         incoherent_radius_px: 8.18831,
     },

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::work::Format;
+pub use crate::budget::format::{FormatClass, TargetFormat};
 
 /// A number of a profile.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,144 +87,6 @@ impl From<Quantity> for RawQuantity {
     }
 }
 
-/// Render-target and texture formats a profile can name: the renderer's
-/// [`Format`]s plus the console formats a port would substitute (7e3 float,
-/// the Xenos fixed-point 16-bit formats, two-channel formats).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum TargetFormat {
-    Rgba8Unorm,
-    Rgba8Srgb,
-    Rgb10a2Unorm,
-    /// Xenos 2_10_10_10_FLOAT: 7e3 floats in [0, 32), 2-bit alpha.
-    Rgb10a2Float,
-    R11g11b10Float,
-    Rg16Unorm,
-    /// Xenos 16_16_16_16: fixed point in [-32, 32].
-    Rgba16Fixed,
-    R16Float,
-    Rg16Float,
-    Rgba16Float,
-    R32Float,
-    Rg32Float,
-    Rgba32Float,
-    D24UnormS8Uint,
-    /// Xenos D24FS8: 20e4 float depth.
-    D24FloatS8Uint,
-    D32Float,
-    D32FloatS8Uint,
-}
-
-/// What kind of values a format holds (for choosing a substitute).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FormatClass {
-    Unorm,
-    /// Floating point or HDR fixed point (range beyond [0, 1]).
-    Hdr,
-    Depth,
-}
-
-impl TargetFormat {
-    pub fn from_work(f: Format) -> TargetFormat {
-        match f {
-            Format::Rgba8Unorm => TargetFormat::Rgba8Unorm,
-            Format::Rgba8Srgb => TargetFormat::Rgba8Srgb,
-            Format::R16Float => TargetFormat::R16Float,
-            Format::Rgba16Float => TargetFormat::Rgba16Float,
-            Format::R32Float => TargetFormat::R32Float,
-            Format::Rgba32Float => TargetFormat::Rgba32Float,
-            Format::D32Float => TargetFormat::D32Float,
-            Format::D24UnormS8Uint => TargetFormat::D24UnormS8Uint,
-            Format::D32FloatS8Uint => TargetFormat::D32FloatS8Uint,
-        }
-    }
-
-    /// Bytes per texel as stored (matches [`Format::bytes_per_texel`]).
-    pub fn bytes(self) -> u32 {
-        use TargetFormat::*;
-        match self {
-            R16Float => 2,
-            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rgb10a2Float | R11g11b10Float | Rg16Unorm
-            | Rg16Float | R32Float | D24UnormS8Uint | D24FloatS8Uint | D32Float => 4,
-            D32FloatS8Uint => 5,
-            Rgba16Fixed | Rgba16Float | Rg32Float => 8,
-            Rgba32Float => 16,
-        }
-    }
-
-    pub fn channels(self) -> u32 {
-        use TargetFormat::*;
-        match self {
-            R16Float | R32Float | D24UnormS8Uint | D24FloatS8Uint | D32Float | D32FloatS8Uint => 1,
-            Rg16Unorm | Rg16Float | Rg32Float => 2,
-            R11g11b10Float => 3,
-            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rgb10a2Float | Rgba16Fixed | Rgba16Float
-            | Rgba32Float => 4,
-        }
-    }
-
-    /// Bits of the widest colour channel (depth: depth bits).
-    pub fn channel_bits(self) -> u32 {
-        use TargetFormat::*;
-        match self {
-            Rgba8Unorm | Rgba8Srgb => 8,
-            Rgb10a2Unorm | Rgb10a2Float => 10,
-            R11g11b10Float => 11,
-            Rg16Unorm | Rgba16Fixed | R16Float | Rg16Float | Rgba16Float => 16,
-            D24UnormS8Uint | D24FloatS8Uint => 24,
-            R32Float | Rg32Float | Rgba32Float | D32Float | D32FloatS8Uint => 32,
-        }
-    }
-
-    pub fn class(self) -> FormatClass {
-        use TargetFormat::*;
-        match self {
-            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rg16Unorm => FormatClass::Unorm,
-            D24UnormS8Uint | D24FloatS8Uint | D32Float | D32FloatS8Uint => FormatClass::Depth,
-            _ => FormatClass::Hdr,
-        }
-    }
-
-    /// How far `self` is from `wanted` as a substitute (smaller is nearer):
-    /// another class or fewer channels cost most (the data would not fit),
-    /// then lost precision, then extra bytes.
-    pub fn distance_from(self, wanted: TargetFormat) -> f64 {
-        let mut d = 0.0;
-        if self.class() != wanted.class() {
-            d += 1000.0;
-        }
-        if self.channels() < wanted.channels() {
-            d += 100.0 * f64::from(wanted.channels() - self.channels());
-        }
-        if self.channel_bits() < wanted.channel_bits() {
-            d += 10.0 * f64::from(wanted.channel_bits() - self.channel_bits()) / 8.0;
-        }
-        if self.is_float() != wanted.is_float() {
-            d += 1.0;
-        }
-        d + (f64::from(self.bytes()) - f64::from(wanted.bytes())).abs() / 4.0
-    }
-
-    /// Floating-point channels.
-    pub fn is_float(self) -> bool {
-        use TargetFormat::*;
-        matches!(
-            self,
-            Rgb10a2Float
-                | R11g11b10Float
-                | R16Float
-                | Rg16Float
-                | Rgba16Float
-                | R32Float
-                | Rg32Float
-                | Rgba32Float
-                | D24FloatS8Uint
-                | D32Float
-                | D32FloatS8Uint
-        )
-    }
-}
-
 /// Identity and kind of a target.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -290,6 +152,53 @@ pub struct Alu {
     /// Peak rate reachable by compute dispatches (`"unknown"` where the GPU
     /// has no compute path).
     pub compute_gflops: Quantity,
+    /// How the ALUs issue ([`Alu::issue`]): instructions per second, 1e9, of a
+    /// GPU whose ALUs issue whole vector instructions (Xenos: a vec4 and a
+    /// scalar slot per ALU per clock; RSX: two vec4 units per pixel pipe).
+    /// One shader instruction takes an issue slot whatever its width, so a
+    /// vec3 multiply leaves a vec4 ALU's fourth lane (and its scalar slot)
+    /// idle, and `gflops`, which counts every lane, overstates the rate.
+    /// Absent on SIMT GPUs (G80 on), whose lanes each run one scalar
+    /// instruction a clock.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vector_ginstr: Option<Quantity>,
+}
+
+/// How a profile's shader instructions are issued (see [`Alu::vector_ginstr`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AluIssue {
+    /// One lane-instruction per lane per clock: `gflops / 2` of them a
+    /// second (a multiply-add counts two flops).
+    Lanes,
+    /// Whole vector instructions at this many 1e9 a second.
+    Vector(Quantity),
+}
+
+impl Alu {
+    pub fn issue(&self) -> AluIssue {
+        self.vector_ginstr.map_or(AluIssue::Lanes, AluIssue::Vector)
+    }
+
+    /// Shader instructions (`ShaderWork::alu`: SPIR-V arithmetic, a vector
+    /// instruction counted once) executed per second, 1e9: on SIMT lanes one
+    /// per lane per clock, `gflops / 2`; on vector-issue ALUs `vector_ginstr`,
+    /// whatever each instruction's width, a compute dispatch at the compute
+    /// path's share of the peak. `Err` names the quantity the profile lacks.
+    pub fn ginstr(&self, compute: bool) -> Result<f64, &'static str> {
+        let pixel = self.gflops.value().ok_or("alu.gflops");
+        let gflops = if compute {
+            self.compute_gflops.value().ok_or("alu.compute_gflops")?
+        } else {
+            pixel?
+        };
+        match self.issue() {
+            AluIssue::Lanes => Ok(gflops / 2.0),
+            AluIssue::Vector(q) => {
+                let v = q.value().ok_or("alu.vector_ginstr")?;
+                Ok(if compute { v * gflops / pixel? } else { v })
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -529,6 +438,24 @@ impl Profile {
         }
         q("alu.gflops", self.alu.gflops)?;
         q("alu.compute_gflops", self.alu.compute_gflops)?;
+        if let Some(v) = self.alu.vector_ginstr {
+            q("alu.vector_ginstr", v)?;
+            // An instruction fills at least one lane: a vector-issue rate above
+            // the lanes' (gflops / 2) contradicts the profile's own gflops.
+            let top = match v {
+                Quantity::Param { max, .. } => Some(max),
+                other => other.value(),
+            };
+            if let (Some(top), Some(g)) = (top, self.alu.gflops.value()) {
+                if top > g / 2.0 {
+                    bail!(
+                        "field `alu.vector_ginstr`: {top} G instructions/s is more than \
+                         alu.gflops / 2 = {} G lane-instructions/s",
+                        g / 2.0
+                    );
+                }
+            }
+        }
         let t = &self.texture;
         q("texture.bilinear_gtexels", t.bilinear_gtexels)?;
         q("texture.point_cost", t.point_cost)?;
@@ -718,29 +645,57 @@ mod tests {
         assert!(e.contains("edram.resolve_gbps"), "{e}");
     }
 
+    /// The Xbox 360's profile with its `vector_ginstr` line replaced.
+    fn with_issue(line: &str) -> String {
+        let t = xbox_text();
+        let start = t.find("vector_ginstr =").unwrap();
+        let end = start + t[start..].find('\n').unwrap();
+        format!("{}{line}{}", &t[..start], &t[end..])
+    }
+
     #[test]
-    fn substitutes_keep_class_and_channels() {
-        use TargetFormat::*;
-        // RGBA16F wanted: another 4-channel HDR format is nearer than RG32F.
-        assert!(Rgba16Fixed.distance_from(Rgba16Float) < Rg32Float.distance_from(Rgba16Float));
-        assert!(Rgb10a2Float.distance_from(Rgba16Float) < Rgba8Unorm.distance_from(Rgba16Float));
-        // R16F wanted: RG16F (one more channel, same bits) beats R32F? Both fit;
-        // RG16F wastes 2 bytes, R32F 2 bytes and widens: equal bytes, so the
-        // tie goes to either; both beat an 8-bit format.
-        assert!(Rg16Float.distance_from(R16Float) < Rgba8Unorm.distance_from(R16Float));
-        assert_eq!(TargetFormat::from_work(Format::Rgba16Float).bytes(), 8);
-        for f in [
-            Format::Rgba8Unorm,
-            Format::Rgba8Srgb,
-            Format::R16Float,
-            Format::Rgba16Float,
-            Format::R32Float,
-            Format::Rgba32Float,
-            Format::D32Float,
-            Format::D24UnormS8Uint,
-            Format::D32FloatS8Uint,
-        ] {
-            assert_eq!(TargetFormat::from_work(f).bytes(), f.bytes_per_texel());
-        }
+    fn vector_issue_is_read_where_given_and_lanes_elsewhere() {
+        let x = Profile::load("xbox360").unwrap();
+        assert_eq!(
+            x.alu.issue(),
+            AluIssue::Vector(Quantity::Param {
+                value: 24.0,
+                min: 24.0,
+                max: 48.0
+            })
+        );
+        assert_eq!(
+            Profile::load("geforce-9800-gtx-plus").unwrap().alu.issue(),
+            AluIssue::Lanes
+        );
+        // Absent (SIMT), a plain number and "unknown" all parse.
+        let p = Profile::parse(&with_issue(""), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Lanes);
+        let p = Profile::parse(&with_issue("vector_ginstr = 30.0"), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Vector(Quantity::Known(30.0)));
+        let p = Profile::parse(&with_issue("vector_ginstr = \"unknown\""), "t.toml").unwrap();
+        assert_eq!(p.alu.issue(), AluIssue::Vector(Quantity::Unknown));
+    }
+
+    #[test]
+    fn a_bad_issue_rate_is_one_line_naming_it() {
+        let e = err_of(&with_issue("vector_ginstr = \"fast\""));
+        assert!(e.contains("[alu]") && e.contains("fast"), "{e}");
+        let e = err_of(&with_issue("vector_ginstr = -24.0"));
+        assert!(e.contains("alu.vector_ginstr"), "{e}");
+        let e = err_of(&with_issue("vector_ginstrs = 24.0"));
+        assert!(e.contains("vector_ginstrs"), "{e}");
+        // More instructions than lanes (240 GFLOPS: 120 G lane-instructions).
+        let e = err_of(&with_issue(
+            "vector_ginstr = { value = 24.0, min = 24.0, max = 121.0 }",
+        ));
+        assert!(e.contains("alu.vector_ginstr") && e.contains("120"), "{e}");
+        let e = err_of(&with_issue(
+            "vector_ginstr = { value = 50.0, min = 24.0, max = 48.0 }",
+        ));
+        assert!(
+            e.contains("alu.vector_ginstr") && e.contains("outside"),
+            "{e}"
+        );
     }
 }

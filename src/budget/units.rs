@@ -13,6 +13,9 @@
 //! slowest bounds the pass; what happens before the draws (clears), outside
 //! the shader (rejection, set-up) or after it (resolves) adds. The `k`s,
 //! `f_inc` and the fixed costs are [`ModelParams`], fitted by `calibration`.
+//! The ALU unit is instructions over the profile's issue rate
+//! ([`crate::budget::profile::Alu::ginstr`]: lane-instructions on SIMT
+//! GPUs, whole vector instructions on Xenos and RSX).
 //! (A p-norm of the unit times in place of their maximum, p fitted, gained
 //! 1 point of median error on the H100 and destabilised the published fit:
 //! not kept.)
@@ -443,17 +446,12 @@ impl Pricing<'_> {
             }
         }
         self.u.memory += n * (s.storage_read_bytes + s.storage_write_bytes);
-        let alu = &self.prof.alu;
-        let (frag_gflops, comp_gflops) = (alu.gflops, alu.compute_gflops);
-        let gflops = if compute {
-            self.need("alu.compute_gflops", comp_gflops)
-        } else {
-            self.need("alu.gflops", frag_gflops)
-        };
-        if let Some(g) = gflops {
-            // An arithmetic instruction per lane per clock; peak GFLOPS count
-            // a multiply-add as two.
-            self.u.alu = n * s.alu / (g / 2.0 * G) * MS;
+        // Instructions over the profile's issue rate (`Alu::ginstr`).
+        match self.prof.alu.ginstr(compute) {
+            Ok(rate) => self.u.alu = n * s.alu / (rate * G) * MS,
+            Err(missing) => {
+                self.need(missing, Quantity::Unknown);
+            }
         }
     }
 

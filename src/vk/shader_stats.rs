@@ -1,8 +1,9 @@
 //! What a SPIR-V module does per invocation, read off its instructions: the
 //! arithmetic instructions executed (function calls expanded, loop bodies times
-//! their trip counts, both sides of a branch taken: an upper bound) and its
-//! static image instructions. Pass declarations take their ALU estimate from
-//! here, so the estimate follows the shader it describes.
+//! their trip counts, both sides of a branch taken: an upper bound), how many of
+//! them work on vectors, and its static image instructions. Pass declarations
+//! take their ALU estimate from here, so the estimate follows the shader it
+//! describes.
 //!
 //! Pure: parses the binary itself (SPIR-V 1.0, structured control flow as
 //! glslang emits it: a loop's blocks lie between its header and its merge block).
@@ -14,6 +15,11 @@ use anyhow::{bail, Context as _, Result};
 use super::shader::{spirv, words};
 
 const OP_EXT_INST: u16 = 12;
+const OP_TYPE_VECTOR: u16 = 23;
+const OP_TYPE_MATRIX: u16 = 24;
+/// OpUndef, OpConstantComposite, OpConstantNull, OpSpecConstantComposite:
+/// module-scope values that may be vectors.
+const MODULE_CONSTANTS: [u16; 4] = [1, 44, 46, 51];
 const OP_FUNCTION: u16 = 54;
 const OP_FUNCTION_END: u16 = 56;
 const OP_FUNCTION_CALL: u16 = 57;
@@ -43,6 +49,8 @@ fn is_image_read(op: u16) -> bool {
 struct Block {
     label: u32,
     alu: u32,
+    /// Of `alu`, the instructions with a vector result or a vector operand.
+    vector_alu: u32,
     /// Merge block of the loop this block heads, if it heads one.
     loop_merge: Option<u32>,
     calls: Vec<u32>,
@@ -50,6 +58,22 @@ struct Block {
 
 struct Function {
     blocks: Vec<Block>,
+}
+
+/// Arithmetic instructions one invocation executes, and how many of them work
+/// on vectors (a vector or matrix result, or a vector operand: `dot`, `length`,
+/// `any`), the rest being scalar. A vec4 + scalar ALU (Xenos) issues one of the
+/// first a clock and may pair a scalar one with it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AluSplit {
+    pub total: f64,
+    pub vector: f64,
+}
+
+impl AluSplit {
+    pub fn scalar(&self) -> f64 {
+        self.total - self.vector
+    }
 }
 
 /// A parsed module: its functions and the entry point.
@@ -71,6 +95,10 @@ impl ShaderStats {
         let mut entry = None;
         let (mut image_reads, mut atomic_adds) = (0, 0);
         let mut current: Option<(u32, Function)> = None;
+        // Ids of vector and matrix types, and the ids whose type is one of
+        // them (results inside functions, and module-scope constants).
+        let mut vector_types: Vec<u32> = Vec::new();
+        let mut vector_ids: std::collections::HashSet<u32> = Default::default();
         let mut i = 5;
         while i < code.len() {
             let count = (code[i] >> 16) as usize;
@@ -79,6 +107,18 @@ impl ShaderStats {
                 bail!("malformed SPIR-V instruction at word {i}");
             }
             let args = &code[i + 1..i + count];
+            if (op == OP_TYPE_VECTOR || op == OP_TYPE_MATRIX) && !args.is_empty() {
+                vector_types.push(args[0]);
+            }
+            // Inside a function, an instruction whose first operand is a type
+            // has a result: its id is the second (no other instruction there
+            // takes a type id first: labels, pointers and values are not types).
+            // Outside, only the constants (names and decorations also start
+            // with a type's id, followed by no result).
+            let has_result = current.is_some() || MODULE_CONSTANTS.contains(&op);
+            if has_result && args.len() >= 2 && vector_types.contains(&args[0]) {
+                vector_ids.insert(args[1]);
+            }
             match op {
                 OP_ENTRY_POINT if entry.is_none() => entry = Some(args[1]),
                 OP_FUNCTION => current = Some((args[1], Function { blocks: Vec::new() })),
@@ -92,6 +132,7 @@ impl ShaderStats {
                         f.blocks.push(Block {
                             label: args[0],
                             alu: 0,
+                            vector_alu: 0,
                             loop_merge: None,
                             calls: Vec::new(),
                         });
@@ -108,7 +149,20 @@ impl ShaderStats {
                         match op {
                             OP_LOOP_MERGE => b.loop_merge = Some(args[0]),
                             OP_FUNCTION_CALL => b.calls.push(args[2]),
-                            o if is_alu(o) => b.alu += 1,
+                            o if is_alu(o) => {
+                                b.alu += 1;
+                                // Operands after the result type and id (an
+                                // extended instruction's after its set and
+                                // number).
+                                let first = if o == OP_EXT_INST { 4 } else { 2 };
+                                let vector = vector_ids.contains(&args[1])
+                                    || args
+                                        .get(first..)
+                                        .is_some_and(|a| a.iter().any(|x| vector_ids.contains(x)));
+                                if vector {
+                                    b.vector_alu += 1;
+                                }
+                            }
                             _ => {}
                         }
                     }
@@ -128,6 +182,11 @@ impl ShaderStats {
     /// counts given in the order their headers are reached (calls expanded
     /// where they are made). Every loop must get a trip count.
     pub fn alu(&self, trips: &[u32]) -> Result<f64> {
+        Ok(self.alu_split(trips)?.total)
+    }
+
+    /// [`ShaderStats::alu`] with the instructions that work on vectors apart.
+    pub fn alu_split(&self, trips: &[u32]) -> Result<AluSplit> {
         let mut next = 0usize;
         let total = self.eval(self.entry, trips, &mut next, 0)?;
         if next != trips.len() {
@@ -139,7 +198,7 @@ impl ShaderStats {
         Ok(total)
     }
 
-    fn eval(&self, id: u32, trips: &[u32], next: &mut usize, depth: u32) -> Result<f64> {
+    fn eval(&self, id: u32, trips: &[u32], next: &mut usize, depth: u32) -> Result<AluSplit> {
         if depth > 64 {
             bail!("call depth over 64 (recursion is not valid SPIR-V for shaders)");
         }
@@ -149,7 +208,7 @@ impl ShaderStats {
             .with_context(|| format!("call of an unknown function %{id}"))?;
         // (merge label, multiplier) of the loops the traversal is inside.
         let mut loops: Vec<(u32, f64)> = Vec::new();
-        let mut total = 0.0;
+        let mut total = AluSplit::default();
         for b in &f.blocks {
             while loops.last().is_some_and(|(m, _)| *m == b.label) {
                 loops.pop();
@@ -171,9 +230,12 @@ impl ShaderStats {
                 }
                 None => outer,
             };
-            total += mult * b.alu as f64;
+            total.total += mult * f64::from(b.alu);
+            total.vector += mult * f64::from(b.vector_alu);
             for &c in &b.calls {
-                total += mult * self.eval(c, trips, next, depth + 1)?;
+                let called = self.eval(c, trips, next, depth + 1)?;
+                total.total += mult * called.total;
+                total.vector += mult * called.vector;
             }
         }
         Ok(total)
@@ -256,6 +318,69 @@ mod tests {
             .filter(|(n, _)| !n.contains('#') && !n.ends_with(".vert"))
             .count();
         assert_eq!(checked, shaders);
+    }
+
+    /// One instruction: its word count and opcode, then its operands.
+    fn inst(op: u16, args: &[u32]) -> Vec<u32> {
+        let mut w = vec![((args.len() as u32 + 1) << 16) | u32::from(op)];
+        w.extend_from_slice(args);
+        w
+    }
+
+    // A hand-assembled module: a scalar add, a vec4 add, a dot product of two
+    // vec4 (a scalar result from vector operands: the vector unit's dp4) and
+    // a scalar multiply of the two scalars. Two of the four are vector work,
+    // the dot product's operands a module-scope constant and a vec4 result.
+    #[test]
+    fn vector_instructions_are_told_from_scalar_ones() {
+        let (void, fnty, float, v4, one, ones, main, label) = (1, 2, 3, 4, 5, 6, 7, 8);
+        let (s, v, d, m) = (9, 10, 11, 12);
+        let mut code = vec![0x0723_0203, 0x0001_0000, 0, 13, 0];
+        for i in [
+            inst(17, &[1]),                            // OpCapability Shader
+            inst(14, &[0, 1]),                         // OpMemoryModel Logical GLSL450
+            inst(15, &[4, main, 0x6e69_616d, 0]),      // OpEntryPoint Fragment %main "main"
+            inst(19, &[void]),                         // OpTypeVoid
+            inst(33, &[fnty, void]),                   // OpTypeFunction
+            inst(22, &[float, 32]),                    // OpTypeFloat 32
+            inst(23, &[v4, float, 4]),                 // OpTypeVector %float 4
+            inst(43, &[float, one, 0x3f80_0000]),      // OpConstant 1.0
+            inst(44, &[v4, ones, one, one, one, one]), // OpConstantComposite
+            inst(54, &[void, main, 0, fnty]),          // OpFunction
+            inst(248, &[label]),                       // OpLabel
+            inst(129, &[float, s, one, one]),          // OpFAdd scalar
+            inst(129, &[v4, v, ones, ones]),           // OpFAdd vec4
+            inst(148, &[float, d, ones, v]),           // OpDot
+            inst(133, &[float, m, s, d]),              // OpFMul scalar
+            inst(253, &[]),                            // OpReturn
+            inst(56, &[]),                             // OpFunctionEnd
+        ] {
+            code.extend(i);
+        }
+        let split = ShaderStats::parse(&code).unwrap().alu_split(&[]).unwrap();
+        assert_eq!(
+            split,
+            AluSplit {
+                total: 4.0,
+                vector: 2.0
+            }
+        );
+        assert_eq!(split.scalar(), 2.0);
+    }
+
+    // The split covers every instruction `alu` counts, loops included, and
+    // both parts scale with the trips.
+    #[test]
+    fn the_split_adds_up_to_the_count() {
+        let s = stats("separable_blur.frag").unwrap();
+        let (a, b) = (s.alu_split(&[8]).unwrap(), s.alu_split(&[16]).unwrap());
+        assert_eq!(a.total, s.alu(&[8]).unwrap());
+        assert!(
+            b.vector > a.vector && b.scalar() > a.scalar(),
+            "{a:?} {b:?}"
+        );
+        let body = (b.vector - a.vector) / 8.0;
+        assert_eq!(s.alu_split(&[24]).unwrap().vector, a.vector + 16.0 * body);
     }
 
     #[test]

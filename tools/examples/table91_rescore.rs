@@ -32,7 +32,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context as _, Result};
 use dermis::budget::model::{price_frame, FrameBudget, PassBudget, Rescale};
 use dermis::budget::params::ParamSet;
-use dermis::budget::profile::Profile;
+use dermis::budget::profile::{Profile, Quantity};
 use dermis::budget::table91::{fit_line, g92_floor_bound_ms, games_line, GRAND_AVERAGE_MS};
 use dermis::budget::FrameInput;
 use dermis::vk::shader_stats::stats;
@@ -127,6 +127,10 @@ struct Variant {
     free_colour_clears: bool,
     /// The weights pass's search ALU at the trips its counted fetches ran.
     searches_as_run: bool,
+    /// On the Xbox 360, every scalar instruction paired with another
+    /// instruction in one ALU clock: a shader takes max(vector, all / 2)
+    /// issue slots ([`paired_alu`]).
+    paired: bool,
 }
 
 /// MLAA ms on both profiles (Xbox 360 as its port runs it, 9800 GTX+'s three
@@ -136,7 +140,13 @@ fn priced(f: &Frame, v: &Variant) -> Result<(FrameBudget, FrameBudget)> {
     if v.searches_as_run {
         searches_as_run(&mut input)?;
     }
-    let x = price_frame(&v.xbox, &input, &v.params, Rescale::AsRun);
+    let x = if v.paired {
+        let mut paired = input.clone();
+        paired_alu(&mut paired)?;
+        price_frame(&v.xbox, &paired, &v.params, Rescale::AsRun)
+    } else {
+        price_frame(&v.xbox, &input, &v.params, Rescale::AsRun)
+    };
     if v.free_colour_clears {
         for p in &mut input.passes {
             if let Work::Raster { clears, .. } = &mut p.work {
@@ -181,6 +191,56 @@ fn searches_as_run(f: &mut FrameInput) -> Result<()> {
     Ok(())
 }
 
+/// Each pass's ALU as issue slots of a vec4 + scalar ALU that pairs every
+/// scalar instruction it can: max(vector, all / 2) of its SPIR-V instructions
+/// (`AluSplit`), the trips of its loops found from the declared count (every
+/// loop of these shaders is declared with the same trips). The lower bound of the slots
+/// a Xenos compiler could reach; the profile's rate is the upper, unpaired one.
+fn paired_alu(f: &mut FrameInput) -> Result<()> {
+    for p in &mut f.passes {
+        let sh = match &mut p.work {
+            Work::Raster {
+                shader: Some(sh), ..
+            } => sh,
+            Work::Compute { shader, .. } => shader,
+            _ => continue,
+        };
+        if sh.alu <= 0.0 {
+            continue;
+        }
+        let st = stats(&sh.shader)?;
+        // The number of loops is the first count alu_split accepts.
+        let loops = (0..16)
+            .find(|&k| st.alu_split(&vec![0; k]).is_ok())
+            .with_context(|| format!("{}: loops", sh.shader))?;
+        // Between the uniform trip counts n and n + 1 that bracket the
+        // declared count (exact at a whole n; the searches as run give
+        // fractional trips), the split taken linearly.
+        let at = |n: u32| st.alu_split(&vec![n; loops]);
+        let mut found = None;
+        for n in 0..256 {
+            let (a, b) = (at(n)?, at(n + 1)?);
+            if a.total <= sh.alu + 1e-9 && sh.alu <= b.total + 1e-9 {
+                let t = if b.total > a.total {
+                    (sh.alu - a.total) / (b.total - a.total)
+                } else {
+                    0.0
+                };
+                found = Some(a.vector + t * (b.vector - a.vector));
+                break;
+            }
+        }
+        let vector = found.with_context(|| {
+            format!(
+                "{}: no trip count gives the declared {} instructions",
+                sh.shader, sh.alu
+            )
+        })?;
+        sh.alu = vector.max(sh.alu / 2.0);
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     let mut frames = Vec::new();
     for a in std::env::args().skip(1) {
@@ -199,6 +259,7 @@ fn main() -> Result<()> {
         params: ParamSet::fitted(),
         free_colour_clears: false,
         searches_as_run: false,
+        paired: false,
     };
     println!("| frame | edge pixels (share) | Xbox 360: edges / weights / blend (+ frame back into eDRAM), MLAA ms | 9800 GTX+: edges / weights / blend, MLAA ms | Xbox 360 / 9800 GTX+ |");
     println!("|---|---|---|---|---|");
@@ -271,22 +332,34 @@ fn main() -> Result<()> {
 /// Each unsourced candidate alone, then together: MLAA on the first frame and
 /// the line through all of them.
 fn sensitivity(frames: &[Frame], base: Variant) -> Result<()> {
-    let alu = |gflops: f64| -> Result<Profile> {
+    // The ALU issue rule's alternatives on the Xbox 360: the old lane rule
+    // (gflops / 2: every lane of every ALU filled) and the profile's upper
+    // bound (every instruction paired).
+    let xbox_with = |issue: Option<Quantity>| -> Result<Profile> {
         let mut x = Profile::load("xbox360")?;
-        x.alu.gflops = dermis::budget::profile::Quantity::Known(gflops);
+        x.alu.vector_ginstr = issue;
         Ok(x)
+    };
+    let bound = match base.xbox.alu.vector_ginstr {
+        Some(Quantity::Param { max, .. }) => max,
+        _ => bail!("xbox360.toml: alu.vector_ginstr is not a parameter"),
     };
     let mut coarse = ParamSet::fitted();
     coarse.peak.reject_scale = coarse.peak.hiz_reject_scale;
     let variants = vec![
         Variant {
-            name: "Xenos ALU at 48 G instructions/s (a vector and a scalar slot per ALU per clock)",
-            xbox: alu(96.0)?,
+            name: "Xenos ALU as lanes (gflops / 2 = 120 G instructions/s: the model before vector issue)",
+            xbox: xbox_with(None)?,
             ..base.clone()
         },
         Variant {
-            name: "Xenos ALU at 24 G instructions/s (one slot per ALU per clock)",
-            xbox: alu(48.0)?,
+            name: "Xenos ALU at the profile's bound, 48 G (every instruction paired with a scalar one)",
+            xbox: xbox_with(Some(Quantity::Known(bound)))?,
+            ..base.clone()
+        },
+        Variant {
+            name: "Xenos ALU paired per shader: max(vector, all / 2) SPIR-V instructions at 24 G",
+            paired: true,
             ..base.clone()
         },
         Variant {
@@ -305,11 +378,11 @@ fn sensitivity(frames: &[Frame], base: Variant) -> Result<()> {
             ..base.clone()
         },
         Variant {
-            name: "all of them, Xenos at 48 G",
-            xbox: alu(96.0)?,
+            name: "all of them, Xenos paired per shader",
             params: coarse,
             free_colour_clears: true,
             searches_as_run: true,
+            paired: true,
             ..base.clone()
         },
     ];
