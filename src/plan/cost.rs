@@ -696,24 +696,17 @@ impl CostModel<'_> {
 
     /// One character's part (alone, less the fixed cost).
     pub fn part_ms(&self, s: &SettingModel, fixed_ms: f64, l: &CharacterLoad) -> Option<f64> {
-        let one = s.group_ms(
-            self.profile,
-            &self.params,
-            std::slice::from_ref(l),
-            self.width,
-            self.height,
-        )?;
-        Some((one - fixed_ms).max(0.0))
+        self.part_ms_near(s, fixed_ms, l, None)
     }
 
     /// [`CostModel::part_ms`] with the passes shaped on stored frame `near`
-    /// (see [`SettingModel::group_frame_near`]).
+    /// (see [`SettingModel::group_frame_near`]; `None`: the nearest).
     pub fn part_ms_near(
         &self,
         s: &SettingModel,
         fixed_ms: f64,
         l: &CharacterLoad,
-        near: usize,
+        near: Option<usize>,
     ) -> Option<f64> {
         let one = s.group_ms_near(
             self.profile,
@@ -721,7 +714,7 @@ impl CostModel<'_> {
             std::slice::from_ref(l),
             self.width,
             self.height,
-            Some(near),
+            near,
         )?;
         Some((one - fixed_ms).max(0.0))
     }

@@ -1,7 +1,7 @@
 //! The planner's per-frame skin estimate: each character's skin pixels and
 //! screen rectangle from a few thousand surface patches instead of the whole
-//! mesh, so that re-planning every frame (issue 16 item 6) costs well under a
-//! millisecond of estimate for a 64-character crowd where the exact
+//! mesh, so that re-planning every frame (issue 16 item 6) costs about 2 ms
+//! of estimate for a 64-character crowd at 720p where the exact
 //! rasterisation of [`super::character`] costs about 125 ms (76 k triangles a
 //! head). Pure: no device.
 //!

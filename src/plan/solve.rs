@@ -511,28 +511,36 @@ mod tests {
         assert!(s.lower_bound.unwrap() <= s.error + 1e-9);
     }
 
+    /// One character with no SSS and `settings` as `(cost ms, err/none)`,
+    /// settings indexed in order, no fixed costs, planned afresh.
+    fn one_character(settings: &[(f64, f64)], budget_ms: f64) -> Problem {
+        let none = Opt {
+            setting: None,
+            cost_ms: 0.0,
+            error: 1.0,
+        };
+        let opts = settings.iter().enumerate().map(|(i, &(cost_ms, error))| Opt {
+            setting: Some(i),
+            cost_ms,
+            error,
+        });
+        Problem {
+            weights: vec![1.0],
+            options: vec![std::iter::once(none).chain(opts).collect()],
+            fixed_ms: vec![0.0; settings.len()],
+            budget_ms,
+            previous: None,
+            switch_margin: 0.0,
+            node_limit: None,
+        }
+    }
+
     #[test]
     fn a_new_setting_must_leave_the_margin_of_the_budget_free() {
         // One character whose only setting costs 0.99 of a 1 ms budget.
         let p = Problem {
-            weights: vec![1.0],
-            options: vec![vec![
-                Opt {
-                    setting: None,
-                    cost_ms: 0.0,
-                    error: 1.0,
-                },
-                Opt {
-                    setting: Some(0),
-                    cost_ms: 0.99,
-                    error: 0.5,
-                },
-            ]],
-            fixed_ms: vec![0.0],
-            budget_ms: 1.0,
-            previous: None,
             switch_margin: 0.02,
-            node_limit: None,
+            ..one_character(&[(0.99, 0.5)], 1.0)
         };
         // Planned afresh it fits.
         assert_eq!(solve(&p).choice, vec![Some(0)]);
@@ -560,31 +568,7 @@ mod tests {
     #[test]
     fn the_switching_margin_keeps_a_previous_choice_unless_the_gain_exceeds_it() {
         // One character: setting 0 (err 0.50) and setting 1 (err 0.45), both affordable.
-        let p = Problem {
-            weights: vec![1.0],
-            options: vec![vec![
-                Opt {
-                    setting: None,
-                    cost_ms: 0.0,
-                    error: 1.0,
-                },
-                Opt {
-                    setting: Some(0),
-                    cost_ms: 0.1,
-                    error: 0.50,
-                },
-                Opt {
-                    setting: Some(1),
-                    cost_ms: 0.1,
-                    error: 0.45,
-                },
-            ]],
-            fixed_ms: vec![0.0, 0.0],
-            budget_ms: 1.0,
-            previous: None,
-            switch_margin: 0.0,
-            node_limit: None,
-        };
+        let p = one_character(&[(0.1, 0.50), (0.1, 0.45)], 1.0);
         assert_eq!(solve(&p).choice, vec![Some(1)]);
         let held = Problem {
             previous: Some(vec![Some(0)]),
