@@ -123,6 +123,21 @@ pub struct GroupReport {
     /// Its colour in `groups.png` (sRGB), when one was written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tint: Option<[u8; 3]>,
+    /// Its one character's cross-fade, when it fades.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade: Option<FadeReport>,
+}
+
+/// A fading character's old setting in a group's report.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FadeReport {
+    /// The old setting as `--assign` spells it.
+    pub from: String,
+    /// Its share of the character's result.
+    pub weight: f64,
+    /// Where the keep is copied, the old setting works and its result is blended.
+    pub region_rects: Vec<[u32; 4]>,
+    pub region_pixels: u64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -414,7 +429,7 @@ pub fn table(passes: &[PassReport], frame: Option<&FrameReport>) -> String {
 pub fn groups_table(groups: &[GroupReport]) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    if groups.len() < 2 {
+    if groups.len() < 2 && groups.iter().all(|g| g.fade.is_none()) {
         return s;
     }
     let _ = writeln!(
@@ -434,6 +449,18 @@ pub fn groups_table(groups: &[GroupReport]) -> String {
             g.region_pixels,
             skin
         );
+        if let Some(f) = &g.fade {
+            let _ = writeln!(
+                s,
+                "{:<6} {:<34} {:>7} {:>10} {:>13} {:>11}",
+                "",
+                format!("  fading from {} ({:.0}%)", f.from, 100.0 * f.weight),
+                "",
+                "",
+                f.region_pixels,
+                ""
+            );
+        }
     }
     s
 }

@@ -16,7 +16,7 @@ use crate::output::{
 };
 use crate::render::groups::GroupMethod;
 use crate::render::{Capture, RenderSettings, Renderer};
-use crate::report::{aggregate, GroupReport, LightReport, PassDecl, Stats};
+use crate::report::{aggregate, FadeReport, GroupReport, LightReport, PassDecl, Stats};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 
@@ -276,6 +276,16 @@ fn group_reports(renderer: &Renderer, capture: Option<&Capture>) -> Vec<GroupRep
             region_pixels: g.region_px.iter().map(|r| r.area()).sum(),
             skin_pixels: skin.as_ref().and_then(|s| s.get(i).copied()),
             tint: None,
+            fade: g.fade.as_ref().map(|f| FadeReport {
+                from: f.spec.label.clone(),
+                weight: f.spec.weight,
+                region_rects: f
+                    .region_px
+                    .iter()
+                    .map(|r| [r.x0, r.y0, r.x1, r.y1])
+                    .collect(),
+                region_pixels: f.region_px.iter().map(|r| r.area()).sum(),
+            }),
         })
         .collect()
 }
@@ -325,7 +335,8 @@ pub fn render_to_dir(
     prepare_render_dir(out, opts.dump)?;
     // A frame of several methods also writes groups.png, which needs each
     // pixel's character: the id pass comes with it (it changes no image).
-    let mixed = crate::render::groups::group_specs(scene, settings)?.len() > 1;
+    let mixed =
+        crate::render::groups::is_mixed(&crate::render::groups::group_specs(scene, settings)?);
     let with_ids;
     let settings = if mixed && !settings.character_ids {
         with_ids = RenderSettings {

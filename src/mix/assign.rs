@@ -181,7 +181,7 @@ impl Rules {
                 ),
             }
         }
-        Ok(Mix { choices })
+        Ok(Mix::new(choices))
     }
 }
 

@@ -7,6 +7,11 @@
 //! one stencil code, one set of passes. Where the choices come from: `--assign`
 //! rules ([`assign`]) or a plan file ([`plan_file`]), both checked against the
 //! method registry before any device opens.
+//!
+//! A character may also be **cross-fading** ([`Fade`]) from the setting it had
+//! to the one it has now (a re-planned sequence's switch, docs/plan-over-time.md):
+//! it then forms a group of its own, whose old setting runs beside its new one
+//! and is blended into the result by the fade's weight.
 
 pub mod assign;
 pub mod plan_file;
@@ -131,13 +136,36 @@ impl Choice {
     }
 }
 
+/// A character between two settings: `from` (the setting it had) still runs on
+/// it and its result counts `weight` of the character's diffuse light, the
+/// new setting's the rest (`out = weight * from + (1 - weight) * new`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fade {
+    pub from: Choice,
+    /// The old setting's share, in (0, 1).
+    pub weight: f64,
+}
+
+impl Fade {
+    /// A fade from `from` at `weight`, checked: a share strictly between 0 and
+    /// 1 (0 is no fade, 1 the old setting alone).
+    pub fn new(from: Choice, weight: f64) -> Result<Fade> {
+        if !(weight.is_finite() && weight > 0.0 && weight < 1.0) {
+            bail!("fade weight {weight} is not a share strictly between 0 and 1");
+        }
+        Ok(Fade { from, weight })
+    }
+}
+
 /// One method instance of a mixed frame: its choice, its characters (frame
-/// indices, ascending) and its stencil code.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// indices, ascending) and its stencil code; a fading character's group also
+/// holds its fade.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Group {
     pub index: usize,
     pub choice: Choice,
     pub characters: Vec<usize>,
+    pub fade: Option<Fade>,
 }
 
 impl Group {
@@ -148,17 +176,25 @@ impl Group {
     }
 }
 
-/// A method per character.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A method per character, and the characters cross-fading.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mix {
     pub choices: Vec<Choice>,
+    /// Fading characters by frame index.
+    pub fades: BTreeMap<usize, Fade>,
 }
 
 impl Mix {
     /// Every one of `n` characters with `choice`.
     pub fn uniform(choice: Choice, n: usize) -> Mix {
+        Mix::new(vec![choice; n])
+    }
+
+    /// `choices` with no fade.
+    pub fn new(choices: Vec<Choice>) -> Mix {
         Mix {
-            choices: vec![choice; n],
+            choices,
+            fades: BTreeMap::new(),
         }
     }
 
@@ -169,16 +205,26 @@ impl Mix {
 
     /// The groups, in the order of their first character; characters whose
     /// choices resolve alike share one. Characters with no SSS form a group
-    /// too (it records no passes). More than [`MAX_GROUPS`] groups cannot be
-    /// told apart by the stencil: an error that says so.
+    /// too (it records no passes). A fading character forms a group of its
+    /// own: its old setting's passes test its stencil code, which must mark it
+    /// alone. More than [`MAX_GROUPS`] groups cannot be told apart by the
+    /// stencil: an error that says so.
     pub fn groups(&self) -> Result<Vec<Group>> {
         let mut groups: Vec<(BTreeMap<&'static str, String>, Group)> = Vec::new();
         for (i, c) in self.choices.iter().enumerate() {
             let key = c.resolved()?;
-            match groups
-                .iter_mut()
-                .find(|(k, g)| g.choice.method == c.method && *k == key)
-            {
+            let fade = self.fades.get(&i).cloned();
+            if let Some(f) = &fade {
+                if f.from.method == c.method && f.from.resolved()? == key {
+                    bail!(
+                        "character {i} fades from {} to the same setting",
+                        f.from.label()
+                    );
+                }
+            }
+            match groups.iter_mut().find(|(k, g)| {
+                fade.is_none() && g.fade.is_none() && g.choice.method == c.method && *k == key
+            }) {
                 Some((_, g)) => g.characters.push(i),
                 None => {
                     let index = groups.len();
@@ -188,10 +234,17 @@ impl Mix {
                             index,
                             choice: c.clone(),
                             characters: vec![i],
+                            fade,
                         },
                     ));
                 }
             }
+        }
+        if let Some(&c) = self.fades.keys().find(|&&c| c >= self.choices.len()) {
+            bail!(
+                "character {c} fades but does not exist (the frame has {})",
+                self.choices.len()
+            );
         }
         if groups.len() > MAX_GROUPS {
             bail!(
@@ -241,16 +294,14 @@ mod tests {
 
     #[test]
     fn choices_resolving_alike_share_a_group() {
-        let mix = Mix {
-            choices: vec![
-                choice("ssg", &[("fit", "4")]),
-                choice("separable", &[]),
-                choice("ssg", &[("fit", "4")]),
-                choice("none", &[]),
-                // The default sample count spelled out is the same setting.
-                choice("separable", &[("samples", "17")]),
-            ],
-        };
+        let mix = Mix::new(vec![
+            choice("ssg", &[("fit", "4")]),
+            choice("separable", &[]),
+            choice("ssg", &[("fit", "4")]),
+            choice("none", &[]),
+            // The default sample count spelled out is the same setting.
+            choice("separable", &[("samples", "17")]),
+        ]);
         let g = mix.groups().unwrap();
         assert_eq!(g.len(), 3);
         assert_eq!(g[0].characters, vec![0, 2]);
@@ -296,7 +347,41 @@ mod tests {
         let choices = (0..MAX_GROUPS + 1)
             .map(|i| choice("separable", &[("sss-width-mm", &format!("{}", i + 1))]))
             .collect();
-        let e = Mix { choices }.groups().unwrap_err().to_string();
+        let e = Mix::new(choices).groups().unwrap_err().to_string();
         assert!(e.contains("tells 128 apart"), "{e}");
+    }
+
+    #[test]
+    fn a_fading_character_forms_a_group_of_its_own() {
+        let mut mix = Mix::new(vec![
+            choice("separable", &[]),
+            choice("separable", &[]),
+            choice("ssg", &[]),
+        ]);
+        mix.fades
+            .insert(1, Fade::new(choice("ssg", &[]), 0.25).unwrap());
+        let g = mix.groups().unwrap();
+        let chars: Vec<_> = g.iter().map(|g| g.characters.clone()).collect();
+        assert_eq!(chars, vec![vec![0], vec![1], vec![2]]);
+        assert_eq!(g[1].fade.as_ref().unwrap().weight, 0.25);
+        assert!(g[0].fade.is_none() && g[2].fade.is_none());
+        // Fading to what it had, or a share outside (0, 1), is refused.
+        mix.fades.insert(
+            1,
+            Fade::new(choice("separable", &[("samples", "17")]), 0.5).unwrap(),
+        );
+        let e = mix.groups().unwrap_err().to_string();
+        assert!(
+            e.contains("character 1 fades from separable:samples=17 to the same setting"),
+            "{e}"
+        );
+        for w in [0.0, 1.0, -0.5, f64::NAN] {
+            assert!(Fade::new(choice("ssg", &[]), w).is_err(), "{w}");
+        }
+        mix.fades.clear();
+        mix.fades
+            .insert(3, Fade::new(choice("ssg", &[]), 0.5).unwrap());
+        let e = mix.groups().unwrap_err().to_string();
+        assert!(e.contains("character 3 fades but does not exist"), "{e}");
     }
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{bail, Context as _, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{Choice, Mix};
+use super::{Choice, Fade, Mix};
 use crate::files::{read_text, MAX_TEXT_FILE};
 
 /// The plan file format's version (bumped on an incompatible change).
@@ -43,6 +43,30 @@ pub struct PlannedCharacter {
     pub predicted_ms: Option<f64>,
     #[serde(default)]
     pub predicted_error: Option<PredictedError>,
+    /// A cross-fade from the setting the character had (a re-planned
+    /// sequence's switch, `dermis plan-motion --fade-frames`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade: Option<PlannedFade>,
+}
+
+/// The setting a character fades from and its share of the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannedFade {
+    pub method: String,
+    #[serde(default)]
+    pub options: BTreeMap<String, String>,
+    /// The old setting's share of the character's diffuse light, in (0, 1).
+    pub weight: f64,
+}
+
+impl PlannedFade {
+    fn fade(&self) -> Result<Fade> {
+        Fade::new(
+            Choice::new(&self.method, self.options.clone())?,
+            self.weight,
+        )
+    }
 }
 
 /// A whole plan.
@@ -105,10 +129,16 @@ impl PlanFile {
             }
             Choice::new(&a.method, a.options.clone())
                 .with_context(|| format!("character {}", a.character))?;
+            if let Some(f) = &a.fade {
+                f.fade()
+                    .with_context(|| format!("character {}'s fade", a.character))?;
+            }
         }
         if let Some(missing) = seen.iter().position(|s| !s) {
             bail!("character {missing} has no assignment");
         }
+        // What only the groups tell: a fade to the setting it had, too many settings.
+        self.mix(self.characters)?.groups()?;
         if let Some(b) = self.budget_ms {
             if !(b.is_finite() && b > 0.0) {
                 bail!("budget_ms {b} is not a positive time");
@@ -127,11 +157,14 @@ impl PlanFile {
                 self.characters
             );
         }
-        let mut choices = vec![Choice::none(); characters];
+        let mut mix = Mix::new(vec![Choice::none(); characters]);
         for a in &self.assignments {
-            choices[a.character] = Choice::new(&a.method, a.options.clone())?;
+            mix.choices[a.character] = Choice::new(&a.method, a.options.clone())?;
+            if let Some(f) = &a.fade {
+                mix.fades.insert(a.character, f.fade()?);
+            }
         }
-        Ok(Mix { choices })
+        Ok(mix)
     }
 }
 
@@ -164,6 +197,24 @@ mod tests {
         );
     }
 
+    /// Character 1 fading from ssg to none, a quarter of ssg left.
+    const FADE: &str = r#""method":"none","fade":{"method":"ssg","weight":0.25}}"#;
+
+    #[test]
+    fn a_fade_round_trips_into_the_mix() {
+        let p = plan(&GOOD.replace("\"method\":\"none\"}", FADE)).unwrap();
+        let mix = p.mix(2).unwrap();
+        let f = &mix.fades[&1];
+        assert_eq!((f.from.label().as_str(), f.weight), ("ssg", 0.25));
+        assert!(!mix.fades.contains_key(&0));
+        let again: PlanFile = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(again, p);
+        // A plan without fades writes no fade field (older readers take it).
+        assert!(!serde_json::to_string(&plan(GOOD).unwrap())
+            .unwrap()
+            .contains("fade"));
+    }
+
     #[test]
     fn malformed_plans_are_one_line_errors() {
         for (json, want) in [
@@ -190,6 +241,23 @@ mod tests {
                 "unknown field",
             ),
             ("{\"version\":1".to_string(), "EOF"),
+            (
+                GOOD.replace("\"method\":\"none\"}", FADE)
+                    .replace("0.25", "1.5"),
+                "character 1's fade: fade weight 1.5 is not a share",
+            ),
+            (
+                GOOD.replace("\"method\":\"none\"}", FADE)
+                    .replace("\"ssg\",\"weight", "\"ssgg\",\"weight"),
+                "character 1's fade: unknown method 'ssgg'",
+            ),
+            (
+                GOOD.replace(
+                    "\"method\":\"none\"}",
+                    &FADE.replace("\"ssg\",\"weight", "\"none\",\"weight"),
+                ),
+                "character 1 fades from none to the same setting",
+            ),
         ] {
             let e = format!("{:#}", plan(&json).unwrap_err());
             assert!(e.contains(want), "{json}: {e}");

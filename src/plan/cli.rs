@@ -736,6 +736,7 @@ pub fn plan_file(
                 interior: r.predicted.0,
                 silhouette: r.predicted.1,
             }),
+            fade: None,
         });
     }
     let w = w.max(1e-12);

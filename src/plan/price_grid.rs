@@ -100,7 +100,10 @@ impl<'a> PriceGrid<'a> {
             (f64::from(j) / SKIN_STEPS_PER_OCTAVE).exp2()
         };
         let load = reference_load(self.reference, x, s);
-        let p = self.fixed[k].and_then(|f| self.cost.part_ms_near(&self.models[k], f, &load, Some(near)));
+        let p = self.fixed[k].and_then(|f| {
+            self.cost
+                .part_ms_near(&self.models[k], f, &load, Some(near))
+        });
         self.priced += 1;
         self.points.insert((k, near, i, j), p);
         p

@@ -519,11 +519,14 @@ mod tests {
             cost_ms: 0.0,
             error: 1.0,
         };
-        let opts = settings.iter().enumerate().map(|(i, &(cost_ms, error))| Opt {
-            setting: Some(i),
-            cost_ms,
-            error,
-        });
+        let opts = settings
+            .iter()
+            .enumerate()
+            .map(|(i, &(cost_ms, error))| Opt {
+                setting: Some(i),
+                cost_ms,
+                error,
+            });
         Problem {
             weights: vec![1.0],
             options: vec![std::iter::once(none).chain(opts).collect()],

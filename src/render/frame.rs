@@ -15,7 +15,7 @@ use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
-use super::groups::{scissors, GroupMethod};
+use super::groups::{scissors, FadeMethod, GroupMethod};
 use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
@@ -24,6 +24,7 @@ use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
 use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
+use crate::method::screen::seed_copy;
 use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
 use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
@@ -496,6 +497,22 @@ impl Frame {
         method: &dyn SssMethod,
         instances: &[Mat4],
     ) -> Vec<PixelRect> {
+        self.region_by(scene, instances, |d, scale| method.reach_px(d, scale))
+    }
+
+    /// The skin of the characters `instances` on screen, reaching no further
+    /// (the whole screen with `--sss-region screen`): where a fade from no SSS
+    /// copies and blends.
+    pub fn skin_region(&self, scene: &Scene, instances: &[Mat4]) -> Vec<PixelRect> {
+        self.region_by(scene, instances, |_, _| Some(0.0))
+    }
+
+    fn region_by(
+        &self,
+        scene: &Scene,
+        instances: &[Mat4],
+        reach: impl Fn(f32, &crate::method::region::ReachScale) -> Option<f32>,
+    ) -> Vec<PixelRect> {
         let full = PixelRect::full(self.extent.width, self.extent.height);
         let s = &self.settings;
         let view = self.view_info();
@@ -505,7 +522,7 @@ impl Frame {
             mm_per_unit: self.mm_per_unit,
             max_strength: 1.0,
         };
-        if s.sss_region == RegionMode::Screen || method.reach_px(1.0, &probe).is_none() {
+        if s.sss_region == RegionMode::Screen || reach(1.0, &probe).is_none() {
             return vec![full];
         }
         let rv = self.region_view();
@@ -515,7 +532,7 @@ impl Frame {
             &rv,
             view.tan_half_fovy(),
             s.sss_region_tile,
-            |d, scale| method.reach_px(d, scale),
+            reach,
         )
     }
 
@@ -614,16 +631,53 @@ impl Frame {
         }
     }
 
+    /// What the old setting of group `g`'s fading character is built
+    /// against: the keep as its diffuse target, its own region, the group's
+    /// stencil code.
+    pub fn fade_view<'a, 'r>(
+        &'a self,
+        res: &'r Resources,
+        g: &'a GroupMethod,
+        f: &'a FadeMethod,
+    ) -> FrameView<'a, 'r> {
+        FrameView {
+            targets: &f.targets,
+            region: &f.scissors,
+            ..self.view(res, g)
+        }
+    }
+
     /// The passes of the groups' methods, each marked with its group (a
-    /// frame of several names them `#N ...`), then the merges.
+    /// frame of several names them `#N ...`), then the merges. With a fading
+    /// character: first the keep of the light before SSS (`#N fade keep`,
+    /// before any group writes the diffuse target in place), its old
+    /// setting's passes (`#N fade ...`) after the groups', and its blend
+    /// after the merges.
     pub fn group_passes<'a>(
         &'a self,
         groups: &'a [GroupMethod],
         merge: &'a Merge,
         res: &Resources,
     ) -> Vec<Pass<'a>> {
-        let mixed = groups.len() > 1;
+        let mixed = groups.len() > 1 || groups.iter().any(|g| g.fade.is_some());
         let mut passes = Vec::new();
+        let fades = || {
+            groups
+                .iter()
+                .filter_map(|g| g.fade.as_ref().map(|f| (g, f)))
+        };
+        for (g, f) in fades() {
+            let i = g.spec.index;
+            let mut p = seed_copy(
+                &format!("#{i} fade keep"),
+                &self.fade_view(res, g, f),
+                self.targets.diffuse,
+                &f.scissors,
+                &[f.keep],
+            );
+            p.group = Some(i);
+            passes.push(p);
+        }
         for g in groups {
             let i = g.spec.index;
             for mut p in g.method.passes(&self.view(res, g)) {
@@ -634,9 +688,30 @@ impl Frame {
                 passes.push(p);
             }
         }
+        for (g, f) in fades() {
+            let i = g.spec.index;
+            for mut p in f.method.passes(&self.fade_view(res, g, f)) {
+                p.group = Some(i);
+                p.name = format!("#{i} fade {}", p.name);
+                passes.push(p);
+            }
+        }
         if mixed {
             for g in groups {
                 if let Some(p) = merge.pass(&self.view(res, g), g.spec.index, g.method.output()) {
+                    passes.push(p);
+                }
+            }
+            for (g, f) in fades() {
+                let view = self.fade_view(res, g, f);
+                // The blend writes the frame's diffuse target, not the keep.
+                let view = FrameView {
+                    targets: &self.targets,
+                    ..view
+                };
+                if let Some(p) =
+                    merge.fade_pass(&view, g.spec.index, f.method.output(), f.spec.weight)
+                {
                     passes.push(p);
                 }
             }

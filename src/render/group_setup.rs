@@ -7,8 +7,8 @@ use anyhow::{Context as _, Result};
 use glam::Mat4;
 
 use super::frame::Frame;
-use super::groups::{GroupMethod, GroupSpec};
-use crate::graph::Resources;
+use super::groups::{is_mixed, FadeMethod, GroupMethod, GroupSpec};
+use crate::graph::{ImageDesc, Resources};
 use crate::method::MethodSetup;
 use crate::scene::Scene;
 use crate::vk::context::Context;
@@ -24,7 +24,7 @@ pub fn build_groups(
     scene: &Scene,
     specs: Vec<GroupSpec>,
 ) -> Result<Vec<GroupMethod>> {
-    let mixed = specs.len() > 1;
+    let mixed = is_mixed(&specs);
     let depth_stencil_format = res.format(frame.targets.depth_stencil);
     let mut groups = Guard::new(ctx, Vec::<GroupMethod>::new());
     for spec in specs {
@@ -40,6 +40,7 @@ pub fn build_groups(
         } else {
             String::new()
         });
+        let fade_spec = spec.fade.clone();
         let method = (spec.entry.build)(&mut MethodSetup {
             ctx,
             res,
@@ -60,6 +61,7 @@ pub fn build_groups(
             region_px: Vec::new(),
             scissors: Vec::new(),
             depths: Vec::new(),
+            fade: None,
         };
         // A group with no SSS records no pass: in a mix it has no region.
         let region = if mixed && g.is_none() {
@@ -69,7 +71,71 @@ pub fn build_groups(
         };
         g.set_region(region);
         g.depths = frame.depths_for(scene, &g.instances);
-        groups.push(g);
+        if let Some(f) = fade_spec {
+            // Pushed first so that an error below frees the new instance too.
+            let i = g.spec.index;
+            groups.push(g);
+            let g = groups.last_mut().expect("just pushed");
+            g.fade = Some(build_fade(ctx, res, frame, scene, i, f, &g.instances)?);
+        } else {
+            groups.push(g);
+        }
     }
     Ok(groups.keep())
+}
+
+/// The old setting of group `index`'s fading character: a keep of the
+/// diffuse target (its levels too: a method that builds a mip chain builds it
+/// on its own input) and the old method built on it under `#N fade `.
+fn build_fade(
+    ctx: &Context,
+    res: &mut Resources,
+    frame: &Frame,
+    scene: &Scene,
+    index: usize,
+    spec: super::groups::FadeSpec,
+    instances: &[Mat4],
+) -> Result<FadeMethod> {
+    let diffuse = frame.targets.diffuse;
+    let depth_stencil_format = res.format(frame.targets.depth_stencil);
+    res.set_name_prefix(&format!("#{index} fade "));
+    let keep = res.declare(
+        ImageDesc::new("keep", res.extent(diffuse), res.format(diffuse))
+            .with_levels(res.levels(diffuse).len() as u32),
+    );
+    let targets = crate::method::FrameTargets {
+        diffuse: keep,
+        ..frame.targets
+    };
+    let method = (spec.entry.build)(&mut MethodSetup {
+        ctx,
+        res,
+        targets: &targets,
+        samplers: &frame.samplers,
+        options: spec.entry.opts(&spec.options),
+        view: frame.view_info(),
+        depth_stencil_format,
+        scene,
+        instances,
+    })
+    .with_context(|| format!("setting up the fade from {}", spec.label));
+    res.set_name_prefix("");
+    let method = method?;
+    // No SSS reaches nowhere: its result is the keep itself, needed only on
+    // the character's skin.
+    let region = if spec.entry.name == crate::method::none::ENTRY.name {
+        frame.skin_region(scene, instances)
+    } else {
+        frame.region_for(scene, &*method, instances)
+    };
+    let mut f = FadeMethod {
+        spec,
+        keep,
+        targets,
+        method,
+        region_px: Vec::new(),
+        scissors: Vec::new(),
+    };
+    f.set_region(region);
+    Ok(f)
 }

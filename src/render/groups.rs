@@ -10,14 +10,23 @@
 //! each gets its own method instance, built over its own characters, with its
 //! own SSS region, image names prefixed `#N ` and stencil code
 //! `mix::stencil_code(N)`.
+//!
+//! A group of one fading character (`mix::Fade`) also holds its old setting's
+//! instance ([`FadeMethod`]): built over the same character and stencil code,
+//! on the frame's targets with the diffuse target replaced by a copy of it
+//! taken before any group writes in place (`#N fade keep`), so that it reads
+//! the light before SSS as its own group would. `frame.rs` records the copy,
+//! the old instance's passes (named `#N fade ...`) and the blend of its result
+//! into the diffuse target by the fade's weight (`merge.rs`).
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use glam::Mat4;
 
 use super::settings::{Assignment, RenderSettings};
+use crate::graph::ImageId;
 use crate::method::region::PixelRect;
-use crate::method::{MethodEntry, MethodOptions, Needs, SssMethod};
+use crate::method::{FrameTargets, MethodEntry, MethodOptions, Needs, SssMethod};
 use crate::mix::{stencil_code, Mix};
 use crate::scene::framing::{frame as frame_scene, Framing, Shot};
 use crate::scene::Scene;
@@ -40,6 +49,18 @@ pub struct GroupSpec {
     pub options: MethodOptions,
     /// Frame indices of its characters, ascending.
     pub characters: Vec<usize>,
+    /// The setting its one character fades from (`None`: no fade).
+    pub fade: Option<FadeSpec>,
+}
+
+/// The old setting of a fading character, resolved like a group's.
+#[derive(Clone, Debug)]
+pub struct FadeSpec {
+    pub label: String,
+    pub entry: &'static MethodEntry,
+    pub options: MethodOptions,
+    /// The old setting's share of the character's result, in (0, 1).
+    pub weight: f64,
 }
 
 impl GroupSpec {
@@ -99,33 +120,62 @@ pub fn group_specs(scene: &Scene, settings: &RenderSettings) -> Result<Vec<Group
             entry: settings.method,
             options: settings.options.clone(),
             characters: (0..n).collect(),
+            fade: None,
         }]);
     };
     let mut specs = Vec::new();
     for g in mix.groups()? {
-        let entry = g.choice.entry()?;
-        let options = g.choice.method_options();
-        super::settings::check_msaa(settings.msaa, Some(entry))?;
-        // ssg's shader branch shades every pixel whose alpha marks skin, the
-        // other groups' too: only the stencil keeps a group to its pixels.
-        if entry.name == "ssg"
-            && entry.opts(&options).resolved().get("mask") == Some(&"branch".into())
-        {
-            bail!(
-                "{}: the branch mask shades every character's skin; in a frame of several \
-                 methods ssg needs mask=stencil",
-                g.choice.label()
-            );
-        }
+        let (entry, options) = mixed_choice(&g.choice, settings)?;
+        let fade = match &g.fade {
+            None => None,
+            Some(f) => {
+                let (entry, options) = mixed_choice(&f.from, settings)
+                    .with_context(|| format!("character {}'s fade", g.characters[0]))?;
+                Some(FadeSpec {
+                    label: f.from.label(),
+                    entry,
+                    options,
+                    weight: f.weight,
+                })
+            }
+        };
         specs.push(GroupSpec {
             index: g.index,
             label: g.choice.label(),
             entry,
             options,
             characters: g.characters,
+            fade,
         });
     }
     Ok(specs)
+}
+
+/// A choice of a frame of several, checked against what such a frame allows.
+fn mixed_choice(
+    c: &crate::mix::Choice,
+    settings: &RenderSettings,
+) -> Result<(&'static MethodEntry, MethodOptions)> {
+    let entry = c.entry()?;
+    let options = c.method_options();
+    super::settings::check_msaa(settings.msaa, Some(entry))?;
+    // ssg's shader branch shades every pixel whose alpha marks skin, the
+    // other groups' too: only the stencil keeps a group to its pixels.
+    if entry.name == "ssg" && entry.opts(&options).resolved().get("mask") == Some(&"branch".into())
+    {
+        bail!(
+            "{}: the branch mask shades every character's skin; in a frame of several \
+             methods ssg needs mask=stencil",
+            c.label()
+        );
+    }
+    Ok((entry, options))
+}
+
+/// Whether the groups make a frame of several methods: more than one, or a
+/// fade (whose old setting is a second instance).
+pub fn is_mixed(specs: &[GroupSpec]) -> bool {
+    specs.len() > 1 || specs.iter().any(|g| g.fade.is_some())
 }
 
 /// What the frame's targets must provide for every group: the normal target
@@ -134,7 +184,11 @@ pub fn group_specs(scene: &Scene, settings: &RenderSettings) -> Result<Vec<Group
 pub fn frame_needs(specs: &[GroupSpec], extent: vk::Extent2D) -> Needs {
     let mut it = specs
         .iter()
-        .map(|g| (g.entry.needs)(&g.entry.opts(&g.options), extent));
+        .flat_map(|g| {
+            let old = g.fade.as_ref().map(|f| (f.entry, &f.options));
+            std::iter::once((g.entry, &g.options)).chain(old)
+        })
+        .map(|(e, o)| (e.needs)(&e.opts(o), extent));
     let first = it.next().unwrap_or(Needs::PLAIN);
     it.fold(first, |a, b| Needs {
         normals: a.normals || b.normals,
@@ -156,6 +210,30 @@ pub struct GroupMethod {
     /// Its skin's depths, `(share, view depth)` per skin cluster on screen
     /// (`view::region::skin_depths`): how wide its kernels are on screen.
     pub depths: Vec<(f64, f32)>,
+    /// Its character's old setting while it fades.
+    pub fade: Option<FadeMethod>,
+}
+
+/// The old setting of a fading character's group, built over the keep.
+pub struct FadeMethod {
+    pub spec: FadeSpec,
+    /// The copy of the diffuse target it reads and (most methods) writes in place.
+    pub keep: ImageId,
+    /// The frame's targets with `diffuse` = `keep`: what it was built on and
+    /// its passes are recorded against.
+    pub targets: FrameTargets,
+    pub method: Box<dyn SssMethod>,
+    /// Its region (its own reach over the character): where the keep is
+    /// copied, its passes work and its result is blended.
+    pub region_px: Vec<PixelRect>,
+    pub scissors: Vec<vk::Rect2D>,
+}
+
+impl FadeMethod {
+    pub fn set_region(&mut self, px: Vec<PixelRect>) {
+        self.scissors = scissors(&px);
+        self.region_px = px;
+    }
 }
 
 /// The rectangles of a pixel region as scissors.
@@ -181,6 +259,18 @@ impl GroupMethod {
         self.region_px = px;
     }
 
+    /// The images its passes fill only inside a region (zeroed at set-up):
+    /// its method's intermediates, and with a fade the keep and the old
+    /// method's.
+    pub fn intermediates(&self) -> Vec<ImageId> {
+        let mut v = self.method.intermediates();
+        if let Some(f) = &self.fade {
+            v.push(f.keep);
+            v.extend(f.method.intermediates());
+        }
+        v
+    }
+
     /// Whether its method records no pass (`none`).
     pub fn is_none(&self) -> bool {
         self.spec.entry.name == crate::method::none::ENTRY.name
@@ -189,7 +279,10 @@ impl GroupMethod {
 
 impl Destroy for GroupMethod {
     fn destroy(&mut self, ctx: &Context) {
-        SssMethod::destroy(self.method.as_mut(), ctx)
+        SssMethod::destroy(self.method.as_mut(), ctx);
+        if let Some(f) = &mut self.fade {
+            SssMethod::destroy(f.method.as_mut(), ctx);
+        }
     }
 }
 

@@ -82,11 +82,7 @@ fn upload_pass<'a>(
 impl Renderer<'_> {
     /// Fills every intermediate of the method with `value` in every channel.
     pub(super) fn fill_intermediates(&mut self, value: f32) -> Result<()> {
-        let ids: Vec<_> = self
-            .groups
-            .iter()
-            .flat_map(|g| g.method.intermediates())
-            .collect();
+        let ids: Vec<_> = self.groups.iter().flat_map(|g| g.intermediates()).collect();
         let passes: Vec<Pass> = ids
             .into_iter()
             .map(|id| {

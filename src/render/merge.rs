@@ -6,6 +6,12 @@
 //! of its output into the diffuse target, limited to its region: the mixed
 //! frame's own overhead, named `mix merge #N`. A single-method frame has no
 //! merge: its composite reads the method's output, as before groups.
+//!
+//! A fading character's group (`groups::FadeMethod`) is blended last: its old
+//! setting's result drawn over the diffuse target, stencil-masked to its code
+//! and limited to the old instance's region, with fixed-function blending by
+//! the constant `weight` (`src * w + dst * (1 - w)`, the new setting's result
+//! being what the target holds by then): `#N fade blend`.
 
 use anyhow::Result;
 use ash::vk;
@@ -16,12 +22,13 @@ use crate::graph::{ImageId, Pass, Resources};
 use crate::method::screen::{fetch, masked_pass, Masked};
 use crate::method::{skin_stencil_test, FrameTargets, FrameView};
 use crate::vk::context::Context;
-use crate::vk::guard::Destroy;
-use crate::vk::pipeline::{Bind, DescriptorPool, GraphicsDesc, Pipeline};
+use crate::vk::guard::{Destroy, Guard};
+use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline};
 
 pub const MERGE_SHADER: &str = "composite_merge.frag";
 
-/// The merge pipeline and one descriptor set per group that needs a copy.
+/// The merge pipelines (the copy's, the fade's blend) and one descriptor set
+/// per group that needs each.
 #[derive(Default)]
 pub struct Merge {
     pipeline: Pipeline,
@@ -29,6 +36,9 @@ pub struct Merge {
     /// pipeline is made (the passes declare their usages before the images
     /// exist), the sets are written by `bind`.
     sets: Vec<(usize, vk::DescriptorSet)>,
+    fade_pipeline: Pipeline,
+    /// (group index, set reading its old setting's result).
+    fade_sets: Vec<(usize, vk::DescriptorSet)>,
 }
 
 /// Whether group `g`'s result must be copied into the diffuse target.
@@ -36,9 +46,16 @@ pub fn needs_merge(g: &GroupMethod, targets: &FrameTargets) -> bool {
     !g.is_none() && g.method.output() != targets.diffuse
 }
 
+/// Whether a frame of `groups` needs a [`Merge`]: a copy or a fade.
+pub fn needs_any(groups: &[GroupMethod], targets: &FrameTargets) -> bool {
+    groups
+        .iter()
+        .any(|g| needs_merge(g, targets) || g.fade.is_some())
+}
+
 impl Merge {
-    /// The pipeline and the groups that need a copy (only a frame of several
-    /// groups with one that needs a copy builds one).
+    /// The pipelines the groups need: the copy's where a group's result lies
+    /// apart, the blend's where a character fades.
     pub fn new(
         ctx: &Context,
         res: &Resources,
@@ -46,22 +63,36 @@ impl Merge {
         groups: &[GroupMethod],
     ) -> Result<Merge> {
         let ds = res.format(targets.depth_stencil);
-        let mut desc =
-            GraphicsDesc::fullscreen("mix merge", MERGE_SHADER, res.format(targets.diffuse));
-        desc.depth_format = Some(ds);
-        desc.stencil_format = Some(ds);
-        desc.stencil = Some(skin_stencil_test());
-        Ok(Merge {
-            pipeline: Pipeline::graphics(ctx, &desc)?,
-            sets: groups
-                .iter()
-                .filter(|g| needs_merge(g, targets))
-                .map(|g| (g.spec.index, vk::DescriptorSet::null()))
-                .collect(),
-        })
+        let desc = |name: &str, blend: Blend| {
+            let mut d = GraphicsDesc::fullscreen(name, MERGE_SHADER, res.format(targets.diffuse));
+            d.depth_format = Some(ds);
+            d.stencil_format = Some(ds);
+            d.stencil = Some(skin_stencil_test());
+            d.blend = blend;
+            d
+        };
+        let mut m = Guard::new(ctx, Merge::default());
+        m.sets = groups
+            .iter()
+            .filter(|g| needs_merge(g, targets))
+            .map(|g| (g.spec.index, vk::DescriptorSet::null()))
+            .collect();
+        m.fade_sets = groups
+            .iter()
+            .filter(|g| g.fade.is_some())
+            .map(|g| (g.spec.index, vk::DescriptorSet::null()))
+            .collect();
+        if !m.sets.is_empty() {
+            m.pipeline = Pipeline::graphics(ctx, &desc("mix merge", Blend::None))?;
+        }
+        if !m.fade_sets.is_empty() {
+            m.fade_pipeline = Pipeline::graphics(ctx, &desc("fade blend", Blend::ConstantMix(0)))?;
+        }
+        Ok(m.keep())
     }
 
-    /// One set per group that needs a copy, reading its output.
+    /// One set per group that needs a copy, reading its output, and per
+    /// fading group, reading its old setting's result.
     pub fn bind(
         &mut self,
         ctx: &Context,
@@ -82,7 +113,54 @@ impl Merge {
                 &[("groupTex", Bind::Texture(res.view(g.method.output())))],
             )?;
         }
+        for (i, set) in &mut self.fade_sets {
+            let Some(f) = groups
+                .iter()
+                .find(|g| g.spec.index == *i)
+                .and_then(|g| g.fade.as_ref())
+            else {
+                continue;
+            };
+            *set = pool.write_set(
+                ctx,
+                &self.fade_pipeline,
+                0,
+                &[("groupTex", Bind::Texture(res.view(f.method.output())))],
+            )?;
+        }
         Ok(())
+    }
+
+    /// The blend of group `g`'s old setting's result (`old`) into the diffuse
+    /// target by `weight`, against `f` (the old instance's region, the group's
+    /// stencil code).
+    pub fn fade_pass<'a>(
+        &'a self,
+        f: &FrameView<'a, '_>,
+        g: usize,
+        old: ImageId,
+        weight: f64,
+    ) -> Option<Pass<'a>> {
+        let &(_, set) = self.fade_sets.iter().find(|(i, _)| *i == g)?;
+        let c = weight as f32;
+        let mut p = masked_pass(
+            f,
+            Masked {
+                name: format!("#{g} fade blend"),
+                shader: MERGE_SHADER,
+                loop_trips: Vec::new(),
+                pipeline: &self.fade_pipeline,
+                set,
+                reads: vec![old],
+                fetches: vec![fetch(f.res, old, "groupTex", Filter::Point, 1.0)],
+                targets: vec![(f.targets.diffuse, true)],
+                stencil: true,
+                depth_test: false,
+            },
+            move |ctx, cmd| unsafe { ctx.device.cmd_set_blend_constants(cmd, &[c, c, c, 1.0]) },
+        );
+        p.group = Some(g);
+        Some(p)
     }
 
     /// The copy of group `g`'s output (`output`) into the diffuse target,
@@ -117,6 +195,7 @@ impl Merge {
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
+        self.fade_pipeline.destroy(ctx);
     }
 }
 

@@ -32,8 +32,8 @@ use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
 use frame::{skin_material_binds, Frame, SkinGroup};
 use group_setup::build_groups;
-use groups::{frame_needs, group_specs, GroupMethod};
-use merge::{needs_merge, Merge};
+use groups::{frame_needs, group_specs, is_mixed, GroupMethod};
+use merge::Merge;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use settings::RenderSettings;
 
@@ -177,7 +177,7 @@ impl<'c> Renderer<'c> {
         };
         let specs = group_specs(scene, settings)?;
         let needs = frame_needs(&specs, extent);
-        let mixed = specs.len() > 1;
+        let mixed = is_mixed(&specs);
         // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
         let targets = targets::declare(ctx, &mut resources, settings, needs)?;
@@ -218,7 +218,7 @@ impl<'c> Renderer<'c> {
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
         let mut merge = Guard::new(ctx, Merge::default());
-        if mixed && groups.iter().any(|g| needs_merge(g, &frame.targets)) {
+        if mixed && merge::needs_any(&groups, &frame.targets) {
             *merge = Merge::new(ctx, &resources, &frame.targets, &groups)?;
         }
         // 2. Every image's usage from the passes that touch it: the frame's, and
@@ -234,7 +234,7 @@ impl<'c> Renderer<'c> {
         accesses.extend(
             groups
                 .iter()
-                .flat_map(|g| g.method.intermediates())
+                .flat_map(|g| g.intermediates())
                 .map(|i| (i, inputs::FILL_ACCESS)),
         );
         resources.allow(&accesses);
@@ -245,15 +245,20 @@ impl<'c> Renderer<'c> {
         frame.bind(ctx, &resources, source)?;
         merge.bind(ctx, &frame.pool, &resources, &frame.targets, &groups)?;
         for g in groups.iter_mut() {
-            g.method.bind(&MethodBind {
+            let bind = |targets| MethodBind {
                 ctx,
                 res: &resources,
                 pool: &frame.pool,
                 samplers: &frame.samplers,
-                targets: &frame.targets,
+                targets,
                 frame_binds: frame.frame_binds(&resources),
                 skin_material_binds: skin_material_binds(&frame),
-            })?;
+            };
+            g.method.bind(&bind(&frame.targets))?;
+            if let Some(f) = &mut g.fade {
+                let targets = f.targets;
+                f.method.bind(&bind(&targets))?;
+            }
         }
         let submit = Submit::new(ctx, slots)?;
         // Complete: the renderer owns (and frees, in its drop) every part.
@@ -269,7 +274,9 @@ impl<'c> Renderer<'c> {
         // Texels of the intermediates outside the region are never written: zero
         // them once so a dump of an intermediate shows black there, not old memory.
         let full = PixelRect::full(extent.width, extent.height);
-        if r.groups.iter().any(|g| g.region_px != [full]) {
+        if r.groups.iter().any(|g| {
+            g.region_px != [full] || g.fade.as_ref().is_some_and(|f| f.region_px != [full])
+        }) {
             r.fill_intermediates(0.0)?;
         }
         ctx.check_validation("while setting up the renderer")?;
@@ -289,6 +296,9 @@ impl<'c> Renderer<'c> {
     pub fn set_region(&mut self, px: Vec<PixelRect>) {
         for g in &mut self.groups {
             g.set_region(px.clone());
+            if let Some(f) = &mut g.fade {
+                f.set_region(px.clone());
+            }
         }
     }
 
@@ -296,6 +306,9 @@ impl<'c> Renderer<'c> {
     fn begin_frame(&mut self) {
         for g in &mut self.groups {
             g.method.begin_frame();
+            if let Some(f) = &mut g.fade {
+                f.method.begin_frame();
+            }
         }
     }
 
