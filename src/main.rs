@@ -259,6 +259,9 @@ enum Command {
         /// Plan each frame against the costs of the next N frames too (0: its own).
         #[arg(long, default_value_t = 0)]
         look_ahead: usize,
+        /// Cross-fade a switch on screen over N frames (0: switch at once).
+        #[arg(long, default_value_t = dermis::plan::over_time::DEFAULT_FADE_FRAMES)]
+        fade_frames: usize,
         #[arg(long, default_value = "out/plan-motion")]
         out: PathBuf,
     },
@@ -780,13 +783,14 @@ fn plan_motion(
     profile: &str,
     budget_ms: &str,
     (frames, walk_heads): (usize, f32),
-    (switch_margin, look_ahead): (f64, usize),
+    (switch_margin, look_ahead, fade_frames): (f64, usize, usize),
     out: &Path,
 ) -> Result<()> {
     use dermis::plan::{cli::PlanArgs, measured::Measured, motion, over_time};
     let args = PlanArgs::parse(profile, budget_ms, out)?;
     let walk = over_time::Walk::new(frames, walk_heads)?;
     over_time::check_margin(switch_margin)?;
+    over_time::check_fade_frames(fade_frames)?;
     if look_ahead >= frames {
         anyhow::bail!("--look-ahead {look_ahead} must be under --frames {frames}");
     }
@@ -807,6 +811,7 @@ fn plan_motion(
             walk,
             switch_margin,
             look_ahead,
+            fade_frames,
             out,
         },
     )?;
@@ -973,13 +978,14 @@ fn main_result() -> Result<()> {
             walk_heads,
             switch_margin,
             look_ahead,
+            fade_frames,
             out,
         } => plan_motion(
             &common,
             &profile,
             &budget_ms,
             (frames, walk_heads),
-            (switch_margin, look_ahead),
+            (switch_margin, look_ahead, fade_frames),
             &out,
         )?,
         Command::Kernel {

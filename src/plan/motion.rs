@@ -7,6 +7,10 @@
 //! of both frames) against the truth's own change over the same pixels at
 //! the same frames. The plan's time per frame is reported, the solver's apart
 //! from the inputs' (estimating the characters and pricing every setting).
+//! With `--fade-frames F` (default 3) a switch on screen is cross-faded over
+//! F frames (`over_time::fades`, rendered through the plan file's `fade`):
+//! its change is then measured over the F + 1 frames it is spread over, and
+//! the fades' extra cost is priced per frame beside the plan's.
 //!
 //! Writes DIR/plan-motion.json and DIR/plan-motion.png / .svg (each
 //! switching character's change against the truth's, frame by frame).
@@ -17,12 +21,14 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::choose::Accuracy;
-use super::cli::{load_models, plan_file, plan_frames_dir, reference_model, NODE_LIMIT};
+use super::cli::{
+    load_models, plan_file, plan_frames_dir, reference_model, registered, NODE_LIMIT,
+};
 use super::frame_inputs::FrameInputs;
 use super::motion_chart::Line;
 use super::over_time::{
-    changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, FramePlan, Pop,
-    Replan, Walk, FLICKER_BOUND,
+    changes, fade_cost_ms, fades, mean_max, pops, replan, spreads, switch_counts, switches, Change,
+    FadeAt, FrameInput, FramePlan, Pop, Replan, Walk, FLICKER_BOUND,
 };
 use super::truth::{render, Truth};
 use crate::budget::profile::Profile;
@@ -50,7 +56,19 @@ pub struct MotionOptions<'a> {
     pub switch_margin: f64,
     /// Frames looked ahead (`over_time::Replan::look_ahead`).
     pub look_ahead: usize,
+    /// Frames a switch on screen is cross-faded over (0: none).
+    pub fade_frames: usize,
     pub out: &'a Path,
+}
+
+/// A character fading at a frame.
+#[derive(Clone, Debug, Serialize)]
+pub struct FadeRow {
+    pub character: usize,
+    /// The setting it fades from ("method setting", "none").
+    pub from: String,
+    /// That setting's share of the character's result.
+    pub weight: f64,
 }
 
 /// One frame of the sequence.
@@ -62,7 +80,13 @@ pub struct FrameRow {
     pub groups: Vec<String>,
     pub predicted_ms: f64,
     pub predicted_error: f64,
-    /// The plan's skin-weighted err/none against this frame's ground truth.
+    /// The characters cross-fading at this frame.
+    pub fades: Vec<FadeRow>,
+    /// What the fades add to the modelled cost (`over_time::fade_cost_ms`;
+    /// `None`: an old setting unpriced), beyond `predicted_ms` and the budget.
+    pub fade_ms: Option<f64>,
+    /// The plan's skin-weighted err/none against this frame's ground truth
+    /// (as rendered: with its fades).
     pub measured_error: f64,
     pub solve_ms: f64,
     pub inputs_ms: f64,
@@ -112,6 +136,7 @@ pub struct MotionReport {
     pub budget_ms: f64,
     pub switch_margin: f64,
     pub look_ahead: usize,
+    pub fade_frames: usize,
     pub accuracy: String,
     /// The ground truth's `--density` (`None`: its default).
     pub truth_density: Option<String>,
@@ -127,8 +152,20 @@ pub struct MotionReport {
     pub max_abs_excess_at_switches: Option<f64>,
     /// Largest |excess| of the switching characters at their other frames.
     pub max_abs_excess_elsewhere: Option<f64>,
-    pub cross_fade_needed: bool,
+    /// Switches that pop as rendered (with the fades, if any).
+    pub popping: usize,
+    /// Without fades (`fade_frames` 0): whether a switch pops, so a
+    /// cross-fade is needed. With fades: not measured (`None`).
+    pub cross_fade_needed: Option<bool>,
+    /// Frames whose plan and fades together exceed the budget, and the
+    /// largest excess (ms).
+    pub frames_over_budget_with_fades: usize,
+    pub max_over_budget_ms: f64,
     pub verdict: String,
+}
+
+fn fade_label(from: &Option<(String, String)>) -> String {
+    group_label(from)
 }
 
 fn group_label(l: &Option<(String, String)>) -> String {
@@ -184,6 +221,7 @@ fn render_frames(
     inputs: &[FrameInput],
     with: &[FramePlan],
     labels: &[Vec<String>],
+    fading: &[Vec<Option<FadeAt>>],
 ) -> Result<Rendered> {
     let n = o.base.heads as usize;
     let mut plan_changes: Vec<Vec<Change>> = vec![Vec::new()];
@@ -195,7 +233,7 @@ fn render_frames(
         let truth = Truth::render(ctx, o.scene, s).with_context(|| format!("frame {k}"))?;
         let fp = &with[k];
         let inp = &inputs[k];
-        let file = plan_file(
+        let mut file = plan_file(
             &o.profile.profile.name,
             o.budget_ms,
             &inp.characters,
@@ -203,6 +241,38 @@ fn render_frames(
             &fp.plan,
             Vec::new(),
         )?;
+        let mut fade_rows = Vec::new();
+        for (c, f) in fading[k].iter().enumerate() {
+            let Some(f) = f else { continue };
+            let (method, options) = match &f.from {
+                None => (crate::mix::Choice::none().method, Default::default()),
+                Some((m, st)) => (
+                    m.clone(),
+                    registered()
+                        .into_iter()
+                        .find(|x| x.method == m.as_str() && x.setting == st.as_str())
+                        .map(|x| x.options)
+                        .with_context(|| format!("setting {m} '{st}' is not registered"))?,
+                ),
+            };
+            let a = file
+                .assignments
+                .iter_mut()
+                .find(|a| a.character == c)
+                .context("a fading character has no assignment")?;
+            a.fade = Some(crate::mix::plan_file::PlannedFade {
+                method,
+                options,
+                weight: f.weight,
+            });
+            fade_rows.push(FadeRow {
+                character: c,
+                from: fade_label(&f.from),
+                weight: f.weight,
+            });
+        }
+        file.check()
+            .with_context(|| format!("frame {k}: the plan with its fades"))?;
         let mut ps = s.clone();
         ps.assignment = Some(Assignment::Plan(file));
         let planned = render(ctx, o.scene, &ps).with_context(|| format!("frame {k}: the plan"))?;
@@ -223,6 +293,8 @@ fn render_frames(
             groups,
             predicted_ms: fp.plan.solution.cost_ms,
             predicted_error: fp.plan.solution.error,
+            fades: fade_rows,
+            fade_ms: fade_cost_ms(&inp.costs, &fp.labels, &fading[k]),
             measured_error: measured,
             solve_ms: fp.solve_ms,
             inputs_ms: inp.inputs_ms,
@@ -258,10 +330,17 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
     let (lw, lwo) = (labels(&with), labels(&without));
     let (cw, cwo) = (switch_counts(&lw, n), switch_counts(&lwo, n));
 
+    let on_screen: Vec<Vec<bool>> = inputs
+        .iter()
+        .map(|f| f.characters.iter().map(|c| c.skin_pixels > 0.0).collect())
+        .collect();
+    let plan_labels: Vec<Vec<Option<(String, String)>>> =
+        with.iter().map(|p| p.labels.clone()).collect();
+    let fading = fades(&plan_labels, &on_screen, o.fade_frames);
     let (rows, plan_changes, truth_changes) =
-        render_frames(ctx, o, &frame_settings, &inputs, &with, &lw)?;
+        render_frames(ctx, o, &frame_settings, &inputs, &with, &lw, &fading)?;
     let sw = switches(&lw);
-    let measured_pops = pops(&sw, &plan_changes, &truth_changes);
+    let measured_pops = pops(&sw, &spreads(&sw, &fading), &plan_changes, &truth_changes);
     let series: Vec<CharacterSeries> = (0..n)
         .map(|c| {
             let pick = |v: &[Vec<Change>], k: usize| {
@@ -305,7 +384,13 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         .filter(|p| pops_out(p))
         .map(|p| p.excess.abs())
         .reduce(f64::max);
-    let needed = worst_pop.is_some();
+    let popping = measured_pops.iter().filter(|p| pops_out(p)).count();
+    let over: Vec<f64> = rows
+        .iter()
+        .map(|f| f.predicted_ms + f.fade_ms.unwrap_or(0.0) - o.budget_ms)
+        .collect();
+    let frames_over = over.iter().filter(|&&x| x > 1e-9).count();
+    let max_over = over.iter().copied().fold(0.0, f64::max);
     let solve: Vec<f64> = with.iter().map(|f| f.solve_ms).collect();
     let inp: Vec<f64> = inputs.iter().map(|f| f.inputs_ms).collect();
     let ((sm, sx), (im, ix)) = (mean_max(&solve), mean_max(&inp));
@@ -313,26 +398,47 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         .iter()
         .filter(|p| p.excess.abs() > FLICKER_BOUND)
         .count();
-    let verdict = match (at, worst_pop) {
+    let faded = o.fade_frames > 0;
+    let (no_pop, pop) = if faded {
+        (
+            format!("with {}-frame cross-fades no switch pops", o.fade_frames),
+            format!(
+                "a switch pops even with {}-frame cross-fades",
+                o.fade_frames
+            ),
+        )
+    } else {
+        (
+            "no cross-fade needed".to_string(),
+            "a switch pops: a cross-fade is needed".to_string(),
+        )
+    };
+    let mut verdict = match (at, worst_pop) {
         (None, _) => "no switch was on screen: nothing to measure".to_string(),
         (Some(_), Some(w)) => format!(
-            "a switch pops: its excess change {w:.5} exceeds the flicker test's bound \
+            "{pop}: its excess change {w:.5} exceeds the flicker test's bound \
              {FLICKER_BOUND} and the same character's change at the frames it does not \
-             switch: a cross-fade is needed"
+             switch"
         ),
         (Some(a), None) if over_bound > 0 => format!(
-            "no cross-fade needed: {over_bound} switch(es) exceed the flicker test's bound \
+            "{no_pop}: {over_bound} switch(es) exceed the flicker test's bound \
              {FLICKER_BOUND} (at most {a:.5}) but none exceeds its character's own change at \
              the frames it does not switch (at most {})",
             elsewhere.map_or("-".to_string(), |e| format!("{e:.5}"))
         ),
         (Some(a), None) => format!(
-            "no cross-fade needed: the largest excess change at a switch, {a:.5}, is within \
+            "{no_pop}: the largest excess change at a switch, {a:.5}, is within \
              the flicker test's bound {FLICKER_BOUND} (the same characters at their other \
              frames: {})",
             elsewhere.map_or("-".to_string(), |e| format!("{e:.5}"))
         ),
     };
+    if frames_over > 0 {
+        verdict.push_str(&format!(
+            "; the fades take {frames_over} frame(s) over the {} ms budget, by up to {max_over:.4} ms",
+            o.budget_ms
+        ));
+    }
     let report = MotionReport {
         device: ctx.facts.name.clone(),
         width: o.base.width,
@@ -345,6 +451,7 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         budget_ms: o.budget_ms,
         switch_margin: o.switch_margin,
         look_ahead: o.look_ahead,
+        fade_frames: o.fade_frames,
         accuracy: o.accuracy_source.clone(),
         truth_density: o.base.options.given("density").map(|d| d.to_string()),
         timing: Timing {
@@ -363,7 +470,10 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         bound: FLICKER_BOUND,
         max_abs_excess_at_switches: at,
         max_abs_excess_elsewhere: elsewhere,
-        cross_fade_needed: needed,
+        popping,
+        cross_fade_needed: (!faded).then_some(popping > 0),
+        frames_over_budget_with_fades: frames_over,
+        max_over_budget_ms: max_over,
         verdict,
     };
     write_json(&o.out.join("plan-motion.json"), &report)?;
@@ -394,7 +504,8 @@ fn chart_lines(r: &MotionReport) -> Vec<Line> {
 pub fn summary(r: &MotionReport) -> String {
     let mut s = format!(
         "{} at {}x{}: {} characters ({:?}) {} head heights away, walking {} head heights \
-         toward the camera over {} frames; {} at {} ms, margin {}, looking {} frames ahead\n",
+         toward the camera over {} frames; {} at {} ms, margin {}, looking {} frames ahead, \
+         fading over {} frames\n",
         r.device,
         r.width,
         r.height,
@@ -406,23 +517,39 @@ pub fn summary(r: &MotionReport) -> String {
         r.profile,
         r.budget_ms,
         r.switch_margin,
-        r.look_ahead
+        r.look_ahead,
+        r.fade_frames
     );
     s.push_str(&format!(
-        "{:>5} {:>6}  {:<40} {:>9} {:>9} {:>9} {:>9}\n",
-        "frame", "walk", "groups", "pred ms", "pred err", "meas err", "solve ms"
+        "{:>5} {:>6}  {:<40} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+        "frame", "walk", "groups", "pred ms", "fade ms", "pred err", "meas err", "solve ms"
     ));
     for f in &r.frames {
         s.push_str(&format!(
-            "{:>5} {:>6.2}  {:<40} {:>9.4} {:>9.4} {:>9.4} {:>9.3}\n",
+            "{:>5} {:>6.2}  {:<40} {:>9.4} {:>9} {:>9.4} {:>9.4} {:>9.3}\n",
             f.frame,
             f.walk_heads,
             f.groups.join(" + "),
             f.predicted_ms,
+            match (f.fades.is_empty(), f.fade_ms) {
+                (true, _) => "-".to_string(),
+                (false, Some(ms)) => format!("{ms:.4}"),
+                (false, None) => "unpriced".to_string(),
+            },
             f.predicted_error,
             f.measured_error,
             f.solve_ms
         ));
+        for fr in &f.fades {
+            s.push_str(&format!(
+                "{:>5} {:>6}  character {} fading from {} ({:.0}%)\n",
+                "",
+                "",
+                fr.character,
+                fr.from,
+                100.0 * fr.weight
+            ));
+        }
     }
     s.push_str(&format!(
         "switches: {} with the margin, {} without\n",
@@ -430,12 +557,20 @@ pub fn summary(r: &MotionReport) -> String {
     ));
     for p in &r.pops {
         s.push_str(&format!(
-            "switch at frame {} of character {} ({} -> {}), {} px: change {:.5}, truth's \
+            "switch at frame {} of character {} ({} -> {}){}, {} px: change {:.5}, truth's \
              {:.5}, excess {:+.5} ({:+.2}% of its level)\n",
             p.frame,
             p.character,
             p.from,
             p.to,
+            if p.spread_frames > 1 {
+                format!(
+                    " faded over {} steps, largest at frame {}",
+                    p.spread_frames, p.measured_frame
+                )
+            } else {
+                String::new()
+            },
             p.pixels,
             p.plan_change,
             p.truth_change,

@@ -10,6 +10,12 @@
 //! against the ground truth's own change over the same pixels at the same
 //! frames (the measure of `tests/suite/stability.rs`'s flicker test).
 //!
+//! A switch on screen may be **cross-faded** over a few frames ([`fades`]):
+//! the character's old setting keeps running beside the new one and its
+//! share of the result falls to 0 in equal steps (the renderer's
+//! `mix::Fade`); its extra cost is [`fade_cost_ms`], and a faded switch's
+//! change is measured over every frame it is spread over ([`pops`]).
+//!
 //! Pure: no device (tests/suite/layers.rs holds it to it); the renders are
 //! `motion.rs`'s.
 
@@ -308,13 +314,20 @@ pub fn changes(
 }
 
 /// A switch measured: the plan's change of the character at the switch
-/// against the truth's change over the same pixels at the same frames.
+/// against the truth's change over the same pixels at the same frames; for a
+/// faded switch, at the frame of its fade where the excess is largest.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Pop {
+    /// The frame the new setting is first used in.
     pub frame: usize,
     pub character: usize,
     pub from: String,
     pub to: String,
+    /// Frames its change is spread over (1: a hard switch; a fade of F
+    /// frames: F + 1, the last step being the old setting's share to 0).
+    pub spread_frames: usize,
+    /// The frame measured below (of `frame..frame + spread_frames`).
+    pub measured_frame: usize,
     pub pixels: usize,
     pub plan_change: f64,
     pub truth_change: f64,
@@ -330,30 +343,52 @@ pub struct Pop {
 
 /// Pops of `switches` from the per-frame changes of the plan and of the
 /// truth (`plan[k][c]`: the change from frame k-1 to k, `plan[0]` unused).
-/// A switch at a frame where the character has no pixel in both frames is
-/// left out (nothing of it is on screen to pop).
-pub fn pops(switches: &[Switch<String>], plan: &[Vec<Change>], truth: &[Vec<Change>]) -> Vec<Pop> {
-    let switched = |k: usize, c: usize| switches.iter().any(|s| s.frame == k && s.character == c);
+/// `spread[i]` is the number of frames switch `i`'s change is spread over (1
+/// without a fade): its excess is the largest over those frames with pixels,
+/// and they are not among the character's "other frames". A switch none of
+/// whose frames has the character's pixels in both frames is left out
+/// (nothing of it is on screen to pop).
+pub fn pops(
+    switches: &[Switch<String>],
+    spread: &[usize],
+    plan: &[Vec<Change>],
+    truth: &[Vec<Change>],
+) -> Vec<Pop> {
+    let span = |i: usize| {
+        let s = &switches[i];
+        s.frame..(s.frame + spread.get(i).copied().unwrap_or(1).max(1)).min(plan.len())
+    };
+    let switching = |k: usize, c: usize| {
+        (0..switches.len()).any(|i| switches[i].character == c && span(i).contains(&k))
+    };
+    let at = |k: usize, c: usize| -> Option<(Change, Change)> {
+        let (p, t) = (*plan.get(k)?.get(c)?, *truth.get(k)?.get(c)?);
+        (p.pixels > 0).then_some((p, t))
+    };
     switches
         .iter()
-        .filter_map(|s| {
-            let (p, t) = (
-                plan.get(s.frame)?.get(s.character)?,
-                truth.get(s.frame)?.get(s.character)?,
-            );
-            if p.pixels == 0 {
-                return None;
-            }
+        .enumerate()
+        .filter_map(|(i, s)| {
+            let c = s.character;
+            let (k, (p, t)) = span(i)
+                .filter_map(|k| at(k, c).map(|x| (k, x)))
+                .max_by(|a, b| {
+                    let e = |x: &(Change, Change)| (x.0.mean_abs - x.1.mean_abs).abs();
+                    e(&a.1).total_cmp(&e(&b.1))
+                })?;
             let excess = p.mean_abs - t.mean_abs;
             let elsewhere = (1..plan.len())
-                .filter(|&k| !switched(k, s.character) && plan[k][s.character].pixels > 0)
-                .map(|k| (plan[k][s.character].mean_abs - truth[k][s.character].mean_abs).abs())
+                .filter(|&k| !switching(k, c))
+                .filter_map(|k| at(k, c))
+                .map(|(p, t)| (p.mean_abs - t.mean_abs).abs())
                 .reduce(f64::max);
             Some(Pop {
                 frame: s.frame,
-                character: s.character,
+                character: c,
                 from: s.from.clone(),
                 to: s.to.clone(),
+                spread_frames: span(i).len(),
+                measured_frame: k,
                 pixels: p.pixels,
                 plan_change: p.mean_abs,
                 truth_change: t.mean_abs,
@@ -363,6 +398,137 @@ pub fn pops(switches: &[Switch<String>], plan: &[Vec<Change>], truth: &[Vec<Chan
             })
         })
         .collect()
+}
+
+/// The fade `dermis plan-motion` uses unless told: 3 frames (the old
+/// setting's share 3/4, 1/2, 1/4), so a switch's change is spread over four
+/// equal steps, a tenth of a second at 30 Hz.
+pub const DEFAULT_FADE_FRAMES: usize = 3;
+
+/// The most frames a fade may take.
+pub const MAX_FADE_FRAMES: usize = 60;
+
+/// Checks a fade length (`--fade-frames`).
+pub fn check_fade_frames(f: usize) -> Result<()> {
+    if f > MAX_FADE_FRAMES {
+        bail!("--fade-frames must be within 0..={MAX_FADE_FRAMES}, got {f}");
+    }
+    Ok(())
+}
+
+/// A character fading at one frame: the setting it fades from (`None`: no
+/// SSS) and that setting's share of its result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FadeAt {
+    pub from: Option<(String, String)>,
+    pub weight: f64,
+}
+
+/// Per frame and character, the cross-fades of a sequence's switches
+/// (`labels[frame][character]`, the plan's settings) over `fade_frames`
+/// frames: a switch at frame `j` of a character on screen at `j - 1` and `j`
+/// (`on_screen`: the planner's estimate of its skin pixels, what a game
+/// knows) keeps its old setting at `j..j + fade_frames` with the share
+/// `(F - t) / (F + 1)` at frame `j + t` (3 frames: 3/4, 1/2, 1/4), so the
+/// change is spread over `F + 1` equal steps. A character leaving the screen
+/// ends its fade; switching again starts a fade from the setting it had the
+/// frame before (the old fade is dropped). 0 frames: no fade.
+pub fn fades(
+    labels: &[Vec<Option<(String, String)>>],
+    on_screen: &[Vec<bool>],
+    fade_frames: usize,
+) -> Vec<Vec<Option<FadeAt>>> {
+    let n = labels.first().map_or(0, Vec::len);
+    let mut out = vec![vec![None; n]; labels.len()];
+    if fade_frames == 0 {
+        return out;
+    }
+    let seen = |k: usize, c: usize| on_screen.get(k).and_then(|f| f.get(c)).copied() == Some(true);
+    for c in 0..n {
+        // (setting faded from, first frame of the fade)
+        let mut current: Option<(Option<(String, String)>, usize)> = None;
+        for k in 1..labels.len() {
+            if labels[k][c] != labels[k - 1][c] {
+                current = (seen(k - 1, c) && seen(k, c)).then(|| (labels[k - 1][c].clone(), k));
+            }
+            if !seen(k, c) {
+                current = None;
+            }
+            if let Some((from, j)) = &current {
+                let t = k - j;
+                if t < fade_frames {
+                    out[k][c] = Some(FadeAt {
+                        from: from.clone(),
+                        weight: (fade_frames - t) as f64 / (fade_frames + 1) as f64,
+                    });
+                } else {
+                    current = None;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The frames each switch's change is spread over, for [`pops`]: 1 + the
+/// frames of its fade (a fade cut short by another switch or by leaving the
+/// screen counts the frames it ran).
+pub fn spreads(switches: &[Switch<String>], fades: &[Vec<Option<FadeAt>>]) -> Vec<usize> {
+    switches
+        .iter()
+        .map(|s| {
+            let faded = (s.frame..fades.len())
+                .take_while(|&k| {
+                    fades[k].get(s.character).is_some_and(Option::is_some)
+                        && (k == s.frame
+                            || fades[k][s.character].as_ref().map(|f| f.weight)
+                                < fades[k - 1][s.character].as_ref().map(|f| f.weight))
+                })
+                .count();
+            // A fade's last step, its share to 0, is the frame after it.
+            if faded > 0 {
+                (faded + 1).min(fades.len() - s.frame)
+            } else {
+                1
+            }
+        })
+        .collect()
+}
+
+/// What the fades of one frame add to its modelled cost (ms): per fading
+/// character its old setting's part and fixed cost (an instance of its
+/// own), and per setting the fixed cost of every instance beyond the one
+/// the plan counted (a fading character's group is apart from the others
+/// that run its new setting). `None` when an old setting is unpriced for
+/// the character at this frame.
+pub fn fade_cost_ms(
+    costs: &[SettingCosts],
+    labels: &[Option<(String, String)>],
+    fades: &[Option<FadeAt>],
+) -> Option<f64> {
+    let index = |l: &(String, String)| {
+        costs
+            .iter()
+            .position(|s| s.method == l.0 && s.setting == l.1)
+    };
+    let mut ms = 0.0;
+    for (c, f) in fades.iter().enumerate() {
+        if let Some(old) = f.as_ref().and_then(|f| f.from.as_ref()) {
+            let s = &costs[index(old)?];
+            ms += s.parts_ms.get(c).copied().flatten()? + s.fixed_ms;
+        }
+    }
+    for (si, s) in costs.iter().enumerate() {
+        let runs = |c: usize| labels[c].as_ref().and_then(index) == Some(si);
+        let fading = (0..labels.len())
+            .filter(|&c| runs(c) && fades.get(c).is_some_and(Option::is_some))
+            .count();
+        let others =
+            (0..labels.len()).any(|c| runs(c) && !fades.get(c).is_some_and(Option::is_some));
+        let instances = fading + usize::from(others);
+        ms += instances.saturating_sub(1) as f64 * s.fixed_ms;
+    }
+    Some(ms)
 }
 
 /// Mean and max of a series (0 for none).
@@ -592,11 +758,112 @@ mod tests {
             from: "a".to_string(),
             to: "b".to_string(),
         }];
-        let p = pops(&s, &plan, &truth);
+        let p = pops(&s, &[1], &plan, &truth);
         assert_eq!(p.len(), 1);
         assert!((p[0].excess - 0.020).abs() < 1e-12);
         assert!((p[0].relative_excess - 0.04).abs() < 1e-12);
         assert!((p[0].excess_elsewhere.unwrap() - 0.002).abs() < 1e-12);
+        assert_eq!((p[0].spread_frames, p[0].measured_frame), (1, 2));
+        // Spread over frames 2 and 3 (a one-frame fade): the larger excess of
+        // the two is the switch's, and only frame 1 is "elsewhere".
+        let p = pops(&s, &[2], &plan, &truth);
+        assert_eq!((p[0].spread_frames, p[0].measured_frame), (2, 2));
+        assert!((p[0].excess_elsewhere.unwrap() - 0.001).abs() < 1e-12);
+    }
+
+    fn l(s: &str) -> Option<(String, String)> {
+        (s != "-").then(|| (s.to_string(), "x".to_string()))
+    }
+
+    #[test]
+    fn a_switch_fades_in_equal_steps_while_on_screen() {
+        // One character: a -> b at frame 2, b -> - at frame 7 (off screen
+        // from frame 7 on, so that switch is not faded).
+        let seq = ["a", "a", "b", "b", "b", "b", "b", "-", "-"];
+        let labels: Vec<_> = seq.iter().map(|x| vec![l(x)]).collect();
+        let on: Vec<_> = (0..seq.len()).map(|k| vec![k < 7]).collect();
+        let f = fades(&labels, &on, 3);
+        let w: Vec<Option<f64>> = f.iter().map(|x| x[0].as_ref().map(|f| f.weight)).collect();
+        assert_eq!(
+            w,
+            [
+                None,
+                None,
+                Some(0.75),
+                Some(0.5),
+                Some(0.25),
+                None,
+                None,
+                None,
+                None
+            ]
+        );
+        assert_eq!(f[2][0].as_ref().unwrap().from, l("a"));
+        assert!(fades(&labels, &on, 0).iter().all(|x| x[0].is_none()));
+        let sw = switches(&seq.iter().map(|x| vec![x.to_string()]).collect::<Vec<_>>());
+        assert_eq!(spreads(&sw, &f), [4, 1]);
+        // Switching again mid-fade starts a new fade from the setting before.
+        let seq = ["a", "b", "c", "c", "c"];
+        let labels: Vec<_> = seq.iter().map(|x| vec![l(x)]).collect();
+        let on = vec![vec![true]; 5];
+        let f = fades(&labels, &on, 2);
+        let got: Vec<_> = f
+            .iter()
+            .map(|x| x[0].as_ref().map(|f| (f.from.clone(), f.weight)))
+            .collect();
+        let third = 1.0 / 3.0;
+        assert_eq!(
+            got,
+            [
+                None,
+                Some((l("a"), 2.0 * third)),
+                Some((l("b"), 2.0 * third)),
+                Some((l("b"), third)),
+                None
+            ]
+        );
+        let sw = switches(&seq.iter().map(|x| vec![x.to_string()]).collect::<Vec<_>>());
+        assert_eq!(spreads(&sw, &f), [1, 3]);
+    }
+
+    #[test]
+    fn a_fade_costs_the_old_setting_and_the_new_setting_s_second_instance() {
+        let setting = |m: &str, fixed: f64, parts: [f64; 3]| SettingCosts {
+            method: m.to_string(),
+            setting: "x".to_string(),
+            fixed_ms: fixed,
+            parts_ms: parts.iter().map(|&p| Some(p)).collect(),
+            texel_mm: vec![None; 3],
+        };
+        let costs = vec![
+            setting("a", 0.1, [1.0, 2.0, 3.0]),
+            setting("b", 0.2, [0.5, 0.6, 0.7]),
+        ];
+        let labels = vec![l("b"), l("b"), l("a")];
+        let fade = |from: &str| {
+            Some(FadeAt {
+                from: l(from),
+                weight: 0.5,
+            })
+        };
+        // Character 0 fades a -> b: a's part and fixed, and b's fixed again
+        // (character 1 runs b in a group of its own).
+        let ms = fade_cost_ms(&costs, &labels, &[fade("a"), None, None]).unwrap();
+        assert!((ms - (1.0 + 0.1 + 0.2)).abs() < 1e-12, "{ms}");
+        // From no SSS: only the second instance of b.
+        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), None, None]).unwrap();
+        assert!((ms - 0.2).abs() < 1e-12, "{ms}");
+        // Both b characters fading: two instances of b where the plan
+        // counted one.
+        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), fade("-"), None]).unwrap();
+        assert!((ms - 0.2).abs() < 1e-12, "{ms}");
+        // Character 2 (a, alone in its group) fading from b: b's part and
+        // fixed, and no second instance of a.
+        let ms = fade_cost_ms(&costs, &labels, &[None, None, fade("b")]).unwrap();
+        assert!((ms - (0.7 + 0.2)).abs() < 1e-12, "{ms}");
+        let mut unpriced = costs.clone();
+        unpriced[0].parts_ms[0] = None;
+        assert!(fade_cost_ms(&unpriced, &labels, &[fade("a"), None, None]).is_none());
     }
 
     #[test]

@@ -152,6 +152,7 @@ fn plan_motion_measures_switches_against_the_truth() {
             walk: Walk::new(5, 1.0).unwrap(),
             switch_margin: DEFAULT_MARGIN,
             look_ahead: 0,
+            fade_frames: 0,
             out: &out,
         },
     )
@@ -176,12 +177,106 @@ fn plan_motion_measures_switches_against_the_truth() {
         assert!(p.truth_change > 0.0, "{p:?}");
         assert!(p.excess.abs() <= FLICKER_BOUND, "the switch pops: {p:?}");
     }
-    assert!(!r.cross_fade_needed, "{}", r.verdict);
+    assert_eq!(r.cross_fade_needed, Some(false), "{}", r.verdict);
     assert!(r.switches_with_margin <= r.switches_without_margin);
     println!("solve per frame: {:?}", r.timing);
     for f in ["plan-motion.json", "plan-motion.png", "plan-motion.svg"] {
         assert!(out.join(f).is_file(), "{f} written");
     }
+}
+
+/// The same sequence with 3-frame cross-fades: the front character's switch
+/// at frame 2 (ss-jittered to none, budget-forced) keeps ss-jittered at
+/// 3/4, 1/2 and 1/4 of its result over frames 2-4, priced beside the plan;
+/// its change is measured over the three frames it is spread over here (the
+/// sequence ends before the fade's last step), and its largest excess there
+/// is under the hard switch's.
+#[test]
+fn plan_motion_cross_fades_a_switch_over_three_frames() {
+    use dermis::plan::motion::{self, MotionOptions};
+    let ctx = common::ctx();
+    let scene = face();
+    let mut base = RenderSettings::study();
+    base.width = 160;
+    base.height = 90;
+    base.heads = 9;
+    base.fovy_deg = 12.0;
+    base.distance_heads = 2.5;
+    base.options.set("density", "1");
+    let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
+    let run = |fade_frames: usize| {
+        let out = tmp(&format!("fade-{fade_frames}"));
+        std::fs::create_dir_all(&out).unwrap();
+        motion::run(
+            &ctx,
+            &MotionOptions {
+                base: base.clone(),
+                scene: &scene,
+                accuracy: &acc,
+                accuracy_source: acc.source(),
+                profile: Profile::load("xbox360").unwrap(),
+                budget_ms: 0.2,
+                walk: Walk::new(5, 1.0).unwrap(),
+                switch_margin: DEFAULT_MARGIN,
+                look_ahead: 0,
+                fade_frames,
+                out: &out,
+            },
+        )
+        .unwrap()
+    };
+    let (hard, faded) = (run(0), run(3));
+    print!("{}", motion::summary(&faded));
+    // The fades do not change the plan.
+    for (a, b) in hard.frames.iter().zip(&faded.frames) {
+        assert_eq!(a.groups, b.groups);
+        assert!(a.fades.is_empty());
+    }
+    let front: Vec<Option<f64>> = faded
+        .frames
+        .iter()
+        .map(|f| f.fades.iter().find(|x| x.character == 0).map(|x| x.weight))
+        .collect();
+    assert_eq!(front, [None, None, Some(0.75), Some(0.5), Some(0.25)]);
+    let f2 = &faded.frames[2];
+    assert!(f2
+        .fades
+        .iter()
+        .any(|x| x.character == 0 && x.from.starts_with("ss-jittered")));
+    // Its cost: ss-jittered's part and fixed cost for the front character.
+    assert!(f2.fade_ms.unwrap() > 0.05, "{f2:?}");
+    let pop = |r: &motion::MotionReport| {
+        r.pops
+            .iter()
+            .find(|p| p.character == 0 && p.frame == 2)
+            .cloned()
+            .expect("the front character's switch is measured")
+    };
+    let (h, f) = (pop(&hard), pop(&faded));
+    assert_eq!((h.spread_frames, f.spread_frames), (1, 3));
+    // At the switch the fade moves a quarter of the way: the jump over the
+    // truth's own change is smaller there (later frames add the method's own
+    // change under motion, the same with or without the fade).
+    let excess = |r: &motion::MotionReport, k: usize| {
+        let c = &r.characters[0];
+        (c.plan_change[k].unwrap() - c.truth_change[k].unwrap()).abs()
+    };
+    for r in [&hard, &faded] {
+        println!(
+            "front character, excess per frame: {:?}",
+            (1..5).map(|k| excess(r, k)).collect::<Vec<_>>()
+        );
+    }
+    assert!(
+        excess(&faded, 2) < excess(&hard, 2),
+        "faded {f:?} against hard {h:?}"
+    );
+    assert_eq!(faded.cross_fade_needed, None);
+    assert_eq!(faded.fade_frames, 3);
+    println!(
+        "front character's switch: excess {:+.5} at once, {:+.5} at most over its fade",
+        h.excess, f.excess
+    );
 }
 
 /// `plan-motion`'s arguments are checked before a device opens: one line
@@ -197,6 +292,7 @@ fn plan_motion_errors_are_one_line_and_need_no_device() {
         (vec!["--frames", "100000"], "--frames"),
         (vec!["--frames", "4", "--look-ahead", "4"], "--look-ahead"),
         (vec!["--switch-margin", "-0.1"], "--switch-margin"),
+        (vec!["--fade-frames", "61"], "--fade-frames"),
         (vec!["--budget-ms", "0"], "not a positive number"),
     ] {
         let mut all = vec!["plan-motion", "--profile", "xbox360"];
