@@ -823,7 +823,8 @@ mod tests {
             ]
         );
         let sw = switches(&seq.iter().map(|x| vec![x.to_string()]).collect::<Vec<_>>());
-        assert_eq!(spreads(&sw, &f), [1, 3]);
+        // The cut fade's rest (a's last third) goes at frame 2, with the new one.
+        assert_eq!(spreads(&sw, &f), [2, 3]);
     }
 
     #[test]
