@@ -339,18 +339,72 @@ pub struct Pop {
     /// switch (its method's own change under motion): what the switch is
     /// told apart from. `None`: no such frame with pixels.
     pub excess_elsewhere: Option<f64>,
+    /// The switch itself: mean absolute difference (per channel) between the
+    /// new setting's and the old one's result for the character at the switch
+    /// frame, both rendered (`None`: not measured). What a hard switch adds
+    /// to the frame's change whatever the motion; the excess also holds each
+    /// method's own change under motion.
+    pub jump: Option<f64>,
+    /// The most of `jump` that one frame shows: the whole of it for a hard
+    /// switch, its largest share step for a fade ([`largest_share_step`]).
+    pub step: Option<f64>,
+}
+
+impl Pop {
+    /// Whether the switch pops: its own step at one frame exceeds what the
+    /// flicker test allows a method's change beyond the truth's. Unmeasured
+    /// (`step` `None`), the excess must exceed the bound and the character's
+    /// own excess at the frames it does not switch.
+    pub fn pops(&self) -> bool {
+        match self.step {
+            Some(s) => s > FLICKER_BOUND,
+            None => {
+                self.excess.abs() > FLICKER_BOUND
+                    && self.excess_elsewhere.is_none_or(|e| self.excess.abs() > e)
+            }
+        }
+    }
+}
+
+/// The largest change of the old setting's share at one frame of a switch's
+/// spread (1 before the switch, the fade's weights, 0 after), over the
+/// frames `has_pixels` says show the character: 1 for a hard switch, 1/(F+1)
+/// for a whole fade of F frames.
+pub fn largest_share_step(
+    s: &Switch<String>,
+    spread: usize,
+    fades: &[Vec<Option<FadeAt>>],
+    has_pixels: impl Fn(usize) -> bool,
+) -> f64 {
+    let share = |k: usize| -> f64 {
+        if k < s.frame {
+            return 1.0;
+        }
+        fades
+            .get(k)
+            .and_then(|f| f.get(s.character))
+            .and_then(|f| f.as_ref())
+            .map_or(0.0, |f| f.weight)
+    };
+    (s.frame..s.frame + spread.max(1))
+        .filter(|&k| has_pixels(k))
+        .map(|k| share(k - 1) - share(k))
+        .fold(0.0, f64::max)
 }
 
 /// Pops of `switches` from the per-frame changes of the plan and of the
 /// truth (`plan[k][c]`: the change from frame k-1 to k, `plan[0]` unused).
 /// `spread[i]` is the number of frames switch `i`'s change is spread over (1
 /// without a fade): its excess is the largest over those frames with pixels,
-/// and they are not among the character's "other frames". A switch none of
+/// and they are not among the character's "other frames". `steps[i]` is the
+/// switch's measured jump and largest share step (`None`: unmeasured). A
+/// switch none of
 /// whose frames has the character's pixels in both frames is left out
 /// (nothing of it is on screen to pop).
 pub fn pops(
     switches: &[Switch<String>],
     spread: &[usize],
+    steps: &[Option<(f64, f64)>],
     plan: &[Vec<Change>],
     truth: &[Vec<Change>],
 ) -> Vec<Pop> {
@@ -395,6 +449,8 @@ pub fn pops(
                 excess,
                 relative_excess: excess / t.mean_level.max(1e-12),
                 excess_elsewhere: elsewhere,
+                jump: steps.get(i).copied().flatten().map(|x| x.0),
+                step: steps.get(i).copied().flatten().map(|x| x.0 * x.1),
             })
         })
         .collect()
@@ -758,7 +814,7 @@ mod tests {
             from: "a".to_string(),
             to: "b".to_string(),
         }];
-        let p = pops(&s, &[1], &plan, &truth);
+        let p = pops(&s, &[1], &[None], &plan, &truth);
         assert_eq!(p.len(), 1);
         assert!((p[0].excess - 0.020).abs() < 1e-12);
         assert!((p[0].relative_excess - 0.04).abs() < 1e-12);
@@ -766,9 +822,20 @@ mod tests {
         assert_eq!((p[0].spread_frames, p[0].measured_frame), (1, 2));
         // Spread over frames 2 and 3 (a one-frame fade): the larger excess of
         // the two is the switch's, and only frame 1 is "elsewhere".
-        let p = pops(&s, &[2], &plan, &truth);
+        let p = pops(&s, &[2], &[Some((0.008, 0.5))], &plan, &truth);
         assert_eq!((p[0].spread_frames, p[0].measured_frame), (2, 2));
         assert!((p[0].excess_elsewhere.unwrap() - 0.001).abs() < 1e-12);
+        // Measured, the switch's own step decides: 0.004 at one frame is
+        // within the bound though the excess (0.020) is not.
+        assert_eq!((p[0].jump, p[0].step), (Some(0.008), Some(0.004)));
+        assert!(!p[0].pops());
+        let p = pops(&s, &[1], &[Some((0.008, 1.0))], &plan, &truth);
+        assert!(p[0].pops());
+        let p = pops(&s, &[1], &[None], &plan, &truth);
+        assert!(
+            p[0].pops(),
+            "unmeasured: excess 0.020 over the bound and over 0.002"
+        );
     }
 
     fn l(s: &str) -> Option<(String, String)> {
@@ -802,6 +869,13 @@ mod tests {
         assert!(fades(&labels, &on, 0).iter().all(|x| x[0].is_none()));
         let sw = switches(&seq.iter().map(|x| vec![x.to_string()]).collect::<Vec<_>>());
         assert_eq!(spreads(&sw, &f), [4, 1]);
+        // Shares 1, 3/4, 1/2, 1/4, 0: a quarter at each of the four frames.
+        assert_eq!(largest_share_step(&sw[0], 4, &f, |_| true), 0.25);
+        // The hard switch to none at frame 7: all of it at once.
+        assert_eq!(largest_share_step(&sw[1], 1, &f, |_| true), 1.0);
+        // Off screen after the first fade frame: only 1 -> 3/4 is seen.
+        assert_eq!(largest_share_step(&sw[0], 4, &f, |k| k == 2), 0.25);
+        assert_eq!(largest_share_step(&sw[0], 4, &f, |_| false), 0.0);
         // Switching again mid-fade starts a new fade from the setting before.
         let seq = ["a", "b", "c", "c", "c"];
         let labels: Vec<_> = seq.iter().map(|x| vec![l(x)]).collect();

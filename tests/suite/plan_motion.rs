@@ -121,10 +121,12 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
 /// ss-jittered setting on the front character fits at the first two frames
 /// and not beyond: the budget forces a switch (ss-jittered to none, 11 136
 /// pixels), and the time freed goes to two characters behind for a frame
-/// (444 pixels each, then 35). Every switch's excess change over the truth's
-/// is within the flicker test's bound (measured at most 0.0024 on lavapipe,
-/// against 0.0038 for the same characters at frames they do not switch), so
-/// no cross-fade; the outputs are written.
+/// (444 pixels each, then 35). Without fades: every switch's excess change
+/// over the truth's is within the flicker test's bound (measured at most
+/// 0.0024), but the front character's switch itself, against the same frame
+/// with it on ss-jittered, changes it by 0.0064 at once: over the bound, a
+/// pop that the motion's own change hides in the excess. So a cross-fade is
+/// needed; the outputs are written.
 #[test]
 fn plan_motion_measures_switches_against_the_truth() {
     use dermis::plan::motion::{self, MotionOptions};
@@ -175,9 +177,20 @@ fn plan_motion_measures_switches_against_the_truth() {
         assert!(p.pixels > 0, "{p:?}");
         // The truth changes too: the character walks.
         assert!(p.truth_change > 0.0, "{p:?}");
-        assert!(p.excess.abs() <= FLICKER_BOUND, "the switch pops: {p:?}");
+        assert!(p.excess.abs() <= FLICKER_BOUND, "{p:?}");
+        assert_eq!(
+            p.step, p.jump,
+            "a hard switch shows all of it at once: {p:?}"
+        );
     }
-    assert_eq!(r.cross_fade_needed, Some(false), "{}", r.verdict);
+    let front = r
+        .pops
+        .iter()
+        .find(|p| p.character == 0)
+        .expect("the front switch");
+    assert!(front.jump.unwrap() > FLICKER_BOUND, "{front:?}");
+    assert_eq!(r.cross_fade_needed, Some(true), "{}", r.verdict);
+    assert_eq!(r.popping, 1, "{}", r.verdict);
     assert!(r.switches_with_margin <= r.switches_without_margin);
     println!("solve per frame: {:?}", r.timing);
     for f in ["plan-motion.json", "plan-motion.png", "plan-motion.svg"] {
@@ -189,8 +202,9 @@ fn plan_motion_measures_switches_against_the_truth() {
 /// at frame 2 (ss-jittered to none, budget-forced) keeps ss-jittered at
 /// 3/4, 1/2 and 1/4 of its result over frames 2-4, priced beside the plan;
 /// its change is measured over the three frames it is spread over here (the
-/// sequence ends before the fade's last step), and its largest excess there
-/// is under the hard switch's.
+/// sequence ends before the fade's last step): at the switch frame its
+/// excess is under the hard switch's, its own jump shows a quarter at a
+/// time, and no switch pops.
 #[test]
 fn plan_motion_cross_fades_a_switch_over_three_frames() {
     use dermis::plan::motion::{self, MotionOptions};
@@ -271,7 +285,19 @@ fn plan_motion_cross_fades_a_switch_over_three_frames() {
         excess(&faded, 2) < excess(&hard, 2),
         "faded {f:?} against hard {h:?}"
     );
+    // The switch itself, measured against the frame with the character on
+    // its old setting: the same jump whether faded or not (the fade's
+    // render holds a quarter of it), a quarter of it at each faded frame.
+    let (hj, fj) = (h.jump.unwrap(), f.jump.unwrap());
+    assert!(
+        hj > 0.0 && (fj - hj).abs() <= 0.02 * hj,
+        "jumps {hj} and {fj}"
+    );
+    assert_eq!(h.step, Some(hj));
+    assert!((f.step.unwrap() - 0.25 * fj).abs() < 1e-12, "{f:?}");
     assert_eq!(faded.cross_fade_needed, None);
+    // With the fade no switch pops.
+    assert_eq!(faded.popping, 0, "{}", faded.verdict);
     assert_eq!(faded.fade_frames, 3);
     println!(
         "front character's switch: excess {:+.5} at once, {:+.5} at most over its fade",
