@@ -297,7 +297,7 @@ fn render_frames(
         // character on its old setting, so the switch's own jump is told
         // apart from each method's change under motion.
         if k > 0 {
-            for c in 0..n {
+            for (c, fade) in fading[k].iter().enumerate() {
                 let (old, new) = (&with[k - 1].labels[c], &fp.labels[c]);
                 let mine = |i: &usize| truth.ids[*i] as usize == c + 1;
                 if old == new || !(0..truth.ids.len()).any(|i| mine(&i)) {
@@ -317,7 +317,7 @@ fn render_frames(
                     .with_context(|| format!("frame {k}: character {c} on its old setting"))?;
                 // The rendered frame holds (1 - w) of the new setting's
                 // difference from the old (w: the fade's weight, 0 without).
-                let w = fading[k][c].as_ref().map_or(0.0, |f| f.weight);
+                let w = fade.as_ref().map_or(0.0, |f| f.weight);
                 let (mut sum, mut px) = (0.0f64, 0usize);
                 for i in (0..truth.ids.len()).filter(mine) {
                     px += 1;
