@@ -345,7 +345,15 @@ fn render_frames(
             predicted_ms: fp.plan.solution.cost_ms,
             predicted_error: fp.plan.solution.error,
             fades: fade_rows,
-            fade_ms: fade_cost_ms(&inp.costs, &fp.labels, &fading[k]),
+            fade_ms: fade_cost_ms(
+                &inp.costs,
+                &fp.labels,
+                &fading[k],
+                &inp.characters
+                    .iter()
+                    .map(|c| c.skin_pixels > 0.0)
+                    .collect::<Vec<_>>(),
+            ),
             measured_error: measured,
             solve_ms: fp.solve_ms,
             inputs_ms: inp.inputs_ms,

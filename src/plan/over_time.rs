@@ -482,13 +482,16 @@ pub struct FadeAt {
 
 /// Per frame and character, the cross-fades of a sequence's switches
 /// (`labels[frame][character]`, the plan's settings) over `fade_frames`
-/// frames: a switch at frame `j` of a character on screen at `j - 1` and `j`
+/// frames: a switch at frame `j` of a character on screen at `j - 1`
 /// (`on_screen`: the planner's estimate of its skin pixels, what a game
 /// knows) keeps its old setting at `j..j + fade_frames` with the share
 /// `(F - t) / (F + 1)` at frame `j + t` (3 frames: 3/4, 1/2, 1/4), so the
-/// change is spread over `F + 1` equal steps. A character leaving the screen
-/// ends its fade; switching again starts a fade from the setting it had the
-/// frame before (the old fade is dropped). 0 frames: no fade.
+/// change is spread over `F + 1` equal steps. The fade runs its frames
+/// whether or not the estimate still sees the character (it drops slivers
+/// under 5% of a character's skin that the frame may show: a switch to none
+/// for want of skin must fade too; a fade off screen has no pixel to work
+/// on). Switching again starts a fade from the setting it had the frame
+/// before (the old fade is dropped). 0 frames: no fade.
 pub fn fades(
     labels: &[Vec<Option<(String, String)>>],
     on_screen: &[Vec<bool>],
@@ -505,10 +508,7 @@ pub fn fades(
         let mut current: Option<(Option<(String, String)>, usize)> = None;
         for k in 1..labels.len() {
             if labels[k][c] != labels[k - 1][c] {
-                current = (seen(k - 1, c) && seen(k, c)).then(|| (labels[k - 1][c].clone(), k));
-            }
-            if !seen(k, c) {
-                current = None;
+                current = seen(k - 1, c).then(|| (labels[k - 1][c].clone(), k));
             }
             if let Some((from, j)) = &current {
                 let t = k - j;
@@ -555,12 +555,14 @@ pub fn spreads(switches: &[Switch<String>], fades: &[Vec<Option<FadeAt>>]) -> Ve
 /// character its old setting's part and fixed cost (an instance of its
 /// own), and per setting the fixed cost of every instance beyond the one
 /// the plan counted (a fading character's group is apart from the others
-/// that run its new setting). `None` when an old setting is unpriced for
-/// the character at this frame.
+/// that run its new setting). A character off screen (`on_screen`, the
+/// estimate) has no part: its old setting has no pixel to work on. `None`
+/// when an old setting is unpriced for a character on screen.
 pub fn fade_cost_ms(
     costs: &[SettingCosts],
     labels: &[Option<(String, String)>],
     fades: &[Option<FadeAt>],
+    on_screen: &[bool],
 ) -> Option<f64> {
     let index = |l: &(String, String)| {
         costs
@@ -571,7 +573,12 @@ pub fn fade_cost_ms(
     for (c, f) in fades.iter().enumerate() {
         if let Some(old) = f.as_ref().and_then(|f| f.from.as_ref()) {
             let s = &costs[index(old)?];
-            ms += s.parts_ms.get(c).copied().flatten()? + s.fixed_ms;
+            let part = if on_screen.get(c).copied().unwrap_or(false) {
+                s.parts_ms.get(c).copied().flatten()?
+            } else {
+                0.0
+            };
+            ms += part + s.fixed_ms;
         }
     }
     for (si, s) in costs.iter().enumerate() {
@@ -844,11 +851,12 @@ mod tests {
 
     #[test]
     fn a_switch_fades_in_equal_steps_while_on_screen() {
-        // One character: a -> b at frame 2, b -> - at frame 7 (off screen
-        // from frame 7 on, so that switch is not faded).
+        // One character: a -> b at frame 2 (on screen at frame 1 only: the
+        // fade runs on), b -> - at frame 7 (off screen from frame 2 on, so
+        // that switch is not faded).
         let seq = ["a", "a", "b", "b", "b", "b", "b", "-", "-"];
         let labels: Vec<_> = seq.iter().map(|x| vec![l(x)]).collect();
-        let on: Vec<_> = (0..seq.len()).map(|k| vec![k < 7]).collect();
+        let on: Vec<_> = (0..seq.len()).map(|k| vec![k < 2]).collect();
         let f = fades(&labels, &on, 3);
         let w: Vec<Option<f64>> = f.iter().map(|x| x[0].as_ref().map(|f| f.weight)).collect();
         assert_eq!(
@@ -923,22 +931,31 @@ mod tests {
         };
         // Character 0 fades a -> b: a's part and fixed, and b's fixed again
         // (character 1 runs b in a group of its own).
-        let ms = fade_cost_ms(&costs, &labels, &[fade("a"), None, None]).unwrap();
+        let on = [true; 3];
+        let ms = fade_cost_ms(&costs, &labels, &[fade("a"), None, None], &on).unwrap();
         assert!((ms - (1.0 + 0.1 + 0.2)).abs() < 1e-12, "{ms}");
+        // Off screen: no part, the instances' fixed costs only.
+        let ms = fade_cost_ms(
+            &costs,
+            &labels,
+            &[fade("a"), None, None],
+            &[false, true, true],
+        );
+        assert!((ms.unwrap() - (0.1 + 0.2)).abs() < 1e-12, "{ms:?}");
         // From no SSS: only the second instance of b.
-        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), None, None]).unwrap();
+        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), None, None], &on).unwrap();
         assert!((ms - 0.2).abs() < 1e-12, "{ms}");
         // Both b characters fading: two instances of b where the plan
         // counted one.
-        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), fade("-"), None]).unwrap();
+        let ms = fade_cost_ms(&costs, &labels, &[fade("-"), fade("-"), None], &on).unwrap();
         assert!((ms - 0.2).abs() < 1e-12, "{ms}");
         // Character 2 (a, alone in its group) fading from b: b's part and
         // fixed, and no second instance of a.
-        let ms = fade_cost_ms(&costs, &labels, &[None, None, fade("b")]).unwrap();
+        let ms = fade_cost_ms(&costs, &labels, &[None, None, fade("b")], &on).unwrap();
         assert!((ms - (0.7 + 0.2)).abs() < 1e-12, "{ms}");
         let mut unpriced = costs.clone();
         unpriced[0].parts_ms[0] = None;
-        assert!(fade_cost_ms(&unpriced, &labels, &[fade("a"), None, None]).is_none());
+        assert!(fade_cost_ms(&unpriced, &labels, &[fade("a"), None, None], &on).is_none());
     }
 
     #[test]
