@@ -583,6 +583,11 @@ struct Common {
     /// Camera distance from the head centre in head heights.
     #[arg(long)]
     distance: Option<f32>,
+    /// Move every character this many head heights toward the camera after the layout is
+    /// placed at --distance (a frame of `plan-motion`'s walk: its plans/frame-KKK.json
+    /// says how far; `plan-motion` walks its own).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    crowd_walked: f32,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = defaults().fovy_deg)]
     fovy: f32,
@@ -708,6 +713,7 @@ impl Common {
             layout: self.layout.into(),
             distance_heads: distance,
             fovy_deg: self.fovy,
+            walk_heads: self.crowd_walked,
             ..base.clone()
         };
         s.light.azimuth_deg = self.light_azimuth.unwrap_or(base.light.azimuth_deg);

@@ -12,8 +12,9 @@
 //! its change is then measured over the F + 1 frames it is spread over, and
 //! the fades' extra cost is priced per frame beside the plan's.
 //!
-//! Writes DIR/plan-motion.json and DIR/plan-motion.png / .svg (each
-//! switching character's change against the truth's, frame by frame).
+//! Writes DIR/plan-motion.json, DIR/plan-motion.png / .svg (each switching
+//! character's change against the truth's, frame by frame) and every frame's
+//! plan file, fades included, as DIR/plans/frame-KKK.json.
 
 use std::path::Path;
 
@@ -194,6 +195,11 @@ fn setting_choice(
     })
 }
 
+/// Where the frames' plan files go: DIR/plans/frame-KKK.json.
+pub fn plans_dir(out: &Path) -> std::path::PathBuf {
+    out.join("plans")
+}
+
 /// The frame before: the plan's diffuse, the truth's, the truth's ids.
 type Previous = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<u32>);
 
@@ -254,6 +260,7 @@ fn render_frames(
     let mut rows = Vec::new();
     let mut jumps = std::collections::BTreeMap::new();
     let mut before: Option<Previous> = None;
+    crate::output::prepare_out_dir(&plans_dir(o.out))?;
     let progress = indicatif::ProgressBar::new(o.walk.frames as u64);
     for (k, s) in frame_settings.iter().enumerate() {
         let truth = Truth::render(ctx, o.scene, s).with_context(|| format!("frame {k}"))?;
@@ -265,7 +272,11 @@ fn render_frames(
             &inp.characters,
             &inp.costs,
             &fp.plan,
-            Vec::new(),
+            vec![format!(
+                "frame {k} of a plan-motion sequence: the crowd walked {} head heights (render \
+                 it with --crowd-walked {} and the sequence's scene options)",
+                s.walk_heads, s.walk_heads
+            )],
         )?;
         let mut fade_rows = Vec::new();
         for (c, f) in fading[k].iter().enumerate() {
@@ -289,6 +300,9 @@ fn render_frames(
         }
         file.check()
             .with_context(|| format!("frame {k}: the plan with its fades"))?;
+        // Every frame's plan, for `render --plan` (with `--walk-heads`) and
+        // `budget --plan` to draw or price that frame again.
+        write_json(&plans_dir(o.out).join(format!("frame-{k:03}.json")), &file)?;
         let mut ps = s.clone();
         ps.assignment = Some(Assignment::Plan(file.clone()));
         let planned = render(ctx, o.scene, &ps).with_context(|| format!("frame {k}: the plan"))?;
