@@ -260,7 +260,7 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         look_ahead: usize,
         /// Cross-fade a switch on screen over N frames (0: switch at once).
-        #[arg(long, default_value_t = dermis::plan::over_time::DEFAULT_FADE_FRAMES)]
+        #[arg(long, default_value_t = dermis::plan::fades::DEFAULT_FADE_FRAMES)]
         fade_frames: usize,
         #[arg(long, default_value = "out/plan-motion")]
         out: PathBuf,
@@ -796,7 +796,7 @@ fn plan_motion(
     let args = PlanArgs::parse(profile, budget_ms, out)?;
     let walk = over_time::Walk::new(frames, walk_heads)?;
     over_time::check_margin(switch_margin)?;
-    over_time::check_fade_frames(fade_frames)?;
+    dermis::plan::fades::check_fade_frames(fade_frames)?;
     if look_ahead >= frames {
         anyhow::bail!("--look-ahead {look_ahead} must be under --frames {frames}");
     }

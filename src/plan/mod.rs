@@ -14,7 +14,8 @@
 //! scoring frames with [`truth`]. docs/plan.md says how it works.
 //! Over time (issue 16 item 6, docs/plan-over-time.md): [`over_time`]
 //! (pure: the walking crowd re-planned with hysteresis, switches and their
-//! measure), the per-frame inputs [`frame_inputs`] (the characters from
+//! measure), [`fades`] (pure: cross-fading its switches), the per-frame
+//! inputs [`frame_inputs`] (the characters from
 //! [`skin_patches`] and their costs from [`price_grid`], both pure) and, with
 //! a device, [`motion`] (`dermis plan-motion`) and its chart
 //! [`motion_chart`].
@@ -26,6 +27,7 @@ pub mod choose;
 pub mod cli;
 pub mod cost;
 pub mod dolly;
+pub mod fades;
 pub mod frame_inputs;
 pub mod measured;
 pub mod motion;

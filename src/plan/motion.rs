@@ -25,12 +25,12 @@ use super::choose::Accuracy;
 use super::cli::{
     load_models, plan_file, plan_frames_dir, reference_model, registered, NODE_LIMIT,
 };
+use super::fades::{fade_cost_ms, fades, largest_share_step, spreads, FadeAt};
 use super::frame_inputs::FrameInputs;
 use super::motion_chart::Line;
 use super::over_time::{
-    changes, fade_cost_ms, fades, largest_share_step, mean_max, pops, replan, spreads,
-    switch_counts, switches, Change, FadeAt, FrameInput, FramePlan, Pop, Replan, Walk,
-    FLICKER_BOUND,
+    changes, mean_max, pops, replan, switch_counts, switches, Change, FrameInput, FramePlan, Pop,
+    Replan, Walk, FLICKER_BOUND,
 };
 use super::truth::{render, Truth};
 use crate::budget::profile::Profile;
@@ -460,26 +460,87 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
         .iter()
         .map(|p| p.excess.abs())
         .reduce(f64::max);
-    let largest_step = measured_pops.iter().filter_map(|p| p.step).reduce(f64::max);
-    let worst_pop = measured_pops
-        .iter()
-        .filter(|p| p.pops())
-        .map(|p| p.step.unwrap_or(p.excess.abs()))
-        .reduce(f64::max);
-    let popping = measured_pops.iter().filter(|p| p.pops()).count();
     let elsewhere = measured_pops
         .iter()
         .filter_map(|p| p.excess_elsewhere)
         .reduce(f64::max);
+    let popping = measured_pops.iter().filter(|p| p.pops()).count();
     let over: Vec<f64> = rows
         .iter()
         .map(|f| f.predicted_ms + f.fade_ms.unwrap_or(0.0) - o.budget_ms)
         .collect();
     let frames_over = over.iter().filter(|&&x| x > 1e-9).count();
     let max_over = over.iter().copied().fold(0.0, f64::max);
+    let verdict = verdict(o, &measured_pops, (frames_over, max_over));
     let solve: Vec<f64> = with.iter().map(|f| f.solve_ms).collect();
     let inp: Vec<f64> = inputs.iter().map(|f| f.inputs_ms).collect();
     let ((sm, sx), (im, ix)) = (mean_max(&solve), mean_max(&inp));
+    let report = MotionReport {
+        device: ctx.facts.name.clone(),
+        width: o.base.width,
+        height: o.base.height,
+        heads: o.base.heads,
+        layout: o.base.layout,
+        distance_heads: o.base.distance_heads,
+        walk: o.walk,
+        profile: o.profile.profile.name.clone(),
+        budget_ms: o.budget_ms,
+        switch_margin: o.switch_margin,
+        look_ahead: o.look_ahead,
+        fade_frames: o.fade_frames,
+        accuracy: o.accuracy_source.clone(),
+        truth_density: o.base.options.given("density").map(|d| d.to_string()),
+        timing: Timing {
+            solve_mean_ms: sm,
+            solve_max_ms: sx,
+            inputs_mean_ms: im,
+            inputs_max_ms: ix,
+            costs_mean_ms: mean_max(&inputs.iter().map(|f| f.costs_ms).collect::<Vec<_>>()).0,
+            frame_ms: FRAME_MS,
+        },
+        switches_with_margin: cw.iter().sum(),
+        switches_without_margin: cwo.iter().sum(),
+        frames: rows,
+        characters: series,
+        pops: measured_pops,
+        bound: FLICKER_BOUND,
+        max_abs_excess_at_switches: at,
+        max_abs_excess_elsewhere: elsewhere,
+        popping,
+        cross_fade_needed: (o.fade_frames == 0).then_some(popping > 0),
+        frames_over_budget_with_fades: frames_over,
+        max_over_budget_ms: max_over,
+        verdict,
+    };
+    write_json(&o.out.join("plan-motion.json"), &report)?;
+    super::motion_chart::write(o.out, o.walk.frames, FLICKER_BOUND, &chart_lines(&report))?;
+    Ok(report)
+}
+
+/// The run's verdict in words: whether a switch pops (`Pop::pops`: the
+/// change it adds at one frame itself against the flicker test's bound; the
+/// excess over the truth's change also holds each method's own change under
+/// motion, which no fade removes), and the frames the fades take over the
+/// budget (`over`: how many, by how much at most).
+fn verdict(
+    o: &MotionOptions,
+    measured_pops: &[Pop],
+    (frames_over, max_over): (usize, f64),
+) -> String {
+    let at = measured_pops
+        .iter()
+        .map(|p| p.excess.abs())
+        .reduce(f64::max);
+    let largest_step = measured_pops.iter().filter_map(|p| p.step).reduce(f64::max);
+    let worst_pop = measured_pops
+        .iter()
+        .filter(|p| p.pops())
+        .map(|p| p.step.unwrap_or(p.excess.abs()))
+        .reduce(f64::max);
+    let elsewhere = measured_pops
+        .iter()
+        .filter_map(|p| p.excess_elsewhere)
+        .reduce(f64::max);
     let over_bound = measured_pops
         .iter()
         .filter(|p| p.excess.abs() > FLICKER_BOUND)
@@ -526,46 +587,7 @@ pub fn run(ctx: &Context, o: &MotionOptions) -> Result<MotionReport> {
             o.budget_ms
         ));
     }
-    let report = MotionReport {
-        device: ctx.facts.name.clone(),
-        width: o.base.width,
-        height: o.base.height,
-        heads: o.base.heads,
-        layout: o.base.layout,
-        distance_heads: o.base.distance_heads,
-        walk: o.walk,
-        profile: o.profile.profile.name.clone(),
-        budget_ms: o.budget_ms,
-        switch_margin: o.switch_margin,
-        look_ahead: o.look_ahead,
-        fade_frames: o.fade_frames,
-        accuracy: o.accuracy_source.clone(),
-        truth_density: o.base.options.given("density").map(|d| d.to_string()),
-        timing: Timing {
-            solve_mean_ms: sm,
-            solve_max_ms: sx,
-            inputs_mean_ms: im,
-            inputs_max_ms: ix,
-            costs_mean_ms: mean_max(&inputs.iter().map(|f| f.costs_ms).collect::<Vec<_>>()).0,
-            frame_ms: FRAME_MS,
-        },
-        switches_with_margin: cw.iter().sum(),
-        switches_without_margin: cwo.iter().sum(),
-        frames: rows,
-        characters: series,
-        pops: measured_pops,
-        bound: FLICKER_BOUND,
-        max_abs_excess_at_switches: at,
-        max_abs_excess_elsewhere: elsewhere,
-        popping,
-        cross_fade_needed: (!faded).then_some(popping > 0),
-        frames_over_budget_with_fades: frames_over,
-        max_over_budget_ms: max_over,
-        verdict,
-    };
-    write_json(&o.out.join("plan-motion.json"), &report)?;
-    super::motion_chart::write(o.out, o.walk.frames, FLICKER_BOUND, &chart_lines(&report))?;
-    Ok(report)
+    verdict
 }
 
 /// The chart's lines: every character that switches, its switches marked.

@@ -9,7 +9,7 @@ use glam::Mat4;
 use super::frame::Frame;
 use super::groups::{is_mixed, FadeMethod, GroupMethod, GroupSpec};
 use crate::graph::{ImageDesc, Resources};
-use crate::method::MethodSetup;
+use crate::method::{MethodBind, MethodSetup};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -138,4 +138,31 @@ fn build_fade(
     };
     f.set_region(region);
     Ok(f)
+}
+
+/// Writes every group's descriptor sets (and its fade's, on the fade's
+/// targets) once the images exist.
+pub fn bind_groups(
+    ctx: &Context,
+    res: &Resources,
+    frame: &Frame,
+    groups: &mut [GroupMethod],
+) -> Result<()> {
+    for g in groups.iter_mut() {
+        let bind = |targets| MethodBind {
+            ctx,
+            res,
+            pool: &frame.pool,
+            samplers: &frame.samplers,
+            targets,
+            frame_binds: frame.frame_binds(res),
+            skin_material_binds: super::frame::skin_material_binds(frame),
+        };
+        g.method.bind(&bind(&frame.targets))?;
+        if let Some(f) = &mut g.fade {
+            let targets = f.targets;
+            f.method.bind(&bind(&targets))?;
+        }
+    }
+    Ok(())
 }

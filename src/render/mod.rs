@@ -23,14 +23,13 @@ use ash::vk;
 use crate::graph::work::PassRole;
 use crate::graph::{record_passes, ImageId, Pass, PassSample, Resources};
 use crate::method::region::PixelRect;
-use crate::method::MethodBind;
 use crate::scene::framing::frame as frame_scene;
 use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
-use frame::{skin_material_binds, Frame, SkinGroup};
+use frame::{Frame, SkinGroup};
 use group_setup::build_groups;
 use groups::{frame_needs, group_specs, is_mixed, GroupMethod};
 use merge::Merge;
@@ -244,22 +243,7 @@ impl<'c> Renderer<'c> {
         let source = frame.composite_source(&groups);
         frame.bind(ctx, &resources, source)?;
         merge.bind(ctx, &frame.pool, &resources, &frame.targets, &groups)?;
-        for g in groups.iter_mut() {
-            let bind = |targets| MethodBind {
-                ctx,
-                res: &resources,
-                pool: &frame.pool,
-                samplers: &frame.samplers,
-                targets,
-                frame_binds: frame.frame_binds(&resources),
-                skin_material_binds: skin_material_binds(&frame),
-            };
-            g.method.bind(&bind(&frame.targets))?;
-            if let Some(f) = &mut g.fade {
-                let targets = f.targets;
-                f.method.bind(&bind(&targets))?;
-            }
-        }
+        group_setup::bind_groups(ctx, &resources, &frame, &mut groups)?;
         let submit = Submit::new(ctx, slots)?;
         // Complete: the renderer owns (and frees, in its drop) every part.
         let mut r = Renderer {

@@ -68,6 +68,7 @@ const PURE_FILES: &[&str] = &[
     "plan/solve.rs",
     "plan/dolly.rs",
     "plan/over_time.rs",
+    "plan/fades.rs",
     "plan/skin_patches.rs",
     "plan/price_grid.rs",
 ];
