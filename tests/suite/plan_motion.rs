@@ -127,8 +127,10 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
 /// with it on ss-jittered, changes it by 0.0064 at once: over the bound, a
 /// pop that the motion's own change hides in the excess. So a cross-fade is
 /// needed; the outputs are written.
-#[test]
-fn plan_motion_measures_switches_against_the_truth() {
+/// `plan-motion` on the 9 characters below, 160x90, fovy 12, from 2.5 head
+/// heights walking 1 over 5 frames, the Xbox 360 at 0.2 ms, the ground truth
+/// at density 1, fading over `fade_frames`; its outputs in `out`.
+fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::motion::MotionReport {
     use dermis::plan::motion::{self, MotionOptions};
     let ctx = common::ctx();
     let scene = face();
@@ -140,9 +142,8 @@ fn plan_motion_measures_switches_against_the_truth() {
     base.distance_heads = 2.5;
     base.options.set("density", "1");
     let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
-    let out = tmp("measure");
-    std::fs::create_dir_all(&out).unwrap();
-    let r = motion::run(
+    std::fs::create_dir_all(out).unwrap();
+    motion::run(
         &ctx,
         &MotionOptions {
             base,
@@ -154,11 +155,18 @@ fn plan_motion_measures_switches_against_the_truth() {
             walk: Walk::new(5, 1.0).unwrap(),
             switch_margin: DEFAULT_MARGIN,
             look_ahead: 0,
-            fade_frames: 0,
-            out: &out,
+            fade_frames,
+            out,
         },
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn plan_motion_measures_switches_against_the_truth() {
+    use dermis::plan::motion;
+    let out = tmp("measure");
+    let r = nine_walking(0, &out);
     print!("{}", motion::summary(&r));
     assert_eq!(r.frames.len(), 5);
     assert_eq!(r.truth_density.as_deref(), Some("1"));
@@ -207,38 +215,8 @@ fn plan_motion_measures_switches_against_the_truth() {
 /// time, and no switch pops.
 #[test]
 fn plan_motion_cross_fades_a_switch_over_three_frames() {
-    use dermis::plan::motion::{self, MotionOptions};
-    let ctx = common::ctx();
-    let scene = face();
-    let mut base = RenderSettings::study();
-    base.width = 160;
-    base.height = 90;
-    base.heads = 9;
-    base.fovy_deg = 12.0;
-    base.distance_heads = 2.5;
-    base.options.set("density", "1");
-    let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
-    let run = |fade_frames: usize| {
-        let out = tmp(&format!("fade-{fade_frames}"));
-        std::fs::create_dir_all(&out).unwrap();
-        motion::run(
-            &ctx,
-            &MotionOptions {
-                base: base.clone(),
-                scene: &scene,
-                accuracy: &acc,
-                accuracy_source: acc.source(),
-                profile: Profile::load("xbox360").unwrap(),
-                budget_ms: 0.2,
-                walk: Walk::new(5, 1.0).unwrap(),
-                switch_margin: DEFAULT_MARGIN,
-                look_ahead: 0,
-                fade_frames,
-                out: &out,
-            },
-        )
-        .unwrap()
-    };
+    use dermis::plan::motion;
+    let run = |fade_frames: usize| nine_walking(fade_frames, &tmp(&format!("fade-{fade_frames}")));
     let (hard, faded) = (run(0), run(3));
     print!("{}", motion::summary(&faded));
     // The fades do not change the plan.
