@@ -336,7 +336,7 @@ pub fn render_to_dir(
     // A frame of several methods also writes groups.png, which needs each
     // pixel's character: the id pass comes with it (it changes no image).
     let mixed =
-        crate::render::groups::is_mixed(&crate::render::groups::group_specs(scene, settings)?);
+        crate::render::groups::specs_mixed(&crate::render::groups::group_specs(scene, settings)?);
     let with_ids;
     let settings = if mixed && !settings.character_ids {
         with_ids = RenderSettings {

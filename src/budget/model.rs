@@ -603,10 +603,9 @@ mod tests {
         assert!(b.passes[1].modelled_ms.is_some());
     }
 
-    #[test]
-    fn a_dispatch_without_a_compute_path_is_priced_as_a_pixel_shader() {
-        let p = prof("xbox360");
-        let c = PassInput::new(
+    /// A compute pass of a million invocations at 240 instructions each.
+    fn gather() -> PassInput {
+        PassInput::new(
             "gather",
             PassRole::Sss,
             Work::Compute {
@@ -616,7 +615,13 @@ mod tests {
                 },
                 invocations: 1_000_000,
             },
-        );
+        )
+    }
+
+    #[test]
+    fn a_dispatch_without_a_compute_path_is_priced_as_a_pixel_shader() {
+        let p = prof("xbox360");
+        let c = gather();
         let b = price_frame(
             &p,
             &frame(vec![c]),
@@ -677,17 +682,7 @@ mod tests {
         // shaders' flops issues half the instructions.
         let mut p = prof("xbox360");
         p.alu.compute_gflops = Quantity::Known(120.0);
-        let c = PassInput::new(
-            "gather",
-            PassRole::Sss,
-            Work::Compute {
-                shader: ShaderWork {
-                    alu: 240.0,
-                    ..Default::default()
-                },
-                invocations: 1_000_000,
-            },
-        );
+        let c = gather();
         let u = price_units(&p, &frame(vec![c]));
         assert!(u[0].substitutions.is_empty());
         assert!(

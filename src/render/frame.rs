@@ -2,7 +2,8 @@
 //! depth is linear) -> geometry pass into the targets (Lambert + transmittance,
 //! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
 //! the stencil) -> each group's method's passes (one group in a single-method
-//! frame) and, in a frame of several, the merges (`merge.rs`) -> composite
+//! frame; where they work and in what order: `group_passes.rs`) and, in a
+//! frame of several, the merges (`merge.rs`) -> composite
 //! (diffuse after SSS + specular) -> Hable tone map -> the post chain's
 //! anti-aliasing stage (`crate::post`, `--aa`; none by default).
 //!
@@ -15,7 +16,7 @@ use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
-use super::groups::{scissors, FadeMethod, GroupMethod};
+use super::groups::{scissors, GroupMethod};
 use super::merge::Merge;
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
@@ -23,9 +24,8 @@ use super::targets::SHADOW_FORMAT;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
-use crate::method::region::{scene_region, PixelRect, RegionMode, RegionView};
-use crate::method::screen::seed_copy;
-use crate::method::{FrameTargets, FrameView, SssMethod, ViewInfo, STENCIL_SKIN};
+use crate::method::region::PixelRect;
+use crate::method::{FrameTargets, ViewInfo, STENCIL_SKIN};
 use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
 use crate::scene::framing::Framing;
@@ -144,7 +144,7 @@ pub struct Frame {
     shadow_set: vk::DescriptorSet,
     instance_set: vk::DescriptorSet,
     ids_instance_set: vk::DescriptorSet,
-    screen_rect: Vec<vk::Rect2D>,
+    pub(super) screen_rect: Vec<vk::Rect2D>,
     /// The stages after the tone map (`enable_post`; none with `--aa none`).
     pub post: PostChain,
 }
@@ -489,71 +489,6 @@ impl Frame {
         }
     }
 
-    /// Where `method`, working on the characters `instances`, has work in
-    /// `scene` (the whole screen without a region).
-    pub fn region_for(
-        &self,
-        scene: &Scene,
-        method: &dyn SssMethod,
-        instances: &[Mat4],
-    ) -> Vec<PixelRect> {
-        self.region_by(scene, instances, |d, scale| method.reach_px(d, scale))
-    }
-
-    /// The skin of the characters `instances` on screen, reaching no further
-    /// (the whole screen with `--sss-region screen`): where a fade from no SSS
-    /// copies and blends.
-    pub fn skin_region(&self, scene: &Scene, instances: &[Mat4]) -> Vec<PixelRect> {
-        self.region_by(scene, instances, |_, _| Some(0.0))
-    }
-
-    fn region_by(
-        &self,
-        scene: &Scene,
-        instances: &[Mat4],
-        reach: impl Fn(f32, &crate::method::region::ReachScale) -> Option<f32>,
-    ) -> Vec<PixelRect> {
-        let full = PixelRect::full(self.extent.width, self.extent.height);
-        let s = &self.settings;
-        let view = self.view_info();
-        let probe = crate::method::region::ReachScale {
-            height_px: self.extent.height,
-            tan_half_fovy: view.tan_half_fovy(),
-            mm_per_unit: self.mm_per_unit,
-            max_strength: 1.0,
-        };
-        if s.sss_region == RegionMode::Screen || reach(1.0, &probe).is_none() {
-            return vec![full];
-        }
-        let rv = self.region_view();
-        scene_region(
-            scene,
-            instances,
-            &rv,
-            view.tan_half_fovy(),
-            s.sss_region_tile,
-            reach,
-        )
-    }
-
-    /// Where the skin of the characters `instances` lies in depth
-    /// (`view::region::skin_depths`).
-    pub fn depths_for(&self, scene: &Scene, instances: &[Mat4]) -> Vec<(f64, f32)> {
-        crate::view::region::skin_depths(scene, instances, &self.region_view())
-    }
-
-    /// The camera as the region code projects with it.
-    fn region_view(&self) -> RegionView {
-        let view = self.view_info();
-        RegionView {
-            view: self.camera.view(),
-            proj: self.camera.proj(view.aspect()),
-            near: self.camera.near,
-            width: self.extent.width,
-            height: self.extent.height,
-        }
-    }
-
     /// The groups' heads and codes the geometry pass draws (rewrites the
     /// instance buffer in group order).
     pub fn set_skin_groups(&mut self, ctx: &Context, groups: Vec<SkinGroup>) -> Result<()> {
@@ -607,116 +542,6 @@ impl Frame {
             pool: &self.pool,
             samplers: &self.samplers,
         })
-    }
-
-    /// What group `g`'s passes are built against: its region and stencil code.
-    pub fn view<'a, 'r>(&'a self, res: &'r Resources, g: &'a GroupMethod) -> FrameView<'a, 'r> {
-        FrameView {
-            targets: &self.targets,
-            res,
-            extent: self.extent,
-            region: &g.scissors,
-            depths: &g.depths,
-            screen: &self.screen_rect,
-            stencil: g.spec.stencil(),
-        }
-    }
-
-    /// What the composite reads: the one group's output, or the diffuse
-    /// target every group's result is merged into.
-    pub fn composite_source(&self, groups: &[GroupMethod]) -> ImageId {
-        match groups {
-            [one] => one.method.output(),
-            _ => self.targets.diffuse,
-        }
-    }
-
-    /// What the old setting of group `g`'s fading character is built
-    /// against: the keep as its diffuse target, its own region, the group's
-    /// stencil code.
-    pub fn fade_view<'a, 'r>(
-        &'a self,
-        res: &'r Resources,
-        g: &'a GroupMethod,
-        f: &'a FadeMethod,
-    ) -> FrameView<'a, 'r> {
-        FrameView {
-            targets: &f.targets,
-            region: &f.scissors,
-            ..self.view(res, g)
-        }
-    }
-
-    /// The passes of the groups' methods, each marked with its group (a
-    /// frame of several names them `#N ...`), then the merges. With a fading
-    /// character: first the keep of the light before SSS (`#N fade keep`,
-    /// before any group writes the diffuse target in place), its old
-    /// setting's passes (`#N fade ...`) after the groups', and its blend
-    /// after the merges.
-    pub fn group_passes<'a>(
-        &'a self,
-        groups: &'a [GroupMethod],
-        merge: &'a Merge,
-        res: &Resources,
-    ) -> Vec<Pass<'a>> {
-        let mixed = groups.len() > 1 || groups.iter().any(|g| g.fade.is_some());
-        let mut passes = Vec::new();
-        let fades = || {
-            groups
-                .iter()
-                .filter_map(|g| g.fade.as_ref().map(|f| (g, f)))
-        };
-        for (g, f) in fades() {
-            let i = g.spec.index;
-            let mut p = seed_copy(
-                &format!("#{i} fade keep"),
-                &self.fade_view(res, g, f),
-                self.targets.diffuse,
-                &f.scissors,
-                &[f.keep],
-            );
-            p.group = Some(i);
-            passes.push(p);
-        }
-        for g in groups {
-            let i = g.spec.index;
-            for mut p in g.method.passes(&self.view(res, g)) {
-                p.group = Some(i);
-                if mixed {
-                    p.name = format!("#{i} {}", p.name);
-                }
-                passes.push(p);
-            }
-        }
-        for (g, f) in fades() {
-            let i = g.spec.index;
-            for mut p in f.method.passes(&self.fade_view(res, g, f)) {
-                p.group = Some(i);
-                p.name = format!("#{i} fade {}", p.name);
-                passes.push(p);
-            }
-        }
-        if mixed {
-            for g in groups {
-                if let Some(p) = merge.pass(&self.view(res, g), g.spec.index, g.method.output()) {
-                    passes.push(p);
-                }
-            }
-            for (g, f) in fades() {
-                let view = self.fade_view(res, g, f);
-                // The blend writes the frame's diffuse target, not the keep.
-                let view = FrameView {
-                    targets: &self.targets,
-                    ..view
-                };
-                if let Some(p) =
-                    merge.fade_pass(&view, g.spec.index, f.method.output(), f.spec.weight)
-                {
-                    passes.push(p);
-                }
-            }
-        }
-        passes
     }
 
     /// The frame's passes in order, the groups' in the middle.

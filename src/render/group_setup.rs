@@ -7,7 +7,7 @@ use anyhow::{Context as _, Result};
 use glam::Mat4;
 
 use super::frame::Frame;
-use super::groups::{is_mixed, FadeMethod, GroupMethod, GroupSpec};
+use super::groups::{specs_mixed, FadeMethod, GroupMethod, GroupSpec};
 use crate::graph::{ImageDesc, Resources};
 use crate::method::{MethodBind, MethodSetup};
 use crate::scene::Scene;
@@ -24,7 +24,7 @@ pub fn build_groups(
     scene: &Scene,
     specs: Vec<GroupSpec>,
 ) -> Result<Vec<GroupMethod>> {
-    let mixed = is_mixed(&specs);
+    let mixed = specs_mixed(&specs);
     let depth_stencil_format = res.format(frame.targets.depth_stencil);
     let mut groups = Guard::new(ctx, Vec::<GroupMethod>::new());
     for spec in specs {

@@ -172,10 +172,16 @@ fn mixed_choice(
     Ok((entry, options))
 }
 
-/// Whether the groups make a frame of several methods: more than one, or a
-/// fade (whose old setting is a second instance).
-pub fn is_mixed(specs: &[GroupSpec]) -> bool {
-    specs.len() > 1 || specs.iter().any(|g| g.fade.is_some())
+/// Whether `groups` groups, `fading` if any has a fade, make a frame of
+/// several methods: more than one, or a fade (whose old setting is a second
+/// instance).
+pub fn is_mixed(groups: usize, fading: bool) -> bool {
+    groups > 1 || fading
+}
+
+/// [`is_mixed`] of resolved groups.
+pub fn specs_mixed(specs: &[GroupSpec]) -> bool {
+    is_mixed(specs.len(), specs.iter().any(|g| g.fade.is_some()))
 }
 
 /// What the frame's targets must provide for every group: the normal target

@@ -142,25 +142,15 @@ impl Merge {
         weight: f64,
     ) -> Option<Pass<'a>> {
         let &(_, set) = self.fade_sets.iter().find(|(i, _)| *i == g)?;
-        let c = weight as f32;
-        let mut p = masked_pass(
+        let name = format!("#{g} fade blend");
+        Some(draw_into_diffuse(
             f,
-            Masked {
-                name: format!("#{g} fade blend"),
-                shader: MERGE_SHADER,
-                loop_trips: Vec::new(),
-                pipeline: &self.fade_pipeline,
-                set,
-                reads: vec![old],
-                fetches: vec![fetch(f.res, old, "groupTex", Filter::Point, 1.0)],
-                targets: vec![(f.targets.diffuse, true)],
-                stencil: true,
-                depth_test: false,
-            },
-            move |ctx, cmd| unsafe { ctx.device.cmd_set_blend_constants(cmd, &[c, c, c, 1.0]) },
-        );
-        p.group = Some(g);
-        Some(p)
+            g,
+            name,
+            (&self.fade_pipeline, set),
+            old,
+            Some(weight as f32),
+        ))
     }
 
     /// The copy of group `g`'s output (`output`) into the diffuse target,
@@ -172,25 +162,15 @@ impl Merge {
         output: ImageId,
     ) -> Option<Pass<'a>> {
         let &(_, set) = self.sets.iter().find(|(i, _)| *i == g)?;
-        let mut p = masked_pass(
+        let name = format!("mix merge #{g}");
+        Some(draw_into_diffuse(
             f,
-            Masked {
-                name: format!("mix merge #{g}"),
-                shader: MERGE_SHADER,
-                loop_trips: Vec::new(),
-                pipeline: &self.pipeline,
-                set,
-                reads: vec![output],
-                fetches: vec![fetch(f.res, output, "groupTex", Filter::Point, 1.0)],
-                targets: vec![(f.targets.diffuse, false)],
-                stencil: true,
-                depth_test: false,
-            },
-            |_, _| {},
-        );
-        debug_assert_eq!(p.role, PassRole::Sss);
-        p.group = Some(g);
-        Some(p)
+            g,
+            name,
+            (&self.pipeline, set),
+            output,
+            None,
+        ))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -203,4 +183,40 @@ impl Destroy for Merge {
     fn destroy(&mut self, ctx: &Context) {
         Merge::destroy(self, ctx)
     }
+}
+
+/// `image` drawn into the diffuse target on group `g`'s pixels (stencil-tested
+/// on its code, in `f`'s region) with `pipeline`: copied, or with `blend` the
+/// constant that mixes it in (`src * c + dst * (1 - c)`).
+fn draw_into_diffuse<'a>(
+    f: &FrameView<'a, '_>,
+    g: usize,
+    name: String,
+    (pipeline, set): (&'a Pipeline, vk::DescriptorSet),
+    image: ImageId,
+    blend: Option<f32>,
+) -> Pass<'a> {
+    let mut p = masked_pass(
+        f,
+        Masked {
+            name,
+            shader: MERGE_SHADER,
+            loop_trips: Vec::new(),
+            pipeline,
+            set,
+            reads: vec![image],
+            fetches: vec![fetch(f.res, image, "groupTex", Filter::Point, 1.0)],
+            targets: vec![(f.targets.diffuse, blend.is_some())],
+            stencil: true,
+            depth_test: false,
+        },
+        move |ctx, cmd| {
+            if let Some(c) = blend {
+                unsafe { ctx.device.cmd_set_blend_constants(cmd, &[c, c, c, 1.0]) }
+            }
+        },
+    );
+    debug_assert_eq!(p.role, PassRole::Sss);
+    p.group = Some(g);
+    p
 }

@@ -7,6 +7,7 @@
 
 pub mod counting;
 pub mod frame;
+pub mod group_passes;
 pub mod group_setup;
 pub mod groups;
 pub mod inputs;
@@ -31,7 +32,7 @@ use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
 use frame::{Frame, SkinGroup};
 use group_setup::build_groups;
-use groups::{frame_needs, group_specs, is_mixed, GroupMethod};
+use groups::{frame_needs, group_specs, specs_mixed, GroupMethod};
 use merge::Merge;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use settings::RenderSettings;
@@ -176,7 +177,7 @@ impl<'c> Renderer<'c> {
         };
         let specs = group_specs(scene, settings)?;
         let needs = frame_needs(&specs, extent);
-        let mixed = is_mixed(&specs);
+        let mixed = specs_mixed(&specs);
         // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
         let targets = targets::declare(ctx, &mut resources, settings, needs)?;
