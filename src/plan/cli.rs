@@ -85,6 +85,14 @@ pub fn registered() -> Vec<Registered> {
         .collect()
 }
 
+/// The options of the registered eval setting `setting` of `method`.
+pub fn setting_options(method: &str, setting: &str) -> Option<BTreeMap<String, String>> {
+    registered()
+        .into_iter()
+        .find(|x| x.method == method && x.setting == setting)
+        .map(|x| x.options)
+}
+
 /// The stored frames of the reference setting among `models`: what every
 /// character's skin and region are estimated against.
 pub fn reference_model(models: &[SettingModel]) -> Result<&SettingModel> {
@@ -714,11 +722,7 @@ pub fn plan_file(
     let (mut wi, mut ws, mut w) = (0.0, 0.0, 0.0);
     for (ci, (c, r)) in chars.iter().zip(&p.rows).enumerate() {
         let (method, setting) = label(costs, r.setting);
-        let options = registered()
-            .into_iter()
-            .find(|x| x.method == method && x.setting == setting)
-            .map(|x| x.options)
-            .unwrap_or_default();
+        let options = setting_options(&method, &setting).unwrap_or_default();
         // Checked as a plan file is checked on reading.
         let choice = Choice::new(&method, options.clone())?;
         wi += r.predicted.0 * c.skin_pixels;

@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use super::choose::Accuracy;
 use super::cli::{
-    load_models, plan_file, plan_frames_dir, reference_model, registered, NODE_LIMIT,
+    load_models, plan_file, plan_frames_dir, reference_model, setting_options, NODE_LIMIT,
 };
 use super::fades::{fade_cost_ms, fades, largest_share_step, spreads, FadeAt};
 use super::frame_inputs::FrameInputs;
@@ -166,10 +166,6 @@ pub struct MotionReport {
     pub verdict: String,
 }
 
-fn fade_label(from: &Option<(String, String)>) -> String {
-    group_label(from)
-}
-
 fn group_label(l: &Option<(String, String)>) -> String {
     match l {
         Some((m, s)) => format!("{m} {s}"),
@@ -186,10 +182,7 @@ fn setting_choice(
         None => (crate::mix::Choice::none().method, Default::default()),
         Some((m, st)) => (
             m.clone(),
-            registered()
-                .into_iter()
-                .find(|x| x.method == m.as_str() && x.setting == st.as_str())
-                .map(|x| x.options)
+            setting_options(m, st)
                 .with_context(|| format!("setting {m} '{st}' is not registered"))?,
         ),
     })
@@ -294,7 +287,7 @@ fn render_frames(
             });
             fade_rows.push(FadeRow {
                 character: c,
-                from: fade_label(&f.from),
+                from: group_label(&f.from),
                 weight: f.weight,
             });
         }
