@@ -25,17 +25,22 @@
 //! file they lead to (tests/suite/layers.rs).
 pub mod aa;
 pub mod accuracy;
+pub mod app;
 pub mod bench;
 pub mod budget;
+pub mod checks;
+pub mod embedded;
 pub mod eval;
 pub mod files;
 pub mod graph;
+pub mod header;
 pub mod method;
 pub mod mix;
 pub mod output;
 pub mod plan;
 pub mod plot;
 pub mod post;
+pub mod ranges;
 pub mod reference;
 pub mod render;
 pub mod report;

@@ -18,22 +18,23 @@ use serde::{Deserialize, Serialize};
 
 use crate::graph::work::{ImageUse, PassRole, Work};
 use crate::graph::PassSample;
+use crate::header::{DeviceHeader, RunHeader};
 use crate::method::region::RegionMode;
+use crate::render::request::FrameSettings;
 use crate::scene::layout::Layout;
 use crate::skin::transmittance::TransmittanceProfile;
 
 /// The JSON report of `render` and `bench`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
-    pub dermis_version: String,
-    pub command: String,
-    pub device: String,
-    pub device_type: String,
-    pub driver: String,
-    pub vulkan_api: String,
-    pub validation: bool,
-    pub width: u32,
-    pub height: u32,
+    /// Version, command line, device, driver, size and frame counts, at the
+    /// top under the names reports have always used.
+    #[serde(flatten)]
+    pub run: RunHeader,
+    /// Everything the frame was made from, whole: `dermis render --settings
+    /// report.json` renders it again. Absent in reports from before issue 27.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settings: Option<FrameSettings>,
     pub method: String,
     /// Every option of the method, given or default.
     #[serde(default)]
@@ -78,8 +79,6 @@ pub struct Report {
     pub distance_heads: f32,
     pub fovy_deg: f32,
     pub light: LightReport,
-    pub warmup_frames: usize,
-    pub measured_frames: usize,
     pub passes: Vec<PassReport>,
     pub frame: Option<FrameReport>,
     /// Sum of the SSS passes (every pass of role `sss`) per frame.
@@ -165,7 +164,7 @@ impl Report {
     /// finite and not negative.
     pub fn check(&self) -> Result<()> {
         use crate::render::settings::{check_fovy, MAX_HEADS, MAX_IMAGE_SIDE};
-        for (what, v) in [("width", self.width), ("height", self.height)] {
+        for (what, v) in [("width", self.run.width), ("height", self.run.height)] {
             if !(1..=MAX_IMAGE_SIDE).contains(&v) {
                 anyhow::bail!(
                     "{what} must be within 1..={MAX_IMAGE_SIDE} pixels (as render's --{what}), got {v}"
@@ -463,6 +462,18 @@ pub fn groups_table(groups: &[GroupReport]) -> String {
         }
     }
     s
+}
+
+/// The header's device part for the device `ctx` opened.
+pub fn device_header(ctx: &crate::vk::context::Context) -> DeviceHeader {
+    let f = &ctx.facts;
+    DeviceHeader {
+        device: f.name.clone(),
+        device_type: f.device_type.clone(),
+        driver: f.driver.clone(),
+        vulkan_api: f.api_version.clone(),
+        validation: ctx.validation,
+    }
 }
 
 #[cfg(test)]

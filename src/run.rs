@@ -10,13 +10,17 @@ use crate::bench::ceilings;
 use crate::bench::floor::floor_ms;
 use crate::graph::work::PassRole;
 use crate::graph::PassSample;
+use crate::header::RunHeader;
 use crate::output::{
-    method_tint, prepare_file, prepare_render_dir, slug, tint_characters, write_character_ids_png,
-    write_depth_exr, write_diffuse_exr, write_exr, write_json, write_png, write_rgba8_png,
+    method_tint, slug, tint_characters, write_character_ids_png, write_depth_exr,
+    write_diffuse_exr, write_exr, write_json, write_png, write_rgba8_png,
 };
 use crate::render::groups::GroupMethod;
-use crate::render::{Capture, RenderSettings, Renderer};
-use crate::report::{aggregate, FadeReport, GroupReport, LightReport, PassDecl, Stats};
+use crate::render::request::FrameSettings;
+use crate::render::{Capture, FrameRequest, RenderSettings, Renderer};
+use crate::report::{
+    aggregate, device_header, FadeReport, GroupReport, LightReport, PassDecl, Stats,
+};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 
@@ -33,10 +37,40 @@ pub struct RunOutput {
     pub frames: Vec<Vec<PassSample>>,
 }
 
+/// How many frames a run renders before it measures, and measures: checked
+/// once ([`FrameCounts::new`]), so a run never checks them again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameCounts {
+    warmup: usize,
+    measured: usize,
+}
+
+impl FrameCounts {
+    /// One measured frame, no warm-up (comparisons, captures).
+    pub const ONE: FrameCounts = FrameCounts {
+        warmup: 0,
+        measured: 1,
+    };
+
+    /// `--warmup` and `--frames`, within their ranges (one line each).
+    pub fn new(warmup: usize, measured: usize) -> Result<Self> {
+        check_frame_counts(warmup, measured)?;
+        crate::checks::ran("frame counts");
+        Ok(FrameCounts { warmup, measured })
+    }
+
+    pub fn warmup(self) -> usize {
+        self.warmup
+    }
+
+    pub fn measured(self) -> usize {
+        self.measured
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct RunOptions {
-    pub warmup: usize,
-    pub measured: usize,
+    pub frames: FrameCounts,
     /// Read back the tone-mapped frame (and with `dump`, every pass output).
     pub capture: bool,
     pub dump: bool,
@@ -55,7 +89,7 @@ pub const MAX_MEASURED_FRAMES: usize = 100_000;
 pub const MAX_WARMUP_FRAMES: usize = 100_000;
 
 /// Checks `--warmup` and `--frames` (before any device opens).
-pub fn check_frame_counts(warmup: usize, measured: usize) -> Result<()> {
+fn check_frame_counts(warmup: usize, measured: usize) -> Result<()> {
     if warmup > MAX_WARMUP_FRAMES {
         anyhow::bail!("--warmup must be within 0..={MAX_WARMUP_FRAMES}, got {warmup}");
     }
@@ -66,16 +100,10 @@ pub fn check_frame_counts(warmup: usize, measured: usize) -> Result<()> {
 }
 
 impl RunOptions {
-    /// The frame counts' ranges (`check_frame_counts`).
-    pub fn validate(&self) -> Result<()> {
-        check_frame_counts(self.warmup, self.measured)
-    }
-
     /// One captured frame, no warm-up, quiet: what comparisons need.
     pub fn capture_once(command: &str) -> Self {
         RunOptions {
-            warmup: 0,
-            measured: 1,
+            frames: FrameCounts::ONE,
             capture: true,
             dump: false,
             ceilings: false,
@@ -85,15 +113,24 @@ impl RunOptions {
     }
 }
 
+/// Checks `settings` in `scene` ([`FrameRequest::new`]) and runs that frame
+/// (tests and tools that hold no request).
 pub fn run(
     ctx: &Context,
     scene: &Scene,
     settings: &RenderSettings,
     opts: &RunOptions,
 ) -> Result<RunOutput> {
-    opts.validate()?;
-    let mut renderer = Renderer::new(ctx, scene, settings)?;
-    let total = opts.warmup + opts.measured;
+    run_request(ctx, &FrameRequest::new(scene, settings.clone())?, opts)
+}
+
+/// Renders a checked frame: warm-up, measured frames, the capture, the
+/// report (with the frame's whole settings and the run header).
+pub fn run_request(ctx: &Context, request: &FrameRequest, opts: &RunOptions) -> Result<RunOutput> {
+    let (scene, settings) = (request.scene(), request.settings());
+    let mut renderer = Renderer::build(ctx, request)?;
+    let (warmup, measured) = (opts.frames.warmup(), opts.frames.measured());
+    let total = warmup + measured;
     let bar = if opts.progress && total > 20 {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
@@ -112,8 +149,8 @@ pub fn run(
             b.inc(1)
         }
     };
-    renderer.run_frames(opts.warmup, tick)?;
-    let (frames, record_ms) = renderer.frames_timed(opts.measured, tick)?;
+    renderer.run_frames(warmup, tick)?;
+    let (frames, record_ms) = renderer.frames_timed(measured, tick)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -163,7 +200,6 @@ pub fn run(
         (None, None)
     };
 
-    let f = &ctx.facts;
     // A frame of several methods names itself `mix`; its groups say the rest.
     let (method, method_options) = match &groups[..] {
         [one] => (
@@ -176,15 +212,16 @@ pub fn run(
         ),
     };
     let report = Report {
-        dermis_version: env!("CARGO_PKG_VERSION").to_string(),
-        command: opts.command.clone(),
-        device: f.name.clone(),
-        device_type: f.device_type.clone(),
-        driver: f.driver.clone(),
-        vulkan_api: f.api_version.clone(),
-        validation: ctx.validation,
-        width: settings.width,
-        height: settings.height,
+        run: RunHeader::new(
+            &opts.command,
+            device_header(ctx),
+            (settings.width, settings.height),
+            (warmup, measured),
+        ),
+        settings: Some(FrameSettings {
+            scene: scene.source.clone(),
+            render: settings.clone(),
+        }),
         method,
         method_options,
         method_details,
@@ -209,8 +246,6 @@ pub fn run(
             elevation_deg: settings.light.elevation_deg,
             intensity: settings.light.intensity,
         },
-        warmup_frames: opts.warmup,
-        measured_frames: opts.measured,
         passes,
         frame,
         sss_total_ms: if has_sss {
@@ -319,35 +354,47 @@ fn group_skin_pixels(c: &Capture, groups: &[GroupMethod]) -> Option<Vec<u64>> {
 pub fn header(r: &Report) -> String {
     format!(
         "dermis {} | {} ({}) | {}x{} | method {} | scene '{}' ({:.1} mm/unit) | {} head(s) | {} measured frames",
-        r.dermis_version, r.device, r.driver, r.width, r.height, r.method, r.scene, r.mm_per_unit, r.heads, r.measured_frames
+        r.run.dermis_version,
+        r.run.device.device,
+        r.run.device.driver,
+        r.run.width,
+        r.run.height,
+        r.method,
+        r.scene,
+        r.mm_per_unit,
+        r.heads,
+        r.run.measured_frames
     )
 }
 
-/// Renders and writes frame.png, diffuse.exr, depth.exr and report.json (with `dump`,
-/// every pass output as EXR under passes/) into `out`.
+/// The files [`render_to_dir`] writes into its folder (`characters.png` and
+/// `groups.png` when the frame has character ids and several methods), and
+/// the dumps it owns there.
+pub const RENDER_FILES: [&str; 6] = [
+    "frame.png",
+    "diffuse.exr",
+    "depth.exr",
+    "report.json",
+    "characters.png",
+    "groups.png",
+];
+/// With `--dump`: every pass output under `passes/`.
+pub const RENDER_DUMPS: crate::output::paths::Owned = crate::output::paths::Owned {
+    sub: "passes",
+    suffix: ".exr",
+};
+
+/// Renders a checked frame and writes frame.png, diffuse.exr, depth.exr and
+/// report.json (with `dump`, every pass output as EXR under passes/; with
+/// character ids, characters.png, and in a frame of several methods
+/// groups.png) into `out`, a folder prepared with [`RENDER_FILES`].
 pub fn render_to_dir(
     ctx: &Context,
-    scene: &Scene,
-    settings: &RenderSettings,
+    request: &FrameRequest,
     out: &Path,
     opts: &RunOptions,
 ) -> Result<RunOutput> {
-    prepare_render_dir(out, opts.dump)?;
-    // A frame of several methods also writes groups.png, which needs each
-    // pixel's character: the id pass comes with it (it changes no image).
-    let mixed =
-        crate::render::groups::specs_mixed(&crate::render::groups::group_specs(scene, settings)?);
-    let with_ids;
-    let settings = if mixed && !settings.character_ids {
-        with_ids = RenderSettings {
-            character_ids: true,
-            ..settings.clone()
-        };
-        &with_ids
-    } else {
-        settings
-    };
-    let mut output = run(ctx, scene, settings, opts)?;
+    let mut output = run_request(ctx, request, opts)?;
     let capture = output.capture.as_ref().context("no frame was captured")?;
     if let Some(ids) = &capture.character_ids {
         write_character_ids_png(
@@ -356,7 +403,7 @@ pub fn render_to_dir(
             capture.height,
             ids,
         )?;
-        if mixed {
+        if request.mixed() {
             let mut tint_of = vec![
                 [0u8; 3];
                 output
@@ -381,7 +428,7 @@ pub fn render_to_dir(
     write_diffuse_exr(&out.join("diffuse.exr"), capture)?;
     write_depth_exr(&out.join("depth.exr"), capture)?;
     if opts.dump {
-        let dir = out.join("passes");
+        let dir = out.join(RENDER_DUMPS.sub);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         for (i, d) in capture.dumps.iter().enumerate() {
             write_exr(
@@ -394,16 +441,15 @@ pub fn render_to_dir(
     Ok(output)
 }
 
-/// Measures many frames and the device ceilings, writes the report to `path`.
+/// Measures many frames and the device ceilings of a checked frame, writes
+/// the report to `path` (prepared by the caller).
 pub fn bench_run(
     ctx: &Context,
-    scene: &Scene,
-    settings: &RenderSettings,
+    request: &FrameRequest,
     opts: &RunOptions,
     path: &Path,
 ) -> Result<RunOutput> {
-    prepare_file(path)?;
-    let output = run(ctx, scene, settings, opts)?;
+    let output = run_request(ctx, request, opts)?;
     write_json(path, &output.report)?;
     Ok(output)
 }

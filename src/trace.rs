@@ -108,7 +108,7 @@ pub fn build(report: &Report, frames: &[Vec<PassSample>]) -> Trace {
         metadata(
             "process_name",
             0,
-            json!({ "name": format!("dermis {} on {}", report.method, report.device) }),
+            json!({ "name": format!("dermis {} on {}", report.method, report.run.device.device) }),
         ),
         metadata(
             "thread_name",
@@ -163,16 +163,16 @@ pub fn build(report: &Report, frames: &[Vec<PassSample>]) -> Trace {
         trace_events: ev,
         display_time_unit: "ms".into(),
         other_data: json!({
-            "dermis_version": report.dermis_version,
-            "command": report.command,
-            "device": report.device,
-            "driver": report.driver,
+            "dermis_version": report.run.dermis_version,
+            "command": report.run.command,
+            "device": report.run.device.device,
+            "driver": report.run.device.driver,
             "method": report.method,
             "scene": report.scene,
-            "width": report.width,
-            "height": report.height,
-            "warmup_frames": report.warmup_frames,
-            "measured_frames": report.measured_frames,
+            "width": report.run.width,
+            "height": report.run.height,
+            "warmup_frames": report.run.warmup_frames,
+            "measured_frames": report.run.measured_frames,
             "timeline": "GPU timestamps; frames laid end to end (the CPU's time between submissions is not in the trace); each pass's barriers are their own slice before it",
         }),
     }

@@ -31,7 +31,7 @@
 mod common;
 
 use dermis::render::{RenderSettings, Renderer};
-use dermis::run::{run, RunOptions};
+use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::{default_scene, egg_scene, Scene};
 use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 
@@ -209,8 +209,7 @@ fn frames_and_renders_stay_flat() {
     // Renders in a row, each with its own renderer (eval's pattern).
     let (scene, settings) = setup("separable");
     let opts = RunOptions {
-        warmup: 0,
-        measured: 2,
+        frames: FrameCounts::new(0, 2).unwrap(),
         ..RunOptions::capture_once("soak")
     };
     let base = live(&ctx);

@@ -16,7 +16,7 @@
 mod common;
 
 use dermis::render::{RenderSettings, Renderer};
-use dermis::run::{run, RunOptions};
+use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::{default_scene, egg_scene, Scene};
 use dermis::vk::context::Context;
 use dermis::vk::memory::Buffer;
@@ -78,8 +78,7 @@ fn every_method_tears_down_clean() {
         let ctx = common::ctx();
         let (scene, settings) = small(m.name);
         let opts = RunOptions {
-            warmup: 1,
-            measured: 2,
+            frames: FrameCounts::new(1, 2).unwrap(),
             ..RunOptions::capture_once("teardown")
         };
         run(&ctx, &scene, &settings, &opts).unwrap_or_else(|e| panic!("{}: {e:#}", m.name));

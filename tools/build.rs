@@ -89,6 +89,49 @@ fn main() {
     }
     table.push_str("];\n");
     std::fs::write(out.join("shaders.rs"), table).expect("writing shaders.rs");
+    embed_data(&out);
+}
+
+/// The project's data a command reads, embedded into the binary (issue 27: a
+/// binary that runs anywhere): the budget profiles, the measured accuracy
+/// tables and the planner's stored frames, as `embedded.rs`'s table of
+/// (path under the project, text), sorted by path.
+const EMBEDDED: [&str; 3] = ["profiles", "profiles/accuracy", "profiles/frames/plan"];
+
+fn embed_data(out: &Path) {
+    let mut files: Vec<PathBuf> = Vec::new();
+    for dir in EMBEDDED {
+        println!("cargo:rerun-if-changed={dir}");
+        let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("reading {dir}: {e}"));
+        for e in entries {
+            let p = e.expect("a folder entry").path();
+            let data = matches!(
+                p.extension().and_then(|x| x.to_str()),
+                Some("toml" | "json")
+            );
+            if p.is_file() && data {
+                println!("cargo:rerun-if-changed={}", p.display());
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    let root = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    let mut table = String::from(
+        "/// (path under the project, text) of every data file a command reads, built by build.rs.\npub static FILES: &[(&str, &str)] = &[\n",
+    );
+    for p in &files {
+        let rel = p.to_string_lossy().replace('\\', "/");
+        let abs = Path::new(&root).join(p);
+        writeln!(
+            table,
+            "    ({rel:?}, include_str!({:?})),",
+            abs.display().to_string()
+        )
+        .unwrap();
+    }
+    table.push_str("];\n");
+    std::fs::write(out.join("embedded.rs"), table).expect("writing embedded.rs");
 }
 
 /// Parses and validates one SPIR-V module with naga; a failure stops the build.

@@ -100,7 +100,7 @@ PY
     --profile xbox360,nvidia-h200 --compare-methods --warmup 0 --frames 1 --out "$d" >/dev/null
   python3 - "$d" "$scene" >> "$out" <<'PY'
 import json, sys, pathlib, hashlib
-TIME = ("measured", "command", "device", "driver", "provenance")
+TIME = ("measured", "command", "device", "driver", "provenance", "dermis_version", "vulkan_api", "validation", "warmup")
 def strip(v):
     if isinstance(v, dict):
         return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}
@@ -130,7 +130,7 @@ PY
     "$B" budget "${common[@]}" "${sargs[@]}" $bargs --warmup 0 --frames 1 --out "$d" >/dev/null
     python3 - "$d" "$scene" "$bname" >> "$out" <<'PY'
 import json, sys, pathlib, hashlib
-TIME = ("measured", "command", "device", "driver", "provenance")
+TIME = ("measured", "command", "device", "driver", "provenance", "dermis_version", "vulkan_api", "validation", "warmup")
 def strip(v):
     if isinstance(v, dict):
         return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}

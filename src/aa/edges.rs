@@ -123,11 +123,18 @@ pub const MLAA_DEPTH_THRESHOLD_MM: f32 = 10.0;
 /// SMAA's quality presets (`SMAA.hlsl`, ANCHORS.md): low (threshold 0.15,
 /// 4 search steps, no diagonals or corners), medium (0.1, 8), high (0.1, 16,
 /// diagonals 8, corner rounding 25 %), ultra (0.05, 32, 16, 25 %).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum Preset {
+    /// Threshold 0.15, 4 search steps, no diagonals or corners.
     Low,
+    /// Threshold 0.1, 8 search steps, no diagonals or corners.
     Medium,
+    /// Threshold 0.1, 16 search steps, diagonals 8, corner rounding 25 %.
     High,
+    /// Threshold 0.05, 32 search steps, diagonals 16, corner rounding 25 %.
     Ultra,
 }
 

@@ -331,15 +331,35 @@ pub struct AccuracyModel {
     pub headers: Vec<data::Header>,
 }
 
-/// The project's data: `profiles/accuracy/` beside Cargo.toml.
+/// The project's data in the source tree: `profiles/accuracy/` beside
+/// Cargo.toml (where `eval --scenes accuracy`'s files are copied to; the
+/// commands read the copies built into the binary).
 pub fn default_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/accuracy")
 }
 
+/// The embedded folder of the project's data.
+const EMBEDDED_DIR: &str = "profiles/accuracy";
+
 impl AccuracyModel {
-    /// The project's data file(s): every `*.toml` in [`default_dir`].
+    /// The project's data file(s) as built into the binary: every `*.toml`
+    /// of `profiles/accuracy/`, by name.
     pub fn load_default() -> Result<AccuracyModel> {
-        AccuracyModel::load(&default_dir())
+        let files = crate::embedded::files_in(EMBEDDED_DIR, ".toml");
+        if files.is_empty() {
+            bail!("accuracy data: no *.toml in the binary's {EMBEDDED_DIR}");
+        }
+        let mut rows = Vec::new();
+        let mut headers = Vec::new();
+        for (name, text) in files {
+            let (h, r) = data::parse(text, &format!("{EMBEDDED_DIR}/{name}"))?;
+            headers.push(h);
+            rows.extend(r);
+        }
+        let mut m = AccuracyModel::from_rows(&rows)
+            .with_context(|| format!("reading the binary's {EMBEDDED_DIR}"))?;
+        m.headers = headers;
+        Ok(m)
     }
 
     /// A data file, or a folder of them (every `*.toml` in it, by name).

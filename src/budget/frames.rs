@@ -215,7 +215,7 @@ pub fn paired_frame(rep: &Report, stored: &FrameInput) -> Result<FrameInput> {
             names(stored.passes.iter().map(|p| p.name.as_str()).collect())
         );
     }
-    let area = u64::from(rep.width) * u64::from(rep.height);
+    let area = u64::from(rep.run.width) * u64::from(rep.run.height);
     let region = rep.sss_region_pixels.unwrap_or(area);
     let rects = rep.sss_region_rects.unwrap_or(1);
     // The stored run's region, from its region-limited draws.
@@ -260,7 +260,7 @@ pub fn paired_frame(rep: &Report, stored: &FrameInput) -> Result<FrameInput> {
     }
     g.provenance.push(format!(
         "counts and times: the report of {} ({}); work, images and fetches: the stored frame",
-        rep.device, rep.command
+        rep.run.device.device, rep.run.command
     ));
     Ok(g)
 }

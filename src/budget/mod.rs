@@ -15,8 +15,8 @@
 //! held-out scores), [`porting`] (docs/budget.md's tables), [`table`] (the
 //! printed table), [`table91`] (thesis Table 9.1 as data and its games' line).
 //!
-//! With a device: [`run`] (`dermis budget`: run, count fetches, price, print,
-//! write) and [`chart`] (the stacked-bar chart).
+//! The chart: [`chart`] (the stacked-bar chart). The command that runs a
+//! frame on a device and prices it is `app::budget`.
 
 pub mod calibration;
 pub mod chart;
@@ -31,7 +31,6 @@ pub mod points;
 pub mod porting;
 pub mod profile;
 pub mod record;
-pub mod run;
 pub mod table;
 pub mod table91;
 pub mod transfers;

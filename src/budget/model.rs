@@ -112,8 +112,10 @@ fn pass_budget(pu: &PassUnits, params: &ModelParams, frame_ms: f64, skin_ms: f64
         unpriced: pu.unpriced.clone(),
         overruns: pu.overruns.clone(),
         share_of_frame: modelled.filter(|_| cost).map(|m| m / frame_ms),
+        // A profile may give skin SSS no share of the frame (0): then no pass
+        // has a share of it, rather than an infinite one.
         share_of_skin_budget: modelled
-            .filter(|_| pu.role == PassRole::Sss)
+            .filter(|_| pu.role == PassRole::Sss && skin_ms > 0.0)
             .map(|m| m / skin_ms),
     }
 }

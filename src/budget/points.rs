@@ -270,8 +270,8 @@ pub fn benchmark() -> Result<(Vec<Point>, Vec<String>)> {
             let name = path.file_stem().unwrap_or_default().to_string_lossy();
             let frame = report::load(&path)
                 .and_then(|r| {
-                    if !r.device.contains(device) {
-                        anyhow::bail!("run on {}, not an {device}", r.device);
+                    if !r.run.device.device.contains(device) {
+                        anyhow::bail!("run on {}, not an {device}", r.run.device.device);
                     }
                     frame_from_record(&r, None, &name)
                 })

@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
 
 pub use crate::budget::format::{FormatClass, TargetFormat};
@@ -141,6 +141,11 @@ pub struct BudgetShares {
     /// The default skin-SSS budget.
     pub sss_share: f64,
     pub post_share: f64,
+    /// The skin-SSS budgets (ms) `dermis plan-check` checks plans at on this
+    /// profile by default (empty: none; the profiles name their own cases,
+    /// no code names a profile).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plan_check_ms: Vec<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -328,46 +333,44 @@ pub struct Profile {
     pub formats: Vec<FormatCaps>,
 }
 
-/// The folder `profiles/` beside Cargo.toml, or `$DERMIS_PROFILES` when set.
+/// The folder `profiles/` of the source tree (the tools that write
+/// profiles and stored frames; a command reads the embedded copies).
 pub fn profiles_dir() -> PathBuf {
-    match std::env::var_os("DERMIS_PROFILES") {
-        Some(p) => PathBuf::from(p),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles"),
-    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles")
 }
 
-/// Names of the profiles in [`profiles_dir`], sorted.
-pub fn list_profiles() -> Result<Vec<String>> {
-    let dir = profiles_dir();
-    let mut names = Vec::new();
-    for e in std::fs::read_dir(&dir).with_context(|| format!("listing {}", dir.display()))? {
-        let p = e?.path();
-        if p.extension().is_some_and(|x| x == "toml") {
-            if let Some(s) = p.file_stem().and_then(|s| s.to_str()) {
-                names.push(s.to_string());
-            }
-        }
-    }
-    names.sort();
-    Ok(names)
+/// Names of the profiles built into the binary, sorted.
+pub fn list_profiles() -> Vec<String> {
+    crate::embedded::files_in("profiles", ".toml")
+        .into_iter()
+        .filter_map(|(name, _)| name.strip_suffix(".toml").map(str::to_string))
+        .collect()
+}
+
+/// Every built-in profile, parsed, sorted by name.
+pub fn builtin_profiles() -> Result<Vec<Profile>> {
+    list_profiles().iter().map(|n| Profile::load(n)).collect()
 }
 
 impl Profile {
-    /// A profile by name (`xbox360` -> `profiles/xbox360.toml`) or by path
-    /// (anything with a `/` or ending in `.toml`).
+    /// A profile by name (`xbox360`: `profiles/xbox360.toml`, built into the
+    /// binary) or by path (anything with a `/` or ending in `.toml`: a
+    /// user's own profile, read through the bounded reader). An unknown
+    /// name is an error listing the built-in ones.
     pub fn load(name_or_path: &str) -> Result<Profile> {
-        let path = if name_or_path.contains('/') || name_or_path.ends_with(".toml") {
-            PathBuf::from(name_or_path)
-        } else {
-            profiles_dir().join(format!("{name_or_path}.toml"))
-        };
-        let text = crate::files::read_text(&path, "profile", crate::files::MAX_TEXT_FILE).map_err(
-            |e| {
-                let known = list_profiles().map(|v| v.join(", ")).unwrap_or_default();
-                anyhow!("{e:#}; profiles: {known}")
-            },
-        )?;
-        Profile::parse(&text, &path.display().to_string())
+        if name_or_path.contains('/') || name_or_path.ends_with(".toml") {
+            let path = PathBuf::from(name_or_path);
+            let text = crate::files::read_text(&path, "profile", crate::files::MAX_TEXT_FILE)?;
+            return Profile::parse(&text, &path.display().to_string());
+        }
+        let file = format!("profiles/{name_or_path}.toml");
+        let text = crate::embedded::file(&file).ok_or_else(|| {
+            anyhow!(
+                "no profile '{name_or_path}' (built in: {}; or give a TOML file's path)",
+                list_profiles().join(", ")
+            )
+        })?;
+        Profile::parse(text, &file)
     }
 
     /// Parses and checks a profile; `file` names it in errors.
@@ -435,6 +438,9 @@ impl Profile {
         let sum: f64 = shares.iter().map(|s| s.1).sum();
         if sum > 1.0 + 1e-9 {
             bail!("fields `budget.*_share` add up to {sum}, more than the frame");
+        }
+        for &ms in &b.plan_check_ms {
+            pos("budget.plan_check_ms", ms)?;
         }
         q("alu.gflops", self.alu.gflops)?;
         q("alu.compute_gflops", self.alu.compute_gflops)?;
@@ -540,7 +546,7 @@ mod tests {
 
     #[test]
     fn every_profile_parses() {
-        let names = list_profiles().unwrap();
+        let names = list_profiles();
         for want in [
             "xbox360",
             "ps3",

@@ -38,7 +38,7 @@ build counted in main (the samples passed when there was no counting run)";
 
 /// How the driver of the run `r` counts fragment invocations.
 pub fn counting(r: &Report) -> FragmentCounting {
-    FragmentCounting::of(&r.device, &r.driver)
+    FragmentCounting::of(&r.run.device.device, &r.run.device.driver)
 }
 
 /// When a driver's pipeline statistics count fragment-shader invocations.
@@ -216,8 +216,8 @@ pub fn frame_from_record(
     }
     let mut provenance = vec![format!(
         "run on {} ({}); fragments: {}",
-        rec.device,
-        rec.driver,
+        rec.run.device.device,
+        rec.run.device.driver,
         match counting {
             FragmentCounting::AfterEarlyTests => "invocation counts (this driver counts after the early tests)",
             FragmentCounting::BeforeEarlyTests =>
@@ -242,8 +242,8 @@ pub fn frame_from_record(
     }
     Ok(FrameInput {
         label: label.to_string(),
-        width: rec.width,
-        height: rec.height,
+        width: rec.run.width,
+        height: rec.run.height,
         passes,
         provenance,
     })

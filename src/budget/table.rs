@@ -107,16 +107,28 @@ pub fn budget_table(b: &FrameBudget, device: &str) -> String {
             " | measured {m:.3} ms on {device}"
         )),
     );
+    // A profile that gives skin SSS no share has no percentage of it.
+    let of_budget = if b.skin_budget_ms > 0.0 {
+        format!(
+            "of {:.2} ms skin budget ({:.0}%)",
+            b.skin_budget_ms,
+            b.sss_ms / b.skin_budget_ms * 100.0
+        )
+    } else {
+        "(the profile gives skin SSS no budget)".to_string()
+    };
     let _ = writeln!(
         s,
-        "{:<22} {:<9} {:>9} of {:.2} ms skin budget ({:.0}%), of which eDRAM resolves/restores {:.3} ms{}",
+        "{:<22} {:<9} {:>9} {of_budget}, of which eDRAM resolves/restores {:.3} ms{}",
         "skin SSS",
         "",
         format!("{:.3}", b.sss_ms),
-        b.skin_budget_ms,
-        b.sss_ms / b.skin_budget_ms * 100.0,
         b.sss_transfer_ms,
-        if b.over_skin_budget { "  OVER BUDGET" } else { "" },
+        if b.over_skin_budget {
+            "  OVER BUDGET"
+        } else {
+            ""
+        },
     );
     for f in flags(b) {
         let _ = writeln!(s, "  ! {f}");

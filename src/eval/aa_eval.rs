@@ -1,5 +1,9 @@
-//! `dermis aa-eval`: every anti-aliasing mode scored against a supersampled
-//! frame (issue 17 item 6). For each scene of the set, the frame is rendered
+//! What `dermis aa-eval` scores and records (no device: the renders are
+//! `app::aa_eval`'s): its views, the scoring of a view's frames, the rows,
+//! the table, the CSV and aa-eval.json's schema (read back typed).
+//!
+//! Every anti-aliasing mode is scored against a supersampled frame (issue 17
+//! item 6). For each scene of the set, the frame is rendered
 //! once at N x N its size with the same camera, SSS method and settings and
 //! box-filtered down (`supersample`), then once per AA mode at its size, timed
 //! like every frame; each mode's frame is scored against the filtered one over
@@ -14,22 +18,15 @@
 //! they cover the same part of the picture. The shadow map keeps its size: it
 //! is the same scene input at both resolutions.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{bail, Context as _, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-use super::supersample::{box_filter_srgb8, check_supersampled, edge_mask, score, AaError};
-use super::{chart, pareto};
-use crate::output::{write_json, write_rgba8_png};
+use super::supersample::{edge_mask, score, AaError};
+use crate::header::RunHeader;
 use crate::post::AaMode;
-use crate::render::settings::{check_msaa, MSAA_COUNTS};
-use crate::render::RenderSettings;
-use crate::run::{run, RunOptions};
-use crate::scene::camera::Camera;
-use crate::scene::gltf_load::TextureOverrides;
-use crate::scene::{builtin, load_gltf_scene, Scene, MAX_IMAGE_SIDE};
-use crate::vk::context::Context;
+use crate::render::settings::ShotPreset;
 
 /// The scene groups `--scenes` takes, comma-separated.
 pub const SCENE_GROUPS: [&str; 3] = ["head", "crowd", "lines"];
@@ -37,7 +34,7 @@ pub const SCENE_GROUPS: [&str; 3] = ["head", "crowd", "lines"];
 pub const DEFAULT_CROWD: u32 = 9;
 
 /// One view of the set.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AaScene {
     pub name: String,
     /// `builtin:NAME` or a glTF path.
@@ -56,7 +53,10 @@ pub fn scene_set(
     crowd: u32,
     fovy_deg: f32,
 ) -> Result<Vec<AaScene>> {
-    let close = Camera::close_up_distance_heads(fovy_deg);
+    let (close, far) = (
+        ShotPreset::Close.distance_heads(fovy_deg),
+        ShotPreset::Far.distance_heads(fovy_deg),
+    );
     let view = |name: String, source: String, d: f32, heads: u32| AaScene {
         name,
         source,
@@ -73,13 +73,13 @@ pub fn scene_set(
                 }
                 for (who, src) in heads {
                     v.push(view(format!("{who} close"), src.clone(), close, 1));
-                    v.push(view(format!("{who} far"), src, 5.0 * close, 1));
+                    v.push(view(format!("{who} far"), src, far, 1));
                 }
             }
             "crowd" => v.push(view(
                 format!("crowd of {crowd}"),
                 "builtin:face".into(),
-                2.0 * close,
+                ShotPreset::Mid.distance_heads(fovy_deg),
                 crowd,
             )),
             "lines" => {
@@ -107,29 +107,8 @@ pub fn scene_set(
     Ok(v)
 }
 
-fn load(s: &AaScene) -> Result<Scene> {
-    match s.source.strip_prefix("builtin:") {
-        Some(name) => builtin(name),
-        None => load_gltf_scene(Path::new(&s.source), &TextureOverrides::default(), None),
-    }
-}
-
-/// What the sweep needs besides the scenes.
-pub struct AaEvalOptions {
-    /// The frame every view starts from (size, method, lights...); its `aa`,
-    /// distance and head count are set per run.
-    pub base: RenderSettings,
-    /// Samples per pixel per axis of the reference.
-    pub factor: u32,
-    pub warmup: usize,
-    pub measured: usize,
-    pub progress: bool,
-    /// Where to write the per-scene PNGs (`None`: nowhere).
-    pub images: Option<PathBuf>,
-}
-
 /// One (scene, mode) result.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AaRow {
     pub scene: String,
     pub mode: String,
@@ -158,55 +137,12 @@ pub fn msaa_label(n: u32) -> String {
     format!("msaa{n}x")
 }
 
-/// The MSAA counts above 1 scored beside the post modes: those the device
-/// renders and the settings' method accepts (none in a frame of several,
-/// whose groups are checked only once they are known).
-pub fn msaa_counts(ctx: &Context, settings: &RenderSettings) -> Vec<u32> {
-    if settings.assignment.is_some() {
-        return Vec::new();
-    }
-    MSAA_COUNTS
-        .into_iter()
-        .filter(|&n| n > 1 && ctx.facts.framebuffer_sample_counts.contains(&n))
-        .filter(|&n| check_msaa(n, Some(settings.method)).is_ok())
-        .collect()
-}
-
 /// The filtered reference of one view and the 1x frames of every mode.
 pub struct ViewFrames {
     pub reference: Vec<u8>,
     /// `(mode, sRGB8 frame, AA ms, frame ms)`, in `AaMode::ALL` order, then
     /// the MSAA rows (`mode_frames`).
     pub modes: Vec<ModeFrame>,
-}
-
-/// Renders the supersampled reference of `settings` and box-filters it.
-pub fn reference(
-    ctx: &Context,
-    scene: &Scene,
-    settings: &RenderSettings,
-    n: u32,
-) -> Result<Vec<u8>> {
-    let max_side = ctx.facts.max_image_dimension_2d.min(MAX_IMAGE_SIDE);
-    let (w, h) = check_supersampled(settings.width, settings.height, n, max_side)?;
-    let big = RenderSettings {
-        width: w,
-        height: h,
-        sss_region_tile: (settings.sss_region_tile * n).min(1024),
-        aa: AaMode::None,
-        // The reference is supersampled, not multisampled.
-        msaa: 1,
-        ..settings.clone()
-    };
-    let out = run(
-        ctx,
-        scene,
-        &big,
-        &RunOptions::capture_once("aa-eval reference"),
-    )
-    .with_context(|| format!("the {n}x{n} supersampled reference ({w}x{h})"))?;
-    let cap = out.capture.context("reference capture")?;
-    box_filter_srgb8(&cap.ldr, settings.width, settings.height, n)
 }
 
 /// The AA stage's GPU ms: the summed median ms of the passes of a frame with
@@ -220,86 +156,6 @@ pub fn aa_pass_ms(passes: &[(String, f64)], none: &[(String, f64)]) -> f64 {
         .filter(|(name, _)| !none.iter().any(|(n, _)| n == name))
         // A fold from +0: `sum` of no pass is -0.0.
         .fold(0.0, |a, (_, ms)| a + ms)
-}
-
-/// One frame with `mode`, measured and captured: (sRGB8, each pass's name
-/// and median GPU ms, the frame's median GPU ms).
-pub fn mode_frame(
-    ctx: &Context,
-    scene: &Scene,
-    settings: &RenderSettings,
-    mode: AaMode,
-    warmup: usize,
-    measured: usize,
-) -> Result<(Vec<u8>, PassTimes, f64)> {
-    let s = RenderSettings {
-        aa: mode,
-        ..settings.clone()
-    };
-    let o = RunOptions {
-        warmup,
-        measured,
-        ..RunOptions::capture_once("aa-eval")
-    };
-    let out = run(ctx, scene, &s, &o).with_context(|| format!("--aa {mode}"))?;
-    let cap = out.capture.context("capture")?;
-    let frame_ms = out.report.frame.as_ref().map_or(0.0, |f| f.gpu_ms.median);
-    let passes = out
-        .report
-        .passes
-        .iter()
-        .map(|p| (p.name.clone(), p.gpu_ms.median))
-        .collect();
-    Ok((cap.ldr, passes, frame_ms))
-}
-
-/// Every mode's frame of one view, in `AaMode::ALL` order (`none` first, whose
-/// passes the others' AA ms are told from), then one frame per count of
-/// [`msaa_counts`] with `--aa none`: `(label, sRGB8, AA ms, frame ms)`. An
-/// MSAA row's AA ms is its frame's median GPU ms over `none`'s (the overhead
-/// Table 10.1 gives for MSAA; 0 when the measurement noise makes it
-/// negative). `on_mode` is called with each label before its run and `done`
-/// after it.
-pub fn mode_frames(
-    ctx: &Context,
-    scene: &Scene,
-    settings: &RenderSettings,
-    (warmup, measured): (usize, usize),
-    on_mode: &dyn Fn(&str),
-    done: &dyn Fn(),
-) -> Result<Vec<ModeFrame>> {
-    // The post modes run on the single-sample frame; MSAA has rows of its own.
-    let settings = &RenderSettings {
-        msaa: 1,
-        ..settings.clone()
-    };
-    let mut none_passes: PassTimes = Vec::new();
-    let mut none_ms = 0.0;
-    let mut out = Vec::new();
-    for mode in AaMode::ALL {
-        on_mode(mode.name());
-        let (frame, passes, frame_ms) = mode_frame(ctx, scene, settings, mode, warmup, measured)?;
-        if mode == AaMode::None {
-            none_passes = passes.clone();
-            none_ms = frame_ms;
-        }
-        let aa = aa_pass_ms(&passes, &none_passes);
-        out.push((mode.name().to_string(), frame, aa, frame_ms));
-        done();
-    }
-    for n in msaa_counts(ctx, settings) {
-        let label = msaa_label(n);
-        on_mode(&label);
-        let s = RenderSettings {
-            msaa: n,
-            ..settings.clone()
-        };
-        let (frame, _, frame_ms) = mode_frame(ctx, scene, &s, AaMode::None, warmup, measured)
-            .with_context(|| format!("--msaa {n}"))?;
-        out.push((label, frame, (frame_ms - none_ms).max(0.0), frame_ms));
-        done();
-    }
-    Ok(out)
 }
 
 /// The rows of one view: every mode scored against the reference over the
@@ -346,82 +202,10 @@ pub fn score_view(
 }
 
 /// A file-name-safe form of a scene name.
-fn slug(name: &str) -> String {
+pub fn slug(name: &str) -> String {
     name.chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
         .collect()
-}
-
-/// Runs the set; one row per (view, mode).
-pub fn sweep(ctx: &Context, scenes: &[AaScene], o: &AaEvalOptions) -> Result<Vec<AaRow>> {
-    let per_view = 1 + (AaMode::ALL.len() + msaa_counts(ctx, &o.base).len()) as u64;
-    let bar = o.progress.then(|| {
-        let b = indicatif::ProgressBar::new(scenes.len() as u64 * per_view);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
-    let step = |msg: String| {
-        if let Some(b) = &bar {
-            b.set_message(msg);
-        }
-    };
-    let tick = || {
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-    };
-    let (w, h) = (o.base.width, o.base.height);
-    let mut rows = Vec::new();
-    for v in scenes {
-        let scene = load(v).with_context(|| format!("loading scene '{}'", v.name))?;
-        let s = RenderSettings {
-            distance_heads: v.distance_heads,
-            heads: v.heads,
-            ..o.base.clone()
-        };
-        step(format!("{}: {n}x{n} reference", v.name, n = o.factor));
-        let reference =
-            reference(ctx, &scene, &s, o.factor).with_context(|| format!("on '{}'", v.name))?;
-        tick();
-        let modes = mode_frames(
-            ctx,
-            &scene,
-            &s,
-            (o.warmup, o.measured),
-            &|mode| step(format!("{}: {mode}", v.name)),
-            &tick,
-        )
-        .with_context(|| format!("on '{}'", v.name))?;
-        let frames = ViewFrames { reference, modes };
-        let (view_rows, mask) = score_view(&v.name, &frames, w, h)?;
-        if let Some(dir) = &o.images {
-            let dir = dir.join(slug(&v.name));
-            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            write_rgba8_png(&dir.join("reference.png"), w, h, frames.reference.clone())?;
-            let m: Vec<u8> = mask
-                .iter()
-                .flat_map(|&e| {
-                    if e {
-                        [255, 255, 255, 255]
-                    } else {
-                        [0, 0, 0, 255]
-                    }
-                })
-                .collect();
-            write_rgba8_png(&dir.join("edges.png"), w, h, m)?;
-            for (mode, frame, ..) in frames.modes {
-                write_rgba8_png(&dir.join(format!("{mode}.png")), w, h, frame)?;
-            }
-        }
-        rows.extend(view_rows);
-    }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    Ok(rows)
 }
 
 const CSV_HEADER: [&str; 12] = [
@@ -492,79 +276,25 @@ pub fn table(rows: &[AaRow]) -> String {
     s
 }
 
-/// Writes aa-eval.json, aa-eval.csv, chart.png and chart.svg into `out`;
-/// returns the paths.
-pub fn write(
-    ctx: &Context,
-    rows: &[AaRow],
-    scenes: &[AaScene],
-    o: &AaEvalOptions,
-    command: &str,
-    out: &Path,
-) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let files = vec![
-        out.join("aa-eval.json"),
-        out.join("aa-eval.csv"),
-        out.join("chart.png"),
-        out.join("chart.svg"),
-    ];
-    write_json(
-        &files[0],
-        &serde_json::json!({
-            "device": ctx.facts.name, "driver": ctx.facts.driver, "command": command,
-            "width": o.base.width, "height": o.base.height, "method": o.base.method.name,
-            "factor": o.factor,
-            "reference": format!("{n}x{n} samples per pixel: the frame rendered at {n} times the size (same camera, SSS method and settings), tone-mapped, then each {n}x{n} block decoded from sRGB, averaged in display-linear light and re-encoded", n = o.factor),
-            "space": "relative RMSE on the display-linear RGB of the sRGB frames (the space the AA modes blend in), FLIP on the sRGB bytes",
-            "edge_pixels": format!("pixels where the filtered reference and the 1x --aa none frame differ by >= {}/255 in a channel", super::supersample::EDGE_THRESHOLD),
-            "scenes": scenes, "rows": rows,
-        }),
-    )?;
-    let table: Vec<Vec<String>> = rows.iter().map(csv_fields).collect();
-    pareto::write_table(&files[1], &CSV_HEADER[..], &table)?;
-    type Pick = fn(&AaRow) -> Option<f64>;
-    let metrics: [(&str, Pick); 5] = [
-        ("edge relative RMSE over no AA's", |r| r.rmse_edges_vs_none),
-        ("relative RMSE, edge pixels", |r| r.error.rmse_edges),
-        ("FLIP, edge pixels", |r| r.error.flip_edges),
-        ("relative RMSE, whole frame", |r| Some(r.error.rmse_frame)),
-        ("FLIP, whole frame", |r| Some(r.error.flip_frame)),
-    ];
-    let panels: Vec<chart::Panel> = metrics
-        .iter()
-        .map(|(title, pick)| chart::Panel {
-            title: (*title).into(),
-            y_label: format!("{title} against the supersampled frame"),
-            points: rows
-                .iter()
-                .filter_map(|r| {
-                    pick(r).map(|e| pareto::EvalPoint {
-                        method: r.mode.clone(),
-                        setting: String::new(),
-                        scene: r.scene.clone(),
-                        gpu_ms: r.aa_ms,
-                        error: e,
-                    })
-                })
-                .collect(),
-            front: false,
-        })
-        .filter(|p| !p.points.is_empty())
-        .collect();
-    chart::panel_chart(
-        &panels,
-        &format!(
-            "AA cost vs error to the {n}x{n} supersampled frame ({}, {} view(s))",
-            ctx.facts.name,
-            scenes.len(),
-            n = o.factor
-        ),
-        "GPU ms (AA passes, median)",
-        &files[2],
-        &files[3],
-    )?;
-    Ok(files)
+/// aa-eval.json: the run, how the reference and the errors are made, the
+/// views and a row per (view, mode); written by `dermis aa-eval`, read back
+/// typed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AaEvalReport {
+    #[serde(flatten)]
+    pub run: RunHeader,
+    pub method: String,
+    pub factor: u32,
+    pub reference: String,
+    pub space: String,
+    pub edge_pixels: String,
+    pub scenes: Vec<AaScene>,
+    pub rows: Vec<AaRow>,
+}
+
+/// The CSV's header and a row's fields.
+pub fn csv(rows: &[AaRow]) -> (&'static [&'static str], Vec<Vec<String>>) {
+    (&CSV_HEADER[..], rows.iter().map(csv_fields).collect())
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //!
 //! Pure code on images read back from the GPU.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Width of the silhouette and depth-step bands on the skin, mm: 2 mm is the
 /// reach of the profile's Gaussians 1-4 (2-3 sigma), where a screen-space tap
@@ -25,7 +25,7 @@ pub const BAND_MM: f32 = 2.0;
 pub const STEP_SLOPE: f32 = 10.0;
 
 /// The band of a pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Band {
     Interior,
@@ -179,7 +179,7 @@ fn ordered(v: f32) -> u32 {
 }
 
 /// The errors of one method's image over one band.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BandError {
     pub pixels: usize,
     /// RMS error over the reference's RMS (energy-normalised relative RMSE).
@@ -195,7 +195,7 @@ pub struct BandError {
 }
 
 /// A method's errors over each band.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BandErrors {
     pub interior: BandError,
     pub silhouette: BandError,

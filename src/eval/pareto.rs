@@ -12,7 +12,7 @@ use anyhow::Result;
 
 /// One measured configuration: what it cost on the GPU and how far it is from
 /// the ground truth.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EvalPoint {
     /// SSS method, e.g. `separable`, `ssg`, `ss-jittered`, `poisson`.
     pub method: String,

@@ -170,7 +170,7 @@ pub fn linear(srgb8: &[u8]) -> Vec<[f32; 4]> {
 }
 
 /// One frame's error against the filtered reference.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct AaError {
     /// Relative RMSE over the edge pixels (`None`: no edge pixel).
     pub rmse_edges: Option<f64>,

@@ -1,22 +1,22 @@
-//! `dermis eval`: every registered method and quality setting, on a scene set,
-//! timed by the same run's timestamps and scored against the ground truth.
+//! What `dermis eval` sweeps and what it records (no device: the sweep
+//! itself is `app::eval`'s): the registered methods' settings, the scene
+//! sets' views, a row per (view, setting), the summary and eval.json's
+//! schema, read back typed.
 //!
 //! A method joins the chart by adding its settings to [`registry`].
 
 use std::path::PathBuf;
 
-use anyhow::{Context as _, Result};
-use serde::Serialize;
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
 
-use super::bands::{bands, Band, BandErrors, BandInput};
-use super::metrics::{flip_ldr, relative_rmse};
+use super::bands::{Band, BandErrors};
 use super::pareto::EvalPoint;
-use crate::method::{ground_truth, lookup, EvalSetting, MethodEntry, METHODS};
+use crate::header::RunHeader;
+use crate::method::{EvalSetting, MethodEntry, METHODS};
 use crate::render::RenderSettings;
-use crate::run::{run, RunOptions};
 use crate::scene::gltf_load::TextureOverrides;
 use crate::scene::{default_scene, load_gltf_scene, Scene};
-use crate::vk::context::Context;
 
 /// One point of the sweep: a method at one quality setting.
 #[derive(Clone, Copy, Debug)]
@@ -41,7 +41,7 @@ pub fn registry() -> Vec<Config> {
 }
 
 /// A view of the scene set.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SceneSpec {
     pub name: String,
     /// `None`: the embedded procedural head.
@@ -59,7 +59,7 @@ pub struct SceneSpec {
 }
 
 /// What a row of the accuracy model records about its view.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracyPoint {
     pub asset: String,
     /// Pixels per millimetre at the head centre's depth.
@@ -139,7 +139,7 @@ pub fn procedural_scene() -> SceneSpec {
 }
 
 /// One row of the detailed report: `point.error` is the interior err/none.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct EvalRow {
     #[serde(flatten)]
     pub point: EvalPoint,
@@ -223,171 +223,28 @@ pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
     super::pareto::write_table(path, &EvalRow::csv_header(), &fields)
 }
 
-pub struct EvalOptions {
-    pub base: RenderSettings,
-    pub warmup: usize,
-    pub measured: usize,
-    pub progress: bool,
+/// What `err/none` means in eval.json.
+pub const ERROR_DEFINITION: &str = "err/none over the interior band: the method's RMS error against the ground truth over the no-SSS frame's (0 perfect, 1 no better than no SSS)";
+
+/// eval.json: the run, the views, every row, the summary and its Pareto
+/// front (on the interior); written by `dermis eval`, read back typed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EvalReport {
+    #[serde(flatten)]
+    pub run: RunHeader,
+    pub error: String,
+    pub scenes: Vec<SceneSpec>,
+    pub rows: Vec<EvalRow>,
+    pub summary: Vec<SummaryRow>,
+    pub pareto_front: Vec<SummaryRow>,
 }
 
-pub(super) fn load(spec: &SceneSpec) -> Result<Scene> {
+/// A view's scene: the embedded face, or the file (no textures given).
+pub fn load(spec: &SceneSpec) -> Result<Scene> {
     match &spec.gltf {
         None => Ok(default_scene()),
         Some(p) => load_gltf_scene(p, &TextureOverrides::default(), None),
     }
-}
-
-/// Runs the sweep; returns one row per (scene, config).
-pub fn sweep(
-    ctx: &Context,
-    scenes: &[SceneSpec],
-    configs: &[Config],
-    opts: &EvalOptions,
-) -> Result<Vec<EvalRow>> {
-    let total = (scenes.len() * (configs.len() + 1)) as u64;
-    let bar = opts.progress.then(|| {
-        let b = indicatif::ProgressBar::new(total);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
-    let mut rows = Vec::new();
-    for spec in scenes {
-        let scene = load(spec).with_context(|| format!("loading scene '{}'", spec.name))?;
-        let mut base = opts.base.clone();
-        base.distance_heads = spec.distance_heads;
-        base.light.azimuth_deg = spec.azimuth_deg;
-        base.light.elevation_deg = spec.elevation_deg;
-        if let Some(f) = spec.fovy_deg {
-            base.fovy_deg = f;
-        }
-        let once = RunOptions::capture_once("eval");
-        let step = |what: &str| {
-            if let Some(b) = &bar {
-                b.set_message(format!("{}: {what}", spec.name));
-            }
-        };
-        step("reference");
-        let reference = run(
-            ctx,
-            &scene,
-            &RenderSettings {
-                method: ground_truth(),
-                ..base.clone()
-            },
-            &once,
-        )?;
-        let view = (
-            reference.report.width as usize,
-            reference.report.height as usize,
-        );
-        let (fovy, mm_per_unit) = (reference.report.fovy_deg, reference.report.mm_per_unit);
-        let reference = reference.capture.context("reference capture")?;
-        // One measured run per config (the progress bar names it).
-        let measure = |c: &Config| {
-            step(&format!("{} {}", c.method.name, c.setting.label));
-            let s = base.clone().with(c.method, c.setting.options);
-            let o = RunOptions {
-                warmup: opts.warmup,
-                measured: opts.measured,
-                capture: true,
-                ..once.clone()
-            };
-            run(ctx, &scene, &s, &o).with_context(|| {
-                format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
-            })
-        };
-        // The no-SSS frame every err/none and gain is relative to: the `none`
-        // config's own measured run when it is swept (rendered once, used twice),
-        // else one captured frame.
-        let none_method = lookup("none")?;
-        let none_at = configs
-            .iter()
-            .position(|c| std::ptr::eq(c.method, none_method));
-        let mut none_run = none_at.map(|i| measure(&configs[i])).transpose()?;
-        let none = match &none_run {
-            Some(out) => out
-                .capture
-                .as_ref()
-                .context("no-SSS capture")?
-                .diffuse
-                .clone(),
-            None => {
-                run(
-                    ctx,
-                    &scene,
-                    &RenderSettings {
-                        method: none_method,
-                        ..base.clone()
-                    },
-                    &once,
-                )?
-                .capture
-                .context("no-SSS capture")?
-                .diffuse
-            }
-        };
-        let mask: Vec<bool> = reference.diffuse.iter().map(|p| p[3] > 0.0).collect();
-        let skin = mask.iter().filter(|&&m| m).count();
-        let band_of = bands(&BandInput::for_view(
-            view,
-            &mask,
-            &reference.depth,
-            fovy,
-            mm_per_unit,
-        ));
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-        for (i, c) in configs.iter().enumerate() {
-            let reuse = if none_at == Some(i) {
-                none_run.take()
-            } else {
-                None
-            };
-            let out = match reuse {
-                Some(out) => out,
-                None => measure(c)?,
-            };
-            let cap = out.capture.context("capture")?;
-            let flip = flip_ldr(&cap.ldr, &reference.ldr, cap.width, cap.height)?;
-            let band_errors = BandErrors::of(
-                &cap.diffuse,
-                &reference.diffuse,
-                Some(&none),
-                &flip.error_map,
-                &band_of,
-            );
-            // With no skin in view there is nothing to score.
-            let rel_rmse = if skin > 0 {
-                relative_rmse(&cap.diffuse, &reference.diffuse, &mask)?
-            } else {
-                0.0
-            };
-            rows.push(EvalRow {
-                point: EvalPoint {
-                    method: c.method.name.to_string(),
-                    setting: c.setting.label.to_string(),
-                    scene: spec.name.clone(),
-                    gpu_ms: out.report.sss_total_ms.map_or(0.0, |s| s.median),
-                    error: band_errors.interior.err_none.unwrap_or(0.0),
-                },
-                skin_pixels: skin,
-                frame_ms: out.report.frame.map_or(0.0, |f| f.gpu_ms.median),
-                rel_rmse_all_skin: rel_rmse,
-                bands: band_errors,
-            });
-            if let Some(b) = &bar {
-                b.inc(1);
-            }
-        }
-    }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    Ok(rows)
 }
 
 /// The summary as the CLI prints it: cost, then err/none per band and the
@@ -413,7 +270,7 @@ pub fn summary_table(summary: &[SummaryRow]) -> String {
 }
 
 /// A band's errors averaged over the scenes where the band has pixels.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 pub struct BandMean {
     /// Scenes in which the band had pixels.
     pub scenes: usize,
@@ -424,7 +281,7 @@ pub struct BandMean {
 }
 
 /// One (method, setting) over the scene set.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SummaryRow {
     pub method: String,
     pub setting: String,

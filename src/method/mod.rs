@@ -424,7 +424,12 @@ pub fn default_method() -> &'static MethodEntry {
     &separable::ENTRY
 }
 
-/// The ground truth's entry.
+/// The entry of no SSS (the baseline every err/none is relative to).
+pub fn none() -> &'static MethodEntry {
+    &none::ENTRY
+}
+
+/// The ground truth's entry (the one method marked `ground_truth`).
 pub fn ground_truth() -> &'static MethodEntry {
     METHODS
         .iter()

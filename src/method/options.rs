@@ -42,7 +42,7 @@ impl OptSpec {
 /// Option values given explicitly (by the CLI, an eval setting, a test), by
 /// key. Keys of every method may be present: `eval` passes one set to all of
 /// them, and each method reads only its own.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct MethodOptions(BTreeMap<String, String>);
 
 impl MethodOptions {

@@ -57,9 +57,31 @@ pub struct Rule {
     pub text: String,
 }
 
-/// The parsed `--assign` value.
+/// The parsed `--assign` value; serialised as the rules' text (what
+/// `--assign` takes), so a report's settings give the same rules back.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rules(pub Vec<Rule>);
+
+impl std::fmt::Display for Rules {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let texts: Vec<&str> = self.0.iter().map(|r| r.text.as_str()).collect();
+        f.write_str(&texts.join(","))
+    }
+}
+
+impl serde::Serialize for Rules {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Rules {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let text = String::deserialize(d)?;
+        text.parse()
+            .map_err(|e: anyhow::Error| serde::de::Error::custom(format!("{e:#}")))
+    }
+}
 
 fn number<T: std::str::FromStr>(s: &str, what: &str, rule: &str) -> Result<T> {
     s.trim()

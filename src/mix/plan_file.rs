@@ -90,6 +90,10 @@ pub struct PlanFile {
     /// Anything the planner wants to say about its choice (the algorithm, its bound).
     #[serde(default)]
     pub notes: Vec<String>,
+    /// The run that wrote it (absent in a hand-written plan): under `run`,
+    /// not flattened, as a plan file takes no field it does not know.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run: Option<crate::header::RunHeader>,
 }
 
 impl PlanFile {
@@ -114,6 +118,10 @@ impl PlanFile {
                 self.version
             );
         }
+        // The count sizes what is allocated below: held to --heads' range.
+        crate::ranges::HEADS
+            .check(self.characters)
+            .context("characters")?;
         let mut seen = vec![false; self.characters];
         for a in &self.assignments {
             if a.character >= self.characters {

@@ -13,9 +13,9 @@
 use std::time::Instant;
 
 use super::character::{from_visible, FrameView};
-use super::cli::{atlas_mm, with_regions};
 use super::cost::SettingModel;
 use super::over_time::FrameInput;
+use super::pipeline::{atlas_mm, with_regions};
 use super::price_grid::PriceGrid;
 use super::skin_patches::{SkinPatches, View};
 use crate::budget::profile::Profile;

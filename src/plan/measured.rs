@@ -64,7 +64,7 @@ mod tests {
     fn the_project_table_answers_for_every_registered_setting_in_its_range() {
         for asset in Asset::ALL {
             let m = Measured::load_default(asset).unwrap();
-            for r in super::super::cli::registered() {
+            for r in super::super::pipeline::registered() {
                 let (lo, hi) = m
                     .model
                     .range(asset, r.method, r.setting)

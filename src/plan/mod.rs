@@ -8,23 +8,25 @@
 //! the accuracy model's interface, the weighted error), [`solve`] (the exact
 //! branch and bound), [`dolly`] (a stand-in accuracy model from the dolly
 //! sweep), [`measured`] (the measured accuracy table, what the planner uses).
-//! With the registry and files: [`cli`] (the command) and [`picture`] (the
-//! schematic of the plan); with a device, [`check`] (`dermis plan-check`:
-//! plans against the ground truth) and its charts [`check_chart`], both
-//! scoring frames with [`truth`]. docs/plan.md says how it works.
+//! With the registry and the stored data: [`pipeline`] (a frame planned:
+//! characters, costs, the plan and its file) and [`picture`] (the schematic
+//! of the plan). The checks' records, pure: [`check`] (`dermis plan-check`:
+//! plans against the ground truth, its cases, record and summary) and its
+//! charts [`check_chart`], scoring frames with [`score`]. docs/plan.md says
+//! how it works. No device opens here: the commands that render (`plan-check`,
+//! `plan-motion`) run in `app`.
 //! Over time (issue 16 item 6, docs/plan-over-time.md): [`over_time`]
 //! (pure: the walking crowd re-planned with hysteresis, switches and their
 //! measure), [`fades`] (pure: cross-fading its switches), the per-frame
 //! inputs [`frame_inputs`] (the characters from
-//! [`skin_patches`] and their costs from [`price_grid`], both pure) and, with
-//! a device, [`motion`] (`dermis plan-motion`) and its chart
+//! [`skin_patches`] and their costs from [`price_grid`], both pure) and
+//! [`motion`] (`dermis plan-motion`'s record and verdict) and its chart
 //! [`motion_chart`].
 
 pub mod character;
 pub mod check;
 pub mod check_chart;
 pub mod choose;
-pub mod cli;
 pub mod cost;
 pub mod dolly;
 pub mod fades;
@@ -34,10 +36,11 @@ pub mod motion;
 pub mod motion_chart;
 pub mod over_time;
 pub mod picture;
+pub mod pipeline;
 pub mod price_grid;
+pub mod score;
 pub mod skin_patches;
 pub mod solve;
-pub mod truth;
 
 /// The cost model's view of a character.
 pub fn load_of(c: &character::CharacterInput) -> cost::CharacterLoad {

@@ -22,7 +22,7 @@
 use std::time::Instant;
 
 use anyhow::{bail, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::character::CharacterInput;
 use super::choose::{plan, Accuracy, Ask, Plan, SettingCosts};
@@ -59,7 +59,7 @@ pub fn check_margin(m: f64) -> Result<()> {
 
 /// The sequence: `frames` frames over which the crowd walks `walk_heads`
 /// head heights toward the camera, at a constant speed.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Walk {
     pub frames: usize,
     pub walk_heads: f32,
@@ -216,7 +216,7 @@ pub fn replan(frames: &[FrameInput], r: &Replan) -> Vec<FramePlan> {
 }
 
 /// A character changing its method between two frames.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Switch<T> {
     /// The frame the new method is first used in (>= 1).
     pub frame: usize,
@@ -255,7 +255,7 @@ pub fn switch_counts<T: PartialEq + Clone>(choices: &[Vec<T>], characters: usize
 }
 
 /// One character's change between two frames over its pixels.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Change {
     /// Pixels that are the character's in both frames (the ground truth's ids).
     pub pixels: usize,
@@ -316,7 +316,7 @@ pub fn changes(
 /// A switch measured: the plan's change of the character at the switch
 /// against the truth's change over the same pixels at the same frames; for a
 /// faded switch, at the frame of its fade where the excess is largest.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Pop {
     /// The frame the new setting is first used in.
     pub frame: usize,

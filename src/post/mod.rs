@@ -40,17 +40,31 @@ use crate::graph::{ImageId, Pass, Resources};
 use crate::vk::context::Context;
 use crate::vk::pipeline::{DescriptorPool, Samplers};
 
-/// Which anti-aliasing the frame gets after the tone map.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+/// Which anti-aliasing the frame gets after the tone map (`--aa`).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum AaMode {
     /// None: the tone-mapped frame is the output (the frame before issue 17).
     #[default]
     None,
-    /// FXAA, quality preset: one pass.
+    /// FXAA, quality preset: one full-screen pass.
     Fxaa,
-    /// Jimenez's MLAA (thesis ch. 9): three stencil-culled passes.
+    /// Jimenez's MLAA (thesis ch. 9): luma edges writing the stencil, then
+    /// blending weights and neighbourhood blending on edge pixels only.
     Mlaa,
-    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), high preset.
+    /// SMAA 1x (thesis ch. 10.4.1-10.4.2), --smaa-preset (default high): edges with
+    /// local contrast adaptation, diagonal patterns, accurate searches, sharp corners.
     Smaa,
 }
 
@@ -106,16 +120,28 @@ impl FromStr for AaMode {
 }
 
 /// What MLAA's and SMAA's first pass finds edges in (`--aa-edges`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum EdgeSource {
-    /// Eq. 9.2's luma of the gamma-encoded colour (ch. 9.3.1, 10.4.1): the
-    /// default of both.
+    /// Luma of the gamma-encoded colour (eq. 9.2, ch. 9.3.1, 10.4.1): both
+    /// modes' default.
     #[default]
     Luma,
-    /// MLAA's depth variant (ch. 9.3, Listing 9.1): the frame's linear view
-    /// depth, threshold `aa::edges::MLAA_DEPTH_THRESHOLD_MM`.
+    /// The frame's linear view depth, 10 mm threshold (MLAA only: ch. 9.3,
+    /// Listing 9.1; `aa::edges::MLAA_DEPTH_THRESHOLD_MM`).
     Depth,
-    /// SMAA's colour variant (ch. 10.4.1): the largest of the R, G, B deltas.
+    /// The largest R, G or B difference (SMAA only: ch. 10.4.1).
     Color,
 }
 
@@ -129,6 +155,11 @@ impl EdgeSource {
             EdgeSource::Depth => "depth",
             EdgeSource::Color => "color",
         }
+    }
+
+    /// Whether `mode` offers it.
+    pub fn applies_to(self, mode: AaMode) -> bool {
+        self.modes().contains(&mode)
     }
 
     /// The AA modes that offer it.
@@ -148,7 +179,10 @@ impl fmt::Display for EdgeSource {
 }
 
 /// The post chain's options besides `--aa` (`RenderSettings::post`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(default, deny_unknown_fields)]
 pub struct PostOptions {
     /// The bloom on the HDR composite (`--bloom`; off: no bloom image, pipeline or pass).
     pub bloom: bool,
@@ -169,6 +203,17 @@ impl PostOptions {
     /// SMAA's preset.
     pub fn smaa_preset(&self) -> Preset {
         self.smaa_preset.unwrap_or(smaa::DEFAULT_PRESET)
+    }
+
+    /// These options as they apply to `aa`: the edge source where `aa`
+    /// offers it, the SMAA preset with SMAA only (a sweep of every mode
+    /// applies each option where it applies).
+    pub fn for_mode(&self, aa: AaMode) -> PostOptions {
+        PostOptions {
+            bloom: self.bloom,
+            aa_edges: self.aa_edges.filter(|e| e.applies_to(aa)),
+            smaa_preset: self.smaa_preset.filter(|_| aa == AaMode::Smaa),
+        }
     }
 
     /// Refuses, in one line, an option that `aa` does not use.

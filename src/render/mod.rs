@@ -14,6 +14,7 @@ pub mod inputs;
 pub mod merge;
 pub mod post_only;
 pub mod readback;
+pub mod request;
 pub mod scene_gpu;
 pub mod settings;
 pub mod targets;
@@ -32,9 +33,10 @@ use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
 use frame::{Frame, SkinGroup};
 use group_setup::build_groups;
-use groups::{frame_needs, group_specs, specs_mixed, GroupMethod};
+use groups::{frame_needs, GroupMethod};
 use merge::Merge;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
+pub use request::FrameRequest;
 pub use settings::RenderSettings;
 
 /// A finished frame read back to the host.
@@ -169,15 +171,25 @@ fn profiler_slots(passes: &[Pass]) -> u32 {
 const CAPTURED_IMAGES: usize = 5;
 
 impl<'c> Renderer<'c> {
+    /// Checks `settings` in `scene` ([`FrameRequest::new`]) and builds the
+    /// renderer of that frame (tests and tools that hold no request).
     pub fn new(ctx: &'c Context, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
-        settings.validate(ctx.facts.max_image_dimension_2d)?;
+        Self::build(ctx, &FrameRequest::new(scene, settings.clone())?)
+    }
+
+    /// Builds the renderer of a checked frame: only the device's own limits
+    /// are checked here (the request checked everything else).
+    pub fn build(ctx: &'c Context, request: &FrameRequest) -> Result<Self> {
+        let (scene, settings) = (request.scene(), request.settings());
+        settings.check_device_limits(ctx.facts.max_image_dimension_2d)?;
+        crate::checks::ran("device limits");
         let extent = vk::Extent2D {
             width: settings.width,
             height: settings.height,
         };
-        let specs = group_specs(scene, settings)?;
+        let specs = request.groups().to_vec();
         let needs = frame_needs(&specs, extent);
-        let mixed = specs_mixed(&specs);
+        let mixed = request.mixed();
         // 1. Declare the frame's and the methods' images.
         let mut resources = Guard::<Resources>::null(ctx);
         let targets = targets::declare(ctx, &mut resources, settings, needs)?;

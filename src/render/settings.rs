@@ -2,6 +2,7 @@
 //! settings, the SSS method (a registry entry) and the options given to it.
 
 use anyhow::{bail, Context as _, Result};
+use serde::{Deserialize, Serialize};
 
 use crate::method::region::{RegionMode, TILE_PX};
 use crate::method::{default_method, MethodEntry, MethodOptions};
@@ -12,42 +13,71 @@ use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
 
-/// The ranges every reader of a frame holds it to (pure: the budget's readers
-/// use them too), re-exported where the settings are checked.
-pub use crate::scene::{MAX_HEADS, MAX_IMAGE_SIDE};
-/// Exposure (a factor on linear light before the tone curve): 2^-10..=2^10
-/// around the default 2. Past it the frame is black or white whatever the
-/// scene (the issue's `--exposure 1e30` was a black frame).
-pub const EXPOSURE_RANGE: std::ops::RangeInclusive<f32> = (1.0 / 1024.0)..=1024.0;
-/// Largest ambient irradiance (default 0.08): like the key light's intensity
-/// (`scene::light::MAX_INTENSITY`), bounded so RGBA16F targets cannot overflow.
-pub const MAX_AMBIENT: f32 = 100.0;
-/// Farthest camera, in head heights (the far shot is 14): at 1000 a head is a
-/// few pixels high in a 4K frame, and f32 still separates near and far planes.
-pub const MAX_DISTANCE_HEADS: f32 = 1000.0;
+use crate::ranges;
+/// The ranges every reader of a frame holds it to (`crate::ranges`, their
+/// one owner), re-exported where the settings are checked.
+pub use crate::ranges::{MAX_AMBIENT, MAX_DISTANCE_HEADS, MAX_HEADS, MAX_IMAGE_SIDE};
 
 /// The vertical field of view's range, (0.5, 170) degrees: `--fovy`, and the
 /// `fovy_deg` of a report `compare` reads.
 pub fn check_fovy(fovy_deg: f32) -> Result<()> {
-    if !fovy_deg.is_finite() || fovy_deg <= 0.5 || fovy_deg >= 170.0 {
-        bail!("vertical field of view must be within 0.5..170 degrees, got {fovy_deg}");
-    }
-    Ok(())
+    ranges::FOVY.check(fovy_deg)
 }
 
 /// Where the methods of a frame of several come from (`render --assign` or
 /// `--plan`): resolved against the frame's characters by
-/// `render::groups::group_specs`.
-#[derive(Clone, Debug)]
+/// `render::groups::group_specs`. Serialised as `{"rules": "0=ssg,*=none"}`
+/// or `{"plan": {...the plan file...}}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+// A frame's settings are made a few times a command, never in a loop of
+// frames: the plan's size inline costs nothing measurable.
+#[allow(clippy::large_enum_variant)]
 pub enum Assignment {
     Rules(Rules),
-    Plan(PlanFile),
+    Plan(#[serde(deserialize_with = "checked_plan")] PlanFile),
 }
 
-#[derive(Clone, Debug)]
+/// A plan read from settings is checked as a plan file is (`PlanFile::load`).
+fn checked_plan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<PlanFile, D::Error> {
+    let plan = PlanFile::deserialize(d)?;
+    plan.check()
+        .map_err(|e| serde::de::Error::custom(format!("plan: {e:#}")))?;
+    Ok(plan)
+}
+
+/// The method as its registry name (`--method`'s spelling); read back
+/// through the registry, aliases included.
+mod method_by_name {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use crate::method::MethodEntry;
+
+    pub fn serialize<S: Serializer>(
+        m: &&'static MethodEntry,
+        s: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(m.name)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> std::result::Result<&'static MethodEntry, D::Error> {
+        let name = String::deserialize(d)?;
+        crate::method::lookup(&name).map_err(|e| serde::de::Error::custom(format!("{e:#}")))
+    }
+}
+
+/// Everything a frame is rendered from but its scene: serialised whole into
+/// every report (`report.json`'s `settings`), so a report renders its frame
+/// again (`dermis render --settings report.json`). A new field reaches the
+/// reports through this derive, with no hand copy.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
+    #[serde(with = "method_by_name")]
     pub method: &'static MethodEntry,
     /// Options given to the methods (each reads its own; see `method::options`).
     pub options: MethodOptions,
@@ -138,6 +168,39 @@ impl Default for RenderSettings {
 /// fills the screen height): the head alone in frame with a little room.
 pub const PORTRAIT_CLOSE_UPS: f32 = 1.25;
 
+/// The named camera distances (`--shot`; the views of `aa-eval` and the
+/// plan check), each a multiple of the close-up distance at the frame's
+/// field of view: the one place they are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShotPreset {
+    /// The default: a portrait, the head alone in frame with a little room
+    /// ([`PORTRAIT_CLOSE_UPS`] close-up distances).
+    Portrait,
+    /// The head fills the screen height.
+    Close,
+    /// Twice the close-up distance.
+    Mid,
+    /// Five times the close-up distance.
+    Far,
+}
+
+impl ShotPreset {
+    /// Close-up distances (1: the head fills the screen height).
+    pub fn close_ups(self) -> f32 {
+        match self {
+            ShotPreset::Portrait => PORTRAIT_CLOSE_UPS,
+            ShotPreset::Close => 1.0,
+            ShotPreset::Mid => 2.0,
+            ShotPreset::Far => 5.0,
+        }
+    }
+
+    /// Camera distance in head heights at a vertical field of view of `fovy_deg`.
+    pub fn distance_heads(self, fovy_deg: f32) -> f32 {
+        self.close_ups() * crate::scene::camera::Camera::close_up_distance_heads(fovy_deg)
+    }
+}
+
 impl RenderSettings {
     /// The fixed view every test, the eval's procedural scene and every run
     /// recorded before issue 15 use: 4 head heights away, the key light 60
@@ -186,33 +249,17 @@ impl RenderSettings {
     }
 
     /// Rejects settings that would give a bad frame or a driver error, with one
-    /// clear message each. Every number has a range (README, "Valid ranges"):
-    /// width, height, shadow map 1..=the device's maxImageDimension2D (16384
-    /// before a device is open); heads 1..=1024; distance (0, 1000] head
+    /// clear message each, before any device opens. Every number has a range
+    /// (docs/usage.md, "Valid ranges"): width, height, shadow map
+    /// 1..=`MAX_IMAGE_SIDE`; heads 1..=1024; distance (0, 1000] head
     /// heights; field of view (0.5, 170) degrees; light azimuth -360..=360,
     /// elevation -90..=90, intensity 0..=100; ambient 0..=100; exposure
     /// 2^-10..=2^10; SSS region tile 1..=1024; the method's own options in
-    /// its `Config::parse`.
-    pub fn validate(&self, max_image_dimension: u32) -> Result<()> {
-        let (limit, whose) = if max_image_dimension <= MAX_IMAGE_SIDE {
-            (max_image_dimension, "the device limit")
-        } else {
-            (MAX_IMAGE_SIDE, "the limit")
-        };
-        for (what, v) in [("width", self.width), ("height", self.height)] {
-            if v == 0 {
-                bail!("{what} must be at least 1 pixel");
-            }
-            if v > limit {
-                bail!("{what} {v} exceeds {whose} of {limit} pixels");
-            }
-        }
-        if self.shadow_size == 0 || self.shadow_size > limit {
-            bail!(
-                "shadow map size must be within 1..={limit}, got {}",
-                self.shadow_size
-            );
-        }
+    /// its `Config::parse`. What only the device knows (its largest image)
+    /// is [`RenderSettings::check_device_limits`], checked once it is open.
+    /// Called once per frame, by `render::request::FrameRequest::new`.
+    pub fn validate(&self) -> Result<()> {
+        self.check_sizes(MAX_IMAGE_SIDE, "the limit")?;
         (self.method.check)(&self.method.opts(&self.options))
             .with_context(|| format!("method {}", self.method.name))?;
         // A frame of several is checked per group once its methods are known
@@ -236,49 +283,44 @@ impl RenderSettings {
                     .with_context(|| format!("method {} (an option of it was given)", m.name))?;
             }
         }
-        if !(1..=1024).contains(&self.sss_region_tile) {
-            bail!(
-                "the SSS region's tile must be 1..=1024 pixels, got {}",
-                self.sss_region_tile
-            );
-        }
-        if self.heads == 0 || self.heads > MAX_HEADS {
-            bail!("heads must be within 1..={MAX_HEADS}, got {}", self.heads);
-        }
-        if !self.distance_heads.is_finite()
-            || self.distance_heads <= 0.0
-            || self.distance_heads > MAX_DISTANCE_HEADS
-        {
-            bail!(
-                "camera distance must be within (0, {MAX_DISTANCE_HEADS}] head heights, got {}",
-                self.distance_heads
-            );
-        }
+        ranges::SSS_REGION_TILE.check(self.sss_region_tile)?;
+        ranges::HEADS.check(self.heads)?;
+        ranges::DISTANCE.check(self.distance_heads)?;
         // Walking past the camera is allowed (a character behind it shows no
         // pixel), but not without bound.
-        if !self.walk_heads.is_finite() || self.walk_heads.abs() > MAX_DISTANCE_HEADS {
-            bail!(
-                "the crowd's walk must be within +-{MAX_DISTANCE_HEADS} head heights, got {}",
-                self.walk_heads
-            );
-        }
+        ranges::CROWD_WALKED.check(self.walk_heads)?;
         self.post.check(self.aa)?;
         check_fovy(self.fovy_deg)?;
         self.light.validate()?;
-        if !self.ambient.is_finite() || !(0.0..=MAX_AMBIENT).contains(&self.ambient) {
-            bail!(
-                "ambient must be within 0..={MAX_AMBIENT}, got {}",
-                self.ambient
-            );
+        ranges::AMBIENT.check(self.ambient)?;
+        ranges::EXPOSURE.check(self.exposure)?;
+        Ok(())
+    }
+}
+
+impl RenderSettings {
+    /// The frame's and the shadow map's sides against the largest image the
+    /// device takes (`maxImageDimension2D`): the one check of the settings
+    /// that needs a device, made once it is open.
+    pub fn check_device_limits(&self, max_image_dimension: u32) -> Result<()> {
+        if max_image_dimension < MAX_IMAGE_SIDE {
+            self.check_sizes(max_image_dimension, "the device limit")?;
         }
-        if !self.exposure.is_finite() || !EXPOSURE_RANGE.contains(&self.exposure) {
-            bail!(
-                "exposure must be within {}..={}, got {}",
-                EXPOSURE_RANGE.start(),
-                EXPOSURE_RANGE.end(),
-                self.exposure
-            );
+        Ok(())
+    }
+
+    fn check_sizes(&self, limit: u32, whose: &str) -> Result<()> {
+        for (r, v) in [(ranges::WIDTH, self.width), (ranges::HEIGHT, self.height)] {
+            if v == 0 {
+                bail!("{} must be at least 1 pixel", r.what);
+            }
+            if v > limit {
+                bail!("{} {v} exceeds {whose} of {limit} pixels", r.what);
+            }
         }
+        ranges::SHADOW_SIZE
+            .up_to(limit as f64)
+            .check(self.shadow_size)?;
         Ok(())
     }
 }
@@ -291,42 +333,41 @@ mod tests {
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
         let s = RenderSettings::default();
-        s.validate(16384).unwrap();
+        s.validate().unwrap();
         let mut b = s.clone();
         b.width = 0;
-        assert!(b.validate(16384).unwrap_err().to_string().contains("width"));
+        assert!(b.validate().unwrap_err().to_string().contains("width"));
         let mut b = s.clone();
         b.height = 20000;
-        assert!(b
-            .validate(16384)
-            .unwrap_err()
-            .to_string()
-            .contains("device limit"));
+        assert!(b.validate().unwrap_err().to_string().contains("the limit"));
+        // The device's own limit, once it is open.
+        let mut b = s.clone();
+        b.width = 5000;
+        b.validate().unwrap();
+        b.check_device_limits(16384).unwrap();
+        let e = b.check_device_limits(4096).unwrap_err().to_string();
+        assert!(e.contains("exceeds the device limit of 4096"), "{e}");
         for tile in [0, 2000] {
             let mut b = s.clone();
             b.sss_region_tile = tile;
-            assert!(b.validate(16384).unwrap_err().to_string().contains("tile"));
+            assert!(b.validate().unwrap_err().to_string().contains("tile"));
         }
         let mut b = s.clone();
         b.distance_heads = f32::NAN;
-        assert!(b
-            .validate(16384)
-            .unwrap_err()
-            .to_string()
-            .contains("distance"));
+        assert!(b.validate().unwrap_err().to_string().contains("distance"));
         let sep = lookup("separable").unwrap();
         let b = s.clone().with(sep, &[("sss-width-mm", "-1")]);
-        assert!(b.validate(16384).is_err());
+        assert!(b.validate().is_err());
         let b = s.clone().with(sep, &[("samples", "16")]);
-        let e = format!("{:#}", b.validate(16384).unwrap_err());
+        let e = format!("{:#}", b.validate().unwrap_err());
         assert!(e.contains("odd"), "{e}");
         // An option of another method is checked too, though not read.
         let b = s.clone().with(lookup("ssg").unwrap(), &[("samples", "16")]);
-        let e = format!("{:#}", b.validate(16384).unwrap_err());
+        let e = format!("{:#}", b.validate().unwrap_err());
         assert!(e.contains("method separable") && e.contains("odd"), "{e}");
         let mut b = s.clone();
         b.light.intensity = f32::NAN;
-        assert!(b.validate(16384).is_err());
+        assert!(b.validate().is_err());
     }
 
     // `--msaa` takes 1, 2, 4 or 8; the methods that cannot run multisampled
@@ -357,9 +398,9 @@ mod tests {
             msaa: 4,
             ..RenderSettings::default()
         };
-        s.validate(16384).unwrap();
+        s.validate().unwrap();
         s.character_ids = true;
-        assert!(s.validate(16384).is_err());
+        assert!(s.validate().is_err());
     }
 
     // Issue 11: every number has an upper bound too; huge values gave black
@@ -370,7 +411,7 @@ mod tests {
         let refused = |f: &dyn Fn(&mut RenderSettings), what: &str| {
             let mut b = s.clone();
             f(&mut b);
-            let e = format!("{:#}", b.validate(u32::MAX).unwrap_err());
+            let e = format!("{:#}", b.validate().unwrap_err());
             assert!(e.contains(what), "{e}");
         };
         for v in [1e30, f32::INFINITY, 1025.0, 0.0, -1.0, 1e-4] {
@@ -385,14 +426,14 @@ mod tests {
         refused(&|b| b.width = u32::MAX, "exceeds");
         let sep = lookup("separable").unwrap();
         let b = s.clone().with(sep, &[("falloff", "1e30,0.5,0.5")]);
-        let e = format!("{:#}", b.validate(u32::MAX).unwrap_err());
+        let e = format!("{:#}", b.validate().unwrap_err());
         assert!(e.contains("falloff"), "{e}");
         // The bounds themselves are accepted.
         let mut b = s;
-        b.exposure = *EXPOSURE_RANGE.end();
+        b.exposure = 1024.0;
         b.ambient = MAX_AMBIENT;
         b.light.intensity = crate::scene::light::MAX_INTENSITY;
         b.distance_heads = MAX_DISTANCE_HEADS;
-        b.validate(u32::MAX).unwrap();
+        b.validate().unwrap();
     }
 }

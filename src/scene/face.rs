@@ -738,6 +738,7 @@ pub fn face_scene() -> Scene {
         }),
         head_bounds,
         forward: Vec3::Z,
+        source: Some(super::source::SceneSource::default()),
     }
 }
 

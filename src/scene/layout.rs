@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::mesh::Aabb;
 
 /// How `--heads N` places the characters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Layout {
     /// A crowd in rows receding from the camera, as a game would stage it: the

@@ -9,10 +9,15 @@ use glam::{Mat4, Quat, Vec3};
 /// the default is 2.5. Beyond, highlights overflow to infinity and the tone map
 /// turns them into NaN.
 pub const MAX_INTENSITY: f32 = 100.0;
+const _: () = assert!(
+    MAX_INTENSITY as f64 == 100.0,
+    "crate::ranges::LIGHT_INTENSITY says 100"
+);
 
 /// A directional key light placed relative to the face, so light setups read the same
 /// for any head orientation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct KeyLight {
     /// 0 = from the camera side (along the face's forward), positive turns
     /// counter-clockwise about +Y seen from above (for a face looking at +Z, +90 lights
@@ -39,30 +44,15 @@ impl KeyLight {
     /// User-facing settings come from the command line: reject values that would
     /// produce NaNs or negative light.
     pub fn validate(&self) -> Result<()> {
-        if !self.azimuth_deg.is_finite() || self.azimuth_deg.abs() > 360.0 {
-            bail!(
-                "light azimuth must be within -360..=360 degrees, got {}",
-                self.azimuth_deg
-            );
-        }
-        if !self.elevation_deg.is_finite() || self.elevation_deg.abs() > 90.0 {
-            bail!(
-                "light elevation must be within -90..90 degrees, got {}",
-                self.elevation_deg
-            );
-        }
+        crate::ranges::LIGHT_AZIMUTH.check(self.azimuth_deg)?;
+        crate::ranges::LIGHT_ELEVATION.check(self.elevation_deg)?;
         if self.color.iter().any(|c| !c.is_finite() || *c < 0.0) {
             bail!(
                 "light colour must be finite and non-negative, got {:?}",
                 self.color
             );
         }
-        if !self.intensity.is_finite() || !(0.0..=MAX_INTENSITY).contains(&self.intensity) {
-            bail!(
-                "light intensity must be within 0..={MAX_INTENSITY}, got {}",
-                self.intensity
-            );
-        }
+        crate::ranges::LIGHT_INTENSITY.check(self.intensity)?;
         Ok(())
     }
 }

@@ -132,6 +132,7 @@ pub fn lines_scene() -> Scene {
             },
         }),
         head_bounds,
+        source: Some(super::source::SceneSource::builtin_named("lines")),
         forward: Vec3::Z,
     }
 }

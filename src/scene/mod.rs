@@ -15,6 +15,7 @@ pub mod lines;
 pub mod mesh;
 pub mod procedural;
 pub mod robust_bounds;
+pub mod source;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
@@ -34,6 +35,10 @@ pub struct Scene {
     pub head_bounds: mesh::Aabb,
     /// Unit vector from the head centre toward the face: where the camera goes.
     pub forward: Vec3,
+    /// Where it came from (a built-in scene or a file, its textures and
+    /// scale): what a report records to render the frame again. `None`: a
+    /// scene built in code (tests).
+    pub source: Option<source::SceneSource>,
 }
 
 impl Scene {
@@ -110,6 +115,9 @@ pub fn builtin_scene(
     if let Some(mm) = mm_per_unit {
         check_mm_per_unit(mm)?;
         s.mm_per_unit = mm;
+        if let Some(src) = &mut s.source {
+            src.mm_per_unit = Some(mm);
+        }
     }
     Ok(s)
 }
@@ -129,6 +137,7 @@ pub fn egg_scene() -> Scene {
         backdrop: Some(backdrop(procedural::backdrop_mesh())),
         head_bounds,
         forward: Vec3::Z,
+        source: Some(source::SceneSource::builtin_named("egg")),
     }
 }
 
@@ -149,31 +158,19 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
     }
 }
 
-/// Millimetres per scene unit dermis accepts, given or derived from the head:
-/// 1e-12..=1e12, so millimetres, their squares (the ground truth's areas) and
-/// their inverses stay normal f32 numbers with room to spare. A file in any
-/// real unit (a femtometre to a million kilometres) fits; outside, a scale is a corrupt
-/// file or a typo.
-pub const MM_PER_UNIT_RANGE: std::ops::RangeInclusive<f32> = 1e-12..=1e12;
-
-/// Largest frame side and shadow map dermis accepts (a device may allow
-/// less: its maxImageDimension2D is checked once it is open). Here, in the pure
-/// core, because every reader of a frame (render's settings, the budget's
-/// profiles and stored frames, reports) holds it to the same range.
-pub const MAX_IMAGE_SIDE: u32 = 16384;
-/// Most characters a scene may hold.
-pub const MAX_HEADS: u32 = 1024;
+/// Largest frame side and shadow map dermis accepts, and most characters a
+/// scene may hold (`crate::ranges`, with every other range: a device may
+/// allow less, checked once it is open). Millimetres per scene unit are
+/// within `ranges::MM_PER_UNIT`, 1e-12..=1e12, given or derived from the
+/// head: millimetres, their squares (the ground truth's areas) and their
+/// inverses stay normal f32 numbers with room to spare. A file in any real
+/// unit (a femtometre to a million kilometres) fits; outside, a scale is a
+/// corrupt file or a typo.
+pub use crate::ranges::{MAX_HEADS, MAX_IMAGE_SIDE};
 
 /// Checks a scene scale (given with `--mm-per-unit` or derived from the head).
 pub fn check_mm_per_unit(mm: f32) -> Result<()> {
-    if !mm.is_finite() || !MM_PER_UNIT_RANGE.contains(&mm) {
-        bail!(
-            "mm_per_unit must be a number within {}..={}, got {mm}",
-            MM_PER_UNIT_RANGE.start(),
-            MM_PER_UNIT_RANGE.end()
-        );
-    }
-    Ok(())
+    crate::ranges::MM_PER_UNIT.check(mm)
 }
 
 /// Loads a head scan. `mm_per_unit` defaults to 230 mm over the measured chin-to-crown
@@ -192,8 +189,17 @@ pub fn load_gltf_scene(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
-    scene_from_head(&name, head, mm_per_unit)
-        .with_context(|| format!("framing the head in {}", path.display()))
+    let mut scene = scene_from_head(&name, head, mm_per_unit)
+        .with_context(|| format!("framing the head in {}", path.display()))?;
+    scene.source = Some(source::SceneSource {
+        scene: Some(path.to_path_buf()),
+        albedo: overrides.albedo.clone(),
+        normal_map: overrides.normal_map.clone(),
+        spec_map: overrides.specular_map.clone(),
+        sidecar_top_down: overrides.sidecar_top_down,
+        mm_per_unit,
+    });
+    Ok(scene)
 }
 
 /// A scene around a loaded head: which way it faces, its scale (given, or 230 mm
@@ -232,6 +238,7 @@ pub fn scene_from_head(name: &str, head: mesh::Object, mm_per_unit: Option<f32>)
         ))),
         head,
         forward,
+        source: None,
     })
 }
 

@@ -109,11 +109,12 @@ pub struct SssParams {
     pub shape: KernelShape,
 }
 
-/// Named parameter sets.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Named parameter sets (`dermis kernel --preset` takes them by name).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
     /// Table 6.1 of the thesis: width 0.014 demo units (3.22 mm),
     /// strength (0.78, 0.70, 0.75), falloff (0.57, 0.13, 0.08).
+    #[value(name = "table6.1", alias = "table61")]
     Table61,
     /// The look of the original demo: width 0.012 demo units (2.76 mm),
     /// strength (0.48, 0.41, 0.28), falloff (1.0, 0.37, 0.3).

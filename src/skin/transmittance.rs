@@ -22,10 +22,15 @@ pub fn transmittance_rgb(s_mm: f32) -> [f32; 3] {
 /// distance d gives sum_i w_i exp(-d^2 / (2 v_i)) instead (the step from eq. 5.9 to
 /// 5.10 drops the 2). That is the same function at s / sqrt(2). `Thesis` is
 /// the default, since it is the published method; `Integral` is the consistent one.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum TransmittanceProfile {
+    /// Eq. 5.12 as published.
+    #[value(alias = "eq5.12")]
     Thesis,
+    /// The profile integrated over a plane: exp(-s^2 / 2v) (docs/accuracy.md).
     Integral,
 }
 

@@ -24,10 +24,20 @@ use crate::scene::mesh::{Aabb, Mesh};
 
 /// Whether the SSS passes work only near skin (the default) or on the whole
 /// screen (the demos' way; kept to measure what the region saves).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum RegionMode {
+    /// The skin's projected bounds widened by the kernel's reach: seed copies
+    /// and stencil-tested draws limited to them.
     Skin,
+    /// The whole frame, as the demos run (kept to measure what the region
+    /// saves). On the command line `frame`; `screen`, its old name (and the
+    /// reports' spelling), is still accepted: "screen" names the screen-space
+    /// methods.
+    #[value(name = "frame", alias = "screen")]
+    #[serde(alias = "frame")]
     Screen,
 }
 

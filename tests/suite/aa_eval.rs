@@ -7,16 +7,27 @@
 
 use crate::common;
 
-use dermis::eval::aa_eval::{mode_frame, mode_frames, reference, score_view, ViewFrames};
+use dermis::app::aa_eval::{mode_frame, mode_frames, plan_view, reference};
+use dermis::eval::aa_eval::{score_view, AaScene, ViewFrames};
 use dermis::eval::supersample::{box_filter_srgb8, edge_mask};
 use dermis::post::AaMode;
 use dermis::render::readback::srgb_to_linear;
 use dermis::render::RenderSettings;
-use dermis::run::{run, RunOptions};
+use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::camera::Camera;
 use dermis::scene::lines::lines_scene;
 use dermis::scene::mesh::{Material, Mesh, Object, Vertex};
 use dermis::scene::Scene;
+
+/// A view of aa-eval's at the distance and head count of `s`.
+fn view_of(s: &RenderSettings) -> AaScene {
+    AaScene {
+        name: "test view".into(),
+        source: "built in code".into(),
+        distance_heads: s.distance_heads,
+        heads: s.heads,
+    }
+}
 
 /// The lines card's frame at `w` x `h`, `k` close-up distances away, with
 /// the study view's SSS method.
@@ -104,8 +115,10 @@ fn every_mode_lowers_the_edge_error_to_the_supersampled_frame_on_thin_lines() {
     let scene = lines_scene();
     for k in [1.0f32, 2.0] {
         let s = lines_settings(w, h, k);
-        let reference = reference(&ctx, &scene, &s, 4).unwrap();
-        let modes = mode_frames(&ctx, &scene, &s, (0, 1), &|_| {}, &|| {}).unwrap();
+        let v = view_of(&s);
+        let p = plan_view(&v, &scene, &s, 4).unwrap();
+        let reference = reference(&ctx, &p).unwrap();
+        let modes = mode_frames(&ctx, &p, FrameCounts::ONE, &|_| {}, &|| {}).unwrap();
         let (rows, _) = score_view("lines", &ViewFrames { reference, modes }, w, h).unwrap();
         for r in &rows {
             eprintln!(
@@ -170,6 +183,7 @@ fn a_frame_with_no_edges_has_the_1x_frame_as_its_reference() {
         backdrop: None,
         head_bounds,
         forward: glam::Vec3::Z,
+        source: None,
     };
     let (w, h) = (64u32, 36u32);
     // Half a close-up away: the card (one head high) overfills the frame.
@@ -178,8 +192,11 @@ fn a_frame_with_no_edges_has_the_1x_frame_as_its_reference() {
     // the card's own shadow-map lookup (acne), an edge of its own.
     s.light.azimuth_deg = 0.0;
     s.light.elevation_deg = 0.0;
-    let reference = reference(&ctx, &scene, &s, 4).unwrap();
-    let (one, ..) = mode_frame(&ctx, &scene, &s, AaMode::None, 0, 1).unwrap();
+    let v = view_of(&s);
+    let p = plan_view(&v, &scene, &s, 4).unwrap();
+    assert_eq!(p.modes[0].0, AaMode::None);
+    let reference = reference(&ctx, &p).unwrap();
+    let (one, ..) = mode_frame(&ctx, &p.modes[0].1, FrameCounts::ONE).unwrap();
     let worst = reference
         .iter()
         .zip(&one)

@@ -54,6 +54,7 @@ fn fading(to: &str, from: &str, weight: f64) -> RenderSettings {
         predicted_ms: None,
         predicted_error: None,
         notes: Vec::new(),
+        run: None,
     };
     plan.check().expect("a good plan");
     RenderSettings {

@@ -15,7 +15,7 @@
 use crate::common;
 
 use dermis::render::RenderSettings;
-use dermis::run::{run, RunOptions};
+use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::gltf_load::fixture::{glb_bytes, Container};
 use dermis::scene::gltf_load::{load_head_with_warnings, TextureOverrides};
 use dermis::scene::load_gltf_scene;
@@ -169,8 +169,7 @@ fn render_small(
         ..RenderSettings::study()
     };
     let opts = RunOptions {
-        warmup: 0,
-        measured: 1,
+        frames: FrameCounts::new(0, 1).unwrap(),
         capture: true,
         dump: false,
         ceilings: false,

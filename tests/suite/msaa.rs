@@ -8,7 +8,7 @@
 
 use crate::common;
 
-use dermis::eval::aa_eval::reference;
+use dermis::app::aa_eval::reference;
 use dermis::eval::supersample::{edge_mask, score};
 use dermis::graph::work::{PassRole, Work};
 use dermis::method::METHODS;
@@ -64,12 +64,12 @@ fn sample_counts_of_the_device_and_one_line_refusals() {
         one_line(&e, &format!("cannot render {n}x MSAA"));
     }
     for n in [0u32, 3, 16] {
-        let e = egg(32, 24, n).validate(u32::MAX).unwrap_err();
+        let e = egg(32, 24, n).validate().unwrap_err();
         one_line(&e, "--msaa must be 1, 2, 4 or 8");
     }
     let mut ids = egg(32, 24, MSAA);
     ids.character_ids = true;
-    one_line(&ids.validate(u32::MAX).unwrap_err(), "--character-ids");
+    one_line(&ids.validate().unwrap_err(), "--character-ids");
 }
 
 /// Every registered method renders a 4x frame under validation, or says in
@@ -83,7 +83,7 @@ fn every_method_renders_at_4x_or_refuses_in_one_line() {
     for m in METHODS {
         let s = egg(64, 48, MSAA).with(m, &[]);
         if m.no_msaa.is_some() {
-            one_line(&s.validate(u32::MAX).unwrap_err(), m.name);
+            one_line(&s.validate().unwrap_err(), m.name);
             let e = Renderer::new(&ctx, &scene, &s).err().unwrap();
             one_line(&e, "--msaa 4");
             continue;
@@ -156,7 +156,14 @@ fn interior_pixels_keep_the_1x_frame_and_silhouettes_approach_the_supersampled_f
                 .ldr
         };
         let (one, four) = (frame(1), frame(MSAA));
-        let truth = reference(&ctx, &scene, &s, 4).unwrap();
+        let view = dermis::eval::aa_eval::AaScene {
+            name: method.into(),
+            source: "built in".into(),
+            distance_heads: s.distance_heads,
+            heads: s.heads,
+        };
+        let p = dermis::app::aa_eval::plan_view(&view, &scene, &s, 4).unwrap();
+        let truth = reference(&ctx, &p).unwrap();
         let mask = edge_mask(&truth, &one).unwrap();
         let (wi, hi) = (w as i64, h as i64);
         let near_edge = |x: i64, y: i64| {

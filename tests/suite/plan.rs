@@ -16,10 +16,10 @@ use dermis::budget::params::ParamSet;
 use dermis::budget::profile::{list_profiles, Profile};
 use dermis::mix::plan_file::PlanFile;
 use dermis::plan::choose::{plan, Accuracy, Ask};
-use dermis::plan::cli::{
+use dermis::plan::cost::{reference_counts, CharacterLoad, CostModel, SettingModel};
+use dermis::plan::pipeline::{
     characters, load_models, load_stored, plan_frames_dir, reference_setting, setting_costs,
 };
-use dermis::plan::cost::{reference_counts, CharacterLoad, CostModel, SettingModel};
 use dermis::render::RenderSettings;
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::load_gltf_scene;
@@ -31,13 +31,13 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn models() -> Vec<SettingModel> {
-    let (m, notes) = load_models(&plan_frames_dir()).expect("the stored plan frames load");
+    let (m, notes) = load_models().expect("the stored plan frames load");
     assert!(notes.is_empty(), "settings without frames: {notes:?}");
     m
 }
 
 fn reference(models: &[SettingModel]) -> &SettingModel {
-    dermis::plan::cli::reference_model(models).unwrap()
+    dermis::plan::pipeline::reference_model(models).unwrap()
 }
 
 /// The stored frame of the reference setting at `d` head heights.
@@ -239,7 +239,7 @@ fn the_split_against_the_group_within_a_measured_margin() {
     let mut over: (f64, String) = (0.0, String::new());
     let mut under: (f64, String) = (0.0, String::new());
     let mut n = 0;
-    for name in list_profiles().unwrap() {
+    for name in list_profiles() {
         let prof = Profile::load(&name).unwrap();
         let cm = CostModel {
             profile: &prof,
@@ -469,7 +469,7 @@ fn plan_time_for_a_64_crowd() {
                 budget_ms: b,
                 previous: None,
                 switch_margin: 0.0,
-                node_limit: Some(dermis::plan::cli::NODE_LIMIT),
+                node_limit: Some(dermis::plan::pipeline::NODE_LIMIT),
             });
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let sol = &plan.solution;
@@ -494,7 +494,9 @@ fn plan_time_for_a_64_crowd() {
 /// group alone, and the outputs are written.
 #[test]
 fn plan_check_scores_plans_against_the_ground_truth() {
-    use dermis::plan::check::{self, CheckOptions};
+    use dermis::app::plan_check::{check, CheckOptions};
+    use dermis::budget::profile::Profile;
+    use dermis::plan::check::{parse_cases, pick_scenes};
     use dermis::plan::measured::Measured;
     let ctx = common::ctx();
     let scene = dermis::scene::builtin_scene("face", &TextureOverrides::default(), None).unwrap();
@@ -504,17 +506,19 @@ fn plan_check_scores_plans_against_the_ground_truth() {
     base.options.set("density", "1");
     let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
     let out = tmp("check");
-    let r = check::run(
+    let profile = |p: &str| (p.to_string(), Profile::load(p).unwrap());
+    let r = check(
         &ctx,
         &CheckOptions {
             base,
             scene: &scene,
             accuracy: &acc,
             accuracy_source: acc.source(),
-            scenes: check::pick_scenes("grid").unwrap(),
-            cases: check::parse_cases("xbox360:2,nvidia-h200:0.5").unwrap(),
+            scenes: pick_scenes("grid").unwrap(),
+            cases: parse_cases("xbox360:2,nvidia-h200:0.5").unwrap(),
+            profiles: vec![profile("xbox360"), profile("nvidia-h200")],
             timed_frames: 1,
-            timed_profile: "nvidia-h200".into(),
+            timed_profile: Some("nvidia-h200".into()),
             out: &out,
         },
     )
@@ -563,12 +567,12 @@ fn plan_check_scores_plans_against_the_ground_truth() {
         assert!(out.join(f).is_file(), "{f} written");
     }
     assert_eq!(
-        check::pick_scenes("crowd16,nope")
+        pick_scenes("crowd16,nope")
             .unwrap_err()
             .to_string()
             .lines()
             .count(),
         1
     );
-    assert!(check::parse_cases("xbox360:-1").is_err() && check::parse_cases("xbox360").is_err());
+    assert!(parse_cases("xbox360:-1").is_err() && parse_cases("xbox360").is_err());
 }

@@ -9,14 +9,12 @@ use std::path::PathBuf;
 
 use crate::common;
 use dermis::budget::profile::Profile;
-use dermis::plan::cli::{
-    characters, load_models, plan_frames_dir, reference_model, setting_costs, NODE_LIMIT,
-};
 use dermis::plan::frame_inputs::FrameInputs;
 use dermis::plan::measured::Measured;
 use dermis::plan::over_time::{
     replan, switch_counts, FrameInput, Replan, Walk, DEFAULT_MARGIN, FLICKER_BOUND,
 };
+use dermis::plan::pipeline::{characters, load_models, reference_model, setting_costs, NODE_LIMIT};
 use dermis::plan::price_grid::PriceGrid;
 use dermis::render::RenderSettings;
 use dermis::scene::gltf_load::TextureOverrides;
@@ -42,7 +40,7 @@ fn tmp(name: &str) -> PathBuf {
 #[test]
 fn plan_time_per_frame_for_a_64_crowd_walking() {
     let scene = face();
-    let (models, _) = load_models(&plan_frames_dir()).unwrap();
+    let (models, _) = load_models().unwrap();
     let refm = reference_model(&models).unwrap();
     let prof = Profile::load("xbox360").unwrap();
     let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
@@ -131,7 +129,7 @@ fn plan_time_per_frame_for_a_64_crowd_walking() {
 /// heights walking 1 over 5 frames, the Xbox 360 at 0.2 ms, the ground truth
 /// at density 1, fading over `fade_frames`; its outputs in `out`.
 fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::motion::MotionReport {
-    use dermis::plan::motion::{self, MotionOptions};
+    use dermis::app::plan_motion::{sequence, MotionOptions};
     let ctx = common::ctx();
     let scene = face();
     let mut base = RenderSettings::study();
@@ -143,7 +141,7 @@ fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::moti
     base.options.set("density", "1");
     let acc = Measured::load_default(Measured::asset_of(None)).unwrap();
     std::fs::create_dir_all(out).unwrap();
-    motion::run(
+    sequence(
         &ctx,
         &MotionOptions {
             base,
@@ -342,7 +340,7 @@ fn plan_motion_errors_are_one_line_and_need_no_device() {
 #[test]
 fn the_per_frame_skin_estimate_against_the_exact_one() {
     let scene = face();
-    let (models, _) = load_models(&plan_frames_dir()).unwrap();
+    let (models, _) = load_models().unwrap();
     let refm = reference_model(&models).unwrap();
     let prof = Profile::load("xbox360").unwrap();
     for (heads, layout, d) in [
@@ -386,7 +384,7 @@ fn the_per_frame_skin_estimate_against_the_exact_one() {
 #[test]
 fn the_per_frame_skin_estimate_of_a_close_up() {
     let scene = face();
-    let (models, _) = load_models(&plan_frames_dir()).unwrap();
+    let (models, _) = load_models().unwrap();
     let refm = reference_model(&models).unwrap();
     let prof = Profile::load("xbox360").unwrap();
     for walk in [1.0f32, 1.5, 1.75, 2.0] {
@@ -473,7 +471,7 @@ const RECT_STEP_MS: f64 = 0.01;
 #[test]
 fn the_price_grid_against_direct_prices() {
     let scene = face();
-    let (models, _) = load_models(&plan_frames_dir()).unwrap();
+    let (models, _) = load_models().unwrap();
     let refm = reference_model(&models).unwrap();
     for p in ["xbox360", "switch-handheld", "steam-deck", "nvidia-h200"] {
         let prof = Profile::load(p).unwrap();

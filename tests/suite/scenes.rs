@@ -5,14 +5,13 @@
 use crate::common;
 
 use dermis::render::RenderSettings;
-use dermis::run::{run, RunOptions};
+use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::{default_scene, load_gltf_scene, Scene};
 
 fn opts(capture: bool) -> RunOptions {
     RunOptions {
-        warmup: 1,
-        measured: 2,
+        frames: FrameCounts::new(1, 2).unwrap(),
         capture,
         dump: capture,
         ceilings: false,
@@ -61,7 +60,7 @@ fn render_and_check(scene: &Scene, s: &RenderSettings) -> dermis::run::Report {
         );
     }
     // The report: every pass timed, the frame total the sum.
-    assert_eq!(r.width, s.width);
+    assert_eq!(r.run.width, s.width);
     assert!(!r.passes.is_empty());
     for p in &r.passes {
         assert!(

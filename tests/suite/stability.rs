@@ -167,6 +167,7 @@ fn halo_scene() -> Scene {
         backdrop: None,
         head_bounds: bounds,
         forward: Vec3::Z,
+        source: None,
     }
 }
 

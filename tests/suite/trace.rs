@@ -87,7 +87,7 @@ fn trace_slices_sum_to_the_report_pass_times() {
             .map(|e| e.dur.unwrap() / 1e3)
             .collect()
     };
-    assert_eq!(report.measured_frames, FRAMES);
+    assert_eq!(report.run.measured_frames, FRAMES);
     assert!(report.passes.len() >= 5);
     for p in &report.passes {
         let pass = durations(GPU_TID, "pass", &p.name);

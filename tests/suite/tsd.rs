@@ -131,6 +131,7 @@ fn scene_of(mesh: Mesh, mm_per_unit: f32, albedo: Option<Texture>) -> Scene {
         backdrop: None,
         head_bounds,
         forward: Vec3::Z,
+        source: None,
     }
 }
 
@@ -644,20 +645,19 @@ fn frame_input(
     s: &RenderSettings,
     label: &str,
 ) -> dermis::budget::FrameInput {
-    use dermis::budget::run::{method_frame, BudgetOptions};
+    use dermis::app::budget::{method_frame, BudgetOptions};
     let (ctx, counting) = (common::ctx(), common::counting_ctx());
     let opts = BudgetOptions {
         profiles: Vec::new(),
-        compare_methods: false,
         out: std::env::temp_dir(),
-        warmup: 0,
-        measured: 1,
+        frames: dermis::run::FrameCounts::ONE,
         rescale: dermis::budget::Rescale::AsRun,
         count_fetches: true,
         print: false,
         command: label.to_string(),
     };
-    method_frame(&ctx, Some(&counting), scene, s, &opts).expect("the budget's frame")
+    let frame = dermis::render::FrameRequest::new(scene, s.clone()).expect("a valid frame");
+    method_frame(&ctx, Some(&counting), &frame, &opts).expect("the budget's frame")
 }
 
 // Every texture-space pass of every character is priced on every hardware
@@ -677,7 +677,7 @@ fn the_budget_model_prices_every_texture_space_pass_on_every_profile() {
         .filter(|p| p.name.ends_with(" c1"))
         .count();
     assert_eq!(per_character, 14);
-    let profiles = list_profiles().unwrap();
+    let profiles = list_profiles();
     assert!(profiles.len() >= 10, "{profiles:?}");
     for name in &profiles {
         let prof = Profile::load(name).unwrap();

@@ -11,12 +11,12 @@
 use std::time::Instant;
 
 use dermis::budget::profile::Profile;
-use dermis::plan::cli::{
-    atlas_mm, characters, load_models, plan_frames_dir, reference_model, setting_costs, NODE_LIMIT,
-};
 use dermis::plan::frame_inputs::FrameInputs;
 use dermis::plan::measured::Measured;
 use dermis::plan::over_time::{replan, FrameInput, Replan, Walk, DEFAULT_MARGIN};
+use dermis::plan::pipeline::{
+    atlas_mm, characters, load_models, reference_model, setting_costs, NODE_LIMIT,
+};
 use dermis::render::RenderSettings;
 use dermis::scene::gltf_load::TextureOverrides;
 
@@ -29,7 +29,7 @@ fn stats(xs: &[f64]) -> (f64, f64) {
 
 fn main() -> anyhow::Result<()> {
     let scene = dermis::scene::builtin_scene("face", &TextureOverrides::default(), None)?;
-    let (models, _) = load_models(&plan_frames_dir())?;
+    let (models, _) = load_models()?;
     let refm = reference_model(&models)?;
     let prof = Profile::load("xbox360")?;
     let acc = Measured::load_default(Measured::asset_of(None))?;

@@ -15,11 +15,11 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, Result};
+use dermis::app::budget::{method_frame, BudgetOptions};
 use dermis::budget::profile::Profile;
-use dermis::budget::run::{method_frame, BudgetOptions};
 use dermis::budget::{price_frame, ParamSet, Rescale};
 use dermis::method::lookup;
-use dermis::render::RenderSettings;
+use dermis::render::{FrameRequest, RenderSettings};
 use dermis::vk::context::{Context, ContextDesc, DeviceChoice};
 
 /// The table's rows: the methods Table 4.4 compares, as dermis names them.
@@ -28,7 +28,7 @@ const ROWS: [&str; 6] = ["none", "ss-jittered", "ssg", "separable", "tsd", "tsd-
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
     let head = args.next().map_or_else(
-        || PathBuf::from(dermis::eval::study::DEFAULT_HEAD),
+        || PathBuf::from(dermis::app::eval::DEFAULT_HEAD),
         PathBuf::from,
     );
     let device = args.next().unwrap_or_else(|| "llvmpipe".into());
@@ -72,16 +72,15 @@ fn main() -> Result<()> {
             s.heads = heads;
             let budget = BudgetOptions {
                 profiles: Vec::new(),
-                compare_methods: false,
                 out: std::env::temp_dir(),
-                warmup: 0,
-                measured: 1,
+                frames: dermis::run::FrameCounts::ONE,
                 rescale: Rescale::AsRun,
                 count_fetches: true,
                 print: false,
                 command: m.to_string(),
             };
-            let frame = method_frame(&ctx, Some(&counting), &scene, &s, &budget)
+            let frame = FrameRequest::new(&scene, s)?;
+            let frame = method_frame(&ctx, Some(&counting), &frame, &budget)
                 .with_context(|| format!("{m}, {heads} heads"))?;
             let ms: Vec<String> = profiles
                 .iter()

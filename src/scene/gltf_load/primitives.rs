@@ -131,6 +131,12 @@ pub(super) fn read_primitive(
             for uv in v.iter_mut() {
                 *uv = t.apply(*uv);
             }
+            // A finite transform can still overflow (a scale of 1e38 on a
+            // coordinate of 10): the file's fault, said here, not NaN
+            // pixels at the writer.
+            let what = format!("{label}: TEXCOORD_0 through the material's KHR_texture_transform");
+            check_finite(v, &what)?;
+            check_texcoord_range(v, &what)?;
         }
     }
     let indices: Vec<u32> = match prim.indices() {

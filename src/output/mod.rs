@@ -16,6 +16,8 @@
 //! output-path checks made before any GPU work live here too, so `run` only
 //! orchestrates.
 
+pub mod paths;
+
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::os::unix::fs::FileTypeExt;
@@ -144,7 +146,27 @@ pub fn write_image(
     format: image::ImageFormat,
 ) -> Result<()> {
     // The encoders may seek (EXR's offset table): the buffered file can.
-    write_with(path, |w| Ok(img.write_to(w, format)?))
+    write_with(path, |w| {
+        img.write_to(w, format)
+            .map_err(|e| encoding_error(e, format))
+    })
+}
+
+/// An encoder's error as what it is: the image crate reports the EXR
+/// encoder's failures (a full disk among them) as *decoding* errors, which
+/// would send a user looking for a file dermis reads.
+fn encoding_error(e: image::ImageError, format: image::ImageFormat) -> anyhow::Error {
+    match e {
+        image::ImageError::IoError(io) => {
+            anyhow::Error::new(io).context(format!("encoding {format:?}"))
+        }
+        image::ImageError::Decoding(d) => {
+            let cause =
+                std::error::Error::source(&d).map_or_else(|| d.to_string(), |s| s.to_string());
+            anyhow::anyhow!("encoding {format:?}: {cause}")
+        }
+        other => anyhow::anyhow!("encoding {format:?}: {other}"),
+    }
 }
 
 /// An 8-bit RGBA picture (error images, bands) as PNG.

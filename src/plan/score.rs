@@ -1,21 +1,17 @@
-//! What a plan's frame is scored against (issue 16 items 5 and 6): the
-//! ground truth of the same frame with the character ids, the frame with no
-//! SSS, the eval's bands, and the per-character err/none of a test frame
-//! (`Truth::score`). `check` (`plan-check`) and `motion` (`plan-motion`)
-//! score their frames with it; a device renders the frames.
+//! How a plan's frame is scored against its ground truth (issue 16 items 5
+//! and 6), pure: the ground truth of the same frame with its character ids,
+//! the frame with no SSS, the eval's bands ([`Truth`]) and the per-character
+//! err/none of a test frame ([`Truth::score`]). `app::truth` renders the
+//! frames; `plan-check` and `plan-motion` score theirs with it.
 
-use anyhow::{bail, Context as _, Result};
-use serde::Serialize;
+use anyhow::{bail, Result};
+use serde::{Deserialize, Serialize};
 
-use crate::eval::bands::{bands, Band, BandInput};
-use crate::method::{ground_truth, lookup, MethodOptions};
-use crate::render::{RenderSettings, Renderer};
-use crate::scene::Scene;
-use crate::vk::context::Context;
+use crate::eval::bands::Band;
 
 /// A frame's measured error (`check`'s module doc defines it: the eval's
 /// err/none per character and band, blended, skin-weighted).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct FrameError {
     /// Skin-weighted err/none of the characters' blended interior/silhouette error.
     pub weighted: f64,
@@ -24,7 +20,7 @@ pub struct FrameError {
 }
 
 /// One character's measured error.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CharacterScore {
     /// Its skin pixels in the ground truth's frame.
     pub skin: usize,
@@ -48,35 +44,6 @@ pub struct Truth {
 }
 
 impl Truth {
-    /// Renders the ground truth of the frame `s` describes (with the
-    /// character ids, and the run's `--density` passed through: a crowd of
-    /// 64 at the default density is more surface than lavapipe holds) and
-    /// the same frame with no SSS, and finds the eval's bands.
-    pub fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<Truth> {
-        let mut gt_s = truth_settings(s)?;
-        gt_s.character_ids = true;
-        let gt = render(ctx, scene, &gt_s).context("ground truth")?;
-        let none = render(ctx, scene, &with_method(s, "none", &[])?).context("no SSS")?;
-        let skin: Vec<bool> = gt.diffuse.iter().map(|p| p[3] > 0.0).collect();
-        let band_input = BandInput::for_view(
-            (gt.width as usize, gt.height as usize),
-            &skin,
-            &gt.depth,
-            s.fovy_deg,
-            scene.mm_per_unit,
-        );
-        Ok(Truth {
-            bands: bands(&band_input),
-            ids: gt
-                .character_ids
-                .clone()
-                .context("the ground truth's character ids")?,
-            diffuse: gt.diffuse,
-            none: none.diffuse,
-            characters: s.heads as usize,
-        })
-    }
-
     /// Per character and band (interior, silhouette): the sums of squared
     /// error of `test` and of no SSS against the truth, and the pixel count.
     pub fn score(&self, test: &[[f32; 4]]) -> Result<FrameError> {
@@ -141,41 +108,6 @@ impl Truth {
         out.weighted = if den > 0.0 { num / den } else { 1.0 };
         Ok(out)
     }
-}
-
-/// The ground truth's settings for the frame `s` describes: the method
-/// options it reads kept (`--density`), every other option dropped.
-pub fn truth_settings(s: &RenderSettings) -> Result<RenderSettings> {
-    let density = s.options.given("density");
-    let opts: Vec<(String, String)> = density
-        .map(|d| ("density".into(), d.to_string()))
-        .into_iter()
-        .collect();
-    with_method(s, ground_truth().name, &opts)
-}
-
-/// `base` with one method for every character.
-pub fn with_method(
-    base: &RenderSettings,
-    method: &str,
-    options: &[(String, String)],
-) -> Result<RenderSettings> {
-    let mut r = base.clone();
-    r.assignment = None;
-    r.method = lookup(method)?;
-    let mut o = MethodOptions::default();
-    for (k, v) in options {
-        o.set(k, v.clone());
-    }
-    r.options = o;
-    Ok(r)
-}
-
-/// Renders one frame of `s` and reads back its diffuse light (and with
-/// `ids`, the character ids and depth).
-pub fn render(ctx: &Context, scene: &Scene, s: &RenderSettings) -> Result<crate::render::Capture> {
-    let mut r = Renderer::new(ctx, scene, s)?;
-    r.capture(false)
 }
 
 #[cfg(test)]

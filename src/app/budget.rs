@@ -5,11 +5,21 @@
 //! method (`frames/METHOD.json`: what calibration stores) and the stacked-bar
 //! chart (`budget.png`, `budget.svg`). Counts (samples passed, fetches) do not
 //! depend on the device's speed, so lavapipe prices a frame as well as a GPU.
+//! The profiles are loaded and every frame priced is checked before any
+//! device opens.
 
 use std::path::PathBuf;
 
 use anyhow::{Context as _, Result};
 use serde::Serialize;
+
+use super::cli::BudgetArgs;
+use super::request::{self, Given};
+use crate::header::{command_line, RunHeader};
+use crate::output::paths::{OutputPaths, Owned};
+use crate::render::FrameRequest;
+use crate::report::device_header;
+use crate::run::{run_request, FrameCounts};
 
 use crate::budget::chart::{budget_chart, Bar, Panel};
 use crate::budget::input::{FrameInput, RESCALE_RULE};
@@ -20,26 +30,22 @@ use crate::budget::record::{frame_from_record, CountedPass, FRAGMENTS_RULE};
 use crate::budget::table::budget_table;
 use crate::graph::work::Work;
 use crate::method::METHODS;
-use crate::output::{prepare_out_dir, write_json};
+use crate::output::write_json;
 use crate::render::counting::{decode_site, PassCounts};
 use crate::render::groups::MIX_NAME;
 use crate::render::{RenderSettings, Renderer};
 use crate::report::PassReport;
-use crate::run::{run, RunOptions};
-use crate::scene::Scene;
+use crate::run::RunOptions;
 use crate::vk::context::{Context, ContextDesc};
 use crate::vk::shader::reflect;
 
 /// What `dermis budget` does.
 #[derive(Clone, Debug)]
 pub struct BudgetOptions {
-    /// Profile names or paths (at least one).
-    pub profiles: Vec<String>,
-    /// Every registered method but the ground truth instead of the one in the settings.
-    pub compare_methods: bool,
+    /// The profiles to price on (at least one), loaded and checked.
+    pub profiles: Vec<Profile>,
     pub out: PathBuf,
-    pub warmup: usize,
-    pub measured: usize,
+    pub frames: FrameCounts,
     /// Price at the profile's resolution (rescaling the counts) or as run.
     pub rescale: Rescale,
     /// Run the fetch-counting build (off: declared fetch counts).
@@ -60,12 +66,8 @@ pub struct MethodBudget {
 /// `budget.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct BudgetReport {
-    pub dermis_version: &'static str,
-    pub command: String,
-    pub device: String,
-    pub driver: String,
-    pub width: u32,
-    pub height: u32,
+    #[serde(flatten)]
+    pub run: RunHeader,
     pub scene: String,
     pub heads: u32,
     pub distance_heads: f32,
@@ -127,28 +129,26 @@ fn counted_pass(p: &PassReport, c: &PassCounts) -> Result<CountedPass> {
     Ok(out)
 }
 
-/// The frame of one run of `settings`: the measured run on `ctx`, the
+/// The frame of one run of a checked frame: the measured run on `ctx`, the
 /// counting run on `counting` when given.
 pub fn method_frame(
     ctx: &Context,
     counting: Option<&Context>,
-    scene: &Scene,
-    settings: &RenderSettings,
+    frame: &FrameRequest,
     opts: &BudgetOptions,
 ) -> Result<FrameInput> {
     let run_opts = RunOptions {
-        warmup: opts.warmup,
-        measured: opts.measured,
+        frames: opts.frames,
         capture: false,
         dump: false,
         ceilings: false,
         command: opts.command.clone(),
         progress: false,
     };
-    let report = run(ctx, scene, settings, &run_opts)?.report;
+    let report = run_request(ctx, frame, &run_opts)?.report;
     let counted = match counting {
         Some(c) => {
-            let counts = Renderer::new(c, scene, settings)?.count_fetches()?;
+            let counts = Renderer::build(c, frame)?.count_fetches()?;
             let passes: Vec<CountedPass> = report
                 .passes
                 .iter()
@@ -162,8 +162,8 @@ pub fn method_frame(
     let label = format!(
         "{} {}x{}, {}, {} head(s) at {:.2} head heights",
         report.method,
-        report.width,
-        report.height,
+        report.run.width,
+        report.run.height,
         report.scene,
         report.heads,
         report.distance_heads
@@ -171,33 +171,34 @@ pub fn method_frame(
     frame_from_record(&report, counted.as_deref(), &label)
 }
 
-/// Runs, counts, prices, prints and writes (module docs).
-pub fn budget(
-    desc: &ContextDesc,
-    scene: &Scene,
-    settings: &RenderSettings,
-    opts: &BudgetOptions,
-) -> Result<BudgetReport> {
-    anyhow::ensure!(!opts.profiles.is_empty(), "give at least one --profile");
-    let profiles: Vec<Profile> = opts
+/// The files budget writes into its folder, and the frames it owns.
+const FILES: [&str; 3] = ["budget.json", "budget.png", "budget.svg"];
+const FRAMES: Owned = Owned {
+    sub: "frames",
+    suffix: ".json",
+};
+
+/// `dermis budget`: the profiles loaded and every frame to price checked
+/// (with `--compare-methods` one per registered method but the ground
+/// truth) before the device opens.
+pub fn run(a: &BudgetArgs, given: &Given) -> Result<()> {
+    let frames = FrameCounts::new(a.frames.warmup, a.frames.frames)?;
+    let profiles: Vec<Profile> = a
         .profiles
         .iter()
-        .map(|p| Profile::load(p))
+        .map(|p| Profile::load(p).with_context(|| format!("--profile {p}")))
         .collect::<Result<_>>()?;
-    prepare_out_dir(&opts.out)?;
-    let ctx = Context::new(desc)?;
-    let counting = if opts.count_fetches {
-        Some(Context::new(&ContextDesc {
-            count_fetches: true,
-            ..desc.clone()
-        })?)
-    } else {
-        None
-    };
+    let (source, settings) = request::frame_settings(&a.frame, given)?;
+    if !a.compare_methods {
+        for n in super::notes::foreign(&settings) {
+            eprintln!("note: {n}");
+        }
+    }
+    let scene = request::load_scene(&source)?;
     // The ground truth is left out of the comparison: it is no real-time
     // method (on the Xbox 360 its brute-force gather models at about a
     // minute), and it alone takes minutes to run on lavapipe.
-    let methods: Vec<RenderSettings> = if opts.compare_methods {
+    let methods: Vec<RenderSettings> = if a.compare_methods {
         METHODS
             .iter()
             .filter(|m| !m.ground_truth)
@@ -211,19 +212,72 @@ pub fn budget(
     } else {
         vec![settings.clone()]
     };
+    let requests: Vec<FrameRequest> = methods
+        .into_iter()
+        .map(|s| {
+            let name = s.method.name;
+            FrameRequest::new(&scene, s).with_context(|| format!("method {name}"))
+        })
+        .collect::<Result<_>>()?;
+    OutputPaths::new()
+        .folder("--out", &a.out, &FILES, &[FRAMES])
+        .prepare()?;
+    let opts = BudgetOptions {
+        profiles,
+        out: a.out.clone(),
+        frames,
+        rescale: if a.as_run {
+            Rescale::AsRun
+        } else {
+            Rescale::ToProfile
+        },
+        count_fetches: !a.declared_fetches,
+        print: true,
+        command: command_line(),
+    };
+    let r = budget(&request::context_desc(&a.frame), &requests, &opts)?;
+    println!(
+        "priced {} method(s) on {} profile(s); wrote budget.json, frames/, budget.png and budget.svg in {}",
+        r.runs.len(),
+        r.profiles.len(),
+        opts.out.display()
+    );
+    Ok(())
+}
+
+/// Runs, counts, prices, prints and writes (module docs) the checked
+/// frames (one per method priced).
+pub fn budget(
+    desc: &ContextDesc,
+    frames: &[FrameRequest],
+    opts: &BudgetOptions,
+) -> Result<BudgetReport> {
+    anyhow::ensure!(!opts.profiles.is_empty(), "give at least one --profile");
+    let first = frames.first().context("no frame to price")?;
+    let (scene, settings) = (first.scene(), first.settings());
+    let ctx = Context::new(desc)?;
+    let counting = if opts.count_fetches {
+        Some(Context::new(&ContextDesc {
+            count_fetches: true,
+            ..desc.clone()
+        })?)
+    } else {
+        None
+    };
     let params = ParamSet::fitted();
     let mut runs = Vec::new();
-    for s in &methods {
+    for f in frames {
         // A frame of several methods is priced as one frame: its passes carry
         // their group in their names (`#N ...`, the merges `mix merge #N`).
-        let name = if s.assignment.is_some() {
+        let name = if f.settings().assignment.is_some() {
             MIX_NAME
         } else {
-            s.method.name
+            f.settings().method.name
         };
-        let frame = method_frame(&ctx, counting.as_ref(), scene, s, opts)
+        let frame = method_frame(&ctx, counting.as_ref(), f, opts)
             .with_context(|| format!("method {name}"))?;
-        let budgets: Vec<FrameBudget> = profiles
+        let budgets: Vec<FrameBudget> = opts
+            .profiles
             .iter()
             .map(|p| price_frame(p, &frame, &params, opts.rescale))
             .collect();
@@ -233,7 +287,7 @@ pub fn budget(
             }
         }
         write_json(
-            &opts.out.join("frames").join(format!("{name}.json")),
+            &opts.out.join(FRAMES.sub).join(format!("{name}.json")),
             &frame,
         )?;
         runs.push(MethodBudget {
@@ -243,12 +297,12 @@ pub fn budget(
         });
     }
     let report = BudgetReport {
-        dermis_version: env!("CARGO_PKG_VERSION"),
-        command: opts.command.clone(),
-        device: ctx.facts.name.clone(),
-        driver: ctx.facts.driver.clone(),
-        width: settings.width,
-        height: settings.height,
+        run: RunHeader::new(
+            &opts.command,
+            device_header(&ctx),
+            (settings.width, settings.height),
+            (opts.frames.warmup(), opts.frames.measured()),
+        ),
         scene: scene.name.clone(),
         heads: settings.heads,
         distance_heads: settings.distance_heads,
@@ -266,7 +320,8 @@ pub fn budget(
         rescale_rule: RESCALE_RULE,
         combining_rule: COMBINING_RULE,
         params,
-        profiles: profiles
+        profiles: opts
+            .profiles
             .iter()
             .map(|p| ProfileSummary {
                 name: p.profile.name.clone(),

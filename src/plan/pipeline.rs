@@ -1,10 +1,9 @@
-//! `dermis plan --profile P --budget-ms B [scene options]`: loads the scene
-//! (no device opens), estimates every character (`character`), prices every
-//! registered eval setting per character on P (`cost`, from the stored frames
-//! of `profiles/frames/plan/`), plans (`choose`, `solve`), prints the table,
-//! and writes DIR/plan.json (`mix::plan_file::PlanFile`) and a schematic of
-//! the frame (DIR/plan.png and .svg: every character's skin rectangle
-//! coloured by its method).
+//! The planner's pipeline (no device): estimates every character of a
+//! scene (`character`), prices every registered eval setting per character
+//! on a profile (`cost`, from the stored frames of `profiles/frames/plan/`,
+//! built into the binary), plans (`choose`, `solve`), prices the plan as the
+//! frame draws it, and makes its plan file (`mix::plan_file::PlanFile`) and
+//! table. `dermis plan` (`app::plan`) prints and writes them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -17,7 +16,6 @@ use super::character::{estimate, CharacterInput};
 use super::choose::{narrow_reach_mm, plan, scatter_reach_mm, Accuracy, Ask, Plan, SettingCosts};
 use super::cost::{reference_counts, CostModel, Reference, Sample, SettingModel};
 use super::dolly::{DollyTable, Point};
-use super::picture;
 use crate::budget::frames::{check_frame, frames_dir, perf_dir};
 use crate::budget::input::FrameInput;
 use crate::budget::params::ParamSet;
@@ -31,30 +29,17 @@ use crate::scene::Scene;
 use crate::view::ViewScale;
 use crate::work::Work;
 
-/// The checked arguments of `dermis plan`.
-pub struct PlanArgs {
-    pub profile: Profile,
-    pub budget_ms: f64,
-    pub out: PathBuf,
-}
-
-impl PlanArgs {
-    /// Checks the profile and the budget (one-line errors; nothing opened).
-    pub fn parse(profile: &str, budget_ms: &str, out: &Path) -> Result<PlanArgs> {
-        let b: f64 = budget_ms
-            .trim()
-            .parse()
-            .map_err(|_| anyhow::anyhow!("--budget-ms '{budget_ms}' is not a number"))?;
-        if !(b.is_finite() && b > 0.0) {
-            bail!("--budget-ms {budget_ms} is not a positive number of milliseconds");
-        }
-        let profile = Profile::load(profile).with_context(|| format!("--profile {profile}"))?;
-        Ok(PlanArgs {
-            profile,
-            budget_ms: b,
-            out: out.to_path_buf(),
-        })
+/// A checked skin-SSS budget in milliseconds (`--budget-ms`): a positive,
+/// finite number.
+pub fn parse_budget_ms(budget_ms: &str) -> Result<f64> {
+    let b: f64 = budget_ms
+        .trim()
+        .parse()
+        .map_err(|_| anyhow::anyhow!("--budget-ms '{budget_ms}' is not a number"))?;
+    if !(b.is_finite() && b > 0.0) {
+        bail!("--budget-ms {budget_ms} is not a positive number of milliseconds");
     }
+    Ok(b)
 }
 
 /// A registered method setting the planner may choose.
@@ -131,10 +116,14 @@ struct Index {
     frames: Vec<IndexRow>,
 }
 
-/// `profiles/frames/plan/`.
+/// `profiles/frames/plan/` in the source tree (the tools that store frames;
+/// the planner reads the copies built into the binary, [`load_models`]).
 pub fn plan_frames_dir() -> PathBuf {
     frames_dir().join("plan")
 }
+
+/// The planner's stored frames as the binary holds them.
+pub const PLAN_FRAMES: &str = "profiles/frames/plan";
 
 /// The px/mm at the centre of a head `distance_heads` head heights away
 /// (a 230 mm head: the stored frames' scenes are scaled to it).
@@ -154,8 +143,13 @@ fn stored_px_per_mm(height: u32, fovy_deg: f64, distance_heads: f64) -> f64 {
 /// its render area, which it is given instead.
 pub fn load_stored(path: &Path) -> Result<FrameInput> {
     let text = crate::files::read_text(path, "stored frame", crate::files::MAX_TEXT_FILE)?;
+    parse_stored(&text, &path.display().to_string())
+}
+
+/// [`load_stored`] of a stored frame's text (`name` names it in errors).
+pub fn parse_stored(text: &str, name: &str) -> Result<FrameInput> {
     let mut f: FrameInput =
-        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+        serde_json::from_str(text).with_context(|| format!("parsing {name}"))?;
     for p in &mut f.passes {
         if let (
             Work::Raster {
@@ -174,19 +168,24 @@ pub fn load_stored(path: &Path) -> Result<FrameInput> {
             }
         }
     }
-    check_frame(&f).with_context(|| format!("stored frame {}", path.display()))?;
+    check_frame(&f).with_context(|| format!("stored frame {name}"))?;
     Ok(f)
 }
 
-/// The stored frames of every registered setting, as cost models; settings
-/// without frames are named in the returned notes.
-pub fn load_models(dir: &Path) -> Result<(Vec<SettingModel>, Vec<String>)> {
-    let index_path = dir.join("index.json");
-    let text =
-        crate::files::read_text(&index_path, "plan frame index", crate::files::MAX_TEXT_FILE)?;
-    let index: Index = serde_json::from_str(&text)
+/// The embedded file `name` of [`PLAN_FRAMES`].
+fn plan_frame_text(name: &str) -> Result<&'static str> {
+    crate::embedded::file(&format!("{PLAN_FRAMES}/{name}"))
+        .with_context(|| format!("{PLAN_FRAMES}/{name} is not built into this binary"))
+}
+
+/// The stored frames of every registered setting (built into the binary),
+/// as cost models; settings without frames are named in the returned notes.
+pub fn load_models() -> Result<(Vec<SettingModel>, Vec<String>)> {
+    let dir = PLAN_FRAMES;
+    let text = plan_frame_text("index.json")?;
+    let index: Index = serde_json::from_str(text)
         .map_err(|e| anyhow::anyhow!("{e}"))
-        .with_context(|| format!("{}: not an index of stored frames", index_path.display()))?;
+        .with_context(|| format!("{dir}/index.json: not an index of stored frames"))?;
     let samples_of = |method: &str, setting: &str| -> Result<Vec<Sample>> {
         index
             .frames
@@ -195,7 +194,7 @@ pub fn load_models(dir: &Path) -> Result<(Vec<SettingModel>, Vec<String>)> {
             .map(|r| {
                 Ok(Sample {
                     px_per_mm: stored_px_per_mm(r.height, r.fovy_deg, r.distance_heads),
-                    frame: load_stored(&dir.join(&r.file))?,
+                    frame: parse_stored(plan_frame_text(&r.file)?, &format!("{dir}/{}", r.file))?,
                 })
             })
             .collect()
@@ -206,10 +205,7 @@ pub fn load_models(dir: &Path) -> Result<(Vec<SettingModel>, Vec<String>)> {
         .filter_map(|s| Some((s.px_per_mm, reference_counts(&s.frame)?)))
         .collect();
     if refs.is_empty() {
-        bail!(
-            "{}: no stored frame of the reference setting {rm} '{rs}' (run tools/plan_frames.sh)",
-            dir.display()
-        );
+        bail!("{dir}: no stored frame of the reference setting {rm} '{rs}' (run tools/plan_frames.sh)");
     }
     let reference = |x: f64| {
         refs.iter()
@@ -222,16 +218,14 @@ pub fn load_models(dir: &Path) -> Result<(Vec<SettingModel>, Vec<String>)> {
         let samples = samples_of(r.method, r.setting)?;
         if samples.is_empty() {
             notes.push(format!(
-                "{} '{}' has no stored frames in {} (tools/plan_frames.sh): not planned",
-                r.method,
-                r.setting,
-                dir.display()
+                "{} '{}' has no stored frames in {dir} (tools/plan_frames.sh): not planned",
+                r.method, r.setting,
             ));
             continue;
         }
         models.push(
             SettingModel::new(r.method, r.setting, samples, reference)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?,
+                .map_err(|e| anyhow::anyhow!("{dir}: {e}"))?,
         );
     }
     Ok((models, notes))
@@ -531,22 +525,33 @@ pub const REFILL_ROUNDS: usize = 4;
 /// is the best found and the bound says how far from optimal it can be).
 pub const NODE_LIMIT: u64 = 20_000;
 
-/// `dermis plan`.
-pub fn run(
-    args: &PlanArgs,
+/// A planned frame: its characters, every setting's costs, the plan and
+/// its file.
+pub struct Planned {
+    pub characters: Vec<CharacterInput>,
+    pub costs: Vec<SettingCosts>,
+    pub plan: Plan,
+    pub file: PlanFile,
+}
+
+/// Plans the frame `settings` describe in `scene` under `budget_ms` on
+/// `profile` (module docs).
+pub fn plan_frame(
+    profile: &Profile,
+    budget_ms: f64,
     settings: &RenderSettings,
     scene: &Scene,
     accuracy: &dyn Accuracy,
     accuracy_source: &str,
-) -> Result<()> {
-    let (models, mut notes) = load_models(&plan_frames_dir())?;
+) -> Result<Planned> {
+    let (models, mut notes) = load_models()?;
     let reference = reference_model(&models)?;
     let t0 = Instant::now();
     let chars = characters(scene, settings, reference);
     let costs = setting_costs(
         &models,
         &chars,
-        &args.profile,
+        profile,
         settings.width,
         settings.height,
         atlas_mm(scene),
@@ -557,14 +562,14 @@ pub fn run(
             characters: &chars,
             settings: &costs,
             accuracy,
-            budget_ms: args.budget_ms,
+            budget_ms,
             previous: None,
             switch_margin: 0.0,
             node_limit: Some(NODE_LIMIT),
         },
         &costs,
         &models,
-        &args.profile,
+        profile,
         (settings.width, settings.height, settings.sss_region_tile),
     );
     let t2 = Instant::now();
@@ -575,35 +580,13 @@ pub fn run(
         (t2 - t1).as_secs_f64() * 1e3,
         p.solution.nodes
     ));
-    let file = plan_file(
-        &args.profile.profile.name,
-        args.budget_ms,
-        &chars,
-        &costs,
-        &p,
-        notes,
-    )?;
-    crate::output::prepare_out_dir(&args.out)?;
-    print!("{}", table(&chars, &costs, &p, &args.profile.profile.name));
-    for n in &file.notes {
-        println!("note: {n}");
-    }
-    crate::output::write_json(&args.out.join("plan.json"), &file)?;
-    picture::write(
-        &args.out,
-        settings.width,
-        settings.height,
-        &chars,
-        &p,
-        &costs,
-    )?;
-    println!(
-        "wrote {}, {} and {}",
-        args.out.join("plan.json").display(),
-        args.out.join("plan.png").display(),
-        args.out.join("plan.svg").display()
-    );
-    Ok(())
+    let file = plan_file(&profile.profile.name, budget_ms, &chars, &costs, &p, notes)?;
+    Ok(Planned {
+        characters: chars,
+        costs,
+        plan: p,
+        file,
+    })
 }
 
 /// What the plan says about itself (algorithm, bound, rules, sources).
@@ -756,28 +739,8 @@ pub fn plan_file(
             silhouette: ws / w,
         }),
         notes,
+        run: None,
     };
     f.check()?;
     Ok(f)
-}
-
-/// The `plan` subcommand: checks the profile and the budget, then the
-/// render settings and the scene (each a one-line error, before anything is
-/// written; no device ever opens), and plans with the measured accuracy
-/// table of the scene's head (`measured`: the scan's for a loaded model, the
-/// procedural face's for a built-in scene).
-pub fn command(
-    profile: &str,
-    budget_ms: &str,
-    out: &Path,
-    scene_path: Option<&Path>,
-    settings: impl FnOnce() -> Result<RenderSettings>,
-    scene: impl FnOnce() -> Result<Scene>,
-) -> Result<()> {
-    let args = PlanArgs::parse(profile, budget_ms, out)?;
-    let settings = settings()?;
-    let scene = scene()?;
-    let acc =
-        super::measured::Measured::load_default(super::measured::Measured::asset_of(scene_path))?;
-    run(&args, &settings, &scene, &acc, &acc.source())
 }

@@ -1,0 +1,464 @@
+//! `dermis eval`: every registered method and quality setting swept over a
+//! scene set against the ground truth, timed by the same run's timestamps;
+//! writes eval.csv, eval.json (`eval::sweep::EvalReport`, read back typed),
+//! the cost/error charts, for a dolly the error against distance, for the
+//! accuracy sets the accuracy model's data.
+//!
+//! Every view's every frame is checked before the first renders: the scenes
+//! are loaded once each, and each (view, setting) is a `FrameRequest` made
+//! up front, so a setting the sweep cannot render is one line before any
+//! device opens, not an error in the middle of the sweep.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context as _, Result};
+
+use super::cli::EvalArgs;
+use super::request::{self, Given};
+use crate::accuracy::Asset;
+use crate::eval::bands::{bands, Band, BandErrors, BandInput};
+use crate::eval::metrics::{flip_ldr, relative_rmse};
+use crate::eval::pareto::{self, EvalPoint};
+use crate::eval::sweep::{self, Config, EvalReport, EvalRow, SceneSpec};
+use crate::eval::{accuracy_set, chart};
+use crate::header::{command_line, RunHeader};
+use crate::method::{ground_truth, lookup, none};
+use crate::output::paths::OutputPaths;
+use crate::output::write_json;
+use crate::render::{FrameRequest, RenderSettings};
+use crate::report::device_header;
+use crate::run::{run_request, FrameCounts, RunOptions};
+use crate::scene::source::SceneSource;
+use crate::scene::{default_scene, Scene};
+use crate::vk::context::Context;
+
+/// The default head scan beside the project (never copied into it).
+pub const DEFAULT_HEAD: &str = "../shared/assets/lee-perry-smith/LeePerrySmith.glb";
+
+/// The scene sets `--scenes` takes.
+pub const SCENE_SETS: [&str; 6] = [
+    "thesis",
+    "dolly",
+    "quick",
+    "accuracy",
+    "accuracy:scan",
+    "accuracy:procedural",
+];
+
+/// The files eval writes into its folder (the accuracy sets' own beside them).
+const FILES: [&str; 6] = [
+    "eval.csv",
+    "eval.json",
+    "chart.png",
+    "chart.svg",
+    "distance.png",
+    "distance.svg",
+];
+
+/// The named scene sets of `eval`.
+pub fn scene_set(name: &str, head: Option<&Path>, base: &RenderSettings) -> Result<Vec<SceneSpec>> {
+    let head = || -> Result<PathBuf> {
+        let head = head.map_or_else(|| PathBuf::from(DEFAULT_HEAD), Path::to_path_buf);
+        if !head.exists() {
+            bail!("the '{name}' scene set needs the head scan: {} not found (give --scene PATH.glb, or --scenes quick)", head.display());
+        }
+        Ok(head)
+    };
+    Ok(match name {
+        "thesis" => sweep::thesis_scenes(Some(head()?)),
+        "dolly" => sweep::dolly_scenes(head()?),
+        "quick" => vec![SceneSpec {
+            distance_heads: base.distance_heads,
+            ..sweep::procedural_scene()
+        }],
+        // The accuracy model's sweep: both heads, or one.
+        "accuracy" => accuracy_set::accuracy_scenes(
+            &[(Asset::Scan, Some(head()?)), (Asset::Procedural, None)],
+            base,
+        )?,
+        "accuracy:scan" => accuracy_set::accuracy_scenes(&[(Asset::Scan, Some(head()?))], base)?,
+        "accuracy:procedural" => accuracy_set::accuracy_scenes(&[(Asset::Procedural, None)], base)?,
+        other => bail!(
+            "unknown scene set '{other}' (valid: {})",
+            SCENE_SETS.join(", ")
+        ),
+    })
+}
+
+/// `dermis eval`.
+pub fn run(a: &EvalArgs, given: &Given) -> Result<()> {
+    let counts = FrameCounts::new(a.frames.warmup, a.frames.frames)?;
+    let (source, settings) = request::frame_settings(&a.frame, given)?;
+    // --assign/--plan are ignored by eval (a note says so).
+    let base = RenderSettings {
+        assignment: None,
+        ..settings
+    };
+    // A glTF --scene is the head of the sets that take one.
+    let head = source.gltf().map(Path::to_path_buf);
+    let specs = scene_set(&a.scenes, head.as_deref(), &base)?;
+    // The accuracy sets measure the heads as they are stored; the other
+    // sets load the head with the given textures and scale.
+    let head_source = if a.scenes.starts_with("accuracy") {
+        SceneSource::default()
+    } else {
+        source.clone()
+    };
+    let scenes = load_scenes(&specs, &head_source)?;
+    let plan = plan_sweep(&specs, &scenes, &base, &sweep::registry())?;
+    OutputPaths::new()
+        .folder("--out", &a.out, &FILES, &[])
+        .prepare()?;
+    let ctx = request::context(&a.frame)?;
+    let outcome = sweep_and_write(&ctx, &plan, &base, counts, &a.out, a.scenes == "dolly");
+    let (summary, files) = ctx.finish_with(outcome)?;
+    print!("{}", sweep::summary_table(&summary));
+    let names: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} in {}", names.join(", "), a.out.display());
+    Ok(())
+}
+
+/// Each distinct scene of `specs`, loaded once (`None` path: the embedded
+/// face; a file with `head`'s textures and scale).
+pub fn load_scenes(
+    specs: &[SceneSpec],
+    head: &SceneSource,
+) -> Result<Vec<(Option<PathBuf>, Scene)>> {
+    let mut scenes: Vec<(Option<PathBuf>, Scene)> = Vec::new();
+    for s in specs {
+        if scenes.iter().any(|(p, _)| *p == s.gltf) {
+            continue;
+        }
+        let scene = match &s.gltf {
+            None => default_scene(),
+            Some(p) => request::load_scene(&SceneSource {
+                scene: Some(p.clone()),
+                ..head.clone()
+            })
+            .with_context(|| format!("loading scene '{}'", s.name))?,
+        };
+        scenes.push((s.gltf.clone(), scene));
+    }
+    Ok(scenes)
+}
+
+/// One view of the sweep, every frame of it checked.
+pub struct ViewPlan<'s> {
+    pub spec: &'s SceneSpec,
+    pub reference: FrameRequest<'s>,
+    /// The no-SSS frame every err/none is relative to, when `none` is not
+    /// among the configs (whose measured run is used then).
+    pub none: Option<FrameRequest<'s>>,
+    pub configs: Vec<(Config, FrameRequest<'s>)>,
+}
+
+/// Every view's frames as checked requests (each a one-line error naming
+/// the view and the setting), before anything renders.
+pub fn plan_sweep<'s>(
+    specs: &'s [SceneSpec],
+    scenes: &'s [(Option<PathBuf>, Scene)],
+    base: &RenderSettings,
+    configs: &[Config],
+) -> Result<Vec<ViewPlan<'s>>> {
+    specs
+        .iter()
+        .map(|spec| {
+            let scene = &scenes
+                .iter()
+                .find(|(p, _)| *p == spec.gltf)
+                .context("a view's scene was not loaded")?
+                .1;
+            let mut view = base.clone();
+            view.distance_heads = spec.distance_heads;
+            view.light.azimuth_deg = spec.azimuth_deg;
+            view.light.elevation_deg = spec.elevation_deg;
+            if let Some(f) = spec.fovy_deg {
+                view.fovy_deg = f;
+            }
+            let on = |what: &str| format!("{what} on '{}'", spec.name);
+            let frame = |s: RenderSettings, what: &str| {
+                FrameRequest::new(scene, s).with_context(|| on(what))
+            };
+            let reference = frame(
+                RenderSettings {
+                    method: ground_truth(),
+                    ..view.clone()
+                },
+                "the ground truth",
+            )?;
+            let swept_none = configs.iter().any(|c| std::ptr::eq(c.method, none()));
+            let none_frame = if swept_none {
+                None
+            } else {
+                Some(frame(
+                    RenderSettings {
+                        method: none(),
+                        ..view.clone()
+                    },
+                    "no SSS",
+                )?)
+            };
+            let configs = configs
+                .iter()
+                .map(|c| {
+                    let what = format!("{} {}", c.method.name, c.setting.label);
+                    Ok((
+                        *c,
+                        frame(view.clone().with(c.method, c.setting.options), &what)?,
+                    ))
+                })
+                .collect::<Result<_>>()?;
+            Ok(ViewPlan {
+                spec,
+                reference,
+                none: none_frame,
+                configs,
+            })
+        })
+        .collect()
+}
+
+/// Renders the sweep; one row per (view, config).
+pub fn sweep(
+    ctx: &Context,
+    plan: &[ViewPlan],
+    counts: FrameCounts,
+    progress: bool,
+) -> Result<Vec<EvalRow>> {
+    let total: usize = plan.iter().map(|v| v.configs.len() + 1).sum();
+    let bar = progress.then(|| {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    let once = RunOptions::capture_once("eval");
+    let measured = RunOptions {
+        frames: counts,
+        ..once.clone()
+    };
+    let mut rows = Vec::new();
+    for view in plan {
+        let spec = view.spec;
+        let step = |what: &str| {
+            if let Some(b) = &bar {
+                b.set_message(format!("{}: {what}", spec.name));
+            }
+        };
+        step("reference");
+        let reference = run_request(ctx, &view.reference, &once)?;
+        let (fovy, mm_per_unit) = (reference.report.fovy_deg, reference.report.mm_per_unit);
+        let reference = reference.capture.context("reference capture")?;
+        let measure = |c: &Config, f: &FrameRequest| {
+            step(&format!("{} {}", c.method.name, c.setting.label));
+            run_request(ctx, f, &measured).with_context(|| {
+                format!("{} {} on '{}'", c.method.name, c.setting.label, spec.name)
+            })
+        };
+        // The no-SSS frame every err/none and gain is relative to: the `none`
+        // config's own measured run when it is swept (rendered once, used
+        // twice), else one captured frame.
+        let none_at = view
+            .configs
+            .iter()
+            .position(|(c, _)| std::ptr::eq(c.method, none()));
+        let mut none_run = none_at
+            .map(|i| measure(&view.configs[i].0, &view.configs[i].1))
+            .transpose()?;
+        let none_diffuse = match (&none_run, &view.none) {
+            (Some(out), _) => out
+                .capture
+                .as_ref()
+                .context("no-SSS capture")?
+                .diffuse
+                .clone(),
+            (None, Some(f)) => {
+                run_request(ctx, f, &once)?
+                    .capture
+                    .context("no-SSS capture")?
+                    .diffuse
+            }
+            (None, None) => bail!("no no-SSS frame was planned for '{}'", spec.name),
+        };
+        let mask: Vec<bool> = reference.diffuse.iter().map(|p| p[3] > 0.0).collect();
+        let skin = mask.iter().filter(|&&m| m).count();
+        let band_of = bands(&BandInput::for_view(
+            (reference.width as usize, reference.height as usize),
+            &mask,
+            &reference.depth,
+            fovy,
+            mm_per_unit,
+        ));
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+        for (i, (c, f)) in view.configs.iter().enumerate() {
+            let out = match (none_at == Some(i)).then(|| none_run.take()).flatten() {
+                Some(out) => out,
+                None => measure(c, f)?,
+            };
+            let cap = out.capture.context("capture")?;
+            let flip = flip_ldr(&cap.ldr, &reference.ldr, cap.width, cap.height)?;
+            let band_errors = BandErrors::of(
+                &cap.diffuse,
+                &reference.diffuse,
+                Some(&none_diffuse),
+                &flip.error_map,
+                &band_of,
+            );
+            // With no skin in view there is nothing to score.
+            let rel_rmse = if skin > 0 {
+                relative_rmse(&cap.diffuse, &reference.diffuse, &mask)?
+            } else {
+                0.0
+            };
+            rows.push(EvalRow {
+                point: EvalPoint {
+                    method: c.method.name.to_string(),
+                    setting: c.setting.label.to_string(),
+                    scene: spec.name.clone(),
+                    gpu_ms: out.report.sss_total_ms.map_or(0.0, |s| s.median),
+                    error: band_errors.interior.err_none.unwrap_or(0.0),
+                },
+                skin_pixels: skin,
+                frame_ms: out.report.frame.map_or(0.0, |f| f.gpu_ms.median),
+                rel_rmse_all_skin: rel_rmse,
+                bands: band_errors,
+            });
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    Ok(rows)
+}
+
+/// Runs the sweep of `plan` and writes eval.csv, eval.json, chart.png/svg
+/// (and for a dolly, distance.png/svg; for the accuracy sets their data)
+/// into `out`; returns the summary and the files written.
+pub fn sweep_and_write(
+    ctx: &Context,
+    plan: &[ViewPlan],
+    base: &RenderSettings,
+    counts: FrameCounts,
+    out: &Path,
+    dolly: bool,
+) -> Result<(Vec<sweep::SummaryRow>, Vec<PathBuf>)> {
+    let rows = sweep(ctx, plan, counts, true)?;
+    let specs: Vec<SceneSpec> = plan.iter().map(|v| v.spec.clone()).collect();
+    let specs = &specs;
+    let command = command_line();
+    let mut files = vec![out.join("eval.csv"), out.join("eval.json")];
+    sweep::write_csv(&files[0], &rows)?;
+    let summary = sweep::summarise(&rows);
+    // The ranking is made on the interior: the bands are shown beside it.
+    let interior: Vec<EvalPoint> = summary.iter().map(|r| r.point(Band::Interior)).collect();
+    let report = EvalReport {
+        run: RunHeader::new(
+            &command,
+            device_header(ctx),
+            (base.width, base.height),
+            (counts.warmup(), counts.measured()),
+        ),
+        error: sweep::ERROR_DEFINITION.to_string(),
+        scenes: specs.clone(),
+        pareto_front: pareto::pareto_front(&interior)
+            .iter()
+            .map(|&i| summary[i].clone())
+            .collect(),
+        rows: rows.clone(),
+        summary: summary.clone(),
+    };
+    write_json(&files[1], &report)?;
+    let panels: Vec<chart::Panel> = Band::ALL
+        .iter()
+        .map(|&band| chart::Panel {
+            title: match band {
+                Band::Interior => "interior (ranking, Pareto front)".into(),
+                b => b.name().into(),
+            },
+            y_label: format!("err/none, {}", band.name()),
+            points: summary
+                .iter()
+                .filter(|r| r.band(band).scenes > 0)
+                .map(|r| r.point(band))
+                .collect(),
+            front: band == Band::Interior,
+        })
+        .filter(|p| !p.points.is_empty())
+        .collect();
+    chart::panel_chart(
+        &panels,
+        &format!(
+            "SSS cost vs error relative to no SSS ({}, {} scene(s))",
+            ctx.facts.name,
+            specs.len()
+        ),
+        "GPU ms (SSS passes, median)",
+        &out.join("chart.png"),
+        &out.join("chart.svg"),
+    )?;
+    files.extend([out.join("chart.png"), out.join("chart.svg")]);
+    if dolly {
+        // Error against distance: where a distance-driven switch changes the
+        // image, the line steps.
+        let mut series: Vec<chart::Series> = Vec::new();
+        for r in &rows {
+            let p = &r.point;
+            // The registry names the lines (`MethodEntry::dolly`).
+            let drawn = lookup(&p.method).is_ok_and(|m| m.dolly.contains(&p.setting.as_str()));
+            if !drawn {
+                continue;
+            }
+            let Some(spec) = specs.iter().find(|s| s.name == p.scene) else {
+                continue;
+            };
+            let label = format!("{} {}", p.method, p.setting);
+            let point = (spec.distance_heads as f64, p.error);
+            match series.iter_mut().find(|s| s.label == label) {
+                Some(s) => s.points.push(point),
+                None => series.push(chart::Series {
+                    label,
+                    points: vec![point],
+                }),
+            }
+        }
+        chart::series_chart(
+            &series,
+            &format!("SSS error along a dolly ({})", ctx.facts.name),
+            "camera distance (head heights)",
+            "err/none over the interior",
+            &out.join("distance.png"),
+            &out.join("distance.svg"),
+        )?;
+        files.extend([out.join("distance.png"), out.join("distance.svg")]);
+    }
+    if specs.iter().any(|s| s.accuracy.is_some()) {
+        // The accuracy model's data, chart and leave-one-scale-out error.
+        let header = crate::accuracy::data::Header {
+            command: command.clone(),
+            device: format!("{} ({})", ctx.facts.name, ctx.facts.driver),
+            frame: format!(
+                "{}x{}, the centre of the {}-row frame at {} deg vertical field of view (this frame's: {:.4} deg)",
+                base.width,
+                base.height,
+                accuracy_set::REFERENCE_HEIGHT_PX,
+                base.fovy_deg,
+                specs.iter().find_map(|s| s.fovy_deg).unwrap_or(base.fovy_deg)
+            ),
+        };
+        let rows = accuracy_set::rows_of(specs, &rows)?;
+        let (loso, written) = accuracy_set::write(&rows, &header, out)?;
+        println!("leave-one-scale-out prediction error (absolute err/none):\n{loso}");
+        files.extend(written);
+    }
+    Ok((summary, files))
+}

@@ -1,0 +1,83 @@
+//! A frame to render, checked once before any device opens (issue 27): its
+//! settings validated and its character groups resolved against the scene.
+//! The renderer and the run take a [`FrameRequest`] and check nothing of it
+//! again; only what the device alone knows (its largest image) is checked
+//! when the renderer is built on it.
+
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+
+use super::groups::{group_specs, specs_mixed, GroupSpec};
+use super::settings::RenderSettings;
+use crate::scene::source::SceneSource;
+use crate::scene::Scene;
+
+/// A checked frame: a scene, settings that passed
+/// [`RenderSettings::validate`], and the groups they resolve to in it.
+/// The only way to one is [`FrameRequest::new`].
+#[derive(Clone, Debug)]
+pub struct FrameRequest<'s> {
+    scene: &'s Scene,
+    settings: RenderSettings,
+    groups: Vec<GroupSpec>,
+}
+
+impl<'s> FrameRequest<'s> {
+    /// Validates `settings` and resolves their groups in `scene`: every
+    /// error is one line naming the setting, rule or plan entry at fault.
+    pub fn new(scene: &'s Scene, settings: RenderSettings) -> Result<Self> {
+        settings.validate()?;
+        crate::checks::ran("settings");
+        let groups = group_specs(scene, &settings)?;
+        crate::checks::ran("groups");
+        Ok(FrameRequest {
+            scene,
+            settings,
+            groups,
+        })
+    }
+
+    pub fn scene(&self) -> &'s Scene {
+        self.scene
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// The character groups: one in a single-method frame.
+    pub fn groups(&self) -> &[GroupSpec] {
+        &self.groups
+    }
+
+    /// A frame of several methods (more than one group, or a fade).
+    pub fn mixed(&self) -> bool {
+        specs_mixed(&self.groups)
+    }
+
+    /// The frame with the character-id pass added (what `groups.png` of a
+    /// frame of several methods needs: it changes no image), where the
+    /// frame can have it: `None` for a multisampled frame, whose ids would
+    /// be drawn against a depth resolved from one sample
+    /// (`RenderSettings::validate` refuses `--character-ids` there).
+    pub fn with_character_ids(&self) -> Option<Self> {
+        (self.settings.msaa == 1).then(|| FrameRequest {
+            settings: RenderSettings {
+                character_ids: true,
+                ..self.settings.clone()
+            },
+            ..self.clone()
+        })
+    }
+}
+
+/// Everything a frame is made from, as `report.json` records it (its
+/// `settings`) and `dermis render --settings` reads it back: the scene's
+/// source and the render settings, both whole, by serialisation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSettings {
+    /// `None`: a scene built in code (a test), which no file names.
+    pub scene: Option<SceneSource>,
+    pub render: RenderSettings,
+}

@@ -1,0 +1,112 @@
+//! Where a frame's scene comes from, as a value: the built-in scene or glTF
+//! file `--scene` names, the texture files that replace the scene's own, and
+//! the scale. Serialised into every report beside the render settings, so a
+//! report names everything its frame was made from (`render --settings`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+
+use super::gltf_load::TextureOverrides;
+use super::{builtin_scene, load_gltf_scene, Scene};
+
+/// `--scene builtin:NAME` names a built-in scene instead of a file.
+pub const BUILTIN_PREFIX: &str = "builtin:";
+
+/// The built-in scene a frame gets when no `--scene` is given.
+pub const DEFAULT_BUILTIN: &str = "face";
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SceneSource {
+    /// A glTF/GLB file, or `builtin:NAME`; `None`: the embedded procedural face.
+    pub scene: Option<PathBuf>,
+    pub albedo: Option<PathBuf>,
+    pub normal_map: Option<PathBuf>,
+    pub spec_map: Option<PathBuf>,
+    /// Texture files beside the scene (or given above) are top-down.
+    pub sidecar_top_down: bool,
+    /// Millimetres per scene unit (`None`: from a 230 mm chin-to-crown head).
+    pub mm_per_unit: Option<f32>,
+}
+
+impl SceneSource {
+    /// The built-in scene `name` (`builtin:NAME`).
+    pub fn builtin_named(name: &str) -> Self {
+        SceneSource {
+            scene: Some(format!("{BUILTIN_PREFIX}{name}").into()),
+            ..Default::default()
+        }
+    }
+
+    /// The built-in scene's name (`face` when no scene is given); `None` for a file.
+    pub fn builtin(&self) -> Option<&str> {
+        match &self.scene {
+            None => Some(DEFAULT_BUILTIN),
+            Some(p) => p.to_str().and_then(|s| s.strip_prefix(BUILTIN_PREFIX)),
+        }
+    }
+
+    /// The glTF file it names (`None` for a built-in scene).
+    pub fn gltf(&self) -> Option<&Path> {
+        match self.builtin() {
+            Some(_) => None,
+            None => self.scene.as_deref(),
+        }
+    }
+
+    fn overrides(&self) -> TextureOverrides {
+        TextureOverrides {
+            albedo: self.albedo.clone(),
+            normal_map: self.normal_map.clone(),
+            specular_map: self.spec_map.clone(),
+            sidecar_top_down: self.sidecar_top_down,
+        }
+    }
+
+    /// Loads the scene (every file through the bounded reader; texture
+    /// files given for a built-in scene are an error, not silently unused).
+    pub fn load(&self) -> Result<Scene> {
+        match (self.gltf(), self.builtin()) {
+            (Some(path), _) => load_gltf_scene(path, &self.overrides(), self.mm_per_unit),
+            (None, name) => builtin_scene(
+                name.unwrap_or(DEFAULT_BUILTIN),
+                &self.overrides(),
+                self.mm_per_unit,
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_source_names_a_builtin_or_a_file() {
+        let none = SceneSource::default();
+        assert_eq!((none.builtin(), none.gltf()), (Some("face"), None));
+        let egg = SceneSource {
+            scene: Some("builtin:egg".into()),
+            ..Default::default()
+        };
+        assert_eq!((egg.builtin(), egg.gltf()), (Some("egg"), None));
+        let file = SceneSource {
+            scene: Some("head.glb".into()),
+            ..Default::default()
+        };
+        assert_eq!(file.builtin(), None);
+        assert_eq!(file.gltf(), Some(Path::new("head.glb")));
+        // A texture given to a built-in scene is refused, not dropped.
+        let bad = SceneSource {
+            albedo: Some("a.png".into()),
+            ..Default::default()
+        };
+        let e = format!("{:#}", bad.load().unwrap_err());
+        assert!(e.contains("glTF --scene"), "{e}");
+        let back: SceneSource =
+            serde_json::from_str(&serde_json::to_string(&file).unwrap()).unwrap();
+        assert_eq!(back, file);
+    }
+}
