@@ -92,6 +92,16 @@ impl Range {
         Ok(())
     }
 
+    /// `v` within the range, where a file names the same quantity `name`:
+    /// the error names both (`characters must be within 1..=1024 (as
+    /// --heads), got 0`).
+    pub fn check_as<T: Checked>(&self, name: &str, v: T) -> Result<()> {
+        if !self.contains(v) {
+            bail!("{name} must be within {self} (as {}), got {v}", self.flag);
+        }
+        Ok(())
+    }
+
     /// The same quantity with its upper end lowered to `hi` (a device's limit).
     pub fn up_to(&self, hi: f64) -> Range {
         Range {
@@ -335,5 +345,28 @@ mod tests {
         flags.sort();
         flags.dedup();
         assert_eq!(flags.len(), ALL.len(), "{flags:?}");
+    }
+}
+
+#[cfg(test)]
+mod docs {
+    use super::*;
+
+    // docs/usage.md's "Valid ranges" names every range as this table does:
+    // `--flag` followed by the range as it prints.
+    #[test]
+    fn the_usage_docs_give_every_range_as_the_table_does() {
+        let usage = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/usage.md"),
+        )
+        .unwrap();
+        // Wrapped lines read as one.
+        let usage = usage.split_whitespace().collect::<Vec<_>>().join(" ");
+        let missing: Vec<String> = ALL
+            .iter()
+            .map(|r| format!("`{}` {r}", r.flag))
+            .filter(|t| !usage.contains(t.as_str()))
+            .collect();
+        assert!(missing.is_empty(), "docs/usage.md lacks: {missing:#?}");
     }
 }

@@ -29,6 +29,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
+use serde_json::json;
 
 use crate::graph::PassSample;
 use crate::output::write_json;
@@ -103,7 +104,6 @@ fn slice(name: String, cat: &str, tid: u32, ts: f64, dur: f64, args: serde_json:
 /// The timeline of `frames` (every measured frame's samples) of the run
 /// `report` describes (module docs).
 pub fn build(report: &Report, frames: &[Vec<PassSample>]) -> Trace {
-    use serde_json::json;
     let mut ev = vec![
         metadata(
             "process_name",
@@ -162,20 +162,23 @@ pub fn build(report: &Report, frames: &[Vec<PassSample>]) -> Trace {
     Trace {
         trace_events: ev,
         display_time_unit: "ms".into(),
-        other_data: json!({
-            "dermis_version": report.run.dermis_version,
-            "command": report.run.command,
-            "device": report.run.device.device,
-            "driver": report.run.device.driver,
-            "method": report.method,
-            "scene": report.scene,
-            "width": report.run.width,
-            "height": report.run.height,
-            "warmup_frames": report.run.warmup_frames,
-            "measured_frames": report.run.measured_frames,
-            "timeline": "GPU timestamps; frames laid end to end (the CPU's time between submissions is not in the trace); each pass's barriers are their own slice before it",
-        }),
+        other_data: other_data(report),
     }
+}
+
+/// The trace's `otherData`: the run header (every field, by serialisation)
+/// and what the timeline is.
+fn other_data(report: &Report) -> serde_json::Value {
+    let mut v = serde_json::to_value(&report.run).unwrap_or_else(|_| json!({}));
+    if let Some(m) = v.as_object_mut() {
+        m.insert("method".into(), json!(report.method));
+        m.insert("scene".into(), json!(report.scene));
+        m.insert(
+            "timeline".into(),
+            json!("GPU timestamps; frames laid end to end (the CPU's time between submissions is not in the trace); each pass's barriers are their own slice before it"),
+        );
+    }
+    v
 }
 
 /// Writes the trace of a run to `path` (through `output`).

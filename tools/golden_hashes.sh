@@ -103,7 +103,7 @@ import json, sys, pathlib, hashlib
 TIME = ("measured", "command", "device", "driver", "provenance", "dermis_version", "vulkan_api", "validation", "warmup")
 def strip(v):
     if isinstance(v, dict):
-        return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}
+        return {k: strip(x) for k, x in sorted(v.items()) if k != "run" and not any(t in k for t in TIME)}
     if isinstance(v, list):
         return [strip(x) for x in v]
     if isinstance(v, str):
@@ -133,7 +133,7 @@ import json, sys, pathlib, hashlib
 TIME = ("measured", "command", "device", "driver", "provenance", "dermis_version", "vulkan_api", "validation", "warmup")
 def strip(v):
     if isinstance(v, dict):
-        return {k: strip(x) for k, x in sorted(v.items()) if not any(t in k for t in TIME)}
+        return {k: strip(x) for k, x in sorted(v.items()) if k != "run" and not any(t in k for t in TIME)}
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v

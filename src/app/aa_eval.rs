@@ -20,6 +20,7 @@ use crate::header::{command_line, RunHeader};
 use crate::output::paths::{OutputPaths, Owned};
 use crate::output::{write_json, write_rgba8_png};
 use crate::post::AaMode;
+use crate::render::request::CheckedSettings;
 use crate::render::settings::{check_msaa, MSAA_COUNTS};
 use crate::render::{FrameRequest, RenderSettings};
 use crate::report::device_header;
@@ -153,6 +154,8 @@ pub fn run(a: &AaEvalArgs, given: &Given) -> Result<()> {
     for n in super::notes::foreign(&base) {
         eprintln!("note: {n}");
     }
+    // The base frame's numbers before any scene loads.
+    CheckedSettings::new(base.clone())?;
     // A glTF --scene is the scan the head views add; a built-in one adds nothing.
     let head = source.gltf();
     let crowd = if base.heads > 1 {

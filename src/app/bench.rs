@@ -7,6 +7,7 @@ use super::cli::BenchArgs;
 use super::request::{self, Given};
 use crate::header::command_line;
 use crate::output::paths::OutputPaths;
+use crate::render::request::CheckedSettings;
 use crate::render::FrameRequest;
 use crate::run::{bench_run, header, FrameCounts, RunOptions};
 
@@ -16,8 +17,9 @@ pub fn run(a: &BenchArgs, given: &Given) -> Result<()> {
     for n in super::notes::foreign(&settings) {
         eprintln!("note: {n}");
     }
+    let settings = CheckedSettings::new(settings)?;
     let scene = request::load_scene(&source)?;
-    let frame = FrameRequest::new(&scene, settings)?;
+    let frame = FrameRequest::of(&scene, settings)?;
     OutputPaths::new()
         .file("--report", Some(&a.report))
         .file("--trace", a.trace.as_deref())

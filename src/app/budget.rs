@@ -17,6 +17,7 @@ use super::cli::BudgetArgs;
 use super::request::{self, Given};
 use crate::header::{command_line, RunHeader};
 use crate::output::paths::{OutputPaths, Owned};
+use crate::render::request::CheckedSettings;
 use crate::render::FrameRequest;
 use crate::report::device_header;
 use crate::run::{run_request, FrameCounts};
@@ -53,6 +54,15 @@ pub struct BudgetOptions {
     /// Print the tables.
     pub print: bool,
     pub command: String,
+}
+
+/// `frames/METHOD.json`: a frame (read back as a `FrameInput`) and the run
+/// that measured it.
+#[derive(Serialize)]
+struct FrameFile<'a> {
+    run: &'a RunHeader,
+    #[serde(flatten)]
+    frame: &'a FrameInput,
 }
 
 /// One method's frame and its prices.
@@ -194,11 +204,12 @@ pub fn run(a: &BudgetArgs, given: &Given) -> Result<()> {
             eprintln!("note: {n}");
         }
     }
+    let checked = CheckedSettings::new(settings.clone())?;
     let scene = request::load_scene(&source)?;
     // The ground truth is left out of the comparison: it is no real-time
     // method (on the Xbox 360 its brute-force gather models at about a
     // minute), and it alone takes minutes to run on lavapipe.
-    let methods: Vec<RenderSettings> = if a.compare_methods {
+    let methods: Vec<CheckedSettings> = if a.compare_methods {
         METHODS
             .iter()
             .filter(|m| !m.ground_truth)
@@ -208,15 +219,19 @@ pub fn run(a: &BudgetArgs, given: &Given) -> Result<()> {
                 assignment: None,
                 ..settings.clone()
             })
-            .collect()
+            .map(|s| {
+                let name = s.method.name;
+                CheckedSettings::new(s).with_context(|| format!("method {name}"))
+            })
+            .collect::<Result<_>>()?
     } else {
-        vec![settings.clone()]
+        vec![checked]
     };
     let requests: Vec<FrameRequest> = methods
         .into_iter()
         .map(|s| {
-            let name = s.method.name;
-            FrameRequest::new(&scene, s).with_context(|| format!("method {name}"))
+            let name = s.get().method.name;
+            FrameRequest::of(&scene, s).with_context(|| format!("method {name}"))
         })
         .collect::<Result<_>>()?;
     OutputPaths::new()
@@ -265,6 +280,12 @@ pub fn budget(
         None
     };
     let params = ParamSet::fitted();
+    let header = RunHeader::new(
+        &opts.command,
+        device_header(&ctx),
+        (settings.width, settings.height),
+        (opts.frames.warmup(), opts.frames.measured()),
+    );
     let mut runs = Vec::new();
     for f in frames {
         // A frame of several methods is priced as one frame: its passes carry
@@ -286,9 +307,14 @@ pub fn budget(
                 println!("{}", budget_table(b, &ctx.facts.name));
             }
         }
+        // The stored frame as calibration reads it (`FrameInput`), with the
+        // run header beside its fields.
         write_json(
             &opts.out.join(FRAMES.sub).join(format!("{name}.json")),
-            &frame,
+            &FrameFile {
+                run: &header,
+                frame: &frame,
+            },
         )?;
         runs.push(MethodBudget {
             method: name.to_string(),
@@ -297,12 +323,7 @@ pub fn budget(
         });
     }
     let report = BudgetReport {
-        run: RunHeader::new(
-            &opts.command,
-            device_header(&ctx),
-            (settings.width, settings.height),
-            (opts.frames.warmup(), opts.frames.measured()),
-        ),
+        run: header,
         scene: scene.name.clone(),
         heads: settings.heads,
         distance_heads: settings.distance_heads,

@@ -525,6 +525,17 @@ impl Args for MethodArgs {
     }
 }
 
+/// The long flag of the frame option (or method option) with clap id `id`.
+pub fn flag(id: &str) -> String {
+    let cmd = <FrameArgs as Args>::augment_args(clap::Command::new("frame"));
+    let long = cmd
+        .get_arguments()
+        .find(|a| a.get_id() == id)
+        .and_then(|a| a.get_long())
+        .map(str::to_string);
+    format!("--{}", long.unwrap_or_else(|| id.replace('_', "-")))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

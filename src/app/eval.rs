@@ -25,6 +25,7 @@ use crate::header::{command_line, RunHeader};
 use crate::method::{ground_truth, lookup, none};
 use crate::output::paths::OutputPaths;
 use crate::output::write_json;
+use crate::render::request::CheckedSettings;
 use crate::render::{FrameRequest, RenderSettings};
 use crate::report::device_header;
 use crate::run::{run_request, FrameCounts, RunOptions};
@@ -94,6 +95,9 @@ pub fn run(a: &EvalArgs, given: &Given) -> Result<()> {
         assignment: None,
         ..settings
     };
+    // The base frame's numbers before any scene loads (each view's frames
+    // are checked again as the frames they are, below).
+    CheckedSettings::new(base.clone())?;
     // A glTF --scene is the head of the sets that take one.
     let head = source.gltf().map(Path::to_path_buf);
     let specs = scene_set(&a.scenes, head.as_deref(), &base)?;

@@ -3,7 +3,7 @@
 //! it says. Their values are still checked (a NaN is an error even where it
 //! would be unused). One table per command, below.
 
-use super::cli::Command;
+use super::cli::{flag, Command};
 use super::request::Given;
 use crate::method::{all_options, foreign_options};
 use crate::render::RenderSettings;
@@ -158,17 +158,6 @@ pub fn foreign(s: &RenderSettings) -> Vec<String> {
         .collect()
 }
 
-/// The long flag of the frame option (or method option) with clap id `id`.
-pub fn flag(id: &str) -> String {
-    let cmd = <super::cli::FrameArgs as clap::Args>::augment_args(clap::Command::new("frame"));
-    let long = cmd
-        .get_arguments()
-        .find(|a| a.get_id() == id)
-        .and_then(|a| a.get_long())
-        .map(str::to_string);
-    format!("--{}", long.unwrap_or_else(|| id.replace('_', "-")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -233,7 +222,10 @@ mod tests {
             n,
             ["--samples is ignored: --assign gives each character its method"]
         );
-        assert_eq!(flag("follow-surface"), "--no-follow-surface");
-        assert_eq!(flag("sss_region"), "--sss-region");
+        assert_eq!(
+            crate::app::cli::flag("follow-surface"),
+            "--no-follow-surface"
+        );
+        assert_eq!(crate::app::cli::flag("sss_region"), "--sss-region");
     }
 }

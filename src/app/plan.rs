@@ -14,6 +14,7 @@ use crate::output::paths::OutputPaths;
 use crate::plan::measured::Measured;
 use crate::plan::picture;
 use crate::plan::pipeline::{parse_budget_ms, plan_frame, table};
+use crate::render::request::CheckedSettings;
 use crate::render::FrameRequest;
 
 /// The files plan writes into its folder.
@@ -28,9 +29,10 @@ pub fn run(a: &PlanArgs, given: &Given) -> Result<()> {
     let budget_ms = parse_budget_ms(&a.budget_ms)?;
     let profile = Profile::load(&a.profile).with_context(|| format!("--profile {}", a.profile))?;
     let (source, settings) = request::frame_settings(&a.frame, given)?;
-    let scene = request::load_scene(&source)?;
     // The frame planned for is one render would accept.
-    let frame = FrameRequest::new(&scene, settings)?;
+    let settings = CheckedSettings::new(settings)?;
+    let scene = request::load_scene(&source)?;
+    let frame = FrameRequest::of(&scene, settings)?;
     let acc = Measured::load_default(Measured::asset_of(source.gltf()))?;
     OutputPaths::new()
         .folder("--out", &a.out, &FILES, &[])

@@ -31,6 +31,7 @@ use crate::plan::pipeline::{
     setting_costs, NODE_LIMIT,
 };
 use crate::plan::score::FrameError;
+use crate::render::request::CheckedSettings;
 use crate::render::settings::Assignment;
 use crate::render::{FrameRequest, RenderSettings, Renderer};
 use crate::report::device_header;
@@ -85,6 +86,8 @@ pub fn run(a: &PlanCheckArgs, given: &Given) -> Result<()> {
         }
     }
     let (source, base) = request::frame_settings(&a.frame, given)?;
+    // The base frame's numbers before the scene loads.
+    let base = CheckedSettings::new(base)?.get().clone();
     let scene = request::load_scene(&source)?;
     for cs in &scenes {
         check_frames(&scene, &settings_for(&base, cs))

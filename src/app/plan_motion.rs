@@ -30,6 +30,7 @@ use crate::plan::over_time::{
     FramePlan, Replan, Walk, FLICKER_BOUND,
 };
 use crate::plan::pipeline::{load_models, parse_budget_ms, plan_file, reference_model, NODE_LIMIT};
+use crate::render::request::CheckedSettings;
 use crate::render::settings::Assignment;
 use crate::render::{FrameRequest, RenderSettings};
 use crate::report::device_header;
@@ -59,6 +60,8 @@ pub fn run(a: &PlanMotionArgs, given: &Given) -> Result<()> {
         );
     }
     let (source, base) = request::frame_settings(&a.frame, given)?;
+    // The base frame's numbers before the scene loads.
+    let base = CheckedSettings::new(base)?.get().clone();
     let scene = request::load_scene(&source)?;
     // Every frame of the walk, its truth and no SSS: checked before any renders.
     for k in 0..walk.frames {

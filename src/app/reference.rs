@@ -9,6 +9,7 @@ use super::request::{self, Given};
 use crate::header::command_line;
 use crate::method::ground_truth;
 use crate::output::paths::OutputPaths;
+use crate::render::request::CheckedSettings;
 use crate::render::{FrameRequest, RenderSettings};
 use crate::run::{header, render_to_dir, FrameCounts, RunOptions, RENDER_FILES};
 
@@ -23,8 +24,9 @@ pub fn run(a: &ReferenceArgs, given: &Given) -> Result<()> {
     for n in super::notes::foreign(&settings) {
         eprintln!("note: {n}");
     }
+    let settings = CheckedSettings::new(settings)?;
     let scene = request::load_scene(&source)?;
-    let frame = FrameRequest::new(&scene, settings)?;
+    let frame = FrameRequest::of(&scene, settings)?;
     OutputPaths::new()
         .folder("--out", &a.out, &RENDER_FILES, &[])
         .prepare()?;

@@ -8,6 +8,7 @@ use super::cli::RenderArgs;
 use super::request::{self, Given};
 use crate::header::command_line;
 use crate::output::paths::OutputPaths;
+use crate::render::request::CheckedSettings;
 use crate::render::FrameRequest;
 use crate::run::{header, render_to_dir, FrameCounts, RunOptions, RENDER_DUMPS, RENDER_FILES};
 
@@ -18,8 +19,9 @@ pub fn run(a: &RenderArgs, given: &Given) -> Result<()> {
     for n in super::notes::foreign(&settings) {
         eprintln!("note: {n}");
     }
+    let settings = CheckedSettings::new(settings)?;
     let scene = request::load_scene(&source)?;
-    let mut frame = FrameRequest::new(&scene, settings)?;
+    let mut frame = FrameRequest::of(&scene, settings)?;
     // A frame of several methods also writes groups.png, which needs each
     // pixel's character: the id pass comes with it (it changes no image).
     if frame.mixed() && !frame.settings().character_ids {

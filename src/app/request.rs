@@ -11,8 +11,7 @@ use anyhow::{bail, Context as _, Result};
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 
-use super::cli::{FrameArgs, View};
-use super::notes::flag;
+use super::cli::{flag, FrameArgs, View};
 use crate::method::lookup;
 use crate::mix::plan_file::PlanFile;
 use crate::render::request::FrameSettings;

@@ -119,9 +119,7 @@ impl PlanFile {
             );
         }
         // The count sizes what is allocated below: held to --heads' range.
-        crate::ranges::HEADS
-            .check(self.characters)
-            .context("characters")?;
+        crate::ranges::HEADS.check_as("characters", self.characters)?;
         let mut seen = vec![false; self.characters];
         for a in &self.assignments {
             if a.character >= self.characters {

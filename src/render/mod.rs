@@ -17,6 +17,7 @@ pub mod readback;
 pub mod request;
 pub mod scene_gpu;
 pub mod settings;
+mod submit;
 pub mod targets;
 
 use anyhow::{bail, Context as _, Result};
@@ -30,7 +31,6 @@ use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
-use crate::vk::profiler::Profiler;
 use frame::{Frame, SkinGroup};
 use group_setup::build_groups;
 use groups::{frame_needs, GroupMethod};
@@ -38,6 +38,7 @@ use merge::Merge;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use request::FrameRequest;
 pub use settings::RenderSettings;
+use submit::Submit;
 
 /// A finished frame read back to the host.
 pub struct Capture {
@@ -59,49 +60,6 @@ pub struct Capture {
     pub hdr_nonfinite: usize,
     /// With `--character-ids`: each pixel's character (frame index + 1; 0: no skin).
     pub character_ids: Option<Vec<u32>>,
-}
-
-/// The submission objects of a renderer.
-struct Submit {
-    profiler: Profiler,
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
-    /// CPU milliseconds the last submission spent recording its command buffer.
-    record_ms: std::cell::Cell<f64>,
-}
-
-impl Submit {
-    fn new(ctx: &Context, slots: u32) -> Result<Self> {
-        // Each is guarded until the submit holds them all.
-        let profiler = Guard::new(ctx, Profiler::new(ctx, slots)?);
-        let cmd = ctx.create("frame commands", |d| unsafe {
-            d.allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(ctx.command_pool)
-                    .command_buffer_count(1),
-            )
-        })?[0];
-        let cmd = Guard::new(ctx, cmd);
-        ctx.name(*cmd, "frame commands");
-        let fence = ctx.create("frame fence", |d| unsafe {
-            d.create_fence(&vk::FenceCreateInfo::default(), None)
-        })?;
-        ctx.name(fence, "frame fence");
-        Ok(Submit {
-            profiler: profiler.keep(),
-            cmd: cmd.keep(),
-            fence,
-            record_ms: std::cell::Cell::new(0.0),
-        })
-    }
-}
-
-impl Destroy for Submit {
-    fn destroy(&mut self, ctx: &Context) {
-        self.fence.destroy(ctx);
-        self.cmd.destroy(ctx);
-        Destroy::destroy(&mut self.profiler, ctx);
-    }
 }
 
 impl Destroy for Frame {

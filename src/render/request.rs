@@ -12,9 +12,27 @@ use super::settings::RenderSettings;
 use crate::scene::source::SceneSource;
 use crate::scene::Scene;
 
+/// Settings that passed [`RenderSettings::validate`] (every check that needs
+/// neither a scene nor a device), checked before the scene loads so that a
+/// bad number is reported before a file is read.
+#[derive(Clone, Debug)]
+pub struct CheckedSettings(RenderSettings);
+
+impl CheckedSettings {
+    pub fn new(settings: RenderSettings) -> Result<Self> {
+        settings.validate()?;
+        crate::checks::ran("settings");
+        Ok(CheckedSettings(settings))
+    }
+
+    pub fn get(&self) -> &RenderSettings {
+        &self.0
+    }
+}
+
 /// A checked frame: a scene, settings that passed
 /// [`RenderSettings::validate`], and the groups they resolve to in it.
-/// The only way to one is [`FrameRequest::new`].
+/// The only ways to one are [`FrameRequest::new`] and [`FrameRequest::of`].
 #[derive(Clone, Debug)]
 pub struct FrameRequest<'s> {
     scene: &'s Scene,
@@ -26,8 +44,12 @@ impl<'s> FrameRequest<'s> {
     /// Validates `settings` and resolves their groups in `scene`: every
     /// error is one line naming the setting, rule or plan entry at fault.
     pub fn new(scene: &'s Scene, settings: RenderSettings) -> Result<Self> {
-        settings.validate()?;
-        crate::checks::ran("settings");
+        Self::of(scene, CheckedSettings::new(settings)?)
+    }
+
+    /// Resolves the groups of checked settings in `scene`.
+    pub fn of(scene: &'s Scene, settings: CheckedSettings) -> Result<Self> {
+        let settings = settings.0;
         let groups = group_specs(scene, &settings)?;
         crate::checks::ran("groups");
         Ok(FrameRequest {

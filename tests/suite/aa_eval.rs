@@ -241,8 +241,14 @@ fn aa_eval_command_writes_its_files_and_guards_the_size() {
         stdout.contains("lines 4x") && stdout.contains("smaa"),
         "{stdout}"
     );
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("aa-eval.json")).unwrap()).unwrap();
+    let text = std::fs::read_to_string(out.join("aa-eval.json")).unwrap();
+    // aa-eval.json reads back typed, with its run header.
+    let typed: dermis::eval::aa_eval::AaEvalReport = serde_json::from_str(&text).unwrap();
+    assert_eq!(
+        (typed.run.width, typed.run.height, typed.factor),
+        (64, 36, 4)
+    );
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     // A row per view and post mode, and per MSAA count the device renders
     // (lavapipe: 4x), scored beside them.
     let counts: Vec<u32> = common::ctx()

@@ -216,7 +216,7 @@ fn a_bad_profile_is_one_error_line() {
     let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
     assert_eq!(lines.len(), 1, "{stderr}");
     assert!(
-        lines[0].contains("xbox-361.toml") && lines[0].contains("xbox360"),
+        lines[0].contains("no profile 'xbox-361'") && lines[0].contains("xbox360"),
         "{stderr}"
     );
 }

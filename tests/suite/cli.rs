@@ -349,8 +349,11 @@ fn reference_and_compare() {
         out.contains("relative RMSE") && out.contains("interior"),
         "{out}"
     );
-    let v: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(a.join("compare.json")).unwrap()).unwrap();
+    let text = std::fs::read(a.join("compare.json")).unwrap();
+    // compare.json reads back typed, with its run header.
+    let typed: dermis::eval::compare::Comparison = serde_json::from_slice(&text).unwrap();
+    assert!(typed.run.command.contains("compare") && typed.run.width > 0);
+    let v: serde_json::Value = serde_json::from_slice(&text).unwrap();
     let e = v["relative_rmse"].as_f64().unwrap();
     assert!(e > 1e-4 && e < 0.2, "separable vs reference: {e}");
     // Inside the face scattering beats doing nothing, and moves light the
@@ -410,8 +413,12 @@ fn eval_writes_csv_json_and_chart() {
     let csv = std::fs::read_to_string(d.join("eval.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), dermis::eval::sweep::registry().len(), "{csv}");
-    let v: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(d.join("eval.json")).unwrap()).unwrap();
+    let text = std::fs::read(d.join("eval.json")).unwrap();
+    // eval.json reads back typed, with its run header.
+    let typed: dermis::eval::sweep::EvalReport = serde_json::from_slice(&text).unwrap();
+    assert_eq!((typed.run.width, typed.run.height), (96, 64));
+    assert_eq!(typed.rows.len(), rows.len());
+    let v: serde_json::Value = serde_json::from_slice(&text).unwrap();
     let summary = v["summary"].as_array().unwrap();
     let error = |m: &str, s: &str| {
         summary

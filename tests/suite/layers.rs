@@ -30,7 +30,11 @@ use std::path::{Path, PathBuf};
 /// sit above it.
 const LAYERS: &[&[&str]] = &[
     &[
+        "checks",
+        "embedded",
         "files",
+        "header",
+        "ranges",
         "shader_constants",
         "work",
         "view",
@@ -52,6 +56,8 @@ const LAYERS: &[&[&str]] = &[
     &["eval"],
     // plan: a method per character under a budget (reads budget, mix, render's settings).
     &["plan"],
+    // app: the command wing (the commands that open a device, the CLI).
+    &["app"],
 ];
 
 /// Files above the pure core that must stay pure too (paths under `src/`).

@@ -36,6 +36,7 @@ mod plan;
 mod plan_motion;
 mod reference;
 mod region;
+mod request;
 mod scenes;
 mod screen;
 mod separable;

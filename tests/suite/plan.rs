@@ -566,6 +566,12 @@ fn plan_check_scores_plans_against_the_ground_truth() {
     ] {
         assert!(out.join(f).is_file(), "{f} written");
     }
+    // plan-check.json reads back typed, with its run header.
+    let back: dermis::plan::check::CheckReport =
+        serde_json::from_slice(&std::fs::read(out.join("plan-check.json")).unwrap()).unwrap();
+    assert_eq!(back.cases.len(), 2);
+    assert_eq!(back.run.width, 160);
+    assert_eq!(back.timed_profile.as_deref(), Some("nvidia-h200"));
     assert_eq!(
         pick_scenes("crowd16,nope")
             .unwrap_err()

@@ -202,6 +202,23 @@ fn plan_motion_measures_switches_against_the_truth() {
     for f in ["plan-motion.json", "plan-motion.png", "plan-motion.svg"] {
         assert!(out.join(f).is_file(), "{f} written");
     }
+    // plan-motion.json reads back typed, with its run header; every frame's
+    // plan is a plan file render reads, carrying the same header.
+    let back: dermis::plan::motion::MotionReport =
+        serde_json::from_slice(&std::fs::read(out.join("plan-motion.json")).unwrap()).unwrap();
+    assert_eq!(back.frames.len(), r.frames.len());
+    assert_eq!(back.run.width, 160);
+    assert!(!back.run.device.driver.is_empty());
+    for k in 0..r.frames.len() {
+        let p = out.join(format!("plans/frame-{k:03}.json"));
+        let plan = dermis::mix::plan_file::PlanFile::load(&p).unwrap();
+        assert_eq!(
+            plan.run.as_ref().map(|h| h.width),
+            Some(160),
+            "{}",
+            p.display()
+        );
+    }
 }
 
 /// The same sequence with 3-frame cross-fades: the front character's switch

@@ -504,6 +504,44 @@ fn sparse_accessors_are_applied() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+// Issue 27: a finite transform that overflows the coordinates (a scale of
+// 1e38 on a coordinate of 4000) is the file's fault, named at load, not NaN
+// pixels blamed on the renderer when the frame is written.
+#[test]
+fn a_texture_transform_that_overflows_is_refused_at_load() {
+    let dir = temp_dir("kht-overflow");
+    image::RgbaImage::new(2, 2)
+        .save(dir.join("albedo.png"))
+        .unwrap();
+    let uv16: Vec<u8> = [0u16, 4000, 4000, 4000, 4000, 0, 0, 0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let p = quad_file(
+        &dir,
+        "q.gltf",
+        serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 3}, "material": 0}),
+        serde_json::json!([{"bufferView": 3, "componentType": 5123, "count": 4, "type": "VEC2"}]),
+        &uv16,
+        None,
+    );
+    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let kht = serde_json::json!({"KHR_texture_transform": {"scale": [1e38, 1e38]}});
+    json["extensionsUsed"] = serde_json::json!(["KHR_mesh_quantization", "KHR_texture_transform"]);
+    json["extensionsRequired"] = serde_json::json!(["KHR_mesh_quantization"]);
+    json["images"] = serde_json::json!([{"uri": "albedo.png"}]);
+    json["textures"] = serde_json::json!([{"source": 0}]);
+    json["materials"] = serde_json::json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": kht}}}]);
+    std::fs::write(&p, serde_json::to_vec(&json).unwrap()).unwrap();
+    let e = load_err(&p);
+    assert!(
+        e.contains("TEXCOORD_0 through the material's KHR_texture_transform")
+            && e.contains("not finite")
+            && !e.contains('\n'),
+        "{e}"
+    );
+}
+
 #[test]
 fn quantized_uvs_go_through_the_texture_transform() {
     // What gltfpack writes: UNSIGNED_SHORT texture coordinates, not normalized,
