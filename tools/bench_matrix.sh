@@ -10,7 +10,7 @@
 #
 # On the device machine (one H200), from the repository root, with a release build carried:
 #   tools/bench_matrix.sh .bin/dermis out/h200 && tar czf "$OUT/h200.tgz" -C out h200
-# then commit the reports as docs/perf/h200/NAME.json; `cargo run --release --example
+# then commit the reports as docs/perf/h200/NAME.json; `cargo run --release --features tools --example
 # budget_calibration` scores the model on them. Set up the device
 # as tools/perf_h100.sh does: .gl (Vulkan loader debs) is unpacked here when present, and the
 # NVIDIA ICD is named when the loader does not find it.

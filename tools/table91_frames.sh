@@ -4,7 +4,7 @@
 # speed), then priced again by tools/examples/table91_rescore.rs:
 #
 #   tools/table91_frames.sh [BIN] [DIR]        BIN: target/release/dermis, DIR: out/table91
-#   cargo run --release --example table91_rescore -- face=DIR/face/budget.json \
+#   cargo run --release --features tools --example table91_rescore -- face=DIR/face/budget.json \
 #     lines1.5=DIR/lines1.5/budget.json lines2.5=DIR/lines2.5/budget.json \
 #     lines5=DIR/lines5/budget.json crowd16=DIR/crowd16/budget.json grid16=DIR/grid16/budget.json
 #

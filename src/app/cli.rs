@@ -229,9 +229,9 @@ pub struct AaEvalArgs {
 pub struct BudgetArgs {
     #[command(flatten)]
     pub frame: FrameArgs,
-    /// Profile name (`dermis budget --profile help` lists them; built into the binary)
-    /// or a TOML file's path; several (repeated or comma-separated) price the same
-    /// frame on each target side by side.
+    /// Profile name (built into the binary; an unknown name's error lists them) or a
+    /// TOML file's path; several (repeated or comma-separated) price the same frame on
+    /// each target side by side.
     #[arg(long = "profile", required = true, value_delimiter = ',')]
     pub profiles: Vec<String>,
     /// Run every registered method and chart their frames side by side.

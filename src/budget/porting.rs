@@ -69,7 +69,7 @@ pub fn summary_table(
     );
     s.push_str("|---|---|---|---|---|---|---|---|---|\n");
     for (config, method, f) in frames {
-        if method == "none" {
+        if method == crate::method::none().name {
             continue;
         }
         let b = price_frame(&prof, f, &set, Rescale::ToProfile);
@@ -117,7 +117,7 @@ pub fn compact_table(
     let set = ParamSet::fitted();
     let mut methods: Vec<&str> = Vec::new();
     let mut configs: Vec<&str> = Vec::new();
-    for (c, m, _) in frames.iter().filter(|f| f.1 != "none") {
+    for (c, m, _) in frames.iter().filter(|f| f.1 != crate::method::none().name) {
         if !methods.contains(&m.as_str()) {
             methods.push(m);
         }

@@ -121,7 +121,7 @@ pub fn rows_of(specs: &[SceneSpec], rows: &[EvalRow]) -> Result<Vec<Row>> {
             continue;
         };
         let Some(a) = &spec.accuracy else { continue };
-        let none = p.method == "none";
+        let none = p.method == crate::method::none().name;
         let interior = if none {
             1.0
         } else {

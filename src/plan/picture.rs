@@ -36,7 +36,11 @@ fn legend(plan: &Plan, costs: &[SettingCosts]) -> Vec<(Option<usize>, String, RG
             }
         }
     }
-    out.push((None, "none".into(), COLOURS[COLOURS.len() - 1]));
+    out.push((
+        None,
+        crate::method::none().name.into(),
+        COLOURS[COLOURS.len() - 1],
+    ));
     out
 }
 

@@ -367,7 +367,7 @@ pub fn reference_regions(
     use crate::view::region::{instance_regions, RegionMode, RegionView};
     let none = || vec![Vec::new(); framing.instances.len()];
     let d = RenderSettings::default();
-    if s.sss_region == RegionMode::Screen || d.method.name != "separable" {
+    if s.sss_region == RegionMode::Screen || !std::ptr::eq(d.method, &separable::ENTRY) {
         return none();
     }
     let Ok(kernel) = separable::Config::parse(&d.method.opts(&d.options))

@@ -123,3 +123,31 @@ fn a_failed_image_comparison_writes_its_difference_image() {
     assert_eq!(img.get_pixel(2 * w as u32, 0).0, [0, 0, 0]);
     std::fs::remove_file(&path).expect("removing the check's image");
 }
+
+/// The README's two commands (a fresh machine's render and its tests) and
+/// `.ci/run` agree: CI runs exactly the README's test command first, and
+/// the README shows exactly two commands under "Two commands".
+#[test]
+fn ci_runs_the_readmes_test_command() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let section = readme
+        .split("## Two commands")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .expect("README's \"Two commands\" section");
+    let blocks: Vec<&str> = section
+        .split("```sh\n")
+        .skip(1)
+        .filter_map(|b| b.split("```").next())
+        .map(str::trim)
+        .collect();
+    assert_eq!(blocks.len(), 2, "{blocks:?}");
+    assert_eq!(blocks[1], "tools/setup.sh && cargo test");
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    let first = ci
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with("set ") && !l.starts_with("cd "))
+        .expect("a command in .ci/run");
+    assert_eq!(first, blocks[1], ".ci/run's first command");
+}

@@ -4,7 +4,7 @@
 //! held-out benchmark rows with their terms.
 //!
 //! ```sh
-//! cargo run --release --example budget_calibration        # ALL_ROWS=1: every benchmark row too
+//! cargo run --release --features tools --example budget_calibration        # ALL_ROWS=1: every benchmark row too
 //! ```
 //! `WORST=N` prints the N worst rows (default 40). It was the ignored unit test
 //! `budget::calibration::tests::print_calibration`: it only prints, so it is a

@@ -4,7 +4,7 @@
 //! for the mid shot of one head.
 //!
 //! ```sh
-//! cargo run --release --example budget_porting_tables
+//! cargo run --release --features tools --example budget_porting_tables
 //! ```
 //! It was the ignored unit test `budget::porting::tests::print_porting_tables`:
 //! it only prints, so it is a program, not a test.

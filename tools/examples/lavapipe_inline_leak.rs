@@ -9,8 +9,8 @@
 //! that binds such a set N times leaks N shaders.
 //!
 //! ```sh
-//! cargo run --example lavapipe_inline_leak -- uniform 1000   # ~860 KB per frame
-//! cargo run --example lavapipe_inline_leak -- opaque 1000    # flat
+//! cargo run --features tools --example lavapipe_inline_leak -- uniform 1000   # ~860 KB per frame
+//! cargo run --features tools --example lavapipe_inline_leak -- opaque 1000    # flat
 //! ```
 //!
 //! The shader is cut down from dermis' geometry pass: a shadow lookup, and a

@@ -15,7 +15,7 @@
 //! fetches the same at every sample count.
 //!
 //! ```sh
-//! cargo run --release --example msaa_score [-- DIR]   # DIR defaults to docs/perf/h200-msaa
+//! cargo run --release --features tools --example msaa_score [-- DIR]   # DIR defaults to docs/perf/h200-msaa
 //! ```
 //!
 //! Prints, per frame and profile, the frame's modelled ms at each count, its

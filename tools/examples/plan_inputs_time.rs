@@ -7,7 +7,7 @@
 //! filled at set-up (`FrameInputs::fill_scene`, as `dermis plan-motion`
 //! does); without, it is priced lazily as the walk reaches new scales.
 //!
-//!   [FILL=1] cargo run --release --example plan_inputs_time [N ...]   (default 16 64 256)
+//!   [FILL=1] cargo run --release --features tools --example plan_inputs_time [N ...]   (default 16 64 256)
 use std::time::Instant;
 
 use dermis::budget::profile::Profile;

@@ -4,7 +4,7 @@
 //! and `opt_{H}h_d{D}.json`), with the issue's targets drawn in.
 //!
 //! ```sh
-//! cargo run --release --example table31_chart -- DIR/t31 docs/perf/h200-tsd/table31
+//! cargo run --release --features tools --example table31_chart -- DIR/t31 docs/perf/h200-tsd/table31
 //! ```
 //! writes `table31.png` and `table31.svg`.
 

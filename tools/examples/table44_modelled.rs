@@ -6,7 +6,7 @@
 //! table; heavy on lavapipe (about two minutes).
 //!
 //! ```sh
-//! cargo run --release --example table44_modelled -- [HEAD.glb] [DEVICE]
+//! cargo run --release --features tools --example table44_modelled -- [HEAD.glb] [DEVICE]
 //! ```
 //! HEAD defaults to the Lee Perry-Smith head beside the project, DEVICE (a
 //! name substring) to llvmpipe. It was `tests/tsd_gpu.rs`'s ignored

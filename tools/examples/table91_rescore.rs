@@ -12,7 +12,7 @@
 //! prints the markdown tables:
 //!
 //! ```sh
-//! cargo run --release --example table91_rescore -- face=DIR/budget.json lines=DIR2/budget.json ...
+//! cargo run --release --features tools --example table91_rescore -- face=DIR/budget.json lines=DIR2/budget.json ...
 //! ```
 //!
 //! MLAA's time on the 9800 GTX+ is its edges, weights and blend passes, without
