@@ -447,17 +447,41 @@ fn eval_writes_csv_json_and_chart() {
 }
 
 /// One flag value tried by `every_flag_at_hostile_values`: exit status and stderr.
+/// `dermis render --device no-such-gpu ARGS` run in this process (the
+/// command wing's own entry, `dermis::app::run`, which the binary's main
+/// calls; 240 processes would each load the scene and the Vulkan loader):
+/// whether it succeeded, and what the binary would print on standard error
+/// (clap's message, or the error's one line).
 fn try_value(args: &[&str]) -> (bool, String) {
+    use clap::{CommandFactory, FromArgMatches};
+    use dermis::app::cli::Cli;
     let d = tmp("sweep");
-    let mut c = dermis();
-    c.args(["render", "--device", "no-such-gpu", "--out"])
-        .arg(&d)
-        .args(args);
-    let o = c.output().unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    let mut argv = vec!["dermis", "render", "--device", "no-such-gpu", "--out"];
+    argv.push(d.to_str().unwrap());
+    argv.extend(args);
+    let m = match Cli::command().try_get_matches_from(&argv) {
+        Ok(m) => m,
+        Err(e) => return (false, e.render().to_string()),
+    };
+    let cli = Cli::from_arg_matches(&m).unwrap();
+    let given = m
+        .subcommand()
+        .map(|(_, sub)| dermis::app::request::Given::of(sub))
+        .unwrap_or_default();
+    let notes: String = dermis::app::notes::ignored(&cli.command, &given)
+        .iter()
+        .map(|n| format!("note: {n}\n"))
+        .collect();
+    match dermis::app::run(&cli.command, &given) {
+        Ok(()) => (true, notes),
+        // As the binary prints it: causes joined, so a newline inside one
+        // message would show as " | " (and is caught below).
+        Err(e) => {
+            let text = format!("{e:#}");
+            assert!(!text.contains('\n'), "{argv:?}: a multi-line error: {text}");
+            (false, format!("{notes}error: {text}\n"))
+        }
+    }
 }
 
 // Issue 11: every flag at 0, negative, NaN, inf and huge values. Each must end
