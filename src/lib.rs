@@ -3,7 +3,7 @@
 //!
 //! Layers, bottom up (a module uses only the ones before it; tests/suite/layers.rs
 //! checks it on every path the code names):
-//! the pure core, `files`, `shader_constants`, `work`, `view`, `scene`, `skin`,
+//! the pure core, `files`, `format`, `shader_constants`, `work`, `view`, `scene`, `skin`,
 //! `reference`, `accuracy`, `aa` (no Vulkan: the one door every user-supplied file is read
 //! through, regular files only and sizes bounded; the numbers shared with the shaders, the
 //! vocabulary of a pass's work, the view's scale and the SSS region, meshes and
@@ -29,6 +29,7 @@ pub mod bench;
 pub mod budget;
 pub mod eval;
 pub mod files;
+pub mod format;
 pub mod graph;
 pub mod method;
 pub mod mix;

@@ -5,6 +5,7 @@
 pub mod barrier;
 pub mod context;
 pub mod error;
+pub mod format;
 pub mod guard;
 pub mod memory;
 pub mod pipeline;

@@ -10,7 +10,7 @@ use crate::common;
 use dermis::eval::aa_eval::{mode_frame, mode_frames, reference, score_view, ViewFrames};
 use dermis::eval::supersample::{box_filter_srgb8, edge_mask};
 use dermis::post::AaMode;
-use dermis::render::readback::srgb_to_linear;
+use dermis::format::srgb_to_linear;
 use dermis::render::RenderSettings;
 use dermis::run::{run, RunOptions};
 use dermis::scene::camera::Camera;

@@ -31,6 +31,7 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[&[&str]] = &[
     &[
         "files",
+        "format",
         "shader_constants",
         "work",
         "view",
