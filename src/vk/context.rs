@@ -22,7 +22,7 @@ use super::undo::Undo;
 
 // The device choice and facts live with the physical device; named here too,
 // where every caller already finds the context.
-pub use super::physical_device::{DeviceChoice, DeviceFacts};
+pub use super::physical_device::{DeviceChoice, DeviceChoiceError, DeviceFacts};
 
 #[derive(Clone, Debug, Default)]
 pub struct ContextDesc {

@@ -2,11 +2,13 @@
 //! renderer and the report need. Queries only: nothing here is created, so
 //! nothing needs destroying.
 
+use std::fmt;
+
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 
 /// How to choose the physical device.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub enum DeviceChoice {
     /// First discrete GPU, else the first device.
     #[default]
@@ -17,13 +19,53 @@ pub enum DeviceChoice {
     Name(String),
 }
 
+/// Why a text names no device choice (see [`DeviceChoice`]'s `FromStr`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DeviceChoiceError(String);
+
+impl fmt::Display for DeviceChoiceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DeviceChoiceError {}
+
 impl std::str::FromStr for DeviceChoice {
-    type Err = std::convert::Infallible;
+    type Err = DeviceChoiceError;
+
+    /// `auto` (any case) is [`DeviceChoice::Auto`]; digits are an index; any
+    /// other text is a part of the device's name. Spaces around it are
+    /// dropped. Empty text is an error (as a name part it would match every
+    /// device), and so is an index too large to be one.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Ok(match s.parse::<usize>() {
-            Ok(i) => DeviceChoice::Index(i),
-            Err(_) => DeviceChoice::Name(s.to_string()),
-        })
+        let t = s.trim();
+        let lists = "`dermis devices` lists them";
+        if t.is_empty() {
+            return Err(DeviceChoiceError(format!(
+                "no device named: give a device's index or a part of its name ({lists})"
+            )));
+        }
+        if t.eq_ignore_ascii_case("auto") {
+            return Ok(DeviceChoice::Auto);
+        }
+        if t.bytes().all(|b| b.is_ascii_digit()) {
+            return t.parse().map(DeviceChoice::Index).map_err(|_| {
+                DeviceChoiceError(format!("device index {t} is out of range ({lists})"))
+            });
+        }
+        Ok(DeviceChoice::Name(t.to_string()))
+    }
+}
+
+/// The text [`DeviceChoice`]'s `FromStr` reads back as the same choice.
+impl fmt::Display for DeviceChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DeviceChoice::Auto => f.write_str("auto"),
+            DeviceChoice::Index(i) => write!(f, "{i}"),
+            DeviceChoice::Name(n) => f.write_str(n),
+        }
     }
 }
 
@@ -261,6 +303,45 @@ fn pick(instance: &ash::Instance, choice: &DeviceChoice) -> Result<vk::PhysicalD
                         list()
                     )
                 })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_device_choice_reads_back_as_itself() {
+        for c in [
+            DeviceChoice::Auto,
+            DeviceChoice::Index(0),
+            DeviceChoice::Index(12),
+            DeviceChoice::Name("llvmpipe".into()),
+            DeviceChoice::Name("NVIDIA H100".into()),
+            DeviceChoice::Name("-1".into()),
+        ] {
+            assert_eq!(c.to_string().parse::<DeviceChoice>(), Ok(c.clone()), "{c}");
+        }
+        let parse = |s: &str| s.parse::<DeviceChoice>();
+        assert_eq!(parse(" 1 "), Ok(DeviceChoice::Index(1)));
+        assert_eq!(parse("AUTO"), Ok(DeviceChoice::Auto));
+        assert_eq!(
+            parse("lavapipe 2"),
+            Ok(DeviceChoice::Name("lavapipe 2".into()))
+        );
+    }
+
+    // Text that names no device is an error at once, in one line, not a
+    // choice that silently matches (an empty name part matches every device).
+    #[test]
+    fn a_device_choice_that_names_nothing_is_refused() {
+        for s in ["", "   ", "99999999999999999999999"] {
+            let e = s.parse::<DeviceChoice>().unwrap_err().to_string();
+            assert!(
+                e.contains("`dermis devices` lists them") && !e.contains('\n'),
+                "{e}"
+            );
         }
     }
 }
