@@ -95,7 +95,9 @@ pub struct FormatInfo {
 }
 
 impl Format {
-    /// Every format, in declaration order.
+    /// Every format, in declaration order (a new format goes here too, and
+    /// into [`Format::info`]'s match, which the compiler holds complete;
+    /// `vk::format::from_vk` finds formats through this list).
     pub const ALL: [Format; 9] = [
         Format::Rgba8Unorm,
         Format::Rgba8Srgb,
