@@ -11,7 +11,7 @@
 // (each Gaussian conserves the light it gathers; src/reference/narrow.rs says
 // why) and adds them to the narrow part. The split comes from NARROW_GAUSSIANS
 // (src/shader_constants.rs).
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = COMPUTE_GROUP_SIDE, local_size_y = COMPUTE_GROUP_SIDE) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;  // L_d(x_o) (no transmittance), alpha = strength
 layout(set = 0, binding = 1) uniform texture2D depthTex;    // linear view depth
 layout(set = 0, binding = 2, rgba32f) uniform image2D accum4;

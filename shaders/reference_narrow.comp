@@ -9,7 +9,7 @@
 #include "fetch_count.glsl"
 #include "shader_constants.glsl"
 #include "view_scale.glsl"
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = COMPUTE_GROUP_SIDE, local_size_y = COMPUTE_GROUP_SIDE) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;   // alpha = SSS strength
 layout(set = 0, binding = 1) uniform texture2D depthTex;     // linear view depth
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D outImage;

@@ -6,7 +6,7 @@
 // times its RGB weight (thesis Table 4.2).
 #include "fetch_count.glsl"
 #include "shader_constants.glsl"
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = COMPUTE_GROUP_SIDE, local_size_y = COMPUTE_GROUP_SIDE) in;
 layout(set = 0, binding = 0) uniform texture2D diffuseTex;  // alpha = SSS strength
 layout(set = 0, binding = 1, rgba32f) uniform image2D outImage;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D accum4;

@@ -77,6 +77,13 @@ pub const BLOOM_LEVELS: usize = 4;
 /// -R..=R, so 3 sigma of its one-texel Gaussian (`post::bloom_pyramid`).
 pub const BLOOM_BLUR_RADIUS: u32 = 3;
 
+/// Side of the square workgroup of the screen-space compute shaders
+/// (reference_narrow.comp, reference_gather.comp, reference_resolve.comp: one
+/// invocation a pixel): their `local_size_x` and `local_size_y`, and the
+/// ground truth's dispatches of ceil(extent / side) groups. vk/shader.rs's
+/// tests read every compute module's workgroup size back from its SPIR-V.
+pub const COMPUTE_GROUP_SIDE: u32 = 8;
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -145,6 +152,7 @@ pub fn glsl() -> String {
     def("MLAA_NUM_DISTANCES", MLAA_NUM_DISTANCES.to_string());
     def("BLOOM_LEVELS", BLOOM_LEVELS.to_string());
     def("BLOOM_BLUR_RADIUS", BLOOM_BLUR_RADIUS.to_string());
+    def("COMPUTE_GROUP_SIDE", COMPUTE_GROUP_SIDE.to_string());
     s.push_str("#endif\n");
     s
 }
@@ -168,6 +176,7 @@ mod tests {
             "SEPARABLE_MAX_SAMPLES",
             "TSD_MAX_ISLANDS",
             "PCF_TAPS",
+            "COMPUTE_GROUP_SIDE",
         ] {
             assert!(h.contains(&format!("#define {name} ")), "{name}");
         }

@@ -36,50 +36,9 @@ impl PassRole {
     }
 }
 
-/// Texel formats the passes read and write.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Format {
-    Rgba8Unorm,
-    Rgba8Srgb,
-    R16Float,
-    Rgba16Float,
-    R32Float,
-    Rgba32Float,
-    D32Float,
-    D24UnormS8Uint,
-    D32FloatS8Uint,
-}
-
-impl Format {
-    /// Bytes of one texel as stored (D24S8 is 4; D32S8 is taken as 5: 4 + 1, as
-    /// most hardware stores the stencil plane apart).
-    pub fn bytes_per_texel(self) -> u32 {
-        match self {
-            Format::R16Float => 2,
-            Format::Rgba8Unorm
-            | Format::Rgba8Srgb
-            | Format::R32Float
-            | Format::D32Float
-            | Format::D24UnormS8Uint => 4,
-            Format::D32FloatS8Uint => 5,
-            Format::Rgba16Float => 8,
-            Format::Rgba32Float => 16,
-        }
-    }
-
-    /// Whether a depth format also has a stencil aspect.
-    pub fn has_stencil(self) -> bool {
-        matches!(self, Format::D24UnormS8Uint | Format::D32FloatS8Uint)
-    }
-
-    pub fn is_depth(self) -> bool {
-        matches!(
-            self,
-            Format::D32Float | Format::D24UnormS8Uint | Format::D32FloatS8Uint
-        )
-    }
-}
+/// Texel formats: their names are the work vocabulary, their facts (bytes,
+/// aspects, readback decode) the one format table's (`crate::format`).
+pub use crate::format::Format;
 
 /// How a fetch filters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

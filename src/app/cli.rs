@@ -18,6 +18,7 @@ use crate::scene::layout::Layout;
 use crate::skin::kernel::Preset;
 use crate::skin::transmittance::TransmittanceProfile;
 use crate::view::region::RegionMode;
+use crate::vk::context::DeviceChoice;
 
 /// The frame's defaults: every render flag's default is read from here, so the
 /// CLI and the library (tests, eval) cannot drift apart.
@@ -353,9 +354,10 @@ pub enum View {
 /// The options of a frame, shared by every command that renders or plans one.
 #[derive(Args, Clone, Debug)]
 pub struct FrameArgs {
-    /// Vulkan device: index or case-insensitive name substring (default: first discrete GPU).
+    /// Vulkan device: index, `auto` or case-insensitive name substring (default: the
+    /// first discrete GPU; `dermis devices` lists them).
     #[arg(long)]
-    pub device: Option<String>,
+    pub device: Option<DeviceChoice>,
     /// Enable the Khronos validation layer with synchronization validation; any message fails the run.
     #[arg(long)]
     pub validate: bool,

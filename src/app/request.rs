@@ -19,7 +19,7 @@ use crate::render::settings::{Assignment, ShotPreset};
 use crate::render::RenderSettings;
 use crate::scene::source::SceneSource;
 use crate::scene::Scene;
-use crate::vk::context::{Context, ContextDesc, DeviceChoice};
+use crate::vk::context::{Context, ContextDesc};
 
 /// The options given on the command line (clap ids), as opposed to defaults.
 #[derive(Clone, Debug, Default)]
@@ -182,11 +182,7 @@ pub fn load_scene(source: &SceneSource) -> Result<Scene> {
 /// The device the options ask for.
 pub fn context_desc(a: &FrameArgs) -> ContextDesc {
     ContextDesc {
-        device: a
-            .device
-            .as_deref()
-            .map(|d| d.parse::<DeviceChoice>().unwrap_or_default())
-            .unwrap_or_default(),
+        device: a.device.clone().unwrap_or_default(),
         validate: a.validate,
         ..Default::default()
     }

@@ -58,16 +58,25 @@ impl TargetFormat {
         }
     }
 
-    /// Bytes per texel as stored (matches [`Format::bytes_per_texel`]).
+    /// The renderer's format this is (`None`: a console format only a port
+    /// would substitute).
+    pub fn to_work(self) -> Option<Format> {
+        Format::ALL
+            .into_iter()
+            .find(|&f| Self::from_work(f) == self)
+    }
+
+    /// Bytes per texel as stored: a renderer format's from the format table
+    /// ([`Format::bytes_per_texel`]), a console format's own.
     pub fn bytes(self) -> u32 {
         use TargetFormat::*;
-        match self {
-            R16Float => 2,
-            Rgba8Unorm | Rgba8Srgb | Rgb10a2Unorm | Rgb10a2Float | R11g11b10Float | Rg16Unorm
-            | Rg16Float | R32Float | D24UnormS8Uint | D24FloatS8Uint | D32Float => 4,
-            D32FloatS8Uint => 5,
-            Rgba16Fixed | Rgba16Float | Rg32Float => 8,
-            Rgba32Float => 16,
+        match self.to_work() {
+            Some(f) => f.bytes_per_texel(),
+            None => match self {
+                Rgba16Fixed | Rg32Float => 8,
+                // Every other console format packs a texel into 32 bits.
+                _ => 4,
+            },
         }
     }
 
@@ -159,18 +168,27 @@ mod tests {
         // tie goes to either; both beat an 8-bit format.
         assert!(Rg16Float.distance_from(R16Float) < Rgba8Unorm.distance_from(R16Float));
         assert_eq!(TargetFormat::from_work(Format::Rgba16Float).bytes(), 8);
-        for f in [
-            Format::Rgba8Unorm,
-            Format::Rgba8Srgb,
-            Format::R16Float,
-            Format::Rgba16Float,
-            Format::R32Float,
-            Format::Rgba32Float,
-            Format::D32Float,
-            Format::D24UnormS8Uint,
-            Format::D32FloatS8Uint,
-        ] {
+        for f in Format::ALL {
+            assert_eq!(TargetFormat::from_work(f).to_work(), Some(f));
             assert_eq!(TargetFormat::from_work(f).bytes(), f.bytes_per_texel());
+        }
+    }
+
+    // The console formats' own sizes (the renderer's come from the format table).
+    #[test]
+    fn console_formats_sizes() {
+        use TargetFormat::*;
+        for (f, bytes) in [
+            (Rgb10a2Unorm, 4),
+            (Rgb10a2Float, 4),
+            (R11g11b10Float, 4),
+            (Rg16Unorm, 4),
+            (Rg16Float, 4),
+            (D24FloatS8Uint, 4),
+            (Rgba16Fixed, 8),
+            (Rg32Float, 8),
+        ] {
+            assert_eq!((f.to_work(), f.bytes()), (None, bytes), "{f:?}");
         }
     }
 }

@@ -25,6 +25,7 @@
 use anyhow::{ensure, Result};
 
 use super::metrics::{flip_ldr, relative_rmse};
+use crate::format::{linear_to_srgb, srgb_to_linear};
 
 /// The default supersampling factor per axis (4 x 4 = 16 samples per pixel,
 /// the minimum).
@@ -70,27 +71,6 @@ pub fn check_supersampled(width: u32, height: u32, n: u32, max_side: u32) -> Res
     Ok((w as u32, h as u32))
 }
 
-/// sRGB byte to linear light (IEC 61966-2-1).
-pub fn decode(c: u8) -> f32 {
-    let c = f32::from(c) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear light to the nearest sRGB byte (clamped to 0..=1).
-pub fn encode(l: f32) -> u8 {
-    let l = if l.is_nan() { 0.0 } else { l.clamp(0.0, 1.0) };
-    let c = if l <= 0.003_130_8 {
-        12.92 * l
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0).round().clamp(0.0, 255.0) as u8
-}
-
 /// Box-filters an sRGB-encoded RGBA8 image of `n width` x `n height` down to
 /// `width` x `height`: each output pixel is the encoded mean of the decoded
 /// (linear) values of its `n` x `n` block; alpha is averaged as is. Rows top
@@ -107,7 +87,7 @@ pub fn box_filter_srgb8(src: &[u8], width: u32, height: u32, n: u32) -> Result<V
         h * n,
         sw * h * n * 4
     );
-    let lut: Vec<f32> = (0..=255u8).map(decode).collect();
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
     let inv = 1.0 / (n * n) as f64;
     let mut out = vec![0u8; w * h * 4];
     for y in 0..h {
@@ -124,7 +104,7 @@ pub fn box_filter_srgb8(src: &[u8], width: u32, height: u32, n: u32) -> Result<V
             }
             let o = &mut out[(y * w + x) * 4..(y * w + x + 1) * 4];
             for c in 0..3 {
-                o[c] = encode((acc[c] * inv) as f32);
+                o[c] = linear_to_srgb((acc[c] * inv) as f32);
             }
             o[3] = (acc[3] * inv).round() as u8;
         }
@@ -155,7 +135,7 @@ pub fn edge_mask(reference: &[u8], none: &[u8]) -> Result<Vec<bool>> {
 
 /// An sRGB8 image's display-linear RGBA (alpha 1: `relative_rmse` ignores it).
 pub fn linear(srgb8: &[u8]) -> Vec<[f32; 4]> {
-    let lut: Vec<f32> = (0..=255u8).map(decode).collect();
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
     srgb8
         .chunks_exact(4)
         .map(|p| {
@@ -229,16 +209,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn srgb_round_trips_every_byte() {
-        for c in 0..=255u8 {
-            assert_eq!(encode(decode(c)), c);
-        }
-        assert_eq!(encode(-1.0), 0);
-        assert_eq!(encode(2.0), 255);
-        assert_eq!(encode(f32::NAN), 0);
-    }
-
-    #[test]
     fn box_filter_averages_in_linear_light() {
         // A 2x2 block half black, half white: linear 0.5, sRGB 188 (not 128).
         let src = [
@@ -247,7 +217,7 @@ mod tests {
         ];
         let out = box_filter_srgb8(&src, 1, 1, 2).unwrap();
         assert_eq!(out, vec![188, 188, 188, 255]);
-        assert_eq!(encode(0.5), 188);
+        assert_eq!(linear_to_srgb(0.5), 188);
     }
 
     #[test]

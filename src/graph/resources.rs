@@ -7,6 +7,7 @@ use ash::vk;
 use super::work::{Format, ImageUse, ImageUseKind};
 use crate::vk::barrier::{image_barrier, AccessKind, ResourceState};
 use crate::vk::context::Context;
+use crate::vk::format::from_vk;
 use crate::vk::memory::Image;
 
 /// A tracked image subresource: one mip level of a declared image (level 0 for
@@ -111,7 +112,7 @@ impl Resources {
         if !self.prefix.is_empty() {
             desc.name = format!("{}{}", self.prefix, desc.name);
         }
-        let texel = work_format(desc.format).unwrap_or_else(|| {
+        let texel = from_vk(desc.format).unwrap_or_else(|| {
             panic!(
                 "image '{}' is declared with {:?}, which the work vocabulary cannot name",
                 desc.name, desc.format
@@ -210,17 +211,14 @@ impl Resources {
         Ok(())
     }
 
-    /// Bytes the declared images take once created (mip chains included; a
-    /// format dermis does not read back is counted at 8 bytes a texel).
+    /// Bytes the declared images take once created, as the format table's
+    /// memory estimate counts a texel (mip chains included).
     pub fn declared_bytes(&self) -> u64 {
         self.slots
             .iter()
             .map(|s| {
                 let d = &s.desc;
-                let texel = match crate::vk::memory::bytes_per_texel(d.format) {
-                    0 => 8,
-                    b => b as u64,
-                };
+                let texel = u64::from(s.texel.info().memory_bytes);
                 let level0 =
                     d.extent.width as u64 * d.extent.height as u64 * texel * d.samples as u64;
                 // A full chain adds a third.
@@ -468,23 +466,6 @@ impl Resources {
             .buffer_memory_barriers(&bb);
         unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
     }
-}
-
-/// The work-declaration format of a Vulkan format dermis uses (checked once,
-/// when an image is declared).
-fn work_format(f: vk::Format) -> Option<Format> {
-    Some(match f {
-        vk::Format::R8G8B8A8_UNORM => Format::Rgba8Unorm,
-        vk::Format::R8G8B8A8_SRGB => Format::Rgba8Srgb,
-        vk::Format::R16_SFLOAT => Format::R16Float,
-        vk::Format::R16G16B16A16_SFLOAT => Format::Rgba16Float,
-        vk::Format::R32_SFLOAT => Format::R32Float,
-        vk::Format::R32G32B32A32_SFLOAT => Format::Rgba32Float,
-        vk::Format::D32_SFLOAT => Format::D32Float,
-        vk::Format::D24_UNORM_S8_UINT => Format::D24UnormS8Uint,
-        vk::Format::D32_SFLOAT_S8_UINT => Format::D32FloatS8Uint,
-        _ => return None,
-    })
 }
 
 #[cfg(test)]

@@ -6,11 +6,13 @@ use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use crate::format::{Aspect, Format};
 use crate::graph::work::{PassRole, Work};
 use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
-use crate::vk::memory::{bytes_per_texel, Buffer};
+use crate::vk::format::{aspect_flag, from_vk};
+use crate::vk::memory::Buffer;
 
 /// One pass output as linear float RGBA.
 pub struct DumpedImage {
@@ -49,76 +51,13 @@ pub struct ReadbackPlan {
 /// Label prefix of the readback passes (a label only: they are found by role).
 const PREFIX: &str = "readback";
 
-/// Bytes per texel copied out of `format`, with the aspect to copy, or `None`
-/// when dermis does not read that format back.
-fn copy_format(format: vk::Format) -> Option<(usize, vk::ImageAspectFlags)> {
-    match format {
-        vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => {
-            Some((4, vk::ImageAspectFlags::DEPTH))
-        }
-        f if bytes_per_texel(f) > 0 => Some((bytes_per_texel(f), vk::ImageAspectFlags::COLOR)),
-        _ => None,
-    }
-}
-
-pub fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Texels of `format` as linear float RGBA (single channels replicated to RGB).
+/// Texels of `format` as linear float RGBA, as the format table decodes a
+/// readback of it (single channels replicated to RGB).
 pub fn to_rgba_f32(format: vk::Format, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
-    Ok(match format {
-        vk::Format::R16G16B16A16_SFLOAT => bytes
-            .chunks_exact(8)
-            .map(|c| {
-                let h =
-                    |i: usize| half::f16::from_bits(u16::from_le_bytes([c[i], c[i + 1]])).to_f32();
-                [h(0), h(2), h(4), h(6)]
-            })
-            .collect(),
-        vk::Format::R32_SFLOAT | vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => bytes
-            .chunks_exact(4)
-            .map(|c| {
-                let v = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
-                [v, v, v, 1.0]
-            })
-            .collect(),
-        vk::Format::R32G32B32A32_SFLOAT => bytes
-            .chunks_exact(16)
-            .map(|c| {
-                let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
-                [f(0), f(4), f(8), f(12)]
-            })
-            .collect(),
-        vk::Format::R8G8B8A8_SRGB => bytes
-            .chunks_exact(4)
-            .map(|c| {
-                [
-                    srgb_to_linear(c[0]),
-                    srgb_to_linear(c[1]),
-                    srgb_to_linear(c[2]),
-                    c[3] as f32 / 255.0,
-                ]
-            })
-            .collect(),
-        vk::Format::R8G8B8A8_UNORM => bytes
-            .chunks_exact(4)
-            .map(|c| {
-                [
-                    c[0] as f32 / 255.0,
-                    c[1] as f32 / 255.0,
-                    c[2] as f32 / 255.0,
-                    c[3] as f32 / 255.0,
-                ]
-            })
-            .collect(),
-        other => bail!("reading back {other:?} is not supported"),
-    })
+    match from_vk(format).and_then(Format::readback) {
+        Some((_, _, decode)) => Ok(decode.to_rgba(bytes)),
+        None => bail!("reading back {format:?} is not supported"),
+    }
 }
 
 impl ReadbackPlan {
@@ -167,17 +106,19 @@ impl ReadbackPlan {
         if res.level_of(id) > 0 || res.samples(id) > 1 {
             return Ok(None);
         }
-        let format = res.format(id);
-        let copied = if self.stencil && crate::vk::memory::has_stencil(format) {
-            Some((1, vk::ImageAspectFlags::STENCIL))
-        } else {
-            copy_format(format)
+        // The aspect and its bytes a texel from the format table: a stencil
+        // plan's stencil, else what the format reads back as.
+        let format = res.texel_format(id);
+        let copied = match format.copy_bytes(Aspect::Stencil) {
+            Some(bytes) if self.stencil => Some((Aspect::Stencil, bytes)),
+            _ => format.readback().map(|(aspect, bytes, _)| (aspect, bytes)),
         };
-        let Some((bpt, aspect)) = copied else {
+        let Some((aspect, bpt)) = copied else {
             return Ok(None);
         };
+        let aspect = aspect_flag(aspect);
         let extent = res.extent(id);
-        let size = extent.width as u64 * extent.height as u64 * bpt as u64;
+        let size = extent.width as u64 * extent.height as u64 * u64::from(bpt);
         let name = format!("{PREFIX} {pass} -> {}", res.name(id));
         let buffer = Buffer::new(
             ctx,
@@ -200,7 +141,7 @@ impl ReadbackPlan {
                 .buffer(buffer_id, AccessKind::TransferWrite)
                 .work(Work::Copy {
                     texels: extent.width as u64 * extent.height as u64,
-                    bytes_per_texel: bpt as u32,
+                    bytes_per_texel: bpt,
                     rects: 1,
                 })
                 .record(move |pc: &PassContext| {

@@ -10,6 +10,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::context::Context;
 use super::error::Error;
+use super::format::{aspect_flags, from_vk};
 use super::guard::{Destroy, Guard};
 
 /// `Default` is the null object: destroying it does nothing (set-up fills
@@ -36,38 +37,6 @@ pub struct Image {
     pub unorm_view: Option<vk::ImageView>,
     pub name: String,
     allocation: Option<Allocation>,
-}
-
-pub fn is_depth_format(f: vk::Format) -> bool {
-    matches!(
-        f,
-        vk::Format::D32_SFLOAT
-            | vk::Format::D16_UNORM
-            | vk::Format::D24_UNORM_S8_UINT
-            | vk::Format::D32_SFLOAT_S8_UINT
-            | vk::Format::D16_UNORM_S8_UINT
-    )
-}
-
-pub fn has_stencil(f: vk::Format) -> bool {
-    matches!(
-        f,
-        vk::Format::D24_UNORM_S8_UINT
-            | vk::Format::D32_SFLOAT_S8_UINT
-            | vk::Format::D16_UNORM_S8_UINT
-    )
-}
-
-/// Bytes per texel of the colour formats dermis reads back or uploads.
-pub fn bytes_per_texel(f: vk::Format) -> usize {
-    match f {
-        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT => 4,
-        vk::Format::R16_SFLOAT => 2,
-        vk::Format::R16G16B16A16_SFLOAT => 8,
-        vk::Format::R32G32B32A32_SFLOAT => 16,
-        vk::Format::D32_SFLOAT => 4,
-        _ => 0,
-    }
 }
 
 /// The Vulkan sample-count flag of `n` samples per pixel (1, 2, 4 or 8:
@@ -186,15 +155,11 @@ impl Image {
         samples: u32,
     ) -> Result<Self> {
         let levels = levels.max(1);
-        let aspect = if is_depth_format(format) {
-            if has_stencil(format) {
-                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
-            } else {
-                vk::ImageAspectFlags::DEPTH
-            }
-        } else {
-            vk::ImageAspectFlags::COLOR
-        };
+        // Its aspects from the format table; a format the table lacks is a
+        // programmer error, refused before anything is made.
+        let aspect = from_vk(format).map(aspect_flags).with_context(|| {
+            format!("image '{name}': {format:?} is not in the format table (src/format.rs)")
+        })?;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -291,7 +256,9 @@ impl Image {
         if self.levels > 1 {
             self.chain_view = make_view(aspect, 0, self.levels)?;
         }
-        if has_stencil(format) && usage.contains(vk::ImageUsageFlags::SAMPLED) {
+        if aspect.contains(vk::ImageAspectFlags::STENCIL)
+            && usage.contains(vk::ImageUsageFlags::SAMPLED)
+        {
             self.depth_view = Some(make_view(vk::ImageAspectFlags::DEPTH, 0, 1)?);
         }
         ctx.name(raw, &name);

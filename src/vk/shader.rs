@@ -263,6 +263,29 @@ mod tests {
         }
     }
 
+    /// Every compute module's workgroup, read back from its SPIR-V (naga's
+    /// reflection), is the side the Rust dispatches divide by
+    /// (`shader_constants::COMPUTE_GROUP_SIDE`): a shader that wrote its own
+    /// local size, or a dispatch sized by another, fails here.
+    #[test]
+    fn compute_workgroups_are_the_shared_side() {
+        let side = crate::shader_constants::COMPUTE_GROUP_SIDE;
+        let mut seen = 0;
+        for (name, bytes) in SHADERS {
+            let module =
+                naga::front::spv::parse_u8_slice(bytes, &naga::front::spv::Options::default())
+                    .unwrap();
+            for e in &module.entry_points {
+                if e.stage == naga::ShaderStage::Compute {
+                    assert_eq!(e.workgroup_size, [side, side, 1], "{name}");
+                    seen += 1;
+                }
+            }
+        }
+        // Three shaders, each also in its fetch-counting build.
+        assert_eq!(seen, 6);
+    }
+
     #[test]
     fn unknown_shader_is_an_error() {
         assert!(spirv("nope.frag").is_err());

@@ -23,7 +23,7 @@ use dermis::aa::mlaa_area::MlaaAreaTex;
 use dermis::aa::mlaa_weights::{edge_pixels, top_line, weights, SEARCH_DISTANCE};
 use dermis::aa::revector;
 use dermis::post::AaMode;
-use dermis::render::readback::srgb_to_linear;
+use dermis::format::srgb_to_linear;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::vk::context::Context;

@@ -395,7 +395,7 @@ fn smaa_presets_follow_their_thresholds() {
 /// The input frame as the post-only run's output reads it back (linear
 /// floats decoded from sRGB), to see which pixels a stage changed.
 fn run_input(rgba8: &[u8]) -> Vec<[f32; 4]> {
-    use dermis::render::readback::srgb_to_linear;
+    use dermis::format::srgb_to_linear;
     rgba8
         .chunks_exact(4)
         .map(|c| {

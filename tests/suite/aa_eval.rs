@@ -11,7 +11,7 @@ use dermis::app::aa_eval::{mode_frame, mode_frames, plan_view, reference};
 use dermis::eval::aa_eval::{score_view, AaScene, ViewFrames};
 use dermis::eval::supersample::{box_filter_srgb8, edge_mask};
 use dermis::post::AaMode;
-use dermis::render::readback::srgb_to_linear;
+use dermis::format::srgb_to_linear;
 use dermis::render::RenderSettings;
 use dermis::run::{run, FrameCounts, RunOptions};
 use dermis::scene::camera::Camera;

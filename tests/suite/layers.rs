@@ -24,41 +24,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// The layers, bottom up, as `src/lib.rs` documents them. A module may use
-/// modules of its own layer index or lower; `run` and `report` share a layer.
-/// The bottom layer is the pure core: it cannot name `vk` or `graph`, which
-/// sit above it.
-const LAYERS: &[&[&str]] = &[
-    &[
-        "checks",
-        "embedded",
-        "files",
-        "header",
-        "ranges",
-        "shader_constants",
-        "work",
-        "view",
-        "scene",
-        "skin",
-        "reference",
-        "accuracy",
-        "aa",
-    ],
-    &["vk"],
-    &["graph"],
-    // mix: which method each character gets (it reads the registry).
-    // post: the anti-aliasing stages after the tone map (read by render).
-    &["method", "mix", "post"],
-    &["render"],
-    &[
-        "report", "bench", "run", "output", "trace", "budget", "plot",
-    ],
-    &["eval"],
-    // plan: a method per character under a budget (reads budget, mix, render's settings).
-    &["plan"],
-    // app: the command wing (the commands that open a device, the CLI).
-    &["app"],
-];
+// The layers, bottom up, written once in `src/lib.rs`. A module may use
+// modules of its own layer index or lower. The bottom layer is the pure core:
+// it cannot name `vk` or `graph`, which sit above it.
+use dermis::LAYERS;
 
 /// Files above the pure core that must stay pure too (paths under `src/`).
 const PURE_FILES: &[&str] = &[
@@ -678,6 +647,30 @@ fn layers_hold_and_modules_form_no_cycle() {
     }
     // Within a layer, modules may use each other, but not in a cycle.
     assert_acyclic(&edges, "modules");
+}
+
+/// The one list names every module `src/lib.rs` declares, each once. (A
+/// listed module without files yet, such as `app` before the command wing
+/// lands, constrains nothing: the rules above read files.)
+#[test]
+fn the_layer_list_names_every_module_once() {
+    let lib = std::fs::read_to_string(src().join("lib.rs")).unwrap();
+    let declared: Vec<&str> = lib
+        .lines()
+        .filter_map(|l| l.strip_prefix("pub mod ")?.strip_suffix(';'))
+        .collect();
+    assert!(declared.len() > 20, "{declared:?}");
+    for m in &declared {
+        assert!(
+            layer(m).is_some(),
+            "src/lib.rs declares `{m}`, which no layer of LAYERS lists"
+        );
+    }
+    let mut listed: Vec<&str> = LAYERS.iter().flat_map(|l| l.iter().copied()).collect();
+    let n = listed.len();
+    listed.sort_unstable();
+    listed.dedup();
+    assert_eq!(listed.len(), n, "LAYERS lists a module twice");
 }
 
 /// Sibling files of one folder (not counting its mod.rs, which declares them)

@@ -53,8 +53,8 @@ const RESOLVE_SHADER: &str = "reference_resolve.comp";
 /// The surface pass's targets: radiance, position + area, normal.
 const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const SURFACE_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
-/// Workgroup side of the gather (reference_gather.comp's local size).
-const GROUP: u32 = 8;
+/// Workgroup side of the compute passes (their shaders' local size).
+const GROUP: u32 = crate::shader_constants::COMPUTE_GROUP_SIDE;
 /// The gather's 3x3x3 cell neighbourhood runs as 9 dispatches of one row of 3
 /// cells each: llvmpipe cuts shader loops after 65,535 iterations.
 const SLABS: i32 = 9;
