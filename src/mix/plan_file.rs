@@ -139,6 +139,25 @@ impl PlanFile {
                 f.fade()
                     .with_context(|| format!("character {}'s fade", a.character))?;
             }
+            // What the planner saw and predicted: no number of a plan is
+            // NaN, infinite or negative, read or not.
+            let predicted = a.predicted_error.map(|e| [e.interior, e.silhouette]);
+            for (what, v) in [("px_per_mm", a.px_per_mm), ("predicted_ms", a.predicted_ms)]
+                .into_iter()
+                .chain(
+                    predicted
+                        .into_iter()
+                        .flatten()
+                        .map(|v| ("predicted_error", Some(v))),
+                )
+            {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                    bail!(
+                        "character {}: {what} {v} is not a finite number >= 0",
+                        a.character
+                    );
+                }
+            }
         }
         if let Some(missing) = seen.iter().position(|s| !s) {
             bail!("character {missing} has no assignment");
@@ -149,6 +168,15 @@ impl PlanFile {
             if !(b.is_finite() && b > 0.0) {
                 bail!("budget_ms {b} is not a positive time");
             }
+        }
+        let predicted = self.predicted_error.map(|e| [e.interior, e.silhouette]);
+        if let Some(v) = self
+            .predicted_ms
+            .into_iter()
+            .chain(predicted.into_iter().flatten())
+            .find(|v| !(v.is_finite() && *v >= 0.0))
+        {
+            bail!("a predicted figure {v} is not a finite number >= 0");
         }
         Ok(())
     }
@@ -237,6 +265,18 @@ mod tests {
             (
                 GOOD.replace("\"character\":1", "\"character\":0"),
                 "assigned twice",
+            ),
+            // Issue 27: every number a plan brings is held to a range.
+            (
+                GOOD.replace("\"characters\":2", "\"characters\":1000000000000"),
+                "characters must be within 1..=1024 (as --heads)",
+            ),
+            (
+                GOOD.replace(
+                    "\"method\":\"none\"",
+                    "\"method\":\"none\",\"predicted_ms\":-1",
+                ),
+                "character 1: predicted_ms -1 is not a finite number >= 0",
             ),
             (
                 GOOD.replace("\"characters\":2", "\"characters\":3"),

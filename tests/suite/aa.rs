@@ -22,8 +22,8 @@ use dermis::aa::edges::{
 use dermis::aa::mlaa_area::MlaaAreaTex;
 use dermis::aa::mlaa_weights::{edge_pixels, top_line, weights, SEARCH_DISTANCE};
 use dermis::aa::revector;
-use dermis::post::AaMode;
 use dermis::format::srgb_to_linear;
+use dermis::post::AaMode;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::vk::context::Context;

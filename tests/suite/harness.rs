@@ -147,7 +147,9 @@ fn ci_runs_the_readmes_test_command() {
     let first = ci
         .lines()
         .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with("set ") && !l.starts_with("cd "))
+        .find(|l| {
+            !l.is_empty() && !l.starts_with('#') && !l.starts_with("set ") && !l.starts_with("cd ")
+        })
         .expect("a command in .ci/run");
     assert_eq!(first, blocks[1], ".ci/run's first command");
 }
