@@ -41,6 +41,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Jittered::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 pub struct Jittered {

@@ -36,10 +36,9 @@ use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
 pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
 
-/// The stencil bit the geometry pass sets on skin pixels (group 0's code,
-/// `mix::stencil_code(0)`, which reads this layer and not the other way
-/// round; render/groups.rs's tests hold the two equal): what a
-/// single-method frame writes and tests.
+/// The stencil bit the geometry pass sets on skin pixels, written only here:
+/// what a single-method frame writes and tests, and group 0's code (a mix's
+/// codes, `mix::stencil_code`, put the group index above it).
 pub const STENCIL_SKIN: u32 = 1;
 
 /// Stencil state of every stencil-masked SSS pass: shade only where the stencil
@@ -270,6 +269,14 @@ pub struct MethodEntry {
     /// Why the method cannot run on a multisampled frame (`--msaa` > 1), in
     /// one line; `None`: it reads the resolved targets like any 1x frame.
     pub no_msaa: Option<&'static str>,
+    /// Why a setting of the method (its options, checked) cannot share a
+    /// frame with other methods' characters, in one line; `None`: it can
+    /// (its passes keep to its own group's stencil code).
+    pub no_mix: fn(&Opts) -> Option<&'static str>,
+    /// The method does no subsurface scattering: no pass, no reach, its
+    /// output the diffuse target as the geometry pass left it (a frame of
+    /// several gives its group no region, a fade from it blends the skin).
+    pub no_sss: bool,
 }
 
 impl MethodEntry {
@@ -424,6 +431,15 @@ pub fn default_method() -> &'static MethodEntry {
     &separable::ENTRY
 }
 
+/// The entry that does no subsurface scattering (`MethodEntry::no_sss`).
+pub fn no_sss() -> &'static MethodEntry {
+    METHODS
+        .iter()
+        .copied()
+        .find(|m| m.no_sss)
+        .expect("the registry has a method without SSS")
+}
+
 /// The ground truth's entry.
 pub fn ground_truth() -> &'static MethodEntry {
     METHODS
@@ -504,6 +520,8 @@ mod tests {
         assert!(e.contains("valid: separable, ssg"), "{e}");
         assert!(ground_truth().eval.is_empty());
         assert_eq!(METHODS.iter().filter(|m| m.ground_truth).count(), 1);
+        assert_eq!(METHODS.iter().filter(|m| m.no_sss).count(), 1);
+        assert!(no_sss().options.is_empty());
     }
 
     // Two methods may share an option key only with the same meaning.

@@ -54,6 +54,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Poisson::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// Levels for a target of `extent` (every level at least one texel).

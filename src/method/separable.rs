@@ -98,6 +98,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Separable::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// The method's options, parsed.

@@ -80,7 +80,22 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Ssg::new(s)?)),
     no_msaa: None,
+    no_mix,
+    no_sss: false,
 };
+
+/// The registry's `no_mix`: the shader's branch shades every pixel whose
+/// alpha marks skin, the other groups' too; only the stencil keeps a group
+/// to its own pixels.
+fn no_mix(o: &Opts) -> Option<&'static str> {
+    match Config::parse(o) {
+        Ok(c) if c.mask == MaskMode::Branch => Some(
+            "the branch mask shades every character's skin; \
+             in a frame of several methods ssg needs mask=stencil",
+        ),
+        _ => None,
+    }
+}
 
 /// How non-skin pixels are kept out of the SSS passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -123,7 +123,7 @@ fn build_fade(
     let method = method?;
     // No SSS reaches nowhere: its result is the keep itself, needed only on
     // the character's skin.
-    let region = if spec.entry.name == crate::method::none::ENTRY.name {
+    let region = if spec.entry.no_sss {
         frame.skin_region(scene, instances)
     } else {
         frame.region_for(scene, &*method, instances)

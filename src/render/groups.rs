@@ -159,15 +159,8 @@ fn mixed_choice(
     let entry = c.entry()?;
     let options = c.method_options();
     super::settings::check_msaa(settings.msaa, Some(entry))?;
-    // ssg's shader branch shades every pixel whose alpha marks skin, the
-    // other groups' too: only the stencil keeps a group to its pixels.
-    if entry.name == "ssg" && entry.opts(&options).resolved().get("mask") == Some(&"branch".into())
-    {
-        bail!(
-            "{}: the branch mask shades every character's skin; in a frame of several \
-             methods ssg needs mask=stencil",
-            c.label()
-        );
+    if let Some(why) = (entry.no_mix)(&entry.opts(&options)) {
+        bail!("{}: {why}", c.label());
     }
     Ok((entry, options))
 }
@@ -277,9 +270,9 @@ impl GroupMethod {
         v
     }
 
-    /// Whether its method records no pass (`none`).
+    /// Whether its method does no SSS (records no pass).
     pub fn is_none(&self) -> bool {
-        self.spec.entry.name == crate::method::none::ENTRY.name
+        self.spec.entry.no_sss
     }
 }
 
@@ -317,7 +310,6 @@ mod tests {
         assert_eq!(g.len(), 1);
         assert_eq!(g[0].characters, vec![0, 1, 2]);
         assert_eq!(g[0].stencil(), crate::method::STENCIL_SKIN);
-        assert_eq!(crate::mix::SKIN_BIT, crate::method::STENCIL_SKIN);
         assert_eq!(g[0].label, "separable");
     }
 

@@ -81,6 +81,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| density(o).map(|_| ()),
     build: |s| Ok(Box::new(Reference::new(s)?)),
     no_msaa: Some("the ground truth renders its own single-sample surface and gathers over it, so its frame would alias whatever --msaa says; it is the reference, not a mode to antialias"),
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 fn density(o: &Opts) -> Result<f32> {

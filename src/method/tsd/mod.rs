@@ -187,6 +187,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o, false).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, false)?)),
     no_msaa: NO_MSAA,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 pub static OPT_ENTRY: MethodEntry = MethodEntry {
@@ -210,6 +212,8 @@ pub static OPT_ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o, true).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, true)?)),
     no_msaa: NO_MSAA,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// How culled texels are skipped (thesis section 3.2).
