@@ -12,11 +12,14 @@
 //! - `bloom`: a Gaussian pyramid on the HDR composite before the tone map
 //!   (thesis ch. 3.1, 11.1); its numbers in `bloom_pyramid` (pure).
 //! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
-//! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
-//!   weights, neighbourhood blending, both stencil-tested) and a copy.
-//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
-//!   local contrast adaptation writing the stencil, blending weights
-//!   (stencil-tested: diagonals, accurate searches, corners), blending.
+//! - `morphological`: the one stage MLAA and SMAA both are (edges writing
+//!   the stencil, blending weights where it is set, neighbourhood blending),
+//!   its variants given as data and their push constants:
+//!   - `mlaa`: Jimenez's MLAA, luma or depth edges, the blend on edge pixels
+//!     only after a copy of the frame;
+//!   - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
+//!     local contrast adaptation, weights with diagonals, accurate searches
+//!     and corners, the blend on every pixel.
 //! - `fxaa`: FXAA's quality preset, one pass.
 //!
 //! The device-free parts (area texture, CPU references) live in `crate::aa`.
@@ -25,6 +28,7 @@ pub mod bloom;
 pub mod bloom_pyramid;
 pub mod fxaa;
 pub mod mlaa;
+pub mod morphological;
 pub mod smaa;
 pub mod tonemap;
 
@@ -39,6 +43,7 @@ use crate::graph::work::{Fetch, Filter};
 use crate::graph::{ImageId, Pass, Resources};
 use crate::vk::context::Context;
 use crate::vk::pipeline::{DescriptorPool, Samplers};
+use morphological::Morphological;
 
 /// Which anti-aliasing the frame gets after the tone map.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -263,8 +268,14 @@ impl PostChain {
         chain.aa = match mode {
             AaMode::None => None,
             AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
-            AaMode::Mlaa => Some(Box::new(mlaa::Mlaa::new(s)?)),
-            AaMode::Smaa => Some(Box::new(smaa::Smaa::new(s)?)),
+            AaMode::Mlaa => Some(Box::new(Morphological::new(
+                s,
+                Box::new(mlaa::Mlaa::new(s)),
+            )?)),
+            AaMode::Smaa => Some(Box::new(Morphological::new(
+                s,
+                Box::new(smaa::Smaa::new(s)),
+            )?)),
         };
         Ok(chain.keep())
     }
