@@ -2,8 +2,7 @@
 //! depth is linear) -> geometry pass into the targets (Lambert + transmittance,
 //! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
 //! the stencil) -> each group's method's passes (one group in a single-method
-//! frame; where they work and in what order: `group_passes.rs`) and, in a
-//! frame of several, the merges (`merge.rs`) -> composite
+//! frame) and, in a frame of several, the merges and fades (`groups/`) -> composite
 //! (diffuse after SSS + specular) -> Hable tone map -> the post chain's
 //! anti-aliasing stage (`crate::post`, `--aa`; none by default).
 //!
@@ -16,8 +15,9 @@ use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
-use super::groups::{scissors, GroupMethod};
-use super::merge::Merge;
+use super::groups::merge::Merge;
+use super::groups::region::scissors;
+use super::groups::{passes as groups, GroupMethod};
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
 use super::targets::SHADOW_FORMAT;
@@ -25,7 +25,7 @@ use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
 use crate::method::region::PixelRect;
-use crate::method::{FrameTargets, ViewInfo, STENCIL_SKIN};
+use crate::method::{FrameTargets, FrameView, ViewInfo, STENCIL_SKIN};
 use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
 use crate::scene::framing::Framing;
@@ -144,7 +144,7 @@ pub struct Frame {
     shadow_set: vk::DescriptorSet,
     instance_set: vk::DescriptorSet,
     ids_instance_set: vk::DescriptorSet,
-    pub(super) screen_rect: Vec<vk::Rect2D>,
+    screen_rect: Vec<vk::Rect2D>,
     /// The stages after the tone map (`enable_post`; none with `--aa none`).
     pub post: PostChain,
 }
@@ -480,6 +480,20 @@ impl Frame {
         }
     }
 
+    /// The frame's own view of its targets (the whole screen, the skin
+    /// bit): what the groups' views narrow down.
+    pub fn view<'a, 'r>(&'a self, res: &'r Resources) -> FrameView<'a, 'r> {
+        FrameView {
+            targets: &self.targets,
+            res,
+            extent: self.extent,
+            region: &self.screen_rect,
+            depths: &[],
+            screen: &self.screen_rect,
+            stencil: STENCIL_SKIN,
+        }
+    }
+
     /// The view the method is built for.
     pub fn view_info(&self) -> ViewInfo {
         ViewInfo {
@@ -552,8 +566,8 @@ impl Frame {
         res: &Resources,
     ) -> Vec<Pass<'a>> {
         let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
-        passes.extend(self.group_passes(groups, merge, res));
-        passes.push(self.composite_pass(res, self.composite_source(groups)));
+        let diffuse = groups::sss(&mut passes, &self.view(res), groups, merge);
+        passes.push(self.composite_pass(res, diffuse));
         passes.extend(self.post.passes(res));
         if let Some(ids) = self.character_ids {
             passes.push(self.character_ids_pass(ids));

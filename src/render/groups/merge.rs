@@ -7,7 +7,7 @@
 //! frame's own overhead, named `mix merge #N`. A single-method frame has no
 //! merge: its composite reads the method's output, as before groups.
 //!
-//! A fading character's group (`groups::FadeMethod`) is blended last: its old
+//! A fading character's group (`fade::FadeMethod`) is blended last: its old
 //! setting's result drawn over the diffuse target, stencil-masked to its code
 //! and limited to the old instance's region, with fixed-function blending by
 //! the constant `weight` (`src * w + dst * (1 - w)`, the new setting's result
@@ -16,7 +16,7 @@
 use anyhow::Result;
 use ash::vk;
 
-use super::groups::GroupMethod;
+use super::GroupMethod;
 use crate::graph::work::{Filter, PassRole};
 use crate::graph::{ImageId, Pass, Resources};
 use crate::method::screen::{fetch, masked_pass, Masked};

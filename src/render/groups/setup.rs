@@ -1,15 +1,17 @@
 //! Building a frame's method instances: each group's method over its own
-//! characters, under its image prefix, with its own SSS region (apart from
-//! `groups.rs`, which `frame.rs` reads, so that the frame and the groups do
-//! not import each other).
+//! characters, under its image prefix, with its own SSS region and skin
+//! depths (and a fading character's old setting beside it), and writing
+//! their descriptor sets once the images exist.
 
 use anyhow::{Context as _, Result};
 use glam::Mat4;
 
-use super::frame::Frame;
-use super::groups::{specs_mixed, FadeMethod, GroupMethod, GroupSpec};
-use crate::graph::{ImageDesc, Resources};
+use super::fade::FadeMethod;
+use super::region::{depths_for, region_for};
+use super::{specs_mixed, GroupMethod, GroupSpec};
+use crate::graph::Resources;
 use crate::method::{MethodBind, MethodSetup};
+use crate::render::frame::{skin_material_binds, Frame};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -67,77 +69,29 @@ pub fn build_groups(
         let region = if mixed && g.is_none() {
             Vec::new()
         } else {
-            frame.region_for(scene, &*g.method, &g.instances)
+            region_for(frame, scene, &*g.method, &g.instances)
         };
         g.set_region(region);
-        g.depths = frame.depths_for(scene, &g.instances);
+        g.depths = depths_for(frame, scene, &g.instances);
         if let Some(f) = fade_spec {
             // Pushed first so that an error below frees the new instance too.
             let i = g.spec.index;
             groups.push(g);
             let g = groups.last_mut().expect("just pushed");
-            g.fade = Some(build_fade(ctx, res, frame, scene, i, f, &g.instances)?);
+            g.fade = Some(FadeMethod::build(
+                ctx,
+                res,
+                frame,
+                scene,
+                i,
+                f,
+                &g.instances,
+            )?);
         } else {
             groups.push(g);
         }
     }
     Ok(groups.keep())
-}
-
-/// The old setting of group `index`'s fading character: a keep of the
-/// diffuse target (its levels too: a method that builds a mip chain builds it
-/// on its own input) and the old method built on it under `#N fade `.
-fn build_fade(
-    ctx: &Context,
-    res: &mut Resources,
-    frame: &Frame,
-    scene: &Scene,
-    index: usize,
-    spec: super::groups::FadeSpec,
-    instances: &[Mat4],
-) -> Result<FadeMethod> {
-    let diffuse = frame.targets.diffuse;
-    let depth_stencil_format = res.format(frame.targets.depth_stencil);
-    res.set_name_prefix(&format!("#{index} fade "));
-    let keep = res.declare(
-        ImageDesc::new("keep", res.extent(diffuse), res.format(diffuse))
-            .with_levels(res.levels(diffuse).len() as u32),
-    );
-    let targets = crate::method::FrameTargets {
-        diffuse: keep,
-        ..frame.targets
-    };
-    let method = (spec.entry.build)(&mut MethodSetup {
-        ctx,
-        res,
-        targets: &targets,
-        samplers: &frame.samplers,
-        options: spec.entry.opts(&spec.options),
-        view: frame.view_info(),
-        depth_stencil_format,
-        scene,
-        instances,
-    })
-    .with_context(|| format!("setting up the fade from {}", spec.label));
-    res.set_name_prefix("");
-    let method = method?;
-    // No SSS reaches nowhere: its result is the keep itself, needed only on
-    // the character's skin.
-    let region = if spec.entry.no_sss {
-        frame.skin_region(scene, instances)
-    } else {
-        frame.region_for(scene, &*method, instances)
-    };
-    let mut f = FadeMethod {
-        spec,
-        keep,
-        targets,
-        method,
-        region_px: Vec::new(),
-        scissors: Vec::new(),
-    };
-    f.set_region(region);
-    Ok(f)
 }
 
 /// Writes every group's descriptor sets (and its fade's, on the fade's
@@ -156,7 +110,7 @@ pub fn bind_groups(
             samplers: &frame.samplers,
             targets,
             frame_binds: frame.frame_binds(res),
-            skin_material_binds: super::frame::skin_material_binds(frame),
+            skin_material_binds: skin_material_binds(frame),
         };
         g.method.bind(&bind(&frame.targets))?;
         if let Some(f) = &mut g.fade {
