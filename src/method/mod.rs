@@ -27,12 +27,12 @@ use anyhow::{bail, Result};
 use ash::vk;
 use glam::Mat4;
 
-use crate::graph::{ImageId, Pass, Resources};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Resources};
 use crate::scene::camera::Camera;
 use crate::scene::Scene;
 use crate::vk::context::Context;
 use crate::vk::guard::Destroy;
-use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
+use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
 pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
 
@@ -162,19 +162,28 @@ pub struct MethodSetup<'a> {
     /// ground truth samples the skin surface itself; tsd draws these heads.
     pub scene: &'a Scene,
     pub instances: &'a [Mat4],
+    /// Set 0 of `lighting.glsl` (the frame: uniforms, shadow map, samplers,
+    /// Beckmann), for methods that shade surfaces.
+    pub frame_binds: Vec<(&'static str, Binding)>,
 }
 
-/// What a method's descriptor sets are written from, once the images exist.
+/// What a method's descriptor sets are written with, once the images exist
+/// (the sets themselves, and so the frame images they bind, were stated
+/// when the method was built: `graph::GraphSet`).
 pub struct MethodBind<'a> {
     pub ctx: &'a Context,
     pub res: &'a Resources,
     pub pool: &'a DescriptorPool,
-    pub samplers: &'a Samplers,
-    pub targets: &'a FrameTargets,
-    /// Set 0 (frame: uniforms, shadow map, samplers, Beckmann) and set 1 (the
-    /// skin material) of `lighting.glsl`, for methods that shade surfaces.
-    pub frame_binds: Vec<(&'static str, Bind)>,
+    /// Set 1 of `lighting.glsl` (the skin material: static textures), for
+    /// methods that shade surfaces.
     pub skin_material_binds: Vec<(&'static str, Bind)>,
+}
+
+impl MethodBind<'_> {
+    /// Writes `set`, made for `pipeline`, from the frame's pool.
+    pub fn write(&self, set: &mut GraphSet, pipeline: &Pipeline) -> Result<()> {
+        set.write(self.ctx, self.pool, self.res, pipeline)
+    }
 }
 
 /// What a method's passes are recorded against in a frame.

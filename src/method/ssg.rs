@@ -21,7 +21,7 @@ use super::{
     OptKind, OptSpec, Opts, SssMethod,
 };
 use crate::graph::work::{Fetch, Filter};
-use crate::graph::{ImageId, Pass};
+use crate::graph::{GraphSet, ImageId, Pass};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -158,8 +158,8 @@ pub struct ScreenPush {
 pub struct Ssg {
     horizontal: Pipeline,
     vertical: Pipeline,
-    set_rt1: vk::DescriptorSet,
-    set_rt2: vk::DescriptorSet,
+    set_rt1: GraphSet,
+    set_rt2: GraphSet,
     rt1: ImageId,
     rt2: ImageId,
     diffuse: ImageId,
@@ -232,10 +232,10 @@ impl Ssg {
             })
             .collect();
         Ok(Ssg {
+            set_rt1: source_set(s, &horizontal, rt1),
+            set_rt2: source_set(s, &vertical, rt2),
             horizontal: horizontal.keep(),
             vertical: vertical.keep(),
-            set_rt1: vk::DescriptorSet::null(),
-            set_rt2: vk::DescriptorSet::null(),
             rt1,
             rt2,
             diffuse,
@@ -270,7 +270,6 @@ impl Ssg {
 
 impl SssMethod for Ssg {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
-        let t = f.targets;
         let (rt1, rt2, diffuse) = (self.rt1, self.rt2, self.diffuse);
         let mut passes = vec![seed_copy(
             "ssg seed copy",
@@ -309,8 +308,7 @@ impl SssMethod for Ssg {
                     shader: "ssg_horizontal.frag",
                     loop_trips: vec![TAPS],
                     pipeline: horizontal,
-                    set: self.set_rt1,
-                    reads: vec![rt1, t.linear_depth],
+                    set: &self.set_rt1,
                     fetches: self.fetches(f, rt1),
                     targets: vec![(rt2, false)],
                     stencil,
@@ -327,8 +325,7 @@ impl SssMethod for Ssg {
                     shader: "ssg_vertical.frag",
                     loop_trips: vec![TAPS],
                     pipeline: vertical,
-                    set: self.set_rt2,
-                    reads: vec![rt2, t.linear_depth],
+                    set: &self.set_rt2,
                     fetches: self.fetches(f, rt2),
                     targets: vec![(rt1, false), (diffuse, true)],
                     stencil,
@@ -359,9 +356,8 @@ impl SssMethod for Ssg {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        self.set_rt1 = source_set(b, &self.horizontal, self.rt1)?;
-        self.set_rt2 = source_set(b, &self.vertical, self.rt2)?;
-        Ok(())
+        b.write(&mut self.set_rt1, &self.horizontal)?;
+        b.write(&mut self.set_rt2, &self.vertical)
     }
 
     fn intermediates(&self) -> Vec<ImageId> {

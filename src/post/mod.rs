@@ -40,9 +40,9 @@ use ash::vk;
 
 use crate::aa::edges::Preset;
 use crate::graph::work::{Fetch, Filter};
-use crate::graph::{ImageId, Pass, Resources};
+use crate::graph::{GraphSet, ImageId, Pass, Resources};
 use crate::vk::context::Context;
-use crate::vk::pipeline::{DescriptorPool, Samplers};
+use crate::vk::pipeline::{DescriptorPool, Pipeline, Samplers};
 use morphological::Morphological;
 
 /// Which anti-aliasing the frame gets after the tone map.
@@ -220,14 +220,22 @@ pub struct PostSetup<'a> {
     pub linear_depth: ImageId,
     /// Millimetres per scene unit (the depth threshold is in millimetres).
     pub mm_per_unit: f32,
+    /// The frame's samplers (the stages' sets are stated when they are built).
+    pub samplers: &'a Samplers,
 }
 
-/// What a stage's descriptor sets are written from, once the images exist.
+/// What a stage's descriptor sets are written with, once the images exist.
 pub struct PostBind<'a> {
     pub ctx: &'a Context,
     pub res: &'a Resources,
     pub pool: &'a DescriptorPool,
-    pub samplers: &'a Samplers,
+}
+
+impl PostBind<'_> {
+    /// Writes `set`, made for `pipeline`, from the frame's pool.
+    pub fn write(&self, set: &mut GraphSet, pipeline: &Pipeline) -> Result<()> {
+        set.write(self.ctx, self.pool, self.res, pipeline)
+    }
 }
 
 /// One anti-aliasing stage of the chain.
@@ -260,7 +268,7 @@ impl PostChain {
         let ctx = s.ctx;
         let mut chain = crate::vk::guard::Guard::new(ctx, PostChain::default());
         if s.options.bloom {
-            chain.bloom = Some(bloom::Bloom::new(ctx, s.res, s.hdr)?);
+            chain.bloom = Some(bloom::Bloom::new(ctx, s.res, s.samplers, s.hdr)?);
         }
         // The tone map reads the bloomed composite when there is one.
         let hdr = chain.bloom.as_ref().map_or(s.hdr, bloom::Bloom::output);
@@ -280,36 +288,56 @@ impl PostChain {
         Ok(chain.keep())
     }
 
-    /// The bloom's passes, the tone map's, then the anti-aliasing stage's.
-    pub fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        let mut passes = self.bloom_passes(res);
+    /// The bloom stage of the frame's recipe: from the HDR composite `hdr`
+    /// to the bloomed composite it hands on (`hdr` itself without `--bloom`).
+    pub fn bloom<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        hdr: ImageId,
+    ) -> ImageId {
+        match &self.bloom {
+            Some(b) => {
+                debug_assert_eq!(b.input(), hdr, "the bloom reads another image");
+                passes.extend(b.passes(res));
+                b.output()
+            }
+            None => hdr,
+        }
+    }
+
+    /// The tone map stage: from `hdr` to the LDR frame.
+    pub fn tonemap<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        hdr: ImageId,
+    ) -> ImageId {
+        debug_assert_eq!(
+            self.tonemap.input(),
+            hdr,
+            "the tone map reads another image"
+        );
         passes.push(self.tonemap.pass(res));
-        passes.extend(self.aa_passes(res));
-        passes
+        self.tonemap.output()
     }
 
-    /// The bloom's passes alone (none without `--bloom`).
-    pub fn bloom_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        self.bloom
-            .as_ref()
-            .map(|b| b.passes(res))
-            .unwrap_or_default()
-    }
-
-    /// The bloom's image named `name` (`bloom::Bloom::images`), `None`
-    /// without `--bloom`.
-    pub fn bloom_image(&self, name: &str) -> Option<ImageId> {
-        self.bloom
-            .as_ref()?
-            .images()
-            .into_iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, id)| id)
-    }
-
-    /// The anti-aliasing stage's passes alone (none without one).
-    pub fn aa_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        self.aa.as_ref().map(|a| a.passes(res)).unwrap_or_default()
+    /// The anti-aliasing stage: from the LDR frame `ldr` to the frame's
+    /// output (`ldr` itself without a stage).
+    pub fn anti_alias<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        ldr: ImageId,
+    ) -> ImageId {
+        match &self.aa {
+            Some(a) => {
+                debug_assert_eq!(self.tonemap.output(), ldr, "the stage reads another image");
+                passes.extend(a.passes(res));
+                a.output()
+            }
+            None => ldr,
+        }
     }
 
     /// The anti-aliased frame, `None` without a stage.

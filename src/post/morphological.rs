@@ -26,9 +26,9 @@ use super::{fetch, AaStage, PostBind, PostSetup};
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{
-    ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+    Binding, ColorTarget, DepthStencil, GraphSet, ImageDesc, ImageId, Load, Pass, PassContext,
+    Resources,
 };
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Image;
@@ -121,7 +121,8 @@ pub struct Morphological {
     weights: ImageId,
     stencil: ImageId,
     output: ImageId,
-    sets: [vk::DescriptorSet; 3],
+    /// Set 0 of the edges, weights and blend passes.
+    sets: [GraphSet; 3],
 }
 
 impl Morphological {
@@ -201,6 +202,34 @@ impl Morphological {
                 &rgba8,
             )?);
         }
+        let linear = (
+            "linearClamp",
+            Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+        );
+        let edges_bind = match spec.edges_input {
+            EdgeInput::Depth => ("depthTex", Binding::Sampled(s.linear_depth)),
+            EdgeInput::Frame => ("colorTex", Binding::SampledUnorm(s.input)),
+        };
+        let mut weights_binds = vec![("edgesTex", Binding::Sampled(edges))];
+        for (image, t) in tables.iter().zip(&spec.tables) {
+            weights_binds.push((t.binding, Binding::Fixed(Bind::Texture(image.view))));
+        }
+        weights_binds.push(linear);
+        let res = &*s.res;
+        let sets = [
+            GraphSet::new(res, &p1, 0, vec![edges_bind]),
+            GraphSet::new(res, &p2, 0, weights_binds),
+            GraphSet::new(
+                res,
+                &p3,
+                0,
+                vec![
+                    ("colorTex", Binding::Sampled(s.input)),
+                    ("weightsTex", Binding::Sampled(weights)),
+                    linear,
+                ],
+            ),
+        ];
         Ok(Morphological {
             variant,
             spec,
@@ -214,15 +243,15 @@ impl Morphological {
             weights,
             stencil,
             output,
-            sets: [vk::DescriptorSet::null(); 3],
+            sets,
         })
     }
 
     /// Pass 1: every pixel runs, edge pixels are written (colour and stencil).
     fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let (read, texture, format) = match self.spec.edges_input {
-            EdgeInput::Depth => (self.depth, "depthTex", res.texel_format(self.depth)),
-            EdgeInput::Frame => (self.input, "colorTex", Format::Rgba8Unorm),
+        let (texture, format) = match self.spec.edges_input {
+            EdgeInput::Depth => ("depthTex", res.texel_format(self.depth)),
+            EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm),
         };
         let (count, exact) = self.spec.edges_fetches;
         let work = ShaderWork {
@@ -239,10 +268,11 @@ impl Morphological {
             alu: alu_estimate(self.spec.edges_shader, &[]),
             ..Default::default()
         };
-        let (pipeline, set, variant) = (&self.edges_pipeline, self.sets[0], &self.variant);
-        Pass::new(format!("{} edges", self.spec.name), PassRole::Post)
-            .sampled(read)
-            .color(ColorTarget::new(self.edges, Load::Clear([0.0; 4])))
+        let (pipeline, variant) = (&self.edges_pipeline, &self.variant);
+        let mut pass = Pass::new(format!("{} edges", self.spec.name), PassRole::Post);
+        // Reads the frame or its depth.
+        let set = pass.set(&self.sets[0]);
+        pass.color(ColorTarget::new(self.edges, Load::Clear([0.0; 4])))
             .depth_stencil(
                 DepthStencil::cleared(self.stencil, 1.0)
                     .depth_test(false)
@@ -293,10 +323,11 @@ impl Morphological {
             alu: alu_estimate(self.spec.weights_shader, &self.spec.weights_loops),
             ..Default::default()
         };
-        let (pipeline, set, variant) = (&self.weights_pipeline, self.sets[1], &self.variant);
-        Pass::new(format!("{} weights", self.spec.name), PassRole::Post)
-            .sampled(self.edges)
-            .color(ColorTarget::new(self.weights, Load::Clear([0.0; 4])))
+        let (pipeline, variant) = (&self.weights_pipeline, &self.variant);
+        let mut pass = Pass::new(format!("{} weights", self.spec.name), PassRole::Post);
+        // Reads the edges (and the tables, which are no frame images).
+        let set = pass.set(&self.sets[1]);
+        pass.color(ColorTarget::new(self.weights, Load::Clear([0.0; 4])))
             .depth_stencil(self.stencil_test())
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
@@ -309,38 +340,28 @@ impl Morphological {
     /// The frame into the output before a blend on edge pixels only.
     fn copy_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
         let extent = res.extent(self.output);
-        let (src, dst) = (self.input, self.output);
-        Pass::new(format!("{} copy", self.spec.name), PassRole::Post)
-            .image(src, AccessKind::TransferRead)
-            .image(dst, AccessKind::TransferWrite)
-            .work(Work::Copy {
-                texels: u64::from(extent.width) * u64::from(extent.height),
-                bytes_per_texel: res.texel_format(src).bytes_per_texel(),
-                rects: 1,
-            })
-            .record(move |pc: &PassContext| {
-                let layers = vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(1);
-                let copy = vk::ImageCopy::default()
-                    .src_subresource(layers)
-                    .dst_subresource(layers)
-                    .extent(vk::Extent3D {
-                        width: extent.width,
-                        height: extent.height,
-                        depth: 1,
-                    });
-                unsafe {
-                    pc.ctx.device.cmd_copy_image(
-                        pc.cmd,
-                        pc.image(src).raw,
-                        pc.layout(src),
-                        pc.image(dst).raw,
-                        pc.layout(dst),
-                        &[copy],
-                    )
-                };
-            })
+        let mut pass = Pass::new(format!("{} copy", self.spec.name), PassRole::Post);
+        let src = pass.transfer_src(self.input);
+        let dst = pass.transfer_dst(self.output);
+        pass.work(Work::Copy {
+            texels: u64::from(extent.width) * u64::from(extent.height),
+            bytes_per_texel: res.texel_format(self.input).bytes_per_texel(),
+            rects: 1,
+        })
+        .record(move |pc: &PassContext| {
+            let layers = vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .layer_count(1);
+            let copy = vk::ImageCopy::default()
+                .src_subresource(layers)
+                .dst_subresource(layers)
+                .extent(vk::Extent3D {
+                    width: extent.width,
+                    height: extent.height,
+                    depth: 1,
+                });
+            pc.copy_image(src, dst, &[copy]);
+        })
     }
 
     /// Pass 3: three weight texels, then the variant's bilinear colour
@@ -364,10 +385,10 @@ impl Morphological {
             alu: alu_estimate(shader, &[]),
             ..Default::default()
         };
-        let (pipeline, set) = (&self.blend_pipeline, self.sets[2]);
-        let pass = Pass::new(format!("{} blend", self.spec.name), PassRole::Post)
-            .sampled(self.input)
-            .sampled(self.weights);
+        let pipeline = &self.blend_pipeline;
+        let mut pass = Pass::new(format!("{} blend", self.spec.name), PassRole::Post);
+        // Reads the frame and the weights.
+        let set = pass.set(&self.sets[2]);
         let pass = match self.spec.blend_on {
             BlendOn::Edges => pass
                 .color(ColorTarget::new(self.output, Load::Keep))
@@ -398,33 +419,10 @@ impl AaStage for Morphological {
     }
 
     fn bind(&mut self, b: &PostBind) -> Result<()> {
-        let (ctx, res, linear) = (b.ctx, b.res, b.samplers.linear_clamp);
-        let edges_bind = match self.spec.edges_input {
-            EdgeInput::Depth => ("depthTex", Bind::Texture(res.view(self.depth))),
-            EdgeInput::Frame => ("colorTex", Bind::Texture(res.unorm_view(self.input))),
-        };
-        let mut weights_binds = vec![("edgesTex", Bind::Texture(res.view(self.edges)))];
-        for (image, t) in self.tables.iter().zip(&self.spec.tables) {
-            weights_binds.push((t.binding, Bind::Texture(image.view)));
-        }
-        weights_binds.push(("linearClamp", Bind::Sampler(linear)));
-        self.sets = [
-            b.pool
-                .write_set(ctx, &self.edges_pipeline, 0, &[edges_bind])?,
-            b.pool
-                .write_set(ctx, &self.weights_pipeline, 0, &weights_binds)?,
-            b.pool.write_set(
-                ctx,
-                &self.blend_pipeline,
-                0,
-                &[
-                    ("colorTex", Bind::Texture(res.view(self.input))),
-                    ("weightsTex", Bind::Texture(res.view(self.weights))),
-                    ("linearClamp", Bind::Sampler(linear)),
-                ],
-            )?,
-        ];
-        Ok(())
+        let [edges, weights, blend] = &mut self.sets;
+        b.write(edges, &self.edges_pipeline)?;
+        b.write(weights, &self.weights_pipeline)?;
+        b.write(blend, &self.blend_pipeline)
     }
 
     fn images(&self) -> Vec<(&'static str, ImageId)> {

@@ -9,11 +9,13 @@ pub mod counting;
 pub mod frame;
 pub mod groups;
 pub mod inputs;
+pub mod instances;
 pub mod post_only;
 pub mod readback;
 pub mod scene_gpu;
 pub mod settings;
 pub mod targets;
+pub mod uniforms;
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
@@ -27,10 +29,11 @@ use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::profiler::Profiler;
-use frame::{Frame, SkinGroup};
+use frame::Frame;
 use groups::merge::{self, Merge};
 use groups::setup::{bind_groups, build_groups};
 use groups::{frame_needs, group_specs, specs_mixed, GroupMethod};
+use instances::SkinGroup;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use settings::RenderSettings;
 
@@ -214,6 +217,8 @@ impl<'c> Renderer<'c> {
         )?;
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
+        let sss_output = groups::passes::output(&groups, &frame.targets);
+        frame.composite_from(&resources, sss_output);
         let mut merge = Guard::new(ctx, Merge::default());
         if mixed && merge::needs_any(&groups, &frame.targets) {
             *merge = Merge::new(ctx, &resources, &frame.targets, &groups)?;
@@ -238,9 +243,8 @@ impl<'c> Renderer<'c> {
         check_memory(ctx, &resources, extent)?;
         // 3. Create the images and write what reads them.
         resources.create(ctx)?;
-        let source = groups::passes::output(&groups, &frame.targets);
-        frame.bind(ctx, &resources, source)?;
-        merge.bind(ctx, &frame.pool, &resources, &frame.targets, &groups)?;
+        frame.bind(ctx, &resources)?;
+        merge.bind(ctx, &frame.pool, &resources)?;
         bind_groups(ctx, &resources, &frame, &mut groups)?;
         let submit = Submit::new(ctx, slots)?;
         // Complete: the renderer owns (and frees, in its drop) every part.

@@ -72,6 +72,7 @@ impl FadeMethod {
             depth_stencil_format,
             scene,
             instances,
+            frame_binds: frame.frame_binds(),
         })
         .with_context(|| format!("setting up the fade from {}", spec.label));
         res.set_name_prefix("");

@@ -53,6 +53,7 @@ pub fn build_groups(
             depth_stencil_format,
             scene,
             instances: &instances,
+            frame_binds: frame.frame_binds(),
         })
         .with_context(|| format!("setting up {}", spec.label));
         res.set_name_prefix("");
@@ -94,28 +95,24 @@ pub fn build_groups(
     Ok(groups.keep())
 }
 
-/// Writes every group's descriptor sets (and its fade's, on the fade's
-/// targets) once the images exist.
+/// Writes every group's descriptor sets (and its fade's) once the images
+/// exist.
 pub fn bind_groups(
     ctx: &Context,
     res: &Resources,
     frame: &Frame,
     groups: &mut [GroupMethod],
 ) -> Result<()> {
+    let bind = MethodBind {
+        ctx,
+        res,
+        pool: &frame.pool,
+        skin_material_binds: skin_material_binds(frame),
+    };
     for g in groups.iter_mut() {
-        let bind = |targets| MethodBind {
-            ctx,
-            res,
-            pool: &frame.pool,
-            samplers: &frame.samplers,
-            targets,
-            frame_binds: frame.frame_binds(res),
-            skin_material_binds: skin_material_binds(frame),
-        };
-        g.method.bind(&bind(&frame.targets))?;
+        g.method.bind(&bind)?;
         if let Some(f) = &mut g.fade {
-            let targets = f.targets;
-            f.method.bind(&bind(&targets))?;
+            f.method.bind(&bind)?;
         }
     }
     Ok(())
