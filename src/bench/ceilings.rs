@@ -9,7 +9,9 @@ use ash::vk;
 use super::floor::Ceilings;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
-use crate::graph::{record_passes, ColorTarget, ImageDesc, Load, Pass, PassContext, Resources};
+use crate::graph::{
+    record_passes, Binding, ColorTarget, GraphSet, ImageDesc, Load, Pass, PassContext, Resources,
+};
 use crate::render::targets::LDR_FORMAT;
 use crate::report::Stats;
 use crate::vk::context::Context;
@@ -35,8 +37,9 @@ struct ProbePush {
 struct Probe<'p> {
     pipeline: &'p Pipeline,
     /// The source's set, and what a fetch of it is (the uploaded sources are
-    /// not frame images: their barriers were made by the upload).
-    src: Option<(vk::DescriptorSet, (Format, Filter))>,
+    /// not frame images: their barriers were made by the upload, and the set
+    /// declares nothing).
+    src: Option<(&'p GraphSet, (Format, Filter))>,
     /// The target as the probe's pass declares it (load op, blending).
     target: ColorTarget,
 }
@@ -134,18 +137,23 @@ fn probe_all(
     let samplers = owned.samplers.as_ref().expect("created above");
     let pool = owned.pool.as_ref().expect("created above");
     let [fetch, fill, fill_ldr, fill_blend] = [0, 1, 2, 3].map(|i| &owned.pipelines[i]);
-    let set = |img: &Image, sampler| {
-        pool.write_set(
-            ctx,
-            fetch,
-            0,
-            &[
-                ("srcTex", Bind::Texture(img.view)),
-                ("srcSampler", Bind::Sampler(sampler)),
-            ],
-        )
+    let set = |img: &Image, sampler| -> Result<GraphSet> {
+        let binds = vec![
+            ("srcTex", Binding::Fixed(Bind::Texture(img.view))),
+            ("srcSampler", Binding::Fixed(Bind::Sampler(sampler))),
+        ];
+        let mut set = GraphSet::new(res, fetch, 0, binds);
+        set.write(ctx, pool, res, fetch)?;
+        Ok(set)
     };
     let [rgba, r32] = sources;
+    let (linear, nearest) = (samplers.linear_clamp, samplers.nearest_clamp);
+    let sets = [
+        set(rgba, linear)?,
+        set(rgba, nearest)?,
+        set(r32, linear)?,
+        set(r32, nearest)?,
+    ];
     let fetch_probe = |s, format| Probe {
         pipeline: fetch,
         src: Some((s, format)),
@@ -159,31 +167,19 @@ fn probe_all(
     let probes: Vec<(&str, Probe)> = vec![
         (
             "bilinear rgba16f",
-            fetch_probe(
-                set(rgba, samplers.linear_clamp)?,
-                (Format::Rgba16Float, Filter::Bilinear),
-            ),
+            fetch_probe(&sets[0], (Format::Rgba16Float, Filter::Bilinear)),
         ),
         (
             "point rgba16f",
-            fetch_probe(
-                set(rgba, samplers.nearest_clamp)?,
-                (Format::Rgba16Float, Filter::Point),
-            ),
+            fetch_probe(&sets[1], (Format::Rgba16Float, Filter::Point)),
         ),
         (
             "bilinear r32f",
-            fetch_probe(
-                set(r32, samplers.linear_clamp)?,
-                (Format::R32Float, Filter::Bilinear),
-            ),
+            fetch_probe(&sets[2], (Format::R32Float, Filter::Bilinear)),
         ),
         (
             "point r32f",
-            fetch_probe(
-                set(r32, samplers.nearest_clamp)?,
-                (Format::R32Float, Filter::Point),
-            ),
+            fetch_probe(&sets[3], (Format::R32Float, Filter::Point)),
         ),
         ("fill rgba16f", fill_probe(fill, overwrite)),
         ("fill rgba8", fill_probe(fill_ldr, overwrite_ldr)),
@@ -298,8 +294,9 @@ impl<'p> Probe<'p> {
             fetches,
             ..Default::default()
         };
-        Pass::new(name, PassRole::Probe)
-            .color(self.target)
+        let mut pass = Pass::new(name, PassRole::Probe);
+        let set = set.map(|s| pass.set(s));
+        pass.color(self.target)
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
                 fullscreen(pc, pipeline, set.as_slice(), |c, cmd| {

@@ -4,7 +4,7 @@
 
 use ash::vk;
 
-use super::PassContext;
+use super::{PassContext, SetRef};
 use crate::vk::context::Context;
 use crate::vk::pipeline::Pipeline;
 
@@ -13,7 +13,7 @@ use crate::vk::pipeline::Pipeline;
 pub fn fullscreen(
     pc: &PassContext,
     pipeline: &Pipeline,
-    sets: &[vk::DescriptorSet],
+    sets: &[SetRef],
     state: impl Fn(&Context, vk::CommandBuffer),
 ) {
     fullscreen_in(pc, pipeline, sets, None, state)
@@ -25,12 +25,12 @@ pub fn fullscreen(
 pub fn fullscreen_in(
     pc: &PassContext,
     pipeline: &Pipeline,
-    sets: &[vk::DescriptorSet],
+    sets: &[SetRef],
     region: Option<&[vk::Rect2D]>,
     state: impl Fn(&Context, vk::CommandBuffer),
 ) {
     let (ctx, cmd) = (pc.ctx, pc.cmd);
-    pipeline.bind(ctx, cmd, sets);
+    pc.bind(pipeline, sets);
     state(ctx, cmd);
     unsafe {
         match region {

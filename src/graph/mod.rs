@@ -1,7 +1,8 @@
 //! The pass graph, as render graphs do it: images are *declared* (name, extent,
 //! format, levels) before they exist; a pass is a name, a role, its declared work,
 //! the resources it reads and writes with their access kinds, and a record
-//! closure that finds views and layouts through the graph at record time. The
+//! closure that records only through the typed references its declaration
+//! handed back (`refs.rs`; descriptor sets through [`GraphSet`]). The
 //! usage flags every image is created with are derived from the accesses the
 //! passes declare, every barrier from the previous and the next access (the one
 //! table in `vk::barrier`), batched into one call per pass, and each pass is
@@ -15,13 +16,21 @@
 //! ([`Resources::create`]) and write the descriptor sets that need their views.
 
 mod attach;
+mod context;
 pub mod draw;
 pub mod mesh;
 mod pass;
+mod record;
+mod refs;
 mod resources;
+mod set;
 /// The pass work vocabulary is pure data (`crate::work`); the graph carries it.
 pub use crate::work;
 
 pub use attach::{ColorTarget, DepthStencil, Load};
-pub use pass::{record_passes, Pass, PassContext, PassSample};
+pub use context::PassContext;
+pub use pass::Pass;
+pub use record::{record_passes, PassSample};
+pub use refs::{BufferRef, ClearDst, ImageRef, SetRef, TransferDst, TransferSrc};
 pub use resources::{BufferId, ImageDesc, ImageId, Resources};
+pub use set::{Binding, GraphSet, Storage};

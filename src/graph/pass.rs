@@ -1,7 +1,9 @@
 //! A pass: a name (a label, nothing else keys on it), its role, what it
 //! declares (its attachments with their load ops, the images and buffers it
-//! reads and writes, its draws or its dispatch), and a record closure; and the
-//! executor that records a list of them.
+//! reads and writes, through the typed references the declaration hands
+//! back, its draws or its dispatch), and a record closure (what it records
+//! with: `context.rs`; the executor that records a list of passes:
+//! `record.rs`).
 //!
 //! A pass states each fact once (Granite's `add_color_output`, kajiya's typed
 //! pass builder): a colour target with its load op, a depth/stencil use, an
@@ -11,38 +13,34 @@
 //! [`Pass::declared_work`] fills the declared work's colour writes, clears,
 //! depth/stencil use, extent and invocations. No record closure chooses a load
 //! op or begins rendering, and no pass types a clear twice.
-//!
-//! Over 800 lines because 225 of them are the unit tests of the declaration
-//! and the executor (multisampled passes and their resolves among them),
-//! which read best beside the code they pin down.
 
 use ash::vk;
 
 use super::attach::{ColorTarget, DepthStencil, Load};
+use super::context::PassContext;
+use super::refs::{BufferRef, ClearDst, ImageRef, SetRef, TransferDst, TransferSrc};
 use super::resources::{BufferId, ImageId, Resources};
+use super::set::GraphSet;
 use super::work::{ColorWrite, DepthStencilUse, PassRole, ShaderWork, Work};
 use crate::vk::barrier::AccessKind;
-use crate::vk::context::Context;
-use crate::vk::memory::Image;
-use crate::vk::profiler::{PassTiming, Profiler};
 
 /// What a raster pass declares: its attachments, render area and draws.
 #[derive(Clone, Debug, Default)]
-struct Raster {
-    colors: Vec<ColorTarget>,
-    depth: Option<DepthStencil>,
+pub(super) struct Raster {
+    pub(super) colors: Vec<ColorTarget>,
+    pub(super) depth: Option<DepthStencil>,
     /// The render area from the origin; `None`: the whole first attachment.
     area: Option<vk::Extent2D>,
     /// Each colour target is rendered alone, one after the other, the record
     /// closure once for each ([`PassContext::target`] says which).
-    each_target_alone: bool,
+    pub(super) each_target_alone: bool,
     /// The fragment shader's work per fragment (`None`: depth-only) and the
     /// triangles the pass submits; `None` until declared.
     draws: Option<(Option<ShaderWork>, u64)>,
 }
 
 /// What a pass costs, as declared.
-enum Cost {
+pub(super) enum Cost {
     Raster(Raster),
     /// `groups` workgroups of `group_size` invocations, dispatched by the
     /// executor after the record closure (which binds and pushes).
@@ -53,53 +51,6 @@ enum Cost {
     },
     /// Copies and clears: their work as written.
     Other(Work),
-}
-
-/// What a pass's record closure gets: the device, the command buffer, and the
-/// graph's images as this pass declared them.
-pub struct PassContext<'a> {
-    pub ctx: &'a Context,
-    pub cmd: vk::CommandBuffer,
-    pub res: &'a Resources,
-    /// In a pass that renders each colour target alone: which one this call
-    /// renders (0 otherwise).
-    pub target: usize,
-    pass: &'a str,
-    images: &'a [(ImageId, AccessKind)],
-}
-
-impl PassContext<'_> {
-    fn access(&self, id: ImageId) -> AccessKind {
-        self.images
-            .iter()
-            .find(|(i, _)| *i == id)
-            .map(|(_, a)| *a)
-            .unwrap_or_else(|| {
-                panic!(
-                    "pass '{}' records with image '{}' it did not declare",
-                    self.pass,
-                    self.res.name(id)
-                )
-            })
-    }
-
-    /// The layout `id` is in during this pass: the one of the access the pass
-    /// declared for it (never typed at the call site).
-    pub fn layout(&self, id: ImageId) -> vk::ImageLayout {
-        self.access(id).info().layout
-    }
-
-    /// The view of the level `id` names (declared by this pass).
-    pub fn view(&self, id: ImageId) -> vk::ImageView {
-        self.access(id);
-        self.res.view(id)
-    }
-
-    /// The image behind `id` (declared by this pass).
-    pub fn image(&self, id: ImageId) -> &Image {
-        self.access(id);
-        self.res.image(id)
-    }
 }
 
 type Record<'a> = Box<dyn Fn(&PassContext) + 'a>;
@@ -113,9 +64,11 @@ pub struct Pass<'a> {
     /// from their declarations.
     pub images: Vec<(ImageId, AccessKind)>,
     pub buffers: Vec<(BufferId, AccessKind)>,
+    /// The descriptor sets it declared (what its closure may bind).
+    pub(super) sets: Vec<vk::DescriptorSet>,
     /// `None` only for passes that record nothing (e.g. the host-visibility
     /// step of a readback).
-    cost: Option<Cost>,
+    pub(super) cost: Option<Cost>,
     pub record: Record<'a>,
     /// The method group the pass belongs to (`mix::Group::index`), `None` for
     /// the frame's own passes (shadow, geometry, composite, tone map).
@@ -129,40 +82,86 @@ impl<'a> Pass<'a> {
             role,
             images: Vec::new(),
             buffers: Vec::new(),
+            sets: Vec::new(),
             cost: None,
             record: Box::new(|_| {}),
             group: None,
         }
     }
 
-    /// An image the pass reads or writes other than as an attachment (copies,
-    /// clears, storage, host access): attachments are declared with
-    /// [`Pass::color`] and [`Pass::depth_stencil`], which know their load ops.
-    pub fn image(mut self, id: ImageId, access: AccessKind) -> Self {
-        assert!(
-            !matches!(
-                access,
-                AccessKind::ColorAttachmentWrite
-                    | AccessKind::ColorAttachmentLoadWrite
-                    | AccessKind::DepthStencilWrite
-                    | AccessKind::DepthStencilReadOnly
-                    | AccessKind::ColorResolveWrite
-                    | AccessKind::DepthStencilResolveWrite
-            ),
-            "pass '{}' declares an attachment with image(): use color() or depth_stencil()",
-            self.name
-        );
-        self.images.push((id, access));
+    /// An image the pass uses other than as an attachment (a copy, a clear,
+    /// a set's read or storage: never an attachment's access, which only
+    /// [`Pass::color`] and [`Pass::depth_stencil`] declare, with their load
+    /// ops), once.
+    fn image(&mut self, id: ImageId, access: AccessKind) {
+        if !self.images.contains(&(id, access)) {
+            self.images.push((id, access));
+        }
+    }
+
+    fn buffer(&mut self, id: BufferId, access: AccessKind) {
+        if !self.buffers.contains(&(id, access)) {
+            self.buffers.push((id, access));
+        }
+    }
+
+    /// The source of a copy.
+    pub fn transfer_src(&mut self, id: ImageId) -> ImageRef<TransferSrc> {
+        self.image(id, AccessKind::TransferRead);
+        ImageRef::new(id, AccessKind::TransferRead)
+    }
+
+    /// The destination of a copy that writes every texel.
+    pub fn transfer_dst(&mut self, id: ImageId) -> ImageRef<TransferDst> {
+        self.image(id, AccessKind::TransferWrite);
+        ImageRef::new(id, AccessKind::TransferWrite)
+    }
+
+    /// The destination of a copy into part of the image: the rest keeps its
+    /// contents, so its barrier discards neither them nor the layout.
+    pub fn transfer_dst_part(&mut self, id: ImageId) -> ImageRef<TransferDst> {
+        self.image(id, AccessKind::TransferWritePartial);
+        ImageRef::new(id, AccessKind::TransferWritePartial)
+    }
+
+    /// An image cleared whole by `vkCmdClearColorImage`.
+    pub fn clear_dst(&mut self, id: ImageId) -> ImageRef<ClearDst> {
+        self.image(id, AccessKind::ClearWrite);
+        ImageRef::new(id, AccessKind::ClearWrite)
+    }
+
+    /// A tracked buffer a copy or fill writes.
+    pub fn transfer_dst_buffer(&mut self, id: BufferId) -> BufferRef<TransferDst> {
+        self.buffer(id, AccessKind::TransferWrite);
+        BufferRef::new(id, AccessKind::TransferWrite)
+    }
+
+    /// A tracked buffer the host reads after the fence (no command of the
+    /// pass uses it: the pass is the host-visibility step).
+    pub fn host_read(mut self, id: BufferId) -> Self {
+        self.buffer(id, AccessKind::HostRead);
         self
     }
 
-    /// An image the fragment shader samples.
-    pub fn sampled(self, id: ImageId) -> Self {
-        self.image(id, AccessKind::FragmentSampledRead)
+    /// Declares every frame image and buffer `set` binds, in its binding
+    /// order (ones this pass already declared alike are not declared again),
+    /// and hands back what the record closure binds.
+    pub fn set(&mut self, set: &GraphSet) -> SetRef {
+        for &(id, access) in &set.images {
+            self.image(id, access);
+        }
+        for &(id, access) in &set.buffers {
+            self.buffer(id, access);
+        }
+        self.sets.push(set.raw);
+        SetRef { raw: set.raw }
     }
 
-    pub fn buffer(mut self, id: BufferId, access: AccessKind) -> Self {
-        self.buffers.push((id, access));
+    /// An image the fragment shader samples, declared here, where the order
+    /// of the pass's declarations (which reports keep) puts it, ahead of the
+    /// set that binds it ([`Pass::set`] then declares it no second time).
+    pub fn sampled(mut self, id: ImageId) -> Self {
+        self.image(id, AccessKind::FragmentSampledRead);
         self
     }
 
@@ -358,7 +357,7 @@ impl<'a> Pass<'a> {
     }
 
     /// The render area of rendering `i` (the `i`th target alone, or all at once).
-    fn area(&self, r: &Raster, res: &Resources, i: usize) -> vk::Extent2D {
+    pub(super) fn area(&self, r: &Raster, res: &Resources, i: usize) -> vk::Extent2D {
         if let Some(a) = r.area {
             return a;
         }
@@ -371,222 +370,12 @@ impl<'a> Pass<'a> {
     }
 }
 
-/// What the GPU measured for one pass in one frame.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PassSample {
-    pub name: String,
-    pub role: PassRole,
-    pub barrier_ms: f64,
-    pub gpu_ms: f64,
-    pub fragment_invocations: Option<u64>,
-    pub samples_passed: u64,
-}
-
-impl PassSample {
-    pub fn new(pass: &Pass, t: PassTiming) -> Self {
-        PassSample {
-            name: pass.name.clone(),
-            role: pass.role,
-            barrier_ms: t.barrier_ms,
-            gpu_ms: t.gpu_ms,
-            fragment_invocations: t.fragment_invocations,
-            samples_passed: t.samples_passed,
-        }
-    }
-}
-
-/// The store op of a written attachment: STORE (every image a pass draws is
-/// read later), but DONT_CARE for a multisampled one that the pass resolves:
-/// nothing reads its samples after the resolve, which happens before the
-/// store, so a tiler need not write them out.
-fn store_op(resolved: bool) -> vk::AttachmentStoreOp {
-    if resolved {
-        vk::AttachmentStoreOp::DONT_CARE
-    } else {
-        vk::AttachmentStoreOp::STORE
-    }
-}
-
-/// Begins dynamic rendering of `colors` and `depth` over `area` from the
-/// origin, views and layouts from the pass's declared accesses, and sets
-/// viewport, scissor and the stencil reference the declaration names.
-fn begin_rendering(
-    pc: &PassContext,
-    colors: &[ColorTarget],
-    depth: Option<DepthStencil>,
-    area: vk::Extent2D,
-) {
-    let color_att: Vec<vk::RenderingAttachmentInfo> = colors
-        .iter()
-        .map(|c| {
-            let (op, clear) = match c.load {
-                Load::Keep => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
-                Load::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
-                Load::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
-            };
-            let att = vk::RenderingAttachmentInfo::default()
-                .image_view(pc.view(c.image))
-                .image_layout(pc.layout(c.image))
-                .load_op(op)
-                .store_op(store_op(c.resolve.is_some()))
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue { float32: clear },
-                });
-            // Every colour format dermis renders is float or UNORM, so the
-            // resolve is the average of the samples (the box filter MSAA is).
-            match c.resolve {
-                Some(single) => att
-                    .resolve_mode(vk::ResolveModeFlags::AVERAGE)
-                    .resolve_image_view(pc.view(single))
-                    .resolve_image_layout(pc.layout(single)),
-                None => att,
-            }
-        })
-        .collect();
-    let ds_att = depth.map(|d| {
-        let att = vk::RenderingAttachmentInfo::default()
-            .image_view(pc.view(d.image))
-            .image_layout(pc.layout(d.image));
-        // Depth and stencil both from sample 0: the one mode every device
-        // has for both (VK_KHR_depth_stencil_resolve), and one surface's
-        // depth and group code together (docs/aa.md).
-        let att = match d.resolve {
-            Some(single) => att
-                .resolve_mode(vk::ResolveModeFlags::SAMPLE_ZERO)
-                .resolve_image_view(pc.view(single))
-                .resolve_image_layout(pc.layout(single)),
-            None => att,
-        };
-        match d.clear {
-            Some((depth, stencil)) => att
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(store_op(d.resolve.is_some()))
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue { depth, stencil },
-                }),
-            // Read-only depth/stencil: loaded for the tests, never stored.
-            None => att
-                .load_op(vk::AttachmentLoadOp::LOAD)
-                .store_op(vk::AttachmentStoreOp::NONE),
-        }
-    });
-    let rect = vk::Rect2D {
-        offset: vk::Offset2D::default(),
-        extent: area,
-    };
-    let mut info = vk::RenderingInfo::default()
-        .render_area(rect)
-        .layer_count(1)
-        .color_attachments(&color_att);
-    if let (Some(att), Some(d)) = (&ds_att, depth) {
-        info = info.depth_attachment(att);
-        if pc.res.texel_format(d.image).has_stencil() {
-            info = info.stencil_attachment(att);
-        }
-    }
-    let (device, cmd) = (&pc.ctx.device, pc.cmd);
-    unsafe {
-        device.cmd_begin_rendering(cmd, &info);
-        device.cmd_set_viewport(
-            cmd,
-            0,
-            &[vk::Viewport {
-                x: 0.0,
-                y: 0.0,
-                width: area.width as f32,
-                height: area.height as f32,
-                min_depth: 0.0,
-                max_depth: 1.0,
-            }],
-        );
-        device.cmd_set_scissor(cmd, 0, &[rect]);
-        // Set before the closure binds its pipeline: the stencil-testing
-        // pipelines take their reference as dynamic state, which a bind keeps.
-        if let Some(reference) = depth.and_then(|d| d.stencil_ref) {
-            device.cmd_set_stencil_reference(cmd, vk::StencilFaceFlags::FRONT_AND_BACK, reference);
-        }
-    }
-}
-
-/// Records one pass's commands: dynamic rendering around its closure for a
-/// raster pass, its dispatch after the closure for a compute pass.
-fn record_one(ctx: &Context, cmd: vk::CommandBuffer, res: &Resources, pass: &Pass) {
-    let pc = |target| PassContext {
-        ctx,
-        cmd,
-        res,
-        target,
-        pass: &pass.name,
-        images: &pass.images,
-    };
-    match &pass.cost {
-        Some(Cost::Raster(r)) => {
-            let renderings: Vec<Vec<ColorTarget>> = if r.each_target_alone {
-                r.colors.iter().map(|&c| vec![c]).collect()
-            } else {
-                vec![r.colors.clone()]
-            };
-            for (i, colors) in renderings.iter().enumerate() {
-                let pc = pc(i);
-                begin_rendering(&pc, colors, r.depth, pass.area(r, res, i));
-                (pass.record)(&pc);
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
-            }
-        }
-        Some(Cost::Dispatch { groups, .. }) => {
-            (pass.record)(&pc(0));
-            unsafe {
-                ctx.device
-                    .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
-            };
-        }
-        Some(Cost::Other(_)) | None => (pass.record)(&pc(0)),
-    }
-}
-
-/// Records `passes` into `cmd` in order. With a profiler, pass `i` uses query
-/// slots `i`; the caller reads them after the fence.
-pub fn record_passes(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    resources: &mut Resources,
-    passes: &[Pass],
-    profiler: Option<&Profiler>,
-) {
-    if let Some(p) = profiler {
-        assert!(
-            passes.len() as u32 <= p.max_passes,
-            "{} passes but the profiler holds {}",
-            passes.len(),
-            p.max_passes
-        );
-        p.reset(ctx, cmd);
-    }
-    for (i, pass) in passes.iter().enumerate() {
-        let i = i as u32;
-        ctx.begin_label(cmd, &pass.name);
-        if let Some(p) = profiler {
-            p.stamp(ctx, cmd, i, 0);
-        }
-        resources.transition(ctx, cmd, &pass.images, &pass.buffers);
-        if let Some(p) = profiler {
-            p.stamp(ctx, cmd, i, 1);
-            p.begin_stats(ctx, cmd, i);
-        }
-        record_one(ctx, cmd, resources, pass);
-        if let Some(p) = profiler {
-            p.end_stats(ctx, cmd, i);
-            p.stamp(ctx, cmd, i, 2);
-        }
-        ctx.end_label(cmd);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::graph::work::Format;
-    use crate::graph::ImageDesc;
+    use crate::graph::{Binding, ImageDesc, Storage};
+    use crate::vk::pipeline::{Bind, Pipeline};
 
     fn image(res: &mut Resources, name: &str, w: u32, h: u32, format: vk::Format) -> ImageId {
         res.declare(ImageDesc::new(
@@ -790,12 +579,125 @@ mod tests {
             .contains(vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT));
     }
 
+    // A command's use hands back a reference and declares the access it
+    // names, once however often it is asked for.
     #[test]
-    #[should_panic(expected = "use color() or depth_stencil()")]
-    fn attachments_cannot_be_declared_without_their_load_op() {
+    fn references_declare_their_access() {
         let mut res = Resources::default();
         let a = image(&mut res, "a", 4, 4, vk::Format::R16G16B16A16_SFLOAT);
-        let _ = Pass::new("p", PassRole::Sss).image(a, AccessKind::ColorAttachmentWrite);
+        let b = image(&mut res, "b", 4, 4, vk::Format::R16G16B16A16_SFLOAT);
+        let buf = res.add_buffer("buf", vk::Buffer::null());
+        type A = AccessKind;
+        let mut p = Pass::new("p", PassRole::Setup);
+        let src = p.transfer_src(a);
+        let dst = p.transfer_dst_part(b);
+        assert_eq!(
+            (src.access(), dst.access()),
+            (A::TransferRead, A::TransferWritePartial)
+        );
+        p.transfer_src(a);
+        let whole = p.transfer_dst(b);
+        let clear = p.clear_dst(a);
+        assert_eq!(
+            (whole.access(), clear.access()),
+            (A::TransferWrite, A::ClearWrite)
+        );
+        p.transfer_dst_buffer(buf);
+        let p = p.host_read(buf);
+        assert_eq!(
+            p.images,
+            vec![
+                (a, A::TransferRead),
+                (b, A::TransferWritePartial),
+                (b, A::TransferWrite),
+                (a, A::ClearWrite)
+            ]
+        );
+        assert_eq!(p.buffers, vec![(buf, A::TransferWrite), (buf, A::HostRead)]);
+    }
+
+    // A set declares what it binds, in its binding order, at the access its
+    // pipeline's stage implies (a chain as every level, one image bound
+    // twice once); reads a pass declared ahead keep their place.
+    #[test]
+    fn a_set_declares_its_images_and_buffers() {
+        let mut res = Resources::default();
+        let c = image(&mut res, "c", 8, 8, vk::Format::R8G8B8A8_SRGB);
+        let chain = res.declare(
+            ImageDesc::new(
+                "chain",
+                vk::Extent2D {
+                    width: 8,
+                    height: 8,
+                },
+                vk::Format::R16G16B16A16_SFLOAT,
+            )
+            .with_levels(3),
+        );
+        let out = image(&mut res, "out", 8, 8, vk::Format::R32G32B32A32_SFLOAT);
+        let buf = res.add_buffer("samples", vk::Buffer::null());
+        let pipeline = |name: &str, bind_point| {
+            let mut p = Pipeline::default();
+            p.name = name.into();
+            p.bind_point = bind_point;
+            p
+        };
+        let raster = pipeline("raster", vk::PipelineBindPoint::GRAPHICS);
+        let set = GraphSet::new(
+            &res,
+            &raster,
+            0,
+            vec![
+                ("colorTex", Binding::Sampled(c)),
+                ("lumaTex", Binding::SampledUnorm(c)),
+                ("chain", Binding::SampledLevels(chain)),
+                (
+                    "linearClamp",
+                    Binding::Fixed(Bind::Sampler(vk::Sampler::null())),
+                ),
+            ],
+        );
+        type A = AccessKind;
+        let levels = res.levels(chain);
+        let mut p = Pass::new("p", PassRole::Sss).sampled(levels[1]);
+        p.set(&set);
+        assert_eq!(
+            p.images,
+            vec![
+                (levels[1], A::FragmentSampledRead),
+                (c, A::FragmentSampledRead),
+                (levels[0], A::FragmentSampledRead),
+                (levels[2], A::FragmentSampledRead)
+            ]
+        );
+        assert!(set.reads(c) && set.reads(levels[2]) && !set.reads(out));
+        let compute = pipeline("compute", vk::PipelineBindPoint::COMPUTE);
+        let set = GraphSet::new(
+            &res,
+            &compute,
+            0,
+            vec![
+                ("src", Binding::Sampled(c)),
+                ("out", Binding::StorageImage(out, Storage::Write)),
+                (
+                    "samples",
+                    Binding::StorageBuffer {
+                        id: buf,
+                        offset: 0,
+                        size: 64,
+                        storage: Storage::Read,
+                    },
+                ),
+            ],
+        );
+        let mut q = Pass::new("q", PassRole::Sss);
+        q.set(&set);
+        assert_eq!(
+            q.images,
+            vec![(c, A::ComputeSampledRead), (out, A::ComputeStorageWrite)]
+        );
+        assert_eq!(q.buffers, vec![(buf, A::ComputeStorageRead)]);
+        assert!(!set.reads(out));
     }
 
     #[test]

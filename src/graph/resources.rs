@@ -246,7 +246,10 @@ impl Resources {
 
     /// The image behind `id` (any level). Panics before [`Resources::create`]:
     /// a pass that records before set-up finished is a programmer error.
-    pub fn image(&self, id: ImageId) -> &Image {
+    /// The graph's alone, as its views are: a frame image's handles reach
+    /// descriptors and commands only through a pass's declared references
+    /// (`refs.rs`).
+    pub(super) fn image(&self, id: ImageId) -> &Image {
         let s = self.slot(id);
         s.image
             .as_ref()
@@ -259,7 +262,7 @@ impl Resources {
     }
 
     /// The view of exactly the level `id` names.
-    pub fn view(&self, id: ImageId) -> vk::ImageView {
+    pub(super) fn view(&self, id: ImageId) -> vk::ImageView {
         self.image(id).level_views[self.images[id.0].level as usize]
     }
 
@@ -278,7 +281,7 @@ impl Resources {
 
     /// The UNORM view of an sRGB image ([`Resources::request_unorm_view`]);
     /// a pass that binds one it did not ask for is a programmer error.
-    pub fn unorm_view(&self, id: ImageId) -> vk::ImageView {
+    pub(super) fn unorm_view(&self, id: ImageId) -> vk::ImageView {
         self.image(id).unorm_view.unwrap_or_else(|| {
             panic!(
                 "image '{}' has no UNORM view (request_unorm_view)",
@@ -347,6 +350,11 @@ impl Resources {
     /// Marks buffer `id` as filled by a finished upload that left it in `access`.
     pub fn set_buffer_uploaded(&mut self, id: BufferId, access: AccessKind) {
         self.buffers[id.0].state = ResourceState::uploaded(access);
+    }
+
+    /// The buffer behind `id` (for the graph's sets and commands).
+    pub(super) fn buffer(&self, id: BufferId) -> vk::Buffer {
+        self.buffers[id.0].raw
     }
 
     pub fn buffer_name(&self, id: BufferId) -> &str {

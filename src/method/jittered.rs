@@ -6,7 +6,6 @@
 use std::any::Any;
 
 use anyhow::Result;
-use ash::vk;
 
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, source_set, Masked};
@@ -16,7 +15,7 @@ use super::{
     SssMethod,
 };
 use crate::graph::work::{Fetch, Filter, Spread};
-use crate::graph::{ImageId, Pass};
+use crate::graph::{GraphSet, ImageId, Pass};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
 use crate::vk::context::Context;
@@ -41,11 +40,13 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Jittered::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 pub struct Jittered {
     pipeline: Pipeline,
-    set: vk::DescriptorSet,
+    set: GraphSet,
     /// The seed the pass reads (the diffuse target is written).
     src: ImageId,
     diffuse: ImageId,
@@ -61,9 +62,10 @@ impl Jittered {
         d.depth_format = Some(s.depth_stencil_format);
         d.stencil_format = Some(s.depth_stencil_format);
         d.stencil = Some(skin_stencil_test());
+        let pipeline = Pipeline::graphics(s.ctx, &d)?;
         Ok(Jittered {
-            pipeline: Pipeline::graphics(s.ctx, &d)?,
-            set: vk::DescriptorSet::null(),
+            set: source_set(s, &pipeline, src),
+            pipeline,
             src,
             diffuse,
             kernel: hable_kernel(),
@@ -132,8 +134,7 @@ impl SssMethod for Jittered {
                     shader: SHADER,
                     loop_trips: vec![RING],
                     pipeline,
-                    set: self.set,
-                    reads: vec![src, t.linear_depth],
+                    set: &self.set,
                     fetches,
                     targets: vec![(diffuse, false)],
                     stencil: true,
@@ -155,8 +156,7 @@ impl SssMethod for Jittered {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        self.set = source_set(b, &self.pipeline, self.src)?;
-        Ok(())
+        b.write(&mut self.set, &self.pipeline)
     }
 
     fn intermediates(&self) -> Vec<ImageId> {

@@ -27,19 +27,18 @@ use anyhow::{bail, Result};
 use ash::vk;
 use glam::Mat4;
 
-use crate::graph::{ImageId, Pass, Resources};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Resources};
 use crate::scene::camera::Camera;
 use crate::scene::Scene;
 use crate::vk::context::Context;
 use crate::vk::guard::Destroy;
-use crate::vk::pipeline::{Bind, DescriptorPool, Samplers};
+use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline, Samplers};
 pub use options::{MethodOptions, OptKind, OptSpec, Opts};
 use region::ReachScale;
 
-/// The stencil bit the geometry pass sets on skin pixels (group 0's code,
-/// `mix::stencil_code(0)`, which reads this layer and not the other way
-/// round; render/groups.rs's tests hold the two equal): what a
-/// single-method frame writes and tests.
+/// The stencil bit the geometry pass sets on skin pixels, written only here:
+/// what a single-method frame writes and tests, and group 0's code (a mix's
+/// codes, `mix::stencil_code`, put the group index above it).
 pub const STENCIL_SKIN: u32 = 1;
 
 /// Stencil state of every stencil-masked SSS pass: shade only where the stencil
@@ -163,19 +162,28 @@ pub struct MethodSetup<'a> {
     /// ground truth samples the skin surface itself; tsd draws these heads.
     pub scene: &'a Scene,
     pub instances: &'a [Mat4],
+    /// Set 0 of `lighting.glsl` (the frame: uniforms, shadow map, samplers,
+    /// Beckmann), for methods that shade surfaces.
+    pub frame_binds: Vec<(&'static str, Binding)>,
 }
 
-/// What a method's descriptor sets are written from, once the images exist.
+/// What a method's descriptor sets are written with, once the images exist
+/// (the sets themselves, and so the frame images they bind, were stated
+/// when the method was built: `graph::GraphSet`).
 pub struct MethodBind<'a> {
     pub ctx: &'a Context,
     pub res: &'a Resources,
     pub pool: &'a DescriptorPool,
-    pub samplers: &'a Samplers,
-    pub targets: &'a FrameTargets,
-    /// Set 0 (frame: uniforms, shadow map, samplers, Beckmann) and set 1 (the
-    /// skin material) of `lighting.glsl`, for methods that shade surfaces.
-    pub frame_binds: Vec<(&'static str, Bind)>,
+    /// Set 1 of `lighting.glsl` (the skin material: static textures), for
+    /// methods that shade surfaces.
     pub skin_material_binds: Vec<(&'static str, Bind)>,
+}
+
+impl MethodBind<'_> {
+    /// Writes `set`, made for `pipeline`, from the frame's pool.
+    pub fn write(&self, set: &mut GraphSet, pipeline: &Pipeline) -> Result<()> {
+        set.write(self.ctx, self.pool, self.res, pipeline)
+    }
 }
 
 /// What a method's passes are recorded against in a frame.
@@ -270,6 +278,14 @@ pub struct MethodEntry {
     /// Why the method cannot run on a multisampled frame (`--msaa` > 1), in
     /// one line; `None`: it reads the resolved targets like any 1x frame.
     pub no_msaa: Option<&'static str>,
+    /// Why a setting of the method (its options, checked) cannot share a
+    /// frame with other methods' characters, in one line; `None`: it can
+    /// (its passes keep to its own group's stencil code).
+    pub no_mix: fn(&Opts) -> Option<&'static str>,
+    /// The method does no subsurface scattering: no pass, no reach, its
+    /// output the diffuse target as the geometry pass left it (a frame of
+    /// several gives its group no region, a fade from it blends the skin).
+    pub no_sss: bool,
 }
 
 impl MethodEntry {
@@ -424,9 +440,14 @@ pub fn default_method() -> &'static MethodEntry {
     &separable::ENTRY
 }
 
-/// The entry of no SSS (the baseline every err/none is relative to).
+/// The entry of no SSS (`MethodEntry::no_sss`: the baseline every err/none
+/// is relative to).
 pub fn none() -> &'static MethodEntry {
-    &none::ENTRY
+    METHODS
+        .iter()
+        .copied()
+        .find(|m| m.no_sss)
+        .expect("the registry has a method without SSS")
 }
 
 /// The ground truth's entry (the one method marked `ground_truth`).
@@ -509,6 +530,8 @@ mod tests {
         assert!(e.contains("valid: separable, ssg"), "{e}");
         assert!(ground_truth().eval.is_empty());
         assert_eq!(METHODS.iter().filter(|m| m.ground_truth).count(), 1);
+        assert_eq!(METHODS.iter().filter(|m| m.no_sss).count(), 1);
+        assert!(none().options.is_empty());
     }
 
     // Two methods may share an option key only with the same meaning.

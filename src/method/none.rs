@@ -29,6 +29,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
         }))
     },
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: true,
 };
 
 pub struct NoSss {

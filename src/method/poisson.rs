@@ -9,7 +9,7 @@
 
 use std::any::Any;
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use ash::vk;
 
 use super::region::ReachScale;
@@ -20,7 +20,7 @@ use super::{
 };
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Filter, PassRole, ShaderWork};
-use crate::graph::{ColorTarget, ImageId, Load, Pass, PassContext};
+use crate::graph::{Binding, ColorTarget, GraphSet, ImageId, Load, Pass, PassContext};
 use crate::skin::poisson::{poisson_disk_32, PoissonParams};
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -54,6 +54,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |_| Ok(()),
     build: |s| Ok(Box::new(Poisson::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// Levels for a target of `extent` (every level at least one texel).
@@ -80,8 +82,12 @@ struct PoissonPush {
 pub struct Poisson {
     mip_pipeline: Pipeline,
     pipeline: Pipeline,
-    mip_sets: Vec<vk::DescriptorSet>,
-    set: vk::DescriptorSet,
+    /// The per-level ids of the colour, depth and normal chains.
+    chains: [Vec<ImageId>; 3],
+    /// Level `l + 1`'s pass reads level `l` of the three chains.
+    mip_sets: Vec<GraphSet>,
+    /// Every level of the three chains.
+    set: GraphSet,
     disk_buffer: Buffer,
     /// The output (seeded with the diffuse target's level 0).
     out: ImageId,
@@ -95,7 +101,7 @@ impl Poisson {
         let t = s.targets;
         let normals = t
             .normals
-            .expect("poisson declares that it needs the normal target");
+            .context("the frame has no normal target, which poisson needs")?;
         let levels = s.res.levels(t.diffuse).len() as u32;
         let out = declare_intermediate(s.res, t.diffuse, "sss intermediate");
         let format = s.res.format(t.diffuse);
@@ -132,28 +138,55 @@ impl Poisson {
             normal_sensitivity: p.normal_sensitivity,
             max_level: levels as i32 - 1,
         };
+        let chains = [t.diffuse, t.linear_depth, normals].map(|c| s.res.levels(c));
+        let [color, depth, normal] = &chains;
+        let mip_sets = (1..levels as usize)
+            .map(|l| {
+                GraphSet::new(
+                    s.res,
+                    &mip_pipeline,
+                    0,
+                    vec![
+                        ("srcColor", Binding::Sampled(color[l - 1])),
+                        ("srcDepth", Binding::Sampled(depth[l - 1])),
+                        ("srcNormal", Binding::Sampled(normal[l - 1])),
+                    ],
+                )
+            })
+            .collect();
+        let set = GraphSet::new(
+            s.res,
+            &pipeline,
+            0,
+            vec![
+                ("colorChain", Binding::SampledLevels(t.diffuse)),
+                ("depthChain", Binding::SampledLevels(t.linear_depth)),
+                ("normalChain", Binding::SampledLevels(normals)),
+                (
+                    "mipClamp",
+                    Binding::Fixed(Bind::Sampler(s.samplers.mip_clamp)),
+                ),
+                (
+                    "disk",
+                    Binding::Fixed(Bind::Uniform {
+                        buffer: disk_buffer.raw,
+                        size: (MAX_TAPS * 16) as u64,
+                    }),
+                ),
+            ],
+        );
         Ok(Poisson {
             mip_pipeline: mip_pipeline.keep(),
             pipeline: pipeline.keep(),
-            mip_sets: Vec::new(),
-            set: vk::DescriptorSet::null(),
+            chains,
+            mip_sets,
+            set,
             disk_buffer: disk_buffer.keep(),
             out,
             push,
             params: p,
             levels,
         })
-    }
-
-    /// The per-level ids of the colour, depth and normal chains.
-    fn chains(&self, f: &FrameView) -> [Vec<ImageId>; 3] {
-        let t = f.targets;
-        let normals = t.normals.expect("poisson has the normal target");
-        [
-            f.res.levels(t.diffuse),
-            f.res.levels(t.linear_depth),
-            f.res.levels(normals),
-        ]
     }
 }
 
@@ -168,7 +201,7 @@ impl SssMethod for Poisson {
             f.screen,
             &[self.out],
         )];
-        let chains = self.chains(f);
+        let chains = &self.chains;
         for l in 1..self.levels as usize {
             let mut fetches = Vec::new();
             let mut pass = Pass::new(format!("poisson mip {l}"), PassRole::Sss);
@@ -184,14 +217,14 @@ impl SssMethod for Poisson {
                 alu: alu_estimate(MIP_SHADER, &[]),
                 ..Default::default()
             };
-            let set = self.mip_sets.get(l - 1).copied().unwrap_or_default();
+            // Its reads are declared above, in the order reports keep.
+            let set = pass.set(&self.mip_sets[l - 1]);
             passes.push(pass.draws(Some(work), 1).record(move |pc: &PassContext| {
                 fullscreen(pc, &self.mip_pipeline, &[set], |_, _| {})
             }));
         }
         // Every level of the three chains is read; the disk's size (8, 16 or
         // 32 taps) depends on each pixel's radius: the declared count is the most.
-        let reads: Vec<ImageId> = chains.iter().flatten().copied().collect();
         let taps = MAX_TAPS as f64;
         let mut fetches = vec![];
         for (c, texture) in chains
@@ -215,8 +248,7 @@ impl SssMethod for Poisson {
                 shader: SHADER,
                 loop_trips: vec![MAX_TAPS],
                 pipeline,
-                set: self.set,
-                reads,
+                set: &self.set,
                 fetches,
                 targets: vec![(self.out, false)],
                 stencil: true,
@@ -238,55 +270,10 @@ impl SssMethod for Poisson {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        let t = b.targets;
-        let normals = t.normals.expect("poisson has the normal target");
-        let [color, depth, normal] = [
-            b.res.levels(t.diffuse),
-            b.res.levels(t.linear_depth),
-            b.res.levels(normals),
-        ];
-        self.mip_sets = (1..self.levels as usize)
-            .map(|l| {
-                b.pool.write_set(
-                    b.ctx,
-                    &self.mip_pipeline,
-                    0,
-                    &[
-                        ("srcColor", Bind::Texture(b.res.view(color[l - 1]))),
-                        ("srcDepth", Bind::Texture(b.res.view(depth[l - 1]))),
-                        ("srcNormal", Bind::Texture(b.res.view(normal[l - 1]))),
-                    ],
-                )
-            })
-            .collect::<Result<Vec<_>>>()?;
-        self.set = b.pool.write_set(
-            b.ctx,
-            &self.pipeline,
-            0,
-            &[
-                (
-                    "colorChain",
-                    Bind::Texture(b.res.image(t.diffuse).chain_view),
-                ),
-                (
-                    "depthChain",
-                    Bind::Texture(b.res.image(t.linear_depth).chain_view),
-                ),
-                (
-                    "normalChain",
-                    Bind::Texture(b.res.image(normals).chain_view),
-                ),
-                ("mipClamp", Bind::Sampler(b.samplers.mip_clamp)),
-                (
-                    "disk",
-                    Bind::Uniform {
-                        buffer: self.disk_buffer.raw,
-                        size: (MAX_TAPS * 16) as u64,
-                    },
-                ),
-            ],
-        )?;
-        Ok(())
+        for set in &mut self.mip_sets {
+            b.write(set, &self.mip_pipeline)?;
+        }
+        b.write(&mut self.set, &self.pipeline)
     }
 
     fn intermediates(&self) -> Vec<ImageId> {

@@ -8,16 +8,15 @@
 //! see a consistent neighbourhood and non-skin pixels leave SSS bit for bit
 //! unchanged.
 
-use anyhow::Result;
 use ash::vk;
 
-use super::{FrameView, MethodBind};
+use super::{FrameView, MethodSetup};
 use crate::graph::draw::fullscreen_in;
 use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
 use crate::graph::{
-    ColorTarget, DepthStencil, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+    Binding, ColorTarget, DepthStencil, GraphSet, ImageDesc, ImageId, Load, Pass, PassContext,
+    Resources,
 };
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::pipeline::{Bind, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
@@ -65,9 +64,10 @@ pub struct Masked<'a> {
     pub shader: &'static str,
     pub loop_trips: Vec<u32>,
     pub pipeline: &'a Pipeline,
-    pub set: vk::DescriptorSet,
-    /// The images the shader samples, and what it fetches from them.
-    pub reads: Vec<ImageId>,
+    /// Its set 0: the images the shader samples (what the pass declares it
+    /// reads), bound by name.
+    pub set: &'a GraphSet,
+    /// What the shader fetches from them.
     pub fetches: Vec<Fetch>,
     /// The colour targets (loaded: pixels outside the mask keep their
     /// contents), each with whether it is blended.
@@ -96,9 +96,7 @@ pub fn masked_pass<'a>(
         ..Default::default()
     };
     let mut pass = Pass::new(m.name, PassRole::Sss);
-    for r in m.reads {
-        pass = pass.sampled(r);
-    }
+    let set = pass.set(m.set);
     pass = pass.depth_stencil(
         DepthStencil::test_only(ds)
             .depth_test(m.depth_test)
@@ -108,7 +106,7 @@ pub fn masked_pass<'a>(
         let target = ColorTarget::new(t, Load::Keep);
         pass = pass.color(if blend { target.blended() } else { target });
     }
-    let (pipeline, set) = (m.pipeline, m.set);
+    let pipeline = m.pipeline;
     pass.draws(Some(work), region.len() as u64)
         .record(move |pc: &PassContext| fullscreen_in(pc, pipeline, &[set], Some(region), &state))
 }
@@ -126,31 +124,32 @@ pub fn seed_copy<'a>(
     let whole = region.len() == 1
         && region[0].offset == vk::Offset2D::default()
         && region[0].extent == extent;
-    // A copy of part of the image keeps the rest (the zeros written at set-up):
-    // its barrier must not discard the old contents.
-    let write = if whole {
-        AccessKind::TransferWrite
-    } else {
-        AccessKind::TransferWritePartial
-    };
     let texels: u64 = region
         .iter()
         .map(|r| r.extent.width as u64 * r.extent.height as u64)
         .sum::<u64>()
         * dsts.len() as u64;
     let bytes_per_texel = f.res.texel_format(src).bytes_per_texel();
-    let mut pass = Pass::new(name, PassRole::Sss)
-        .image(src, AccessKind::TransferRead)
-        .work(Work::Copy {
-            texels,
-            bytes_per_texel,
-            rects: (region.len() * dsts.len()) as u32,
-        });
-    for &d in dsts {
-        pass = pass.image(d, write);
-    }
-    let dsts = dsts.to_vec();
-    pass.record(move |pc: &PassContext| {
+    let mut pass = Pass::new(name, PassRole::Sss);
+    let src = pass.transfer_src(src);
+    // A copy of part of the image keeps the rest (the zeros written at set-up):
+    // its barrier must not discard the old contents.
+    let dsts: Vec<_> = dsts
+        .iter()
+        .map(|&d| {
+            if whole {
+                pass.transfer_dst(d)
+            } else {
+                pass.transfer_dst_part(d)
+            }
+        })
+        .collect();
+    pass.work(Work::Copy {
+        texels,
+        bytes_per_texel,
+        rects: (region.len() * dsts.len()) as u32,
+    })
+    .record(move |pc: &PassContext| {
         let layers = vk::ImageSubresourceLayers::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
             .layer_count(1);
@@ -178,38 +177,25 @@ pub fn seed_copy<'a>(
             return; // no skin on screen: nothing reads the seeds
         }
         for &dst in &dsts {
-            unsafe {
-                pc.ctx.device.cmd_copy_image(
-                    pc.cmd,
-                    pc.image(src).raw,
-                    pc.layout(src),
-                    pc.image(dst).raw,
-                    pc.layout(dst),
-                    &copies,
-                )
-            };
+            pc.copy_image(src, dst, &copies);
         }
     })
 }
 
 /// Set 0 of a blur that reads `color` and the linear depth through the
 /// bilinear sampler (`colorTex`, `depthTex`, `linearClamp`).
-pub fn source_set(
-    b: &MethodBind,
-    pipeline: &Pipeline,
-    color: ImageId,
-) -> Result<vk::DescriptorSet> {
-    b.pool.write_set(
-        b.ctx,
+pub fn source_set(s: &MethodSetup, pipeline: &Pipeline, color: ImageId) -> GraphSet {
+    GraphSet::new(
+        s.res,
         pipeline,
         0,
-        &[
-            ("colorTex", Bind::Texture(b.res.view(color))),
+        vec![
+            ("colorTex", Binding::Sampled(color)),
+            ("depthTex", Binding::Sampled(s.targets.linear_depth)),
             (
-                "depthTex",
-                Bind::Texture(b.res.view(b.targets.linear_depth)),
+                "linearClamp",
+                Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
             ),
-            ("linearClamp", Bind::Sampler(b.samplers.linear_clamp)),
         ],
     )
 }

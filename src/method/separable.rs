@@ -15,7 +15,7 @@ use super::{
     OptKind, OptSpec, Opts, SssMethod,
 };
 use crate::graph::work::Filter;
-use crate::graph::{ImageId, Pass};
+use crate::graph::{Binding, GraphSet, ImageId, Pass};
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -98,6 +98,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Separable::new(s)?)),
     no_msaa: None,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// The method's options, parsed.
@@ -173,7 +175,9 @@ pub struct Separable {
     /// The intermediate the horizontal pass writes.
     tmp: ImageId,
     diffuse: ImageId,
-    sets: [vk::DescriptorSet; 2],
+    /// The horizontal pass's (reading the diffuse target) and the
+    /// vertical's (reading the intermediate).
+    sets: [GraphSet; 2],
     push: [SssPush; 2],
 }
 
@@ -211,6 +215,30 @@ impl Separable {
             // A zero-width kernel has no extent to compare depth steps against.
             follow_surface: (config.follow_surface && tol > 0.0) as i32,
         };
+        let size = (SeparableKernel::MAX_SAMPLES * 16) as u64;
+        let set = |color: ImageId| {
+            GraphSet::new(
+                s.res,
+                &pipeline,
+                0,
+                vec![
+                    ("colorTex", Binding::Sampled(color)),
+                    ("depthTex", Binding::Sampled(s.targets.linear_depth)),
+                    (
+                        "linearClamp",
+                        Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                    ),
+                    (
+                        "kernel",
+                        Binding::Fixed(Bind::Uniform {
+                            buffer: kernel_buffer.raw,
+                            size,
+                        }),
+                    ),
+                ],
+            )
+        };
+        let sets = [set(diffuse), set(tmp)];
         Ok(Separable {
             pipeline: pipeline.keep(),
             push: [push([1.0, 0.0]), push([0.0, 1.0])],
@@ -219,7 +247,7 @@ impl Separable {
             kernel_buffer: kernel_buffer.keep(),
             tmp,
             diffuse,
-            sets: [vk::DescriptorSet::null(); 2],
+            sets,
         })
     }
 
@@ -256,8 +284,7 @@ impl SssMethod for Separable {
                     shader: SHADER,
                     loop_trips: vec![n as u32 - 1],
                     pipeline,
-                    set: self.sets[pass],
-                    reads: vec![src, t.linear_depth],
+                    set: &self.sets[pass],
                     fetches,
                     targets: vec![(dst, false)],
                     stencil: true,
@@ -282,30 +309,9 @@ impl SssMethod for Separable {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        let size = (SeparableKernel::MAX_SAMPLES * 16) as u64;
-        let set = |color: ImageId| {
-            b.pool.write_set(
-                b.ctx,
-                &self.pipeline,
-                0,
-                &[
-                    ("colorTex", Bind::Texture(b.res.view(color))),
-                    (
-                        "depthTex",
-                        Bind::Texture(b.res.view(b.targets.linear_depth)),
-                    ),
-                    ("linearClamp", Bind::Sampler(b.samplers.linear_clamp)),
-                    (
-                        "kernel",
-                        Bind::Uniform {
-                            buffer: self.kernel_buffer.raw,
-                            size,
-                        },
-                    ),
-                ],
-            )
-        };
-        self.sets = [set(self.diffuse)?, set(self.tmp)?];
+        for set in &mut self.sets {
+            b.write(set, &self.pipeline)?;
+        }
         Ok(())
     }
 

@@ -21,7 +21,7 @@ use super::{
     OptKind, OptSpec, Opts, SssMethod,
 };
 use crate::graph::work::{Fetch, Filter};
-use crate::graph::{ImageId, Pass};
+use crate::graph::{GraphSet, ImageId, Pass};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -80,7 +80,22 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Ssg::new(s)?)),
     no_msaa: None,
+    no_mix,
+    no_sss: false,
 };
+
+/// The registry's `no_mix`: the shader's branch shades every pixel whose
+/// alpha marks skin, the other groups' too; only the stencil keeps a group
+/// to its own pixels.
+fn no_mix(o: &Opts) -> Option<&'static str> {
+    match Config::parse(o) {
+        Ok(c) if c.mask == MaskMode::Branch => Some(
+            "the branch mask shades every character's skin; \
+             in a frame of several methods ssg needs mask=stencil",
+        ),
+        _ => None,
+    }
+}
 
 /// How non-skin pixels are kept out of the SSS passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -143,8 +158,8 @@ pub struct ScreenPush {
 pub struct Ssg {
     horizontal: Pipeline,
     vertical: Pipeline,
-    set_rt1: vk::DescriptorSet,
-    set_rt2: vk::DescriptorSet,
+    set_rt1: GraphSet,
+    set_rt2: GraphSet,
     rt1: ImageId,
     rt2: ImageId,
     diffuse: ImageId,
@@ -217,10 +232,10 @@ impl Ssg {
             })
             .collect();
         Ok(Ssg {
+            set_rt1: source_set(s, &horizontal, rt1),
+            set_rt2: source_set(s, &vertical, rt2),
             horizontal: horizontal.keep(),
             vertical: vertical.keep(),
-            set_rt1: vk::DescriptorSet::null(),
-            set_rt2: vk::DescriptorSet::null(),
             rt1,
             rt2,
             diffuse,
@@ -255,7 +270,6 @@ impl Ssg {
 
 impl SssMethod for Ssg {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
-        let t = f.targets;
         let (rt1, rt2, diffuse) = (self.rt1, self.rt2, self.diffuse);
         let mut passes = vec![seed_copy(
             "ssg seed copy",
@@ -294,8 +308,7 @@ impl SssMethod for Ssg {
                     shader: "ssg_horizontal.frag",
                     loop_trips: vec![TAPS],
                     pipeline: horizontal,
-                    set: self.set_rt1,
-                    reads: vec![rt1, t.linear_depth],
+                    set: &self.set_rt1,
                     fetches: self.fetches(f, rt1),
                     targets: vec![(rt2, false)],
                     stencil,
@@ -312,8 +325,7 @@ impl SssMethod for Ssg {
                     shader: "ssg_vertical.frag",
                     loop_trips: vec![TAPS],
                     pipeline: vertical,
-                    set: self.set_rt2,
-                    reads: vec![rt2, t.linear_depth],
+                    set: &self.set_rt2,
                     fetches: self.fetches(f, rt2),
                     targets: vec![(rt1, false), (diffuse, true)],
                     stencil,
@@ -344,9 +356,8 @@ impl SssMethod for Ssg {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        self.set_rt1 = source_set(b, &self.horizontal, self.rt1)?;
-        self.set_rt2 = source_set(b, &self.vertical, self.rt2)?;
-        Ok(())
+        b.write(&mut self.set_rt1, &self.horizontal)?;
+        b.write(&mut self.set_rt2, &self.vertical)
     }
 
     fn intermediates(&self) -> Vec<ImageId> {

@@ -21,11 +21,10 @@ use std::collections::BTreeMap;
 use anyhow::{bail, Context as _, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::method::{lookup, EvalSetting, MethodEntry, MethodOptions};
+use crate::method::{lookup, none, EvalSetting, MethodEntry, MethodOptions, STENCIL_SKIN};
 
-/// The stencil bit the geometry pass sets on every skin pixel (as before groups).
-pub const SKIN_BIT: u32 = 1;
-/// Bits of the 8-bit stencil above the skin bit that carry the group index.
+/// Bits of the 8-bit stencil above the skin bit (`method::STENCIL_SKIN`, the
+/// one place it is written) that carry the group index.
 pub const GROUP_BITS: u32 = 7;
 /// How many groups one frame can tell apart by stencil (2^7).
 pub const MAX_GROUPS: usize = 1 << GROUP_BITS;
@@ -35,7 +34,7 @@ pub const MAX_GROUPS: usize = 1 << GROUP_BITS;
 /// and tests exactly what it did before groups existed.
 pub fn stencil_code(group: usize) -> u32 {
     debug_assert!(group < MAX_GROUPS);
-    SKIN_BIT | ((group as u32) << 1)
+    STENCIL_SKIN | ((group as u32) << 1)
 }
 
 /// One character's method and the option values given to it.
@@ -82,10 +81,10 @@ impl Choice {
         Ok(c)
     }
 
-    /// No SSS for this character.
+    /// No SSS for this character (the registry's `no_sss` entry, `method::none`).
     pub fn none() -> Choice {
         Choice {
-            method: "none".into(),
+            method: none().name.into(),
             options: BTreeMap::new(),
         }
     }
@@ -96,7 +95,7 @@ impl Choice {
     }
 
     pub fn is_none(&self) -> bool {
-        self.method == "none"
+        self.method == none().name
     }
 
     /// The options as the method reads them.
@@ -284,11 +283,11 @@ mod tests {
 
     #[test]
     fn stencil_codes_keep_the_skin_bit_and_group_zero_is_the_old_code() {
-        assert_eq!(stencil_code(0), SKIN_BIT);
+        assert_eq!(stencil_code(0), STENCIL_SKIN);
         assert_eq!(stencil_code(1), 3);
         assert_eq!(stencil_code(MAX_GROUPS - 1), 255);
         for g in 0..MAX_GROUPS {
-            assert_eq!(stencil_code(g) & SKIN_BIT, SKIN_BIT);
+            assert_eq!(stencil_code(g) & STENCIL_SKIN, STENCIL_SKIN);
         }
     }
 

@@ -24,10 +24,12 @@ use super::bloom_pyramid::{
 use super::{fetch, PostBind};
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Filter, PassRole, ShaderWork};
-use crate::graph::{ColorTarget, ImageDesc, ImageId, Load, Pass, PassContext, Resources};
+use crate::graph::{
+    Binding, ColorTarget, GraphSet, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+};
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
-use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline, Samplers};
 use crate::vk::shader_stats::alu_estimate;
 
 pub const DOWN_SHADER: &str = "bloom_down.frag";
@@ -68,16 +70,21 @@ pub struct Bloom {
     input: ImageId,
     output: ImageId,
     levels: Vec<Level>,
-    /// Per level: reduction, horizontal blur, vertical blur (null until
+    /// Per level: reduction, horizontal blur, vertical blur (written by
     /// `bind`: the passes are first built to derive the images' usages).
-    level_sets: [[vk::DescriptorSet; 3]; LEVELS],
-    combine_set: vk::DescriptorSet,
+    level_sets: Vec<[GraphSet; 3]>,
+    combine_set: GraphSet,
 }
 
 impl Bloom {
     /// Declares the pyramid's images for the composite `input` and builds the
     /// pipelines; on an error what was built is destroyed.
-    pub fn new(ctx: &Context, res: &mut Resources, input: ImageId) -> Result<Self> {
+    pub fn new(
+        ctx: &Context,
+        res: &mut Resources,
+        samplers: &Samplers,
+        input: ImageId,
+    ) -> Result<Self> {
         let extent = res.extent(input);
         let format = res.format(input);
         let levels = (1..=LEVELS)
@@ -94,7 +101,7 @@ impl Bloom {
                     )),
                 }
             })
-            .collect();
+            .collect::<Vec<Level>>();
         let output = res.declare(ImageDesc::new("bloomed hdr", extent, format));
         let build = |name, frag| {
             Pipeline::graphics(ctx, &GraphicsDesc::fullscreen(name, frag, format))
@@ -103,6 +110,32 @@ impl Bloom {
         let down = build("bloom down", DOWN_SHADER)?;
         let blur = build("bloom blur", BLUR_SHADER)?;
         let combine = build("bloom combine", COMBINE_SHADER)?;
+        let linear = (
+            "linearClamp",
+            Binding::Fixed(Bind::Sampler(samplers.linear_clamp)),
+        );
+        let res = &*res;
+        let src = |p: &Pipeline, id, sampler: bool| {
+            let mut binds = vec![("srcTex", Binding::Sampled(id))];
+            binds.extend(sampler.then_some(linear));
+            GraphSet::new(res, p, 0, binds)
+        };
+        let mut below = input;
+        let mut level_sets = Vec::with_capacity(LEVELS);
+        for l in &levels {
+            level_sets.push([
+                src(&down, below, true),
+                src(&blur, l.down, false),
+                src(&blur, l.across, false),
+            ]);
+            below = l.down;
+        }
+        let names = ["level1Tex", "level2Tex", "level3Tex", "level4Tex"];
+        let mut binds = vec![("hdrTex", Binding::Sampled(input)), linear];
+        for (name, l) in names.into_iter().zip(&levels) {
+            binds.push((name, Binding::Sampled(l.blurred)));
+        }
+        let combine_set = GraphSet::new(res, &combine, 0, binds);
         Ok(Bloom {
             down_pipeline: down.keep(),
             blur_pipeline: blur.keep(),
@@ -110,9 +143,14 @@ impl Bloom {
             input,
             output,
             levels,
-            level_sets: [[vk::DescriptorSet::null(); 3]; LEVELS],
-            combine_set: vk::DescriptorSet::null(),
+            level_sets,
+            combine_set,
         })
+    }
+
+    /// The HDR composite it reads.
+    pub fn input(&self) -> ImageId {
+        self.input
     }
 
     /// The bloomed HDR image the tone map reads.
@@ -121,44 +159,13 @@ impl Bloom {
     }
 
     pub fn bind(&mut self, b: &PostBind) -> Result<()> {
-        let (ctx, res, linear) = (b.ctx, b.res, b.samplers.linear_clamp);
-        let mut below = self.input;
-        for (l, sets) in self.levels.iter().zip(&mut self.level_sets) {
-            *sets = [
-                b.pool.write_set(
-                    ctx,
-                    &self.down_pipeline,
-                    0,
-                    &[
-                        ("srcTex", Bind::Texture(res.view(below))),
-                        ("linearClamp", Bind::Sampler(linear)),
-                    ],
-                )?,
-                b.pool.write_set(
-                    ctx,
-                    &self.blur_pipeline,
-                    0,
-                    &[("srcTex", Bind::Texture(res.view(l.down)))],
-                )?,
-                b.pool.write_set(
-                    ctx,
-                    &self.blur_pipeline,
-                    0,
-                    &[("srcTex", Bind::Texture(res.view(l.across)))],
-                )?,
-            ];
-            below = l.down;
+        for sets in &mut self.level_sets {
+            let [down, across, blurred] = sets;
+            b.write(down, &self.down_pipeline)?;
+            b.write(across, &self.blur_pipeline)?;
+            b.write(blurred, &self.blur_pipeline)?;
         }
-        let names = ["level1Tex", "level2Tex", "level3Tex", "level4Tex"];
-        let mut binds = vec![
-            ("hdrTex", Bind::Texture(res.view(self.input))),
-            ("linearClamp", Bind::Sampler(linear)),
-        ];
-        for (name, l) in names.into_iter().zip(&self.levels) {
-            binds.push((name, Bind::Texture(res.view(l.blurred))));
-        }
-        self.combine_set = b.pool.write_set(ctx, &self.combine_pipeline, 0, &binds)?;
-        Ok(())
+        b.write(&mut self.combine_set, &self.combine_pipeline)
     }
 
     /// The reductions, each level's two blurs, then the combine. Every fetch
@@ -173,11 +180,12 @@ impl Bloom {
                 alu: alu_estimate(DOWN_SHADER, &[]),
                 ..Default::default()
             };
-            let (pipeline, set) = (&self.down_pipeline, self.level_sets[i][0]);
+            let pipeline = &self.down_pipeline;
+            let mut pass = Pass::new(format!("bloom down {}", i + 1), PassRole::Post);
+            // Reads the level below (the composite for the first).
+            let set = pass.set(&self.level_sets[i][0]);
             passes.push(
-                Pass::new(format!("bloom down {}", i + 1), PassRole::Post)
-                    .sampled(below)
-                    .color(ColorTarget::new(l.down, Load::DontCare))
+                pass.color(ColorTarget::new(l.down, Load::DontCare))
                     .draws(Some(work), 1)
                     .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {})),
             );
@@ -186,8 +194,8 @@ impl Bloom {
         let weights = blur_weights();
         for (i, l) in self.levels.iter().enumerate() {
             for (axis, src, dst, dir, set) in [
-                ("h", l.down, l.across, [1, 0], self.level_sets[i][1]),
-                ("v", l.across, l.blurred, [0, 1], self.level_sets[i][2]),
+                ("h", l.down, l.across, [1, 0], &self.level_sets[i][1]),
+                ("v", l.across, l.blurred, [0, 1], &self.level_sets[i][2]),
             ] {
                 let work = ShaderWork {
                     shader: BLUR_SHADER.into(),
@@ -204,10 +212,11 @@ impl Bloom {
                 };
                 let pipeline = &self.blur_pipeline;
                 let push = BlurPush { weights, dir };
+                let mut pass = Pass::new(format!("bloom blur {axis} {}", i + 1), PassRole::Post);
+                // Reads `src`.
+                let set = pass.set(set);
                 passes.push(
-                    Pass::new(format!("bloom blur {axis} {}", i + 1), PassRole::Post)
-                        .sampled(src)
-                        .color(ColorTarget::new(dst, Load::DontCare))
+                    pass.color(ColorTarget::new(dst, Load::DontCare))
                         .draws(Some(work), 1)
                         .record(move |pc: &PassContext| {
                             fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &push))
@@ -230,11 +239,10 @@ impl Bloom {
             level_weights: LEVEL_WEIGHTS,
             strength: STRENGTH,
         };
-        let (pipeline, set) = (&self.combine_pipeline, self.combine_set);
-        let mut combine = Pass::new("bloom combine", PassRole::Post).sampled(self.input);
-        for l in &self.levels {
-            combine = combine.sampled(l.blurred);
-        }
+        let pipeline = &self.combine_pipeline;
+        let mut combine = Pass::new("bloom combine", PassRole::Post);
+        // Reads the composite and every blurred level.
+        let set = combine.set(&self.combine_set);
         passes.push(
             combine
                 .color(ColorTarget::new(self.output, Load::DontCare))

@@ -3,12 +3,13 @@
 //! baseline the morphological modes are charted against (issue 17).
 
 use anyhow::Result;
-use ash::vk;
 
 use super::{AaStage, PostBind, PostSetup};
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
-use crate::graph::{ColorTarget, ImageDesc, ImageId, Load, Pass, PassContext, Resources};
+use crate::graph::{
+    Binding, ColorTarget, GraphSet, ImageDesc, ImageId, Load, Pass, PassContext, Resources,
+};
 use crate::vk::context::Context;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
@@ -23,7 +24,7 @@ pub struct Fxaa {
     pipeline: Pipeline,
     input: ImageId,
     output: ImageId,
-    set: vk::DescriptorSet,
+    set: GraphSet,
 }
 
 impl Fxaa {
@@ -35,11 +36,24 @@ impl Fxaa {
         s.res.request_unorm_view(s.input);
         let pipeline =
             Pipeline::graphics(s.ctx, &GraphicsDesc::fullscreen("fxaa", SHADER, format))?;
+        let set = GraphSet::new(
+            s.res,
+            &pipeline,
+            0,
+            vec![
+                ("colorTex", Binding::Sampled(s.input)),
+                ("lumaTex", Binding::SampledUnorm(s.input)),
+                (
+                    "linearClamp",
+                    Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                ),
+            ],
+        );
         Ok(Fxaa {
             pipeline,
             input: s.input,
             output,
-            set: vk::DescriptorSet::null(),
+            set,
         })
     }
 }
@@ -72,9 +86,11 @@ impl AaStage for Fxaa {
             alu: alu_estimate(SHADER, &[SEARCH_STEPS]),
             ..Default::default()
         };
-        let (pipeline, set) = (&self.pipeline, self.set);
-        vec![Pass::new("fxaa", PassRole::Post)
-            .sampled(self.input)
+        let pipeline = &self.pipeline;
+        let mut pass = Pass::new("fxaa", PassRole::Post);
+        // Reads the tone-mapped frame (and its UNORM view).
+        let set = pass.set(&self.set);
+        vec![pass
             .color(ColorTarget::new(self.output, Load::DontCare))
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))]
@@ -85,17 +101,7 @@ impl AaStage for Fxaa {
     }
 
     fn bind(&mut self, b: &PostBind) -> Result<()> {
-        self.set = b.pool.write_set(
-            b.ctx,
-            &self.pipeline,
-            0,
-            &[
-                ("colorTex", Bind::Texture(b.res.view(self.input))),
-                ("lumaTex", Bind::Texture(b.res.unorm_view(self.input))),
-                ("linearClamp", Bind::Sampler(b.samplers.linear_clamp)),
-            ],
-        )?;
-        Ok(())
+        b.write(&mut self.set, &self.pipeline)
     }
 
     fn images(&self) -> Vec<(&'static str, ImageId)> {

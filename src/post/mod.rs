@@ -12,11 +12,14 @@
 //! - `bloom`: a Gaussian pyramid on the HDR composite before the tone map
 //!   (thesis ch. 3.1, 11.1); its numbers in `bloom_pyramid` (pure).
 //! - `tonemap`: Hable's filmic curve, HDR composite -> LDR frame.
-//! - `mlaa`: Jimenez's MLAA, three passes (edges writing the stencil, blending
-//!   weights, neighbourhood blending, both stencil-tested) and a copy.
-//! - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
-//!   local contrast adaptation writing the stencil, blending weights
-//!   (stencil-tested: diagonals, accurate searches, corners), blending.
+//! - `morphological`: the one stage MLAA and SMAA both are (edges writing
+//!   the stencil, blending weights where it is set, neighbourhood blending),
+//!   its variants given as data and their push constants:
+//!   - `mlaa`: Jimenez's MLAA, luma or depth edges, the blend on edge pixels
+//!     only after a copy of the frame;
+//!   - `smaa`: SMAA 1x (thesis ch. 10.4.1-10.4.2), its presets: edges with
+//!     local contrast adaptation, weights with diagonals, accurate searches
+//!     and corners, the blend on every pixel.
 //! - `fxaa`: FXAA's quality preset, one pass.
 //!
 //! The device-free parts (area texture, CPU references) live in `crate::aa`.
@@ -25,6 +28,7 @@ pub mod bloom;
 pub mod bloom_pyramid;
 pub mod fxaa;
 pub mod mlaa;
+pub mod morphological;
 pub mod smaa;
 pub mod tonemap;
 
@@ -36,9 +40,10 @@ use ash::vk;
 
 use crate::aa::edges::Preset;
 use crate::graph::work::{Fetch, Filter};
-use crate::graph::{ImageId, Pass, Resources};
+use crate::graph::{GraphSet, ImageId, Pass, Resources};
 use crate::vk::context::Context;
-use crate::vk::pipeline::{DescriptorPool, Samplers};
+use crate::vk::pipeline::{DescriptorPool, Pipeline, Samplers};
+use morphological::Morphological;
 
 /// Which anti-aliasing the frame gets after the tone map (`--aa`).
 #[derive(
@@ -260,14 +265,22 @@ pub struct PostSetup<'a> {
     pub linear_depth: ImageId,
     /// Millimetres per scene unit (the depth threshold is in millimetres).
     pub mm_per_unit: f32,
+    /// The frame's samplers (the stages' sets are stated when they are built).
+    pub samplers: &'a Samplers,
 }
 
-/// What a stage's descriptor sets are written from, once the images exist.
+/// What a stage's descriptor sets are written with, once the images exist.
 pub struct PostBind<'a> {
     pub ctx: &'a Context,
     pub res: &'a Resources,
     pub pool: &'a DescriptorPool,
-    pub samplers: &'a Samplers,
+}
+
+impl PostBind<'_> {
+    /// Writes `set`, made for `pipeline`, from the frame's pool.
+    pub fn write(&self, set: &mut GraphSet, pipeline: &Pipeline) -> Result<()> {
+        set.write(self.ctx, self.pool, self.res, pipeline)
+    }
 }
 
 /// One anti-aliasing stage of the chain.
@@ -300,7 +313,7 @@ impl PostChain {
         let ctx = s.ctx;
         let mut chain = crate::vk::guard::Guard::new(ctx, PostChain::default());
         if s.options.bloom {
-            chain.bloom = Some(bloom::Bloom::new(ctx, s.res, s.hdr)?);
+            chain.bloom = Some(bloom::Bloom::new(ctx, s.res, s.samplers, s.hdr)?);
         }
         // The tone map reads the bloomed composite when there is one.
         let hdr = chain.bloom.as_ref().map_or(s.hdr, bloom::Bloom::output);
@@ -308,42 +321,68 @@ impl PostChain {
         chain.aa = match mode {
             AaMode::None => None,
             AaMode::Fxaa => Some(Box::new(fxaa::Fxaa::new(s)?)),
-            AaMode::Mlaa => Some(Box::new(mlaa::Mlaa::new(s)?)),
-            AaMode::Smaa => Some(Box::new(smaa::Smaa::new(s)?)),
+            AaMode::Mlaa => Some(Box::new(Morphological::new(
+                s,
+                Box::new(mlaa::Mlaa::new(s)),
+            )?)),
+            AaMode::Smaa => Some(Box::new(Morphological::new(
+                s,
+                Box::new(smaa::Smaa::new(s)),
+            )?)),
         };
         Ok(chain.keep())
     }
 
-    /// The bloom's passes, the tone map's, then the anti-aliasing stage's.
-    pub fn passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        let mut passes = self.bloom_passes(res);
+    /// The bloom stage of the frame's recipe: from the HDR composite `hdr`
+    /// to the bloomed composite it hands on (`hdr` itself without `--bloom`).
+    pub fn bloom<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        hdr: ImageId,
+    ) -> ImageId {
+        match &self.bloom {
+            Some(b) => {
+                debug_assert_eq!(b.input(), hdr, "the bloom reads another image");
+                passes.extend(b.passes(res));
+                b.output()
+            }
+            None => hdr,
+        }
+    }
+
+    /// The tone map stage: from `hdr` to the LDR frame.
+    pub fn tonemap<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        hdr: ImageId,
+    ) -> ImageId {
+        debug_assert_eq!(
+            self.tonemap.input(),
+            hdr,
+            "the tone map reads another image"
+        );
         passes.push(self.tonemap.pass(res));
-        passes.extend(self.aa_passes(res));
-        passes
+        self.tonemap.output()
     }
 
-    /// The bloom's passes alone (none without `--bloom`).
-    pub fn bloom_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        self.bloom
-            .as_ref()
-            .map(|b| b.passes(res))
-            .unwrap_or_default()
-    }
-
-    /// The bloom's image named `name` (`bloom::Bloom::images`), `None`
-    /// without `--bloom`.
-    pub fn bloom_image(&self, name: &str) -> Option<ImageId> {
-        self.bloom
-            .as_ref()?
-            .images()
-            .into_iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, id)| id)
-    }
-
-    /// The anti-aliasing stage's passes alone (none without one).
-    pub fn aa_passes<'a>(&'a self, res: &Resources) -> Vec<Pass<'a>> {
-        self.aa.as_ref().map(|a| a.passes(res)).unwrap_or_default()
+    /// The anti-aliasing stage: from the LDR frame `ldr` to the frame's
+    /// output (`ldr` itself without a stage).
+    pub fn anti_alias<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        ldr: ImageId,
+    ) -> ImageId {
+        match &self.aa {
+            Some(a) => {
+                debug_assert_eq!(self.tonemap.output(), ldr, "the stage reads another image");
+                passes.extend(a.passes(res));
+                a.output()
+            }
+            None => ldr,
+        }
     }
 
     /// The anti-aliased frame, `None` without a stage.

@@ -3,14 +3,13 @@
 //! encodes). Every frame has it, whatever `--aa` says.
 
 use anyhow::Result;
-use ash::vk;
 
 use super::PostBind;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
-use crate::graph::{ColorTarget, ImageId, Load, Pass, PassContext, Resources};
+use crate::graph::{Binding, ColorTarget, GraphSet, ImageId, Load, Pass, PassContext, Resources};
 use crate::vk::context::Context;
-use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
 
 pub const SHADER: &str = "tonemap.frag";
@@ -29,7 +28,7 @@ struct TonemapPush {
 #[derive(Default)]
 pub struct Tonemap {
     pipeline: Pipeline,
-    set: vk::DescriptorSet,
+    set: GraphSet,
     input: ImageId,
     output: ImageId,
     exposure: f32,
@@ -44,23 +43,28 @@ impl Tonemap {
         exposure: f32,
     ) -> Result<Self> {
         let desc = GraphicsDesc::fullscreen("tonemap", SHADER, res.format(output));
+        let pipeline = Pipeline::graphics(ctx, &desc)?;
         Ok(Tonemap {
-            pipeline: Pipeline::graphics(ctx, &desc)?,
-            set: vk::DescriptorSet::null(),
+            set: GraphSet::new(res, &pipeline, 0, vec![("hdrTex", Binding::Sampled(input))]),
+            pipeline,
             input,
             output,
             exposure,
         })
     }
 
+    /// The HDR image it reads.
+    pub fn input(&self) -> ImageId {
+        self.input
+    }
+
+    /// The LDR frame it writes.
+    pub fn output(&self) -> ImageId {
+        self.output
+    }
+
     pub fn bind(&mut self, b: &PostBind) -> Result<()> {
-        self.set = b.pool.write_set(
-            b.ctx,
-            &self.pipeline,
-            0,
-            &[("hdrTex", Bind::Texture(b.res.view(self.input)))],
-        )?;
-        Ok(())
+        b.write(&mut self.set, &self.pipeline)
     }
 
     /// One point fetch of the HDR composite per pixel, every pixel written.
@@ -83,10 +87,11 @@ impl Tonemap {
             exposure: self.exposure,
             white_point: WHITE_POINT,
         };
-        let (pipeline, set) = (&self.pipeline, self.set);
-        Pass::new("tonemap", PassRole::Post)
-            .sampled(self.input)
-            .color(ColorTarget::new(self.output, Load::DontCare))
+        let pipeline = &self.pipeline;
+        let mut pass = Pass::new("tonemap", PassRole::Post);
+        // Reads the HDR composite.
+        let set = pass.set(&self.set);
+        pass.color(ColorTarget::new(self.output, Load::DontCare))
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
                 fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &push))

@@ -4,7 +4,6 @@
 //! read-back, so the counts are per pass.
 
 use anyhow::{bail, Context as _, Result};
-use ash::vk;
 
 use super::Renderer;
 use crate::graph::work::{Filter, PassRole, Work};
@@ -59,8 +58,7 @@ impl Renderer<'_> {
             .fetch_counts
             .as_ref()
             .context("counting fetches needs a context made with count_fetches")?;
-        let raw = counter.raw;
-        let id = self.resources.add_buffer("fetch counters", raw);
+        let id = self.resources.add_buffer("fetch counters", counter.raw);
         let mut out = Vec::new();
         // One frame, recorded pass by pass.
         self.begin_frame();
@@ -77,16 +75,11 @@ impl Renderer<'_> {
             };
             let name = pass.name.clone();
             pass.buffers.push((id, counted));
-            let zero = Pass::new("zero fetch counters", PassRole::Setup)
-                // vkCmdFillBuffer runs in the copy stage (what synchronization validation sees).
-                .buffer(id, AccessKind::TransferWrite)
-                .record(move |pc: &PassContext| unsafe {
-                    pc.ctx
-                        .device
-                        .cmd_fill_buffer(pc.cmd, raw, 0, vk::WHOLE_SIZE, 0)
-                });
-            let host = Pass::new("fetch counters to host", PassRole::Setup)
-                .buffer(id, AccessKind::HostRead);
+            let mut zero = Pass::new("zero fetch counters", PassRole::Setup);
+            // vkCmdFillBuffer runs in the copy stage (what synchronization validation sees).
+            let counters = zero.transfer_dst_buffer(id);
+            let zero = zero.record(move |pc: &PassContext| pc.fill_buffer(counters, 0));
+            let host = Pass::new("fetch counters to host", PassRole::Setup).host_read(id);
             super::submit_passes(
                 ctx,
                 &self.submit,

@@ -1,38 +1,44 @@
-//! The frame around the SSS methods: shadow map (key light, orthographic, so its
-//! depth is linear) -> geometry pass into the targets (Lambert + transmittance,
-//! Kelemen/Szirmay-Kalos specular, linear depth, each character's group code in
-//! the stencil) -> each group's method's passes (one group in a single-method
-//! frame; where they work and in what order: `group_passes.rs`) and, in a
-//! frame of several, the merges (`merge.rs`) -> composite
-//! (diffuse after SSS + specular) -> Hable tone map -> the post chain's
-//! anti-aliasing stage (`crate::post`, `--aa`; none by default).
+//! The frame around the SSS methods, and its recipe ([`Frame::passes`]):
+//! shadow map (key light, orthographic, so its depth is linear) -> geometry
+//! pass into the targets (Lambert + transmittance, Kelemen/Szirmay-Kalos
+//! specular, linear depth, each character's group code in the stencil) ->
+//! the groups' SSS (each group's method's passes, one group in a
+//! single-method frame; in a frame of several the merges and fades:
+//! `groups/`) -> composite (diffuse after SSS + specular) -> bloom -> Hable
+//! tone map -> the anti-aliasing stage (`crate::post`) -> the character ids
+//! (`--character-ids`). Each stage records its passes and hands the next
+//! the images it wrote.
 //!
-//! Over 800 lines because every pass the frame itself records (shadow,
-//! geometry, composite, tone map, the character ids) reads the private
-//! pipelines, sets and instance slots of the one `Frame` they draw from: their
-//! pipelines, descriptor sets and passes read best beside that struct.
+//! The frame's own stages (shadow, geometry, composite, character ids) are
+//! here, beside the pipelines, sets and instance slots they draw with; the
+//! instance buffer is `instances.rs`, the uniform block `uniforms.rs`.
 
 use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
-use super::groups::{scissors, GroupMethod};
-use super::merge::Merge;
+use super::groups::merge::Merge;
+use super::groups::region::scissors;
+use super::groups::{passes as groups, GroupMethod};
+use super::instances::{Instances, SkinGroup};
 use super::scene_gpu::GpuObject;
 use super::settings::RenderSettings;
 use super::targets::SHADOW_FORMAT;
+use super::uniforms::FrameUniforms;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
-use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext, Resources};
+use crate::graph::{
+    Binding, ColorTarget, DepthStencil, GraphSet, ImageId, Load, Pass, PassContext, Resources,
+};
 use crate::method::region::PixelRect;
-use crate::method::{FrameTargets, ViewInfo, STENCIL_SKIN};
+use crate::method::{FrameTargets, FrameView, ViewInfo, STENCIL_SKIN};
 use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
 use crate::scene::framing::Framing;
 use crate::scene::light::LightFrame;
 use crate::scene::Scene;
+use crate::shader_constants::PCF_TRIPS;
 use crate::skin::beckmann::beckmann_lut;
-use crate::skin::transmittance::shrink_units;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::{Buffer, Image};
@@ -47,29 +53,10 @@ use crate::vk::upload;
 const DESCRIPTOR_SETS: u32 = 256;
 /// Side of the Beckmann look-up texture (seed 004's specular): 256 x 256 R16F.
 const BECKMANN_SIZE: u32 = 256;
-/// Receiver bias of the shadow test along the light, in millimetres: half a
-/// millimetre keeps skin from shadowing itself at the shadow map's resolution.
-const SHADOW_BIAS_MM: f32 = 0.5;
 /// Slope-scaled depth bias of the shadow pass (in units of the depth slope):
 /// the usual 1.5 against acne on curved skin at grazing light.
 const SHADOW_SLOPE_BIAS: f32 = 1.5;
 const COMPOSITE_SHADER: &str = "composite.frag";
-use crate::shader_constants::PCF_TRIPS;
-
-/// std140 layout of `FrameUniforms` (shaders/frame_uniforms.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FrameUniforms {
-    pub view_proj: [[f32; 4]; 4],
-    pub view: [[f32; 4]; 4],
-    pub light_view_proj: [[f32; 4]; 4],
-    pub camera_pos: [f32; 4],
-    pub light_dir: [f32; 4],
-    pub light_color: [f32; 4],
-    pub ambient: [f32; 4],
-    pub params: [f32; 4],
-    pub shadow_params: [f32; 4],
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -90,16 +77,6 @@ const IDS_SHADER: &str = "geometry_ids.frag";
 /// read per instance.
 const GEOMETRY_VERT: &str = "geometry_instanced.vert";
 
-/// A full-screen post pass: what it reads (image, shader variable), what it writes.
-struct PostPass<'a, 'r> {
-    name: &'r str,
-    pipeline: &'a Pipeline,
-    shader: &'static str,
-    set: vk::DescriptorSet,
-    reads: &'r [(ImageId, &'r str)],
-    target: ImageId,
-}
-
 /// The frame's pipelines, uniforms, scene objects and placement.
 pub struct Frame {
     pub settings: RenderSettings,
@@ -119,10 +96,14 @@ pub struct Frame {
     /// `--character-ids` only: the pass that writes each head's index + 1
     /// into `character_ids` after the frame (null otherwise).
     ids_pipeline: Pipeline,
-    ids_set: vk::DescriptorSet,
+    ids_set: GraphSet,
     pub character_ids: Option<ImageId>,
-    frame_set: vk::DescriptorSet,
-    composite_set: vk::DescriptorSet,
+    /// Set 0 of the geometry pass (`lighting.glsl`'s frame set: it samples
+    /// the shadow map).
+    frame_set: GraphSet,
+    /// The composite's set: the diffuse light after SSS and the specular
+    /// target (`composite_from`).
+    composite_set: GraphSet,
     frame_ubo: Buffer,
     beckmann: Image,
     pub objects: Vec<GpuObject>,
@@ -131,35 +112,20 @@ pub struct Frame {
     /// stencil reference (one group of every character, code 1, until
     /// `set_skin_groups`).
     pub skin_groups: Vec<SkinGroup>,
-    /// Every character's model matrix, group after group, then the
+    /// Every character's model matrix in `skin_groups`' order, then the
     /// backdrop's: the shadow, geometry and id passes draw instances of it.
-    instance_buffer: Buffer,
-    /// Each group's first slot in it and count; the backdrop's slot; each
-    /// character's slot.
-    group_slots: Vec<(u32, u32)>,
-    backdrop_slot: u32,
-    character_slots: Vec<u32>,
+    instance_buffer: Instances,
     /// The instance buffer as the shadow pipeline's set 0 and the geometry
-    /// and id pipelines' set 2.
+    /// and id pipelines' set 2 (no frame image: plain sets).
     shadow_set: vk::DescriptorSet,
     instance_set: vk::DescriptorSet,
     ids_instance_set: vk::DescriptorSet,
-    pub(super) screen_rect: Vec<vk::Rect2D>,
-    /// The stages after the tone map (`enable_post`; none with `--aa none`).
+    screen_rect: Vec<vk::Rect2D>,
+    /// The bloom, the tone map and the anti-aliasing stage (`enable_post`).
     pub post: PostChain,
 }
 
-/// The heads of one group as the geometry pass draws them.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SkinGroup {
-    pub stencil: u32,
-    /// Frame indices (into `Frame::instances`).
-    pub characters: Vec<usize>,
-}
-
 impl Frame {
-    /// Pipelines, uniforms and scene objects (no descriptor set that needs a
-    /// frame image yet: `bind` writes those once the images exist).
     /// Pipelines, uniforms and scene objects (no descriptor set that needs a
     /// frame image yet: `bind` writes those once the images exist). On an
     /// error, whatever was made is destroyed.
@@ -193,10 +159,10 @@ impl Frame {
             geometry_pipeline: Pipeline::default(),
             composite_pipeline: Pipeline::default(),
             ids_pipeline: Pipeline::default(),
-            ids_set: vk::DescriptorSet::null(),
+            ids_set: GraphSet::default(),
             character_ids: None,
-            frame_set: vk::DescriptorSet::null(),
-            composite_set: vk::DescriptorSet::null(),
+            frame_set: GraphSet::default(),
+            composite_set: GraphSet::default(),
             frame_ubo: Buffer::default(),
             beckmann: Image::default(),
             objects: Vec::new(),
@@ -204,10 +170,7 @@ impl Frame {
                 stencil: STENCIL_SKIN,
                 characters: every,
             }],
-            instance_buffer: Buffer::default(),
-            group_slots: Vec::new(),
-            backdrop_slot: 0,
-            character_slots: Vec::new(),
+            instance_buffer: Instances::default(),
             shadow_set: vk::DescriptorSet::null(),
             instance_set: vk::DescriptorSet::null(),
             ids_instance_set: vk::DescriptorSet::null(),
@@ -246,13 +209,20 @@ impl Frame {
             vk::Format::R16_SFLOAT,
             bytemuck::cast_slice(&lut),
         )?;
-        let uniforms = self.uniforms(scene, transmittance);
+        let uniforms = FrameUniforms::new(
+            &self.settings,
+            scene,
+            self.camera,
+            self.light_frame,
+            transmittance,
+        );
         self.frame_ubo = Buffer::with_data(
             ctx,
             "frame uniforms",
             bytemuck::bytes_of(&uniforms),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
+        self.frame_set = GraphSet::new(res, &self.geometry_pipeline, 0, self.frame_binds());
         let objects = scene
             .backdrop
             .iter()
@@ -272,36 +242,12 @@ impl Frame {
         self.write_instances(ctx)
     }
 
-    /// The instance buffer of `skin_groups` (group after group, then the
-    /// backdrop) and the sets that read it.
+    /// The instance buffer of `skin_groups` and the sets that read it.
     fn write_instances(&mut self, ctx: &Context) -> Result<()> {
-        let mut models: Vec<[[f32; 4]; 4]> = Vec::new();
-        self.group_slots.clear();
-        self.character_slots = vec![0; self.instances.len()];
-        for g in &self.skin_groups {
-            self.group_slots
-                .push((models.len() as u32, g.characters.len() as u32));
-            for &c in &g.characters {
-                self.character_slots[c] = models.len() as u32;
-                models.push(self.instances[c].to_cols_array_2d());
-            }
-        }
-        self.backdrop_slot = models.len() as u32;
-        models.push(self.backdrop.to_cols_array_2d());
         self.instance_buffer.destroy(ctx);
-        self.instance_buffer = Buffer::with_data(
-            ctx,
-            "character instances",
-            bytemuck::cast_slice(&models),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )?;
-        let bind = [(
-            "Instances",
-            Bind::Uniform {
-                buffer: self.instance_buffer.raw,
-                size: (models.len() * std::mem::size_of::<[[f32; 4]; 4]>()) as u64,
-            },
-        )];
+        self.instance_buffer =
+            Instances::new(ctx, &self.skin_groups, &self.instances, self.backdrop)?;
+        let bind = [self.instance_buffer.binding()];
         self.shadow_set = self.pool.write_set(ctx, &self.shadow_pipeline, 0, &bind)?;
         self.instance_set = self
             .pool
@@ -411,13 +357,15 @@ impl Frame {
                 blend: Blend::None,
             },
         )?;
+        // The frame's uniforms alone (the id shader reads nothing else).
+        self.ids_set = GraphSet::new(res, &self.ids_pipeline, 0, self.frame_binds()[..1].to_vec());
         self.character_ids = Some(ids);
         self.write_instances(ctx)
     }
 
-    /// Builds the post chain: the tone map, and the stage `settings.aa`
-    /// names with its images declared (before the usages are derived: its
-    /// passes declare them). Every frame needs it.
+    /// Builds the post chain: the bloom with `--bloom`, the tone map, and
+    /// the stage `settings.aa` names, with their images declared (before the
+    /// usages are derived: their passes declare them). Every frame needs it.
     pub fn enable_post(&mut self, ctx: &Context, res: &mut Resources) -> Result<()> {
         let depth_stencil_format = res.format(self.targets.depth_stencil);
         self.post = PostChain::new(
@@ -432,9 +380,26 @@ impl Frame {
                 options: self.settings.post,
                 linear_depth: self.targets.linear_depth,
                 mm_per_unit: self.mm_per_unit,
+                samplers: &self.samplers,
             },
         )?;
         Ok(())
+    }
+
+    /// The composite reads `diffuse` (what the groups' stage hands it: the
+    /// method's output in a single-method frame, the merged diffuse target
+    /// in a frame of several) and the specular target (before the usages are
+    /// derived: its pass declares them through this set).
+    pub fn composite_from(&mut self, res: &Resources, diffuse: ImageId) {
+        self.composite_set = GraphSet::new(
+            res,
+            &self.composite_pipeline,
+            0,
+            vec![
+                ("diffuseTex", Binding::Sampled(diffuse)),
+                ("specularTex", Binding::Sampled(self.targets.specular)),
+            ],
+        );
     }
 
     /// The frame's output image: the anti-aliased frame, or the tone-mapped
@@ -443,40 +408,17 @@ impl Frame {
         self.post.output().unwrap_or(self.targets.ldr)
     }
 
-    /// The frame's uniforms: camera, key light, shadow and transmittance parameters.
-    fn uniforms(&self, scene: &Scene, transmittance: bool) -> FrameUniforms {
-        let settings = &self.settings;
-        let aspect = settings.width as f32 / settings.height as f32;
-        let (camera, light_frame) = (self.camera, self.light_frame);
-        let light_dir = settings.light.direction_to_light(scene.forward);
-        let light = settings.light;
-        let mm = scene.mm_per_unit;
-        let bias = SHADOW_BIAS_MM / mm / light_frame.depth_range_units;
-        FrameUniforms {
-            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
-            view: camera.view().to_cols_array_2d(),
-            light_view_proj: light_frame.view_proj.to_cols_array_2d(),
-            camera_pos: camera.eye.extend(1.0).to_array(),
-            light_dir: light_dir.extend(0.0).to_array(),
-            light_color: [
-                light.color[0] * light.intensity,
-                light.color[1] * light.intensity,
-                light.color[2] * light.intensity,
-                0.0,
-            ],
-            ambient: [settings.ambient; 4],
-            params: [
-                mm,
-                light_frame.depth_range_units,
-                shrink_units(mm),
-                (settings.transmittance && transmittance) as u32 as f32,
-            ],
-            shadow_params: [
-                1.0 / settings.shadow_size as f32,
-                bias,
-                settings.transmittance_profile.exponent_scale(),
-                0.0,
-            ],
+    /// The frame's own view of its targets (the whole screen, the skin
+    /// bit): what the groups' views narrow down.
+    pub fn view<'a, 'r>(&'a self, res: &'r Resources) -> FrameView<'a, 'r> {
+        FrameView {
+            targets: &self.targets,
+            res,
+            extent: self.extent,
+            region: &self.screen_rect,
+            depths: &[],
+            screen: &self.screen_rect,
+            stencil: STENCIL_SKIN,
         }
     }
 
@@ -496,127 +438,108 @@ impl Frame {
         self.write_instances(ctx)
     }
 
-    /// The bindings of `lighting.glsl`'s set 0 (frame).
-    pub fn frame_binds(&self, res: &Resources) -> Vec<(&'static str, Bind)> {
+    /// The bindings of `lighting.glsl`'s set 0 (frame): its uniforms, the
+    /// shadow map (a frame image: a pass binding them declares it), the
+    /// samplers and the Beckmann table.
+    pub fn frame_binds(&self) -> Vec<(&'static str, Binding)> {
+        let fixed = |b| Binding::Fixed(b);
         vec![
             (
                 "frame",
-                Bind::Uniform {
+                fixed(Bind::Uniform {
                     buffer: self.frame_ubo.raw,
                     size: std::mem::size_of::<FrameUniforms>() as u64,
-                },
+                }),
             ),
-            ("shadowMap", Bind::Texture(res.view(self.targets.shadow))),
-            ("shadowCompare", Bind::Sampler(self.samplers.shadow_compare)),
-            ("nearestClamp", Bind::Sampler(self.samplers.nearest_clamp)),
-            ("beckmannTex", Bind::Texture(self.beckmann.view)),
-            ("linearClamp", Bind::Sampler(self.samplers.linear_clamp)),
+            ("shadowMap", Binding::Sampled(self.targets.shadow)),
+            (
+                "shadowCompare",
+                fixed(Bind::Sampler(self.samplers.shadow_compare)),
+            ),
+            (
+                "nearestClamp",
+                fixed(Bind::Sampler(self.samplers.nearest_clamp)),
+            ),
+            ("beckmannTex", fixed(Bind::Texture(self.beckmann.view))),
+            (
+                "linearClamp",
+                fixed(Bind::Sampler(self.samplers.linear_clamp)),
+            ),
         ]
     }
 
-    /// The descriptor sets that read frame images (after they exist); the
-    /// composite reads `sss_output`: the method's output in a single-method
-    /// frame, the (merged) diffuse target in a frame of several.
-    pub fn bind(&mut self, ctx: &Context, res: &Resources, sss_output: ImageId) -> Result<()> {
-        let t = self.targets;
-        self.frame_set =
-            self.pool
-                .write_set(ctx, &self.geometry_pipeline, 0, &self.frame_binds(res))?;
-        self.composite_set = self.pool.write_set(
-            ctx,
-            &self.composite_pipeline,
-            0,
-            &[
-                ("diffuseTex", Bind::Texture(res.view(sss_output))),
-                ("specularTex", Bind::Texture(res.view(t.specular))),
-            ],
-        )?;
+    /// Writes the frame's and the post chain's descriptor sets (once the
+    /// images exist).
+    pub fn bind(&mut self, ctx: &Context, res: &Resources) -> Result<()> {
+        let pool = &self.pool;
+        self.frame_set
+            .write(ctx, pool, res, &self.geometry_pipeline)?;
+        self.composite_set
+            .write(ctx, pool, res, &self.composite_pipeline)?;
         if self.character_ids.is_some() {
-            self.ids_set =
-                self.pool
-                    .write_set(ctx, &self.ids_pipeline, 0, &self.frame_binds(res)[..1])?;
+            self.ids_set.write(ctx, pool, res, &self.ids_pipeline)?;
         }
-        self.post.bind(&PostBind {
-            ctx,
-            res,
-            pool: &self.pool,
-            samplers: &self.samplers,
-        })
+        self.post.bind(&PostBind { ctx, res, pool })
     }
 
-    /// The frame's passes in order, the groups' in the middle.
+    /// The frame's recipe: each stage records its passes into `passes` and
+    /// hands the next the images it wrote.
     pub fn passes<'a>(
         &'a self,
         groups: &'a [GroupMethod],
         merge: &'a Merge,
         res: &Resources,
     ) -> Vec<Pass<'a>> {
-        let mut passes = vec![self.shadow_pass(), self.geometry_pass(res)];
-        passes.extend(self.group_passes(groups, merge, res));
-        passes.push(self.composite_pass(res, self.composite_source(groups)));
-        passes.extend(self.post.passes(res));
+        let mut passes = Vec::new();
+        let shadow = self.shadow_map(&mut passes);
+        let gbuffer = self.geometry(&mut passes, res, shadow);
+        let diffuse = groups::sss(&mut passes, &gbuffer, groups, merge);
+        let hdr = self.composite(&mut passes, res, diffuse, gbuffer.targets.specular);
+        let hdr = self.post.bloom(&mut passes, res, hdr);
+        let ldr = self.post.tonemap(&mut passes, res, hdr);
+        self.post.anti_alias(&mut passes, res, ldr);
         if let Some(ids) = self.character_ids {
-            passes.push(self.character_ids_pass(ids));
+            self.character_ids(&mut passes, ids, gbuffer.targets.depth_stencil);
         }
         passes
     }
 
-    /// After the frame (`--character-ids`): every head again, depth-tested
-    /// EQUAL against the frame's depth, writing its frame index + 1. Set-up
-    /// work, not frame cost; only the flag adds it.
-    fn character_ids_pass<'a>(&'a self, ids: ImageId) -> Pass<'a> {
-        Pass::new("character ids", PassRole::Setup)
-            .color(ColorTarget::new(ids, Load::Clear([0.0; 4])))
-            .depth_stencil(DepthStencil::test_only(self.targets.depth_stencil).depth_test(true))
-            .draws(None, self.triangles(true))
-            .record(move |pc: &PassContext| {
-                let (ctx, cmd) = (pc.ctx, pc.cmd);
-                let p = &self.ids_pipeline;
-                p.bind(ctx, cmd, &[self.ids_set]);
-                p.bind_sets(ctx, cmd, 2, &[self.ids_instance_set]);
-                for obj in self.objects.iter().filter(|o| o.skin) {
-                    for (c, &slot) in self.character_slots.iter().enumerate() {
-                        p.push(ctx, cmd, &IdPush { id: (c + 1) as f32 });
-                        obj.draw_instances(ctx, cmd, slot, 1);
+    /// The key light's depth from every head (the backdrop receives shadows
+    /// but casts none worth a texel): the shadow map.
+    fn shadow_map<'a>(&'a self, passes: &mut Vec<Pass<'a>>) -> ImageId {
+        let shadow = self.targets.shadow;
+        passes.push(
+            Pass::new("shadow map", PassRole::Shadow)
+                .depth_stencil(DepthStencil::cleared(shadow, 1.0))
+                .draws(None, self.triangles(true))
+                .record(move |pc: &PassContext| {
+                    let (ctx, cmd) = (pc.ctx, pc.cmd);
+                    self.shadow_pipeline.bind(ctx, cmd, &[self.shadow_set]);
+                    let push = ShadowPush {
+                        light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
+                    };
+                    self.shadow_pipeline.push(ctx, cmd, &push);
+                    // Every character in one instanced draw.
+                    let heads = self.instance_buffer.backdrop_slot;
+                    for obj in self.objects.iter().filter(|o| o.skin) {
+                        obj.draw_instances(ctx, cmd, 0, heads);
                     }
-                }
-            })
+                }),
+        );
+        shadow
     }
 
-    /// Triangles the skin objects submit per frame (every character), and all objects.
-    fn triangles(&self, skin_only: bool) -> u64 {
-        self.objects
-            .iter()
-            .filter(|o| o.skin || !skin_only)
-            .map(|o| {
-                let copies = if o.skin { self.instances.len() } else { 1 };
-                o.mesh.triangles() * copies as u64
-            })
-            .sum()
-    }
-
-    fn shadow_pass<'a>(&'a self) -> Pass<'a> {
-        Pass::new("shadow map", PassRole::Shadow)
-            .depth_stencil(DepthStencil::cleared(self.targets.shadow, 1.0))
-            .draws(None, self.triangles(true))
-            .record(move |pc: &PassContext| {
-                let (ctx, cmd) = (pc.ctx, pc.cmd);
-                self.shadow_pipeline.bind(ctx, cmd, &[self.shadow_set]);
-                let push = ShadowPush {
-                    light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
-                };
-                self.shadow_pipeline.push(ctx, cmd, &push);
-                // Heads only: the backdrop receives shadows but casts none worth
-                // a texel. Every character in one instanced draw.
-                let heads = self.backdrop_slot;
-                for obj in self.objects.iter().filter(|o| o.skin) {
-                    obj.draw_instances(ctx, cmd, 0, heads);
-                }
-            })
-    }
-
-    fn geometry_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
+    /// Every object lit by the key light through `shadow` into the targets:
+    /// the frame's view of them (what the SSS methods read) is what it hands
+    /// on.
+    fn geometry<'a, 'r>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &'r Resources,
+        shadow: ImageId,
+    ) -> FrameView<'a, 'r> {
         let t = self.targets;
+        debug_assert!(self.frame_set.reads(shadow));
         let shader = geometry_shader(&t);
         let rgba8 = |texture: &str, exact| Fetch {
             texture: texture.into(),
@@ -627,7 +550,7 @@ impl Frame {
             coherent: true,
             spread: Vec::new(),
         };
-        let shadow_format = res.texel_format(t.shadow);
+        let shadow_format = res.texel_format(shadow);
         // Per fragment: the 3x3 PCF, the three material maps (the normal map
         // only where the tangent frame is valid), the Beckmann lobe where
         // N.L > 0, and one shadow-map texel for transmittance on skin.
@@ -686,8 +609,10 @@ impl Frame {
             Some(m) => DepthStencil::cleared(m.depth_stencil, 1.0).resolved_into(t.depth_stencil),
             None => DepthStencil::cleared(t.depth_stencil, 1.0),
         };
-        let mut pass = Pass::new("geometry", PassRole::Geometry)
-            .sampled(t.shadow)
+        let mut pass = Pass::new("geometry", PassRole::Geometry);
+        // The frame's set samples the shadow map.
+        let frame = pass.set(&self.frame_set);
+        pass = pass
             .color(clear(t.diffuse, ms.map(|m| m.diffuse), [0.0; 4]))
             .color(clear(t.specular, ms.map(|m| m.specular), [0.0; 4]))
             .color(clear(
@@ -700,12 +625,13 @@ impl Frame {
         if let Some(n) = t.normals {
             pass = pass.color(clear(n, ms.and_then(|m| m.normals), [0.0; 4]));
         }
-        pass.draws(Some(work), self.triangles(false))
-            .record(move |pc: &PassContext| {
+        passes.push(pass.draws(Some(work), self.triangles(false)).record(
+            move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.geometry_pipeline;
-                p.bind(ctx, cmd, &[self.frame_set]);
+                pc.bind(p, &[frame]);
                 p.bind_sets(ctx, cmd, 2, &[self.instance_set]);
+                let slots = &self.instance_buffer;
                 let set_reference = |r: u32| unsafe {
                     ctx.device.cmd_set_stencil_reference(
                         cmd,
@@ -717,68 +643,100 @@ impl Frame {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
                     if !obj.skin {
                         set_reference(0);
-                        obj.draw_instances(ctx, cmd, self.backdrop_slot, 1);
+                        obj.draw_instances(ctx, cmd, slots.backdrop_slot, 1);
                         continue;
                     }
                     // Each group's heads in one instanced draw with its code
                     // (one group: every head in frame order, code 1, as
                     // before groups).
-                    for (g, &(first, count)) in self.skin_groups.iter().zip(&self.group_slots) {
+                    for (g, &(first, count)) in self.skin_groups.iter().zip(&slots.group_slots) {
                         set_reference(g.stencil);
                         obj.draw_instances(ctx, cmd, first, count);
                     }
                 }
-            })
+            },
+        ));
+        self.view(res)
     }
 
-    fn fullscreen_pass<'a>(&'a self, res: &Resources, p: PostPass<'a, '_>) -> Pass<'a> {
-        let PostPass {
-            name,
-            pipeline,
-            shader,
-            set,
-            reads,
-            target,
-        } = p;
+    /// The diffuse light after SSS plus the specular target, into the HDR
+    /// target: one point fetch of each per pixel, every pixel written.
+    fn composite<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        res: &Resources,
+        diffuse: ImageId,
+        specular: ImageId,
+    ) -> ImageId {
+        debug_assert!(self.composite_set.reads(diffuse) && self.composite_set.reads(specular));
+        let hdr = self.targets.hdr;
+        let point = |image, texture: &str| Fetch {
+            texture: texture.into(),
+            format: res.texel_format(image),
+            filter: Filter::Point,
+            count: 1.0,
+            exact: true,
+            coherent: true,
+            spread: Vec::new(),
+        };
         let work = ShaderWork {
-            shader: shader.into(),
-            fetches: reads
-                .iter()
-                .map(|&(id, texture)| Fetch {
-                    texture: texture.into(),
-                    format: res.texel_format(id),
-                    filter: Filter::Point,
-                    count: 1.0,
-                    exact: true,
-                    coherent: true,
-                    spread: Vec::new(),
-                })
-                .collect(),
-            alu: alu_estimate(shader, &[]),
+            shader: COMPOSITE_SHADER.into(),
+            fetches: vec![point(diffuse, "diffuseTex"), point(specular, "specularTex")],
+            alu: alu_estimate(COMPOSITE_SHADER, &[]),
             ..Default::default()
         };
-        let mut pass = Pass::new(name, PassRole::Post);
-        for &(r, _) in reads {
-            pass = pass.sampled(r);
-        }
-        pass.color(ColorTarget::new(target, Load::DontCare))
-            .draws(Some(work), 1)
-            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
+        let pipeline = &self.composite_pipeline;
+        let mut pass = Pass::new("composite", PassRole::Post);
+        let set = pass.set(&self.composite_set);
+        passes.push(
+            pass.color(ColorTarget::new(hdr, Load::DontCare))
+                .draws(Some(work), 1)
+                .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {})),
+        );
+        hdr
     }
 
-    fn composite_pass<'a>(&'a self, res: &Resources, sss_output: ImageId) -> Pass<'a> {
-        let t = self.targets;
-        self.fullscreen_pass(
-            res,
-            PostPass {
-                name: "composite",
-                pipeline: &self.composite_pipeline,
-                shader: COMPOSITE_SHADER,
-                set: self.composite_set,
-                reads: &[(sss_output, "diffuseTex"), (t.specular, "specularTex")],
-                target: t.hdr,
-            },
-        )
+    /// After the frame (`--character-ids`): every head again, depth-tested
+    /// EQUAL against the frame's depth, writing its frame index + 1 into
+    /// `ids`. Set-up work, not frame cost; only the flag adds it.
+    fn character_ids<'a>(
+        &'a self,
+        passes: &mut Vec<Pass<'a>>,
+        ids: ImageId,
+        depth_stencil: ImageId,
+    ) {
+        let mut pass = Pass::new("character ids", PassRole::Setup);
+        let set = pass.set(&self.ids_set);
+        passes.push(
+            pass.color(ColorTarget::new(ids, Load::Clear([0.0; 4])))
+                .depth_stencil(DepthStencil::test_only(depth_stencil).depth_test(true))
+                .draws(None, self.triangles(true))
+                .record(move |pc: &PassContext| {
+                    let (ctx, cmd) = (pc.ctx, pc.cmd);
+                    let p = &self.ids_pipeline;
+                    pc.bind(p, &[set]);
+                    p.bind_sets(ctx, cmd, 2, &[self.ids_instance_set]);
+                    let slots = &self.instance_buffer.character_slots;
+                    for obj in self.objects.iter().filter(|o| o.skin) {
+                        for (c, &slot) in slots.iter().enumerate() {
+                            p.push(ctx, cmd, &IdPush { id: (c + 1) as f32 });
+                            obj.draw_instances(ctx, cmd, slot, 1);
+                        }
+                    }
+                }),
+        );
+    }
+
+    /// Triangles the skin objects submit per frame (every character), and all objects.
+    fn triangles(&self, skin_only: bool) -> u64 {
+        self.objects
+            .iter()
+            .filter(|o| o.skin || !skin_only)
+            .map(|o| {
+                let copies = if o.skin { self.instances.len() } else { 1 };
+                o.mesh.triangles() * copies as u64
+            })
+            .sum()
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -16,9 +16,11 @@ use crate::vk::barrier::AccessKind;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 
-/// How the uploads write the targets (whole contents).
+/// How the uploads write the targets (whole contents): what
+/// `Pass::transfer_dst` declares.
 const UPLOAD_ACCESS: AccessKind = AccessKind::TransferWrite;
-/// How fills write the intermediates (whole contents, by a clear).
+/// How fills write the intermediates (whole contents, by a clear): what
+/// `Pass::clear_dst` declares.
 pub const FILL_ACCESS: AccessKind = AccessKind::ClearWrite;
 
 /// The images `upload_sss_inputs`, `upload_normals`, `upload_hdr` and `upload_ldr` write.
@@ -42,41 +44,34 @@ fn upload_pass<'a>(
     extent: vk::Extent2D,
     bytes: u64,
 ) -> Pass<'a> {
-    Pass::new(name, PassRole::Setup)
-        .image(image, UPLOAD_ACCESS)
-        .work(Work::Copy {
-            texels: extent.width as u64 * extent.height as u64,
-            bytes_per_texel: (bytes / (extent.width as u64 * extent.height as u64).max(1)) as u32,
-            rects: aspects.len() as u32,
-        })
-        .record(move |pc: &PassContext| {
-            let regions: Vec<vk::BufferImageCopy> = aspects
-                .iter()
-                .map(|&(aspect, offset)| {
-                    vk::BufferImageCopy::default()
-                        .buffer_offset(offset)
-                        .image_subresource(
-                            vk::ImageSubresourceLayers::default()
-                                .aspect_mask(aspect)
-                                .layer_count(1),
-                        )
-                        .image_extent(vk::Extent3D {
-                            width: extent.width,
-                            height: extent.height,
-                            depth: 1,
-                        })
-                })
-                .collect();
-            unsafe {
-                pc.ctx.device.cmd_copy_buffer_to_image(
-                    pc.cmd,
-                    buffer,
-                    pc.image(image).raw,
-                    pc.layout(image),
-                    &regions,
-                )
-            };
-        })
+    let mut pass = Pass::new(name, PassRole::Setup);
+    let dst = pass.transfer_dst(image);
+    debug_assert_eq!(dst.access(), UPLOAD_ACCESS);
+    pass.work(Work::Copy {
+        texels: extent.width as u64 * extent.height as u64,
+        bytes_per_texel: (bytes / (extent.width as u64 * extent.height as u64).max(1)) as u32,
+        rects: aspects.len() as u32,
+    })
+    .record(move |pc: &PassContext| {
+        let regions: Vec<vk::BufferImageCopy> = aspects
+            .iter()
+            .map(|&(aspect, offset)| {
+                vk::BufferImageCopy::default()
+                    .buffer_offset(offset)
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(aspect)
+                            .layer_count(1),
+                    )
+                    .image_extent(vk::Extent3D {
+                        width: extent.width,
+                        height: extent.height,
+                        depth: 1,
+                    })
+            })
+            .collect();
+        pc.copy_buffer_to_image(buffer, dst, &regions);
+    })
 }
 
 impl Renderer<'_> {
@@ -87,29 +82,24 @@ impl Renderer<'_> {
             .into_iter()
             .map(|id| {
                 let e = self.resources.extent(id);
-                Pass::new(format!("fill {}", self.resources.name(id)), PassRole::Setup)
-                    .image(id, FILL_ACCESS)
-                    .work(Work::Clear {
-                        texels: e.width as u64 * e.height as u64,
-                        bytes_per_texel: 8,
-                    })
-                    .record(move |pc: &PassContext| {
-                        let range = vk::ImageSubresourceRange::default()
-                            .aspect_mask(vk::ImageAspectFlags::COLOR)
-                            .level_count(1)
-                            .layer_count(1);
-                        unsafe {
-                            pc.ctx.device.cmd_clear_color_image(
-                                pc.cmd,
-                                pc.image(id).raw,
-                                pc.layout(id),
-                                &vk::ClearColorValue {
-                                    float32: [value; 4],
-                                },
-                                &[range],
-                            )
-                        };
-                    })
+                let mut pass =
+                    Pass::new(format!("fill {}", self.resources.name(id)), PassRole::Setup);
+                let dst = pass.clear_dst(id);
+                debug_assert_eq!(dst.access(), FILL_ACCESS);
+                pass.work(Work::Clear {
+                    texels: e.width as u64 * e.height as u64,
+                    bytes_per_texel: 8,
+                })
+                .record(move |pc: &PassContext| {
+                    let range = vk::ImageSubresourceRange::default()
+                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .level_count(1)
+                        .layer_count(1);
+                    let value = vk::ClearColorValue {
+                        float32: [value; 4],
+                    };
+                    pc.clear_color_image(dst, &value, &[range]);
+                })
             })
             .collect();
         self.submit_untimed(&passes, "while filling the intermediates")

@@ -1,17 +1,15 @@
 //! The renderer: the frame (`frame.rs`) around its SSS methods
 //! (`crate::method`): one in a single-method frame, one per group of
-//! characters in a frame of several (`groups.rs`, `merge.rs`), set up in the
+//! characters in a frame of several (`groups/`), set up in the
 //! graph's three steps (declare images, derive their usages from
 //! the passes, create them and write the descriptor sets), then recorded,
 //! submitted and measured frame by frame.
 
 pub mod counting;
 pub mod frame;
-pub mod group_passes;
-pub mod group_setup;
 pub mod groups;
 pub mod inputs;
-pub mod merge;
+pub mod instances;
 pub mod post_only;
 pub mod readback;
 pub mod request;
@@ -19,6 +17,7 @@ pub mod scene_gpu;
 pub mod settings;
 mod submit;
 pub mod targets;
+pub mod uniforms;
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
@@ -31,10 +30,11 @@ use crate::scene::Scene;
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
-use frame::{Frame, SkinGroup};
-use group_setup::build_groups;
+use frame::Frame;
+use groups::merge::{self, Merge};
+use groups::setup::{bind_groups, build_groups};
 use groups::{frame_needs, GroupMethod};
-use merge::Merge;
+use instances::SkinGroup;
 use readback::{to_rgba_f32, DumpedImage, ReadbackPlan};
 pub use request::FrameRequest;
 pub use settings::RenderSettings;
@@ -187,6 +187,8 @@ impl<'c> Renderer<'c> {
         )?;
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
+        let sss_output = groups::passes::output(&groups, &frame.targets);
+        frame.composite_from(&resources, sss_output);
         let mut merge = Guard::new(ctx, Merge::default());
         if mixed && merge::needs_any(&groups, &frame.targets) {
             *merge = Merge::new(ctx, &resources, &frame.targets, &groups)?;
@@ -211,10 +213,9 @@ impl<'c> Renderer<'c> {
         check_memory(ctx, &resources, extent)?;
         // 3. Create the images and write what reads them.
         resources.create(ctx)?;
-        let source = frame.composite_source(&groups);
-        frame.bind(ctx, &resources, source)?;
-        merge.bind(ctx, &frame.pool, &resources, &frame.targets, &groups)?;
-        group_setup::bind_groups(ctx, &resources, &frame, &mut groups)?;
+        frame.bind(ctx, &resources)?;
+        merge.bind(ctx, &frame.pool, &resources)?;
+        bind_groups(ctx, &resources, &frame, &mut groups)?;
         let submit = Submit::new(ctx, slots)?;
         // Complete: the renderer owns (and frees, in its drop) every part.
         let mut r = Renderer {
@@ -358,7 +359,7 @@ impl<'c> Renderer<'c> {
         let t = &self.frame.targets;
         let mut finals = vec![
             self.frame.output(),
-            self.frame.composite_source(&self.groups),
+            groups::passes::output(&self.groups, t),
             t.linear_depth,
             t.hdr,
         ];
@@ -448,13 +449,12 @@ impl<'c> Renderer<'c> {
     /// as f32 RGBA with the pass samples.
     pub fn run_sss_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
         self.begin_frame();
-        let passes = self
-            .frame
-            .group_passes(&self.groups, &self.merge, &self.resources);
+        let mut passes = Vec::new();
+        let view = self.frame.view(&self.resources);
+        let output = groups::passes::sss(&mut passes, &view, &self.groups, &self.merge);
         if passes.is_empty() {
             bail!("the SSS-only run needs a method with passes");
         }
-        let output = self.frame.composite_source(&self.groups);
         submit_and_read(
             self.ctx,
             &self.submit,

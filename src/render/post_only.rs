@@ -12,11 +12,15 @@ impl Renderer<'_> {
     /// would overwrite the uploaded frame) and reads back the frame's output (linear
     /// float RGBA, decoded from sRGB) with each pass's samples.
     pub fn run_post_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
-        let passes = self.frame.post.aa_passes(&self.resources);
+        let mut passes = Vec::new();
+        let ldr = self.frame.targets.ldr;
+        let output = self
+            .frame
+            .post
+            .anti_alias(&mut passes, &self.resources, ldr);
         if passes.is_empty() {
             bail!("the post-only run needs an anti-aliasing stage (--aa)");
         }
-        let output = self.frame.output();
         submit_and_read(
             self.ctx,
             &self.submit,
@@ -32,10 +36,12 @@ impl Renderer<'_> {
     /// (`Renderer::upload_hdr` puts a synthetic image there) and reads back
     /// the bloomed composite with each pass's samples.
     pub fn run_bloom_only(&mut self) -> Result<(Vec<[f32; 4]>, Vec<PassSample>)> {
-        let passes = self.frame.post.bloom_passes(&self.resources);
-        let Some(output) = self.frame.post.bloom_image("bloomed") else {
+        let mut passes = Vec::new();
+        let hdr = self.frame.targets.hdr;
+        let output = self.frame.post.bloom(&mut passes, &self.resources, hdr);
+        if passes.is_empty() {
             bail!("the bloom-only run needs --bloom");
-        };
+        }
         submit_and_read(
             self.ctx,
             &self.submit,

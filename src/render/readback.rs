@@ -9,7 +9,6 @@ use gpu_allocator::MemoryLocation;
 use crate::format::{Aspect, Format};
 use crate::graph::work::{PassRole, Work};
 use crate::graph::{BufferId, ImageId, Pass, PassContext, Resources};
-use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::format::{aspect_flag, from_vk};
 use crate::vk::memory::Buffer;
@@ -128,44 +127,34 @@ impl ReadbackPlan {
             MemoryLocation::GpuToCpu,
         )?;
         let buffer_id = res.add_buffer(&name, buffer.raw);
-        let raw_buf = buffer.raw;
         self.pending.push(Pending {
             pass: pass.to_string(),
             image: id,
             buffer,
             buffer_id,
         });
+        let mut copy = Pass::new(name, PassRole::Readback);
+        let (src, dst) = (copy.transfer_src(id), copy.transfer_dst_buffer(buffer_id));
         Ok(Some(
-            Pass::new(name, PassRole::Readback)
-                .image(id, AccessKind::TransferRead)
-                .buffer(buffer_id, AccessKind::TransferWrite)
-                .work(Work::Copy {
-                    texels: extent.width as u64 * extent.height as u64,
-                    bytes_per_texel: bpt,
-                    rects: 1,
-                })
-                .record(move |pc: &PassContext| {
-                    let region = vk::BufferImageCopy::default()
-                        .image_subresource(
-                            vk::ImageSubresourceLayers::default()
-                                .aspect_mask(aspect)
-                                .layer_count(1),
-                        )
-                        .image_extent(vk::Extent3D {
-                            width: extent.width,
-                            height: extent.height,
-                            depth: 1,
-                        });
-                    unsafe {
-                        pc.ctx.device.cmd_copy_image_to_buffer(
-                            pc.cmd,
-                            pc.image(id).raw,
-                            pc.layout(id),
-                            raw_buf,
-                            &[region],
-                        )
-                    };
-                }),
+            copy.work(Work::Copy {
+                texels: extent.width as u64 * extent.height as u64,
+                bytes_per_texel: bpt,
+                rects: 1,
+            })
+            .record(move |pc: &PassContext| {
+                let region = vk::BufferImageCopy::default()
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(aspect)
+                            .layer_count(1),
+                    )
+                    .image_extent(vk::Extent3D {
+                        width: extent.width,
+                        height: extent.height,
+                        depth: 1,
+                    });
+                pc.copy_image_to_buffer(src, dst, &[region]);
+            }),
         ))
     }
 
@@ -209,7 +198,7 @@ impl ReadbackPlan {
         }
         let mut host = Pass::new(format!("{PREFIX} to host"), PassRole::Readback);
         for p in &self.pending {
-            host = host.buffer(p.buffer_id, AccessKind::HostRead);
+            host = host.host_read(p.buffer_id);
         }
         out.push(host);
         Ok(out)

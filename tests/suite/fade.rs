@@ -1,5 +1,5 @@
 //! The cross-fade of a character switching settings (issue 16 item 6,
-//! render/groups.rs `FadeMethod`, render/merge.rs): on lavapipe with
+//! render/groups/fade.rs `FadeMethod`, render/groups/merge.rs): on lavapipe with
 //! validation, a fading character's diffuse light is `w * old + (1 - w) *
 //! new` of the single-method frames of its two settings, to the rounding of
 //! the half-float blend; its old setting's passes and the blend pass exactly

@@ -1,4 +1,4 @@
-//! Several methods in one frame (issue 16 item 1, render/groups.rs): on
+//! Several methods in one frame (issue 16 item 1, render/groups/): on
 //! lavapipe with validation, inside each character's pixels a mixed frame
 //! equals the single-method frame of that character's method (exactly where
 //! no tap reaches another character's pixels); each group's stencil-masked

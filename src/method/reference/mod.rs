@@ -33,7 +33,7 @@ use super::region::ReachScale;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::{BufferId, ImageId, Pass};
+use crate::graph::{BufferId, GraphSet, ImageId, Pass};
 use crate::reference::sampling::SurfaceSample;
 use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::vk::context::{Context, DeviceFacts};
@@ -81,6 +81,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| density(o).map(|_| ()),
     build: |s| Ok(Box::new(Reference::new(s)?)),
     no_msaa: Some("the ground truth renders its own single-sample surface and gathers over it, so its frame would alias whatever --msaa says; it is the reference, not a mode to antialias"),
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 fn density(o: &Opts) -> Result<f32> {
@@ -115,8 +117,8 @@ struct Chunk {
     buffer_ids: Vec<BufferId>,
     radiance: ImageId,
     /// (set, first sample of the draw within the chunk, samples) per draw.
-    draws: Vec<(vk::DescriptorSet, u32, u32)>,
-    gather_set: vk::DescriptorSet,
+    draws: Vec<(GraphSet, u32, u32)>,
+    gather_set: GraphSet,
 }
 
 impl Destroy for Chunk {
@@ -157,13 +159,13 @@ pub struct Reference {
     narrow: Pipeline,
     gather: Pipeline,
     resolve: Pipeline,
-    resolve_set: vk::DescriptorSet,
+    resolve_set: GraphSet,
     /// Per wide Gaussian: accumulated radiance (rgb) and weight (a).
     accum: [ImageId; 3],
     material_set: vk::DescriptorSet,
-    frame_set: vk::DescriptorSet,
+    frame_set: GraphSet,
     surf_material: vk::DescriptorSet,
-    narrow_set: vk::DescriptorSet,
+    narrow_set: GraphSet,
     chunks: Vec<Chunk>,
     draw_samples: u32,
     cells: Buffer,

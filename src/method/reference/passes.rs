@@ -6,13 +6,12 @@ use ash::vk;
 
 use super::{Reference, GATHER_SHADER, GROUP, NARROW_SHADER, RESOLVE_SHADER, SURFACE_SHADER};
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
-use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext};
+use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext, SetRef};
 use crate::method::screen::fetch;
 use crate::method::FrameView;
 use crate::reference::chunks::RADIANCE_WIDTH;
 use crate::reference::sampling::SurfaceSample;
 use crate::shader_constants::{NARROW_GAUSSIANS as NARROW, PCF_TRIPS, WIDE_GAUSSIANS};
-use crate::vk::barrier::AccessKind;
 use crate::vk::shader_stats::alu_estimate;
 
 /// Push constants of the surface pass (geometry.vert's model, then the frag's scale).
@@ -67,22 +66,26 @@ impl Reference {
             .sum();
         // Each chunk's radiance target is rendered alone (its rows stacked in
         // the work's area), every texel of it overwritten.
-        let mut pass = Pass::new("reference irradiance", PassRole::Sss)
-            .sampled(f.targets.shadow)
-            .each_target_alone();
+        let mut pass = Pass::new("reference irradiance", PassRole::Sss);
+        // Each draw's set: the frame's (the shadow map) and its range of
+        // the chunk's samples.
+        let sets: Vec<Vec<SetRef>> = self
+            .chunks
+            .iter()
+            .map(|c| c.draws.iter().map(|(set, ..)| pass.set(set)).collect())
+            .collect();
+        pass = pass.each_target_alone();
         for c in &self.chunks {
-            pass = pass
-                .buffer(c.buffer_ids[0], AccessKind::FragmentStorageRead)
-                .color(ColorTarget::new(c.radiance, Load::DontCare));
+            pass = pass.color(ColorTarget::new(c.radiance, Load::DontCare));
         }
         pass.draws(Some(shader), draws)
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let c = &self.chunks[pc.target];
                 let p = &self.irradiance;
-                p.bind(ctx, cmd, &[]);
+                pc.bind(p, &[]);
                 p.bind_sets(ctx, cmd, 1, &[self.material_set]);
-                for &(set, first, n) in &c.draws {
+                for (&set, &(_, first, n)) in sets[pc.target].iter().zip(&c.draws) {
                     let first_row = first / RADIANCE_WIDTH;
                     let scissor = vk::Rect2D {
                         offset: vk::Offset2D {
@@ -94,7 +97,7 @@ impl Reference {
                             height: n.div_ceil(RADIANCE_WIDTH),
                         },
                     };
-                    p.bind_sets(ctx, cmd, 0, &[set]);
+                    pc.bind_sets(p, 0, &[set]);
                     unsafe { ctx.device.cmd_set_scissor(cmd, 0, &[scissor]) };
                     p.push(ctx, cmd, &[n, RADIANCE_WIDTH, first_row]);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
@@ -125,9 +128,10 @@ impl Reference {
         };
         // The three subsample targets and the depth start cleared.
         let clear = |t| ColorTarget::new(t, Load::Clear([0.0; 4]));
-        Pass::new("reference surface", PassRole::Sss)
-            .sampled(f.targets.shadow)
-            .color(clear(sf.radiance))
+        let mut pass = Pass::new("reference surface", PassRole::Sss);
+        // The frame's set samples the shadow map.
+        let frame = pass.set(&self.frame_set);
+        pass.color(clear(sf.radiance))
             .color(clear(sf.position))
             .color(clear(sf.normal))
             .depth_stencil(DepthStencil::cleared(sf.depth, 1.0))
@@ -138,7 +142,8 @@ impl Reference {
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.surface_pipeline;
-                p.bind(ctx, cmd, &[self.frame_set, self.surf_material]);
+                pc.bind(p, &[frame]);
+                p.bind_sets(ctx, cmd, 1, &[self.surf_material]);
                 unsafe {
                     ctx.device
                         .cmd_bind_vertex_buffers(cmd, 0, &[self.surf.vertices.raw], &[0]);
@@ -170,28 +175,19 @@ impl Reference {
     pub(super) fn clear_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let accum = self.accum;
         let e = f.extent;
-        let mut pass = Pass::new("reference clear", PassRole::Sss).work(Work::Clear {
+        let mut pass = Pass::new("reference clear", PassRole::Sss);
+        let accum = accum.map(|a| pass.clear_dst(a));
+        pass.work(Work::Clear {
             texels: 3 * e.width as u64 * e.height as u64,
             bytes_per_texel: 16,
-        });
-        for a in accum {
-            pass = pass.image(a, AccessKind::ClearWrite);
-        }
-        pass.record(move |pc: &PassContext| {
+        })
+        .record(move |pc: &PassContext| {
             let range = vk::ImageSubresourceRange::default()
                 .aspect_mask(vk::ImageAspectFlags::COLOR)
                 .level_count(1)
                 .layer_count(1);
             for a in accum {
-                unsafe {
-                    pc.ctx.device.cmd_clear_color_image(
-                        pc.cmd,
-                        pc.image(a).raw,
-                        pc.layout(a),
-                        &vk::ClearColorValue::default(),
-                        &[range],
-                    )
-                };
+                pc.clear_color_image(a, &vk::ClearColorValue::default(), &[range]);
             }
         })
     }
@@ -207,15 +203,11 @@ impl Reference {
             storage_read_bytes: 64.0,
             storage_write_bytes: 16.0,
         };
-        let set = self.resolve_set;
-        let mut pass = Pass::new("reference resolve", PassRole::Sss)
-            .image(t.diffuse, AccessKind::ComputeSampledRead)
-            .image(self.out, AccessKind::ComputeStorageReadWrite);
-        for a in self.accum {
-            pass = pass.image(a, AccessKind::ComputeStorageRead);
-        }
+        let mut pass = Pass::new("reference resolve", PassRole::Sss);
+        // Samples the diffuse target, reads the accumulators, adds to the output.
+        let set = pass.set(&self.resolve_set);
         pass.dispatch(work, screen_groups(extent), GROUP * GROUP)
-            .record(move |pc: &PassContext| self.resolve.bind(pc.ctx, pc.cmd, &[set]))
+            .record(move |pc: &PassContext| pc.bind(&self.resolve, &[set]))
     }
 
     /// The narrow part, written into the output for every pixel.
@@ -245,16 +237,11 @@ impl Reference {
             storage_write_bytes: 16.0,
             ..Default::default()
         };
-        let set = self.narrow_set;
-        Pass::new("reference narrow", PassRole::Sss)
-            .image(t.diffuse, AccessKind::ComputeSampledRead)
-            .image(t.linear_depth, AccessKind::ComputeSampledRead)
-            .image(sf.radiance, AccessKind::ComputeSampledRead)
-            .image(sf.position, AccessKind::ComputeSampledRead)
-            .image(sf.normal, AccessKind::ComputeSampledRead)
-            .image(self.out, AccessKind::ComputeStorageWrite)
-            .dispatch(work, screen_groups(extent), GROUP * GROUP)
-            .record(move |pc: &PassContext| self.narrow.bind(pc.ctx, pc.cmd, &[set]))
+        let mut pass = Pass::new("reference narrow", PassRole::Sss);
+        // Samples the targets and the surface, writes the output.
+        let set = pass.set(&self.narrow_set);
+        pass.dispatch(work, screen_groups(extent), GROUP * GROUP)
+            .record(move |pc: &PassContext| pc.bind(&self.narrow, &[set]))
     }
 
     /// Slab `k` (of the 9) of the wide Gaussians' gather over chunk `ci`'s
@@ -264,8 +251,6 @@ impl Reference {
         let groups = screen_groups(f.extent);
         let one = self.chunks.len() == 1;
         let c = &self.chunks[ci];
-        // Every slab adds to the narrow part.
-        let out_access = AccessKind::ComputeStorageReadWrite;
         let name = if one {
             format!("reference gather {}/9", k + 1)
         } else {
@@ -308,21 +293,14 @@ impl Reference {
             first: c.first,
             count: c.count,
         };
-        let set = c.gather_set;
-        Pass::new(name, PassRole::Sss)
-            .image(t.diffuse, AccessKind::ComputeSampledRead)
-            .image(t.linear_depth, AccessKind::ComputeSampledRead)
-            .image(c.radiance, AccessKind::ComputeSampledRead)
-            .image(self.surf.normal, AccessKind::ComputeSampledRead)
-            .image(self.accum[0], out_access)
-            .image(self.accum[1], out_access)
-            .image(self.accum[2], out_access)
-            .buffer(c.buffer_ids[1], AccessKind::ComputeStorageRead)
-            .buffer(c.buffer_ids[2], AccessKind::ComputeStorageRead)
-            .buffer(self.cells_id, AccessKind::ComputeStorageRead)
-            .dispatch(work, groups, GROUP * GROUP)
+        let mut pass = Pass::new(name, PassRole::Sss);
+        // Samples the targets, the chunk's radiance and the surface normals,
+        // reads the chunk's positions and normals and the grid, adds to the
+        // accumulators.
+        let set = pass.set(&c.gather_set);
+        pass.dispatch(work, groups, GROUP * GROUP)
             .record(move |pc: &PassContext| {
-                self.gather.bind(pc.ctx, pc.cmd, &[set]);
+                pc.bind(&self.gather, &[set]);
                 self.gather.push(pc.ctx, pc.cmd, &push);
             })
     }

@@ -217,6 +217,7 @@ impl Reference {
         self.sample_count = count;
         self.grid_dims = grid.dims;
         self.surface = surface;
+        self.describe_sets(s);
         Ok(())
     }
 

@@ -55,7 +55,7 @@ use super::{
     EvalSetting, FrameView, MethodBind, MethodEntry, Needs, OptKind, OptSpec, Opts, SssMethod,
 };
 use crate::graph::mesh::GpuMesh;
-use crate::graph::{ImageId, Pass};
+use crate::graph::{GraphSet, ImageId, Pass};
 use crate::skin::tsd::{self, refreshes, Atlas, TsdGaussian, EDGE_GUARD_TEXELS};
 use crate::vk::context::Context;
 use crate::vk::guard::Destroy;
@@ -187,6 +187,8 @@ pub static ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o, false).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, false)?)),
     no_msaa: NO_MSAA,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 pub static OPT_ENTRY: MethodEntry = MethodEntry {
@@ -210,6 +212,8 @@ pub static OPT_ENTRY: MethodEntry = MethodEntry {
     check: |o| Config::parse(o, true).map(|_| ()),
     build: |s| Ok(Box::new(Tsd::new(s, true)?)),
     no_msaa: NO_MSAA,
+    no_mix: |_| None,
+    no_sss: false,
 };
 
 /// How culled texels are skipped (thesis section 3.2).
@@ -311,7 +315,7 @@ struct CharacterUniforms {
 }
 
 /// One character: where it stands, what the optimisations decided for it, its map.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Character {
     pub model: Mat4,
     /// Eq. 3.1 (1 without depth-sized maps).
@@ -331,7 +335,7 @@ pub struct Character {
     /// Set 2 of the mask pipelines (depth, backface, cull) and of the irradiance one.
     uv_sets: [vk::DescriptorSet; 4],
     /// Set 1 of the final pass.
-    final_set: vk::DescriptorSet,
+    final_set: GraphSet,
 }
 
 /// The shared texture-space images (one character's chain at a time).

@@ -80,49 +80,50 @@ impl Tsd {
             ..Default::default()
         };
         let up = self.updates(k);
-        Pass::new(format!("tsd mask c{k}"), PassRole::Sss)
-            .depth_stencil(
-                DepthStencil::cleared(mask, 1.0)
-                    .depth_test(cfg.z_prepass)
-                    .depth_write(cfg.z_prepass)
-                    .stencil_write(cfg.cull == Cull::Stencil),
-            )
-            .render_area(square(c.size))
-            .draws(Some(work), self.triangles() * draws)
-            .record(move |pc: &PassContext| {
-                if !up {
-                    return;
-                }
-                let (ctx, cmd) = (pc.ctx, pc.cmd);
-                let p = &self.pipelines;
-                let c = &self.characters[k];
-                if cfg.z_prepass {
-                    p.mask_depth.bind(ctx, cmd, &[self.sets.frame[0]]);
-                    p.mask_depth.bind_sets(ctx, cmd, 2, &[c.uv_sets[0]]);
-                    p.mask_depth.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
-                    self.draw_head(ctx, cmd);
-                    p.mask_backface.bind(ctx, cmd, &[self.sets.frame[1]]);
-                    p.mask_backface.bind_sets(ctx, cmd, 2, &[c.uv_sets[1]]);
-                    p.mask_backface
-                        .push(ctx, cmd, &uv_push(1.0, -BACKFACE_BIAS, 0.0));
-                    self.draw_head(ctx, cmd);
-                }
-                if cfg.cull == Cull::Stencil {
-                    p.mask_cull.bind(ctx, cmd, &[self.sets.frame[2]]);
-                    p.mask_cull.bind_sets(ctx, cmd, 2, &[c.uv_sets[2]]);
-                    // Set after the bind: the pre-pass pipelines before it
-                    // take no dynamic stencil reference.
-                    unsafe {
-                        ctx.device.cmd_set_stencil_reference(
-                            cmd,
-                            vk::StencilFaceFlags::FRONT_AND_BACK,
-                            1,
-                        )
-                    };
-                    p.mask_cull.push(ctx, cmd, &uv_push(0.0, CULL_COS, 1.0));
-                    self.draw_head(ctx, cmd);
-                }
-            })
+        let mut pass = Pass::new(format!("tsd mask c{k}"), PassRole::Sss);
+        let frame = [0, 1, 2].map(|i| self.sets.frame[i].as_ref().map(|s| pass.set(s)));
+        pass.depth_stencil(
+            DepthStencil::cleared(mask, 1.0)
+                .depth_test(cfg.z_prepass)
+                .depth_write(cfg.z_prepass)
+                .stencil_write(cfg.cull == Cull::Stencil),
+        )
+        .render_area(square(c.size))
+        .draws(Some(work), self.triangles() * draws)
+        .record(move |pc: &PassContext| {
+            if !up {
+                return;
+            }
+            let (ctx, cmd) = (pc.ctx, pc.cmd);
+            let p = &self.pipelines;
+            let c = &self.characters[k];
+            if cfg.z_prepass {
+                pc.bind(&p.mask_depth, frame[0].as_slice());
+                p.mask_depth.bind_sets(ctx, cmd, 2, &[c.uv_sets[0]]);
+                p.mask_depth.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
+                self.draw_head(ctx, cmd);
+                pc.bind(&p.mask_backface, frame[1].as_slice());
+                p.mask_backface.bind_sets(ctx, cmd, 2, &[c.uv_sets[1]]);
+                p.mask_backface
+                    .push(ctx, cmd, &uv_push(1.0, -BACKFACE_BIAS, 0.0));
+                self.draw_head(ctx, cmd);
+            }
+            if cfg.cull == Cull::Stencil {
+                pc.bind(&p.mask_cull, frame[2].as_slice());
+                p.mask_cull.bind_sets(ctx, cmd, 2, &[c.uv_sets[2]]);
+                // Set after the bind: the pre-pass pipelines before it
+                // take no dynamic stencil reference.
+                unsafe {
+                    ctx.device.cmd_set_stencil_reference(
+                        cmd,
+                        vk::StencilFaceFlags::FRONT_AND_BACK,
+                        1,
+                    )
+                };
+                p.mask_cull.push(ctx, cmd, &uv_push(0.0, CULL_COS, 1.0));
+                self.draw_head(ctx, cmd);
+            }
+        })
     }
 
     /// The irradiance pass of character `k` (MRT: irradiance, stretch u, stretch v).
@@ -153,8 +154,10 @@ impl Tsd {
         } else {
             Load::DontCare
         };
-        let mut pass = Pass::new(format!("tsd irradiance c{k}"), PassRole::Sss)
-            .sampled(f.targets.shadow)
+        let mut pass = Pass::new(format!("tsd irradiance c{k}"), PassRole::Sss);
+        // The frame's set samples the shadow map.
+        let frame = self.sets.frame[3].as_ref().map(|s| pass.set(s));
+        pass = pass
             .color(ColorTarget::new(m.irradiance, load))
             .color(ColorTarget::new(m.stretch_u, load))
             .color(ColorTarget::new(m.stretch_v, load));
@@ -166,7 +169,8 @@ impl Tsd {
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.pipelines.irradiance;
-                p.bind(ctx, cmd, &[self.sets.frame[3], self.sets.material]);
+                pc.bind(p, frame.as_slice());
+                p.bind_sets(ctx, cmd, 1, &[self.sets.material]);
                 p.bind_sets(ctx, cmd, 2, &[self.characters[k].uv_sets[3]]);
                 p.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
                 self.draw_head(ctx, cmd);
@@ -225,10 +229,18 @@ impl Tsd {
             Load::Keep
         };
         let axis = if v { "v" } else { "u" };
-        let mut pass = Pass::new(format!("tsd g{} {axis} c{k}", gauss.index), PassRole::Sss)
-            .sampled(src)
-            .sampled(stretch)
-            .color(ColorTarget::new(dst, start));
+        let mut pass = Pass::new(format!("tsd g{} {axis} c{k}", gauss.index), PassRole::Sss);
+        // Reads `src` and `stretch`.
+        let set = pass.set(
+            &self.sets.blur[if v {
+                2
+            } else if g % 2 == 0 {
+                0
+            } else {
+                1
+            }],
+        );
+        pass = pass.color(ColorTarget::new(dst, start));
         if v {
             // A character not updated keeps its map. An updated one starts
             // from zeros: the first Gaussian blends with w' = 1, but a NaN in
@@ -243,13 +255,6 @@ impl Tsd {
         if let Some(mask) = m.mask {
             pass = pass.depth_stencil(self.mask_test(mask));
         }
-        let set = self.sets.blur[if v {
-            2
-        } else if g % 2 == 0 {
-            0
-        } else {
-            1
-        }];
         let push = BlurPush {
             dir: if v { [0.0, 1.0] } else { [1.0, 0.0] },
             std_mm: gauss.std_mm,
@@ -292,16 +297,20 @@ impl Tsd {
         let mut pass = Pass::new("tsd final", PassRole::Sss)
             .color(ColorTarget::new(self.diffuse, Load::Keep))
             .depth_stencil(DepthStencil::test_only(ds).depth_test(true));
-        for c in &self.characters {
-            pass = pass.sampled(c.map);
-        }
+        let frame = self.sets.frame[4].as_ref().map(|s| pass.set(s));
+        // Each character's set samples its map.
+        let maps: Vec<_> = self
+            .characters
+            .iter()
+            .map(|c| pass.set(&c.final_set))
+            .collect();
         pass.draws(Some(work), self.triangles() * self.characters.len() as u64)
             .record(move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.pipelines.final_pass;
-                p.bind(ctx, cmd, &[self.sets.frame[4]]);
-                for c in &self.characters {
-                    p.bind_sets(ctx, cmd, 1, &[c.final_set]);
+                pc.bind(p, frame.as_slice());
+                for (c, &map) in self.characters.iter().zip(&maps) {
+                    pc.bind_sets(p, 1, &[map]);
                     p.push(ctx, cmd, &c.model.to_cols_array_2d());
                     self.draw_head(ctx, cmd);
                 }

@@ -14,7 +14,7 @@ use super::{
     MAP_FORMAT, MAX_ISLANDS, STRETCH_FORMAT,
 };
 use crate::graph::mesh::GpuMesh;
-use crate::graph::{ImageDesc, Resources};
+use crate::graph::{GraphSet, ImageDesc, Resources};
 use crate::method::MethodSetup;
 use crate::scene::mesh::Vertex;
 use crate::skin::tsd::{
@@ -148,7 +148,7 @@ impl Tsd {
                 far: cfg.z_prepass && head_px < cfg.far_px,
                 map,
                 uv_sets: [vk::DescriptorSet::null(); 4],
-                final_set: vk::DescriptorSet::null(),
+                final_set: GraphSet::default(),
             });
         }
         self.character_ubo = Buffer::with_data(
@@ -170,6 +170,7 @@ impl Tsd {
         self.upload_mesh(s)?;
         self.pipelines = make_pipelines(s.ctx, &cfg, self.mask_format, s.res.format(self.diffuse))?;
         self.pool = DescriptorPool::new(s.ctx, 16 + 6 * s.instances.len() as u32)?;
+        self.describe_sets(s);
         Ok(())
     }
 

@@ -7,23 +7,22 @@
 //! frame's own overhead, named `mix merge #N`. A single-method frame has no
 //! merge: its composite reads the method's output, as before groups.
 //!
-//! A fading character's group (`groups::FadeMethod`) is blended last: its old
+//! A fading character's group (`fade::FadeMethod`) is blended last: its old
 //! setting's result drawn over the diffuse target, stencil-masked to its code
 //! and limited to the old instance's region, with fixed-function blending by
 //! the constant `weight` (`src * w + dst * (1 - w)`, the new setting's result
 //! being what the target holds by then): `#N fade blend`.
 
 use anyhow::Result;
-use ash::vk;
 
-use super::groups::GroupMethod;
+use super::GroupMethod;
 use crate::graph::work::{Filter, PassRole};
-use crate::graph::{ImageId, Pass, Resources};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Resources};
 use crate::method::screen::{fetch, masked_pass, Masked};
 use crate::method::{skin_stencil_test, FrameTargets, FrameView};
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
-use crate::vk::pipeline::{Bind, Blend, DescriptorPool, GraphicsDesc, Pipeline};
+use crate::vk::pipeline::{Blend, DescriptorPool, GraphicsDesc, Pipeline};
 
 pub const MERGE_SHADER: &str = "composite_merge.frag";
 
@@ -35,10 +34,10 @@ pub struct Merge {
     /// (group index, set reading its output): the groups are known when the
     /// pipeline is made (the passes declare their usages before the images
     /// exist), the sets are written by `bind`.
-    sets: Vec<(usize, vk::DescriptorSet)>,
+    sets: Vec<(usize, GraphSet)>,
     fade_pipeline: Pipeline,
     /// (group index, set reading its old setting's result).
-    fade_sets: Vec<(usize, vk::DescriptorSet)>,
+    fade_sets: Vec<(usize, GraphSet)>,
 }
 
 /// Whether group `g`'s result must be copied into the diffuse target.
@@ -72,61 +71,43 @@ impl Merge {
             d
         };
         let mut m = Guard::new(ctx, Merge::default());
-        m.sets = groups
+        let copies: Vec<&GroupMethod> = groups.iter().filter(|g| needs_merge(g, targets)).collect();
+        let fades: Vec<(usize, ImageId)> = groups
             .iter()
-            .filter(|g| needs_merge(g, targets))
-            .map(|g| (g.spec.index, vk::DescriptorSet::null()))
+            .filter_map(|g| Some((g.spec.index, g.fade.as_ref()?.method.output())))
             .collect();
-        m.fade_sets = groups
-            .iter()
-            .filter(|g| g.fade.is_some())
-            .map(|g| (g.spec.index, vk::DescriptorSet::null()))
-            .collect();
-        if !m.sets.is_empty() {
+        if !copies.is_empty() {
             m.pipeline = Pipeline::graphics(ctx, &desc("mix merge", Blend::None))?;
         }
-        if !m.fade_sets.is_empty() {
+        if !fades.is_empty() {
             m.fade_pipeline = Pipeline::graphics(ctx, &desc("fade blend", Blend::ConstantMix(0)))?;
         }
+        let set = |pipeline: &Pipeline, image| {
+            GraphSet::new(
+                res,
+                pipeline,
+                0,
+                vec![("groupTex", Binding::Sampled(image))],
+            )
+        };
+        m.sets = copies
+            .iter()
+            .map(|g| (g.spec.index, set(&m.pipeline, g.method.output())))
+            .collect();
+        m.fade_sets = fades
+            .into_iter()
+            .map(|(i, old)| (i, set(&m.fade_pipeline, old)))
+            .collect();
         Ok(m.keep())
     }
 
-    /// One set per group that needs a copy, reading its output, and per
-    /// fading group, reading its old setting's result.
-    pub fn bind(
-        &mut self,
-        ctx: &Context,
-        pool: &DescriptorPool,
-        res: &Resources,
-        targets: &FrameTargets,
-        groups: &[GroupMethod],
-    ) -> Result<()> {
-        for (i, set) in &mut self.sets {
-            let Some(g) = groups.iter().find(|g| g.spec.index == *i) else {
-                continue;
-            };
-            debug_assert!(needs_merge(g, targets));
-            *set = pool.write_set(
-                ctx,
-                &self.pipeline,
-                0,
-                &[("groupTex", Bind::Texture(res.view(g.method.output())))],
-            )?;
+    /// Writes the sets (once the images exist).
+    pub fn bind(&mut self, ctx: &Context, pool: &DescriptorPool, res: &Resources) -> Result<()> {
+        for (_, set) in &mut self.sets {
+            set.write(ctx, pool, res, &self.pipeline)?;
         }
-        for (i, set) in &mut self.fade_sets {
-            let Some(f) = groups
-                .iter()
-                .find(|g| g.spec.index == *i)
-                .and_then(|g| g.fade.as_ref())
-            else {
-                continue;
-            };
-            *set = pool.write_set(
-                ctx,
-                &self.fade_pipeline,
-                0,
-                &[("groupTex", Bind::Texture(res.view(f.method.output())))],
-            )?;
+        for (_, set) in &mut self.fade_sets {
+            set.write(ctx, pool, res, &self.fade_pipeline)?;
         }
         Ok(())
     }
@@ -141,7 +122,7 @@ impl Merge {
         old: ImageId,
         weight: f64,
     ) -> Option<Pass<'a>> {
-        let &(_, set) = self.fade_sets.iter().find(|(i, _)| *i == g)?;
+        let (_, set) = self.fade_sets.iter().find(|(i, _)| *i == g)?;
         let name = format!("#{g} fade blend");
         Some(draw_into_diffuse(
             f,
@@ -161,7 +142,7 @@ impl Merge {
         g: usize,
         output: ImageId,
     ) -> Option<Pass<'a>> {
-        let &(_, set) = self.sets.iter().find(|(i, _)| *i == g)?;
+        let (_, set) = self.sets.iter().find(|(i, _)| *i == g)?;
         let name = format!("mix merge #{g}");
         Some(draw_into_diffuse(
             f,
@@ -192,7 +173,7 @@ fn draw_into_diffuse<'a>(
     f: &FrameView<'a, '_>,
     g: usize,
     name: String,
-    (pipeline, set): (&'a Pipeline, vk::DescriptorSet),
+    (pipeline, set): (&'a Pipeline, &'a GraphSet),
     image: ImageId,
     blend: Option<f32>,
 ) -> Pass<'a> {
@@ -204,7 +185,6 @@ fn draw_into_diffuse<'a>(
             loop_trips: Vec::new(),
             pipeline,
             set,
-            reads: vec![image],
             fetches: vec![fetch(f.res, image, "groupTex", Filter::Point, 1.0)],
             targets: vec![(f.targets.diffuse, blend.is_some())],
             stencil: true,

@@ -1,23 +1,33 @@
-//! The method groups of a frame (issue 16): which characters each method
-//! instance works on, resolved from the settings before any device opens
-//! ([`group_specs`]), and the built instances the renderer holds
-//! ([`GroupMethod`]).
+//! Frames of several methods (issue 16), their GPU side in one room; which
+//! method each character gets is `crate::mix` (pure: choices, fades, rules,
+//! plan files).
 //!
-//! A single-method frame is one group (index 0, stencil code 1: the old skin
+//! - here: the groups of a frame, resolved from the settings before any
+//!   device opens ([`group_specs`]), what the targets must provide for all
+//!   of them ([`frame_needs`]), and the built instances the renderer holds
+//!   ([`GroupMethod`]);
+//! - `setup.rs`: each group's method built over its own characters, under
+//!   its image prefix, and bound;
+//! - `region.rs`: where a group works (its SSS region and skin depths);
+//! - `passes.rs`: the groups' stage of the frame, every group's passes in
+//!   order with the merges and the fades, and the image the composite reads;
+//! - `merge.rs`: a group's result drawn into the diffuse target on its own
+//!   pixels (the copy `mix merge #N`, a fade's blend);
+//! - `fade.rs`: a character cross-fading between two settings.
+//!
+//! A single-method frame is one group (index 0, stencil code 1: the skin
 //! bit) holding every character, built from `RenderSettings::method` and its
 //! options exactly as before groups existed. A frame with `--assign` or
 //! `--plan` has one group per distinct resolved choice (`mix::Mix::groups`):
 //! each gets its own method instance, built over its own characters, with its
 //! own SSS region, image names prefixed `#N ` and stencil code
 //! `mix::stencil_code(N)`.
-//!
-//! A group of one fading character (`mix::Fade`) also holds its old setting's
-//! instance ([`FadeMethod`]): built over the same character and stencil code,
-//! on the frame's targets with the diffuse target replaced by a copy of it
-//! taken before any group writes in place (`#N fade keep`), so that it reads
-//! the light before SSS as its own group would. `frame.rs` records the copy,
-//! the old instance's passes (named `#N fade ...`) and the blend of its result
-//! into the diffuse target by the fade's weight (`merge.rs`).
+
+pub mod fade;
+pub mod merge;
+pub mod passes;
+pub mod region;
+pub mod setup;
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
@@ -26,12 +36,14 @@ use glam::Mat4;
 use super::settings::{Assignment, RenderSettings};
 use crate::graph::ImageId;
 use crate::method::region::PixelRect;
-use crate::method::{FrameTargets, MethodEntry, MethodOptions, Needs, SssMethod};
+use crate::method::{MethodEntry, MethodOptions, Needs, SssMethod};
 use crate::mix::{stencil_code, Mix};
 use crate::scene::framing::{frame as frame_scene, Framing, Shot};
 use crate::scene::Scene;
 use crate::vk::context::Context;
 use crate::vk::guard::Destroy;
+use fade::FadeMethod;
+use region::scissors;
 
 /// What a report calls the method of a frame of several (`Report::method`,
 /// the budget's frame file `frames/mix.json`).
@@ -159,15 +171,8 @@ fn mixed_choice(
     let entry = c.entry()?;
     let options = c.method_options();
     super::settings::check_msaa(settings.msaa, Some(entry))?;
-    // ssg's shader branch shades every pixel whose alpha marks skin, the
-    // other groups' too: only the stencil keeps a group to its pixels.
-    if entry.name == "ssg" && entry.opts(&options).resolved().get("mask") == Some(&"branch".into())
-    {
-        bail!(
-            "{}: the branch mask shades every character's skin; in a frame of several \
-             methods ssg needs mask=stencil",
-            c.label()
-        );
+    if let Some(why) = (entry.no_mix)(&entry.opts(&options)) {
+        bail!("{}: {why}", c.label());
     }
     Ok((entry, options))
 }
@@ -220,45 +225,6 @@ pub struct GroupMethod {
     pub fade: Option<FadeMethod>,
 }
 
-/// The old setting of a fading character's group, built over the keep.
-pub struct FadeMethod {
-    pub spec: FadeSpec,
-    /// The copy of the diffuse target it reads and (most methods) writes in place.
-    pub keep: ImageId,
-    /// The frame's targets with `diffuse` = `keep`: what it was built on and
-    /// its passes are recorded against.
-    pub targets: FrameTargets,
-    pub method: Box<dyn SssMethod>,
-    /// Its region (its own reach over the character): where the keep is
-    /// copied, its passes work and its result is blended.
-    pub region_px: Vec<PixelRect>,
-    pub scissors: Vec<vk::Rect2D>,
-}
-
-impl FadeMethod {
-    pub fn set_region(&mut self, px: Vec<PixelRect>) {
-        self.scissors = scissors(&px);
-        self.region_px = px;
-    }
-}
-
-/// The rectangles of a pixel region as scissors.
-pub fn scissors(region: &[PixelRect]) -> Vec<vk::Rect2D> {
-    region
-        .iter()
-        .map(|r| vk::Rect2D {
-            offset: vk::Offset2D {
-                x: r.x0 as i32,
-                y: r.y0 as i32,
-            },
-            extent: vk::Extent2D {
-                width: r.width(),
-                height: r.height(),
-            },
-        })
-        .collect()
-}
-
 impl GroupMethod {
     pub fn set_region(&mut self, px: Vec<PixelRect>) {
         self.scissors = scissors(&px);
@@ -277,9 +243,9 @@ impl GroupMethod {
         v
     }
 
-    /// Whether its method records no pass (`none`).
+    /// Whether its method does no SSS (records no pass).
     pub fn is_none(&self) -> bool {
-        self.spec.entry.name == crate::method::none::ENTRY.name
+        self.spec.entry.no_sss
     }
 }
 
@@ -317,7 +283,6 @@ mod tests {
         assert_eq!(g.len(), 1);
         assert_eq!(g[0].characters, vec![0, 1, 2]);
         assert_eq!(g[0].stencil(), crate::method::STENCIL_SKIN);
-        assert_eq!(crate::mix::SKIN_BIT, crate::method::STENCIL_SKIN);
         assert_eq!(g[0].label, "separable");
     }
 
