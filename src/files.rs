@@ -275,11 +275,8 @@ pub fn read_rgba32f(path: &Path, what: &str, bound: &ImageBound) -> Result<image
 mod tests {
     use super::*;
 
-    fn dir(tag: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("dermis-files-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn dir(tag: &str) -> crate::scene::gltf_load::fixture::TempDir {
+        crate::scene::gltf_load::fixture::temp_dir(&format!("files-{tag}"))
     }
 
     fn err<T>(r: Result<T>) -> String {

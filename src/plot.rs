@@ -151,9 +151,7 @@ mod tests {
     // skipped in silence for another font, and any size was read).
     #[test]
     fn a_font_the_user_names_is_read_through_the_door() {
-        let dir = std::env::temp_dir().join(format!("dermis-font-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scene::gltf_load::fixture::temp_dir("font");
         let fifo = dir.join("font.ttf");
         let made = std::process::Command::new("mkfifo").arg(&fifo).status();
         assert!(made.is_ok_and(|s| s.success()), "mkfifo");

@@ -499,6 +499,7 @@ mod tests {
                 PassSample {
                     name: "a".into(),
                     role: PassRole::Sss,
+                    merge: false,
                     barrier_ms: 0.0,
                     gpu_ms: a,
                     fragment_invocations: Some(5),
@@ -507,6 +508,7 @@ mod tests {
                 PassSample {
                     name: "b".into(),
                     role: PassRole::Post,
+                    merge: false,
                     barrier_ms: 0.5,
                     gpu_ms: b,
                     fragment_invocations: None,

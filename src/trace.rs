@@ -196,6 +196,7 @@ mod tests {
         PassSample {
             name: name.into(),
             role: PassRole::Sss,
+            merge: false,
             barrier_ms,
             gpu_ms,
             fragment_invocations: Some(7),

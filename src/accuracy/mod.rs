@@ -649,8 +649,7 @@ mod tests {
 
     #[test]
     fn a_malformed_file_is_a_one_line_error() {
-        let dir = std::env::temp_dir().join(format!("dermis-accuracy-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scene::gltf_load::fixture::temp_dir("accuracy");
         let f = dir.join("bad.toml");
         std::fs::write(&f, "command = \"c\"\nrows = [ { asset = \"scan\" ").unwrap();
         let e = format!("{:#}", AccuracyModel::load(&f).unwrap_err());

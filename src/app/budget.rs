@@ -289,7 +289,8 @@ pub fn budget(
     let mut runs = Vec::new();
     for f in frames {
         // A frame of several methods is priced as one frame: its passes carry
-        // their group in their names (`#N ...`, the merges `mix merge #N`).
+        // their group in their names (`#N ...`; the merges are marked,
+        // `Pass::merge`).
         let name = if f.settings().assignment.is_some() {
             MIX_NAME
         } else {

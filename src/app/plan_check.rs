@@ -180,7 +180,7 @@ fn time_sss(ctx: &Context, scene: &Scene, s: &RenderSettings, n: usize) -> Resul
         let on = f.iter().filter(|p| p.role == PassRole::Sss);
         sss.push(on.clone().map(|p| p.gpu_ms).sum());
         merge.push(
-            on.filter(|p| p.name.starts_with("mix merge"))
+            on.filter(|p| p.merge)
                 .map(|p| p.gpu_ms)
                 .sum(),
         );

@@ -210,7 +210,7 @@ mod tests {
 
     #[test]
     fn writes_png_and_svg_with_every_bar() {
-        let dir = std::env::temp_dir().join(format!("dermis-budget-chart-{}", std::process::id()));
+        let dir = crate::scene::gltf_load::fixture::temp_dir("budget-chart");
         let bar = |label: &str, sss| Bar {
             label: label.into(),
             segments: [1.0, 8.0, sss, 0.9, 1.5],

@@ -431,7 +431,6 @@ fn outline(shape: Shape) -> Vec<(i32, i32)> {
 mod tests {
     use super::*;
     use std::fs;
-    use std::path::PathBuf;
 
     fn pt(method: &str, gpu_ms: f64, error: f64) -> EvalPoint {
         EvalPoint {
@@ -443,10 +442,8 @@ mod tests {
         }
     }
 
-    fn temp_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("dermis-chart-{tag}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        dir
+    fn temp_dir(tag: &str) -> crate::scene::gltf_load::fixture::TempDir {
+        crate::scene::gltf_load::fixture::temp_dir(&format!("chart-{tag}"))
     }
 
     /// Checks the PNG decodes at full size and is not blank: its luminance

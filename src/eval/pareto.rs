@@ -157,7 +157,7 @@ mod tests {
 
     #[test]
     fn csv_round_trips() {
-        let dir = std::env::temp_dir().join(format!("dermis-pareto-{}", std::process::id()));
+        let dir = crate::scene::gltf_load::fixture::temp_dir("pareto");
         let path = dir.join("sub").join("points.csv");
         let mut points = vec![
             pt("separable", 0.125, 0.0123456789),
@@ -200,8 +200,7 @@ mod tests {
 
     #[test]
     fn csv_unwritable_path_errors() {
-        let dir = std::env::temp_dir().join(format!("dermis-pareto-nw-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scene::gltf_load::fixture::temp_dir("pareto-nw");
         // A path whose "parent" is a regular file cannot be created.
         let file = dir.join("file");
         std::fs::write(&file, "x").unwrap();

@@ -73,6 +73,11 @@ pub struct Pass<'a> {
     /// The method group the pass belongs to (`mix::Group::index`), `None` for
     /// the frame's own passes (shadow, geometry, composite, tone map).
     pub group: Option<usize>,
+    /// A merge: the copy of a group's result into the frame's diffuse target
+    /// in a frame of several methods, the mixed frame's own overhead
+    /// (`render/groups/merge.rs`). What measures the overhead reads this,
+    /// never the pass's label.
+    pub merge: bool,
 }
 
 impl<'a> Pass<'a> {
@@ -86,6 +91,7 @@ impl<'a> Pass<'a> {
             cost: None,
             record: Box::new(|_| {}),
             group: None,
+            merge: false,
         }
     }
 

@@ -19,6 +19,8 @@ use crate::vk::profiler::{PassTiming, Profiler};
 pub struct PassSample {
     pub name: String,
     pub role: PassRole,
+    /// The pass is a mixed frame's merge (`Pass::merge`).
+    pub merge: bool,
     pub barrier_ms: f64,
     pub gpu_ms: f64,
     pub fragment_invocations: Option<u64>,
@@ -30,6 +32,7 @@ impl PassSample {
         PassSample {
             name: pass.name.clone(),
             role: pass.role,
+            merge: pass.merge,
             barrier_ms: t.barrier_ms,
             gpu_ms: t.gpu_ms,
             fragment_invocations: t.fragment_invocations,

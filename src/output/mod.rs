@@ -421,11 +421,8 @@ pub fn slug(s: &str) -> String {
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("dermis-output-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn tmp(name: &str) -> crate::scene::gltf_load::fixture::TempDir {
+        crate::scene::gltf_load::fixture::temp_dir(&format!("output-{name}"))
     }
 
     /// The names in `d`, sorted.
@@ -572,8 +569,7 @@ mod tests {
     // tint mixes skin pixels only.
     #[test]
     fn character_ids_round_trip_and_tint_skin_only() {
-        let d = std::env::temp_dir().join(format!("dermis-ids-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
+        let d = crate::scene::gltf_load::fixture::temp_dir("ids");
         let ids = vec![0, 1, 256, 1024, 2, 0];
         let p = d.join("characters.png");
         write_character_ids_png(&p, 3, 2, &ids).unwrap();

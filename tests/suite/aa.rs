@@ -837,7 +837,7 @@ fn mlaa_blend_is_the_area_weighted_average_of_eq_9_1() {
 /// error line.
 #[test]
 fn render_reports_the_mode_and_its_passes() {
-    let dir = std::env::temp_dir().join(format!("dermis-aa-{}", std::process::id()));
+    let dir = dermis::scene::gltf_load::fixture::temp_dir("aa");
     let render = |aa: Option<&str>, out: &std::path::Path| {
         let mut c = common::dermis();
         c.args([

@@ -213,8 +213,7 @@ fn a_frame_with_no_edges_has_the_1x_frame_as_its_reference() {
 /// chart; and the size guard's one-line errors before any device opens.
 #[test]
 fn aa_eval_command_writes_its_files_and_guards_the_size() {
-    let out = std::env::temp_dir().join(format!("dermis-aa-eval-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out = dermis::scene::gltf_load::fixture::temp_dir("aa-eval");
     let o = common::dermis()
         .args([
             "aa-eval",

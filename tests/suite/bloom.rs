@@ -244,7 +244,7 @@ fn without_bloom_the_frame_has_no_bloom_pass() {
 /// `bloom` key and no pass touches a bloom image.
 #[test]
 fn render_reports_the_bloom_passes() {
-    let dir = std::env::temp_dir().join(format!("dermis-bloom-{}", std::process::id()));
+    let dir = dermis::scene::gltf_load::fixture::temp_dir("bloom");
     let render = |bloom: bool, out: &std::path::Path| {
         let mut c = common::dermis();
         c.args(["render", "--validate", "--device", "llvmpipe"])

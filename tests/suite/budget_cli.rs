@@ -3,20 +3,18 @@
 //! pass of the frame listed and none unpriced, the JSON, frame files and chart
 //! written; a bad profile is one error line.
 
-use std::path::PathBuf;
+use dermis::scene::gltf_load::fixture::TempDir;
 
 use crate::common::dermis;
 use dermis::method::METHODS;
 use serde_json::Value;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dermis-budget-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir(&format!("budget-{name}"))
 }
 
 /// Runs `dermis budget` small on lavapipe with validation; returns budget.json and stdout.
-fn budget(name: &str, args: &[&str]) -> (Value, String, PathBuf) {
+fn budget(name: &str, args: &[&str]) -> (Value, String, TempDir) {
     let out = tmp(name);
     let o = dermis()
         .args([

@@ -1,6 +1,7 @@
 //! The command line: bad input gives one clear error line and a non-zero exit,
 //! never a panic or a validation error; good input writes what it promises.
 
+use dermis::scene::gltf_load::fixture::TempDir;
 use dermis::scene::gltf_load::fixture::{Container, Model};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -11,10 +12,8 @@ fn dermis() -> Command {
     c
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dermis-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmp(name: &str) -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir(&format!("cli-{name}"))
 }
 
 /// Runs `dermis render` on lavapipe with validation and the given extra

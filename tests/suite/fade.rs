@@ -240,7 +240,7 @@ fn a_fade_returns_uniform_light_as_it_came_in() {
 /// before any device opens.
 #[test]
 fn a_bad_fade_is_one_line_before_any_device_opens() {
-    let dir = std::env::temp_dir().join(format!("dermis-fade-plans-{}", std::process::id()));
+    let dir = dermis::scene::gltf_load::fixture::temp_dir("fade-plans");
     std::fs::create_dir_all(&dir).unwrap();
     let plan = |fade: &str| {
         format!(

@@ -12,6 +12,7 @@
 //!     DERMIS_FUZZ_ITERS=50000 DERMIS_FUZZ_SEED=7 cargo test --release --test suite gltf_fuzz -- --nocapture
 //! DERMIS_FUZZ_RENDER=0 skips the rendering part (no Vulkan needed).
 
+use dermis::scene::gltf_load::fixture::TempDir;
 use crate::common;
 
 use dermis::render::RenderSettings;
@@ -182,11 +183,8 @@ fn render_small(
     Ok((cap.diffuse, cap.ldr))
 }
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dermis-gltf-fuzz-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+fn temp_dir() -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir("gltf-fuzz")
 }
 
 fn env_usize(key: &str, default: usize) -> usize {

@@ -5,7 +5,8 @@
 //! truncated file is left under a final name: `output::write_with` writes a
 //! temporary beside it and renames it only when complete.
 
-use std::path::{Path, PathBuf};
+use dermis::scene::gltf_load::fixture::TempDir;
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -15,11 +16,8 @@ fn dermis() -> Command {
     c
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dermis-hostile-out-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmp(name: &str) -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir(&format!("hostile-out-{name}"))
 }
 
 /// A small render or bench on lavapipe with validation.
@@ -114,8 +112,8 @@ fn a_full_disk_is_one_error_line_and_a_failure() {
     let _ = std::fs::remove_dir_all(d);
 }
 
-/// A tmpfs of a few kilobytes, unmounted on drop.
-struct TinyDisk(PathBuf);
+/// A tmpfs of a few kilobytes, unmounted on drop (before its folder goes).
+struct TinyDisk(TempDir);
 
 impl TinyDisk {
     /// `None` where this process may not mount (not root, no CAP_SYS_ADMIN).
@@ -133,8 +131,7 @@ impl TinyDisk {
 
 impl Drop for TinyDisk {
     fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
-        let _ = std::fs::remove_dir_all(&self.0);
+        let _ = Command::new("umount").arg(self.0.path()).status();
     }
 }
 

@@ -189,7 +189,7 @@ fn each_groups_stencil_masked_passes_pass_exactly_its_skin_pixels() {
 /// `dermis render` with `args` (lavapipe's name as the device, which no
 /// device is called here if a device were opened: the error must come first).
 fn refused(args: &[&str], phrase: &str) {
-    let out = std::env::temp_dir().join(format!("dermis-mix-{}", std::process::id()));
+    let out = dermis::scene::gltf_load::fixture::temp_dir("mix");
     let o = common::dermis()
         .args([
             "render",
@@ -234,7 +234,7 @@ fn bad_assignments_are_one_line_before_any_device_opens() {
         &["--assign", "0=ssg:mask=branch,*=none", "--heads", "2"],
         "needs mask=stencil",
     );
-    let dir = std::env::temp_dir().join(format!("dermis-mix-plans-{}", std::process::id()));
+    let dir = dermis::scene::gltf_load::fixture::temp_dir("mix-plans");
     std::fs::create_dir_all(&dir).unwrap();
     let good = r#"{"version":1,"characters":2,"assignments":[
         {"character":0,"method":"ssg","options":{"fit":"4"}},{"character":1,"method":"none"}]}"#;

@@ -275,8 +275,7 @@ fn sss_stencil_passes_pass_exactly_the_resolved_skin_pixels() {
 /// is one error line before a device opens.
 #[test]
 fn render_reports_and_budget_prices_the_multisampled_geometry_pass() {
-    let dir = std::env::temp_dir().join(format!("dermis-msaa-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = dermis::scene::gltf_load::fixture::temp_dir("msaa");
     let cli = |cmd: &str, msaa: &str, out: &std::path::Path, extra: &[&str]| {
         common::dermis()
             .args([cmd, "--validate", "--device", "llvmpipe", "--width", "96"])

@@ -7,6 +7,7 @@
 //! 64 characters, and the command's one-line errors and its files, with no
 //! Vulkan driver reachable.
 
+use dermis::scene::gltf_load::fixture::TempDir;
 use std::path::PathBuf;
 
 use crate::common::{self, dermis};
@@ -24,10 +25,8 @@ use dermis::render::RenderSettings;
 use dermis::scene::gltf_load::TextureOverrides;
 use dermis::scene::load_gltf_scene;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dermis-plan-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir(&format!("plan-{name}"))
 }
 
 fn models() -> Vec<SettingModel> {

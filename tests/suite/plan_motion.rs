@@ -5,7 +5,7 @@
 //! character's frame-to-frame change against the ground truth's own change
 //! within the flicker test's bound, the files written.
 
-use std::path::PathBuf;
+use dermis::scene::gltf_load::fixture::TempDir;
 
 use crate::common;
 use dermis::budget::profile::Profile;
@@ -24,10 +24,8 @@ fn face() -> dermis::scene::Scene {
     dermis::scene::builtin_scene("face", &TextureOverrides::default(), None).unwrap()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dermis-motion-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> TempDir {
+    dermis::scene::gltf_load::fixture::temp_dir(&format!("motion-{name}"))
 }
 
 /// 64 characters walking 1 head height toward the camera over 6 frames at

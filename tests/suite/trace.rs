@@ -24,8 +24,7 @@ fn close(a: Stats, b: Stats, what: &str) {
 
 #[test]
 fn trace_slices_sum_to_the_report_pass_times() {
-    let d = std::env::temp_dir().join(format!("dermis-trace-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
+    let d = dermis::scene::gltf_load::fixture::temp_dir("trace");
     let trace_path = d.join("t/trace.json");
     let o = Command::new(env!("CARGO_BIN_EXE_dermis"))
         .args([

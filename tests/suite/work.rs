@@ -155,27 +155,47 @@ fn rust_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
     }
 }
 
-/// Labels name passes; behaviour keys on roles and declared work. So no code
-/// outside tests compares a string with a pass's label: collected here from
-/// every method's frame as recorded (up to the first digit, so "ssg g2
-/// horizontal" stands for every Gaussian's pass).
+/// Labels name passes; behaviour keys on roles, declared work and marks
+/// (`Pass::merge`). So no code outside tests compares a string with a pass's
+/// label: collected here from every method's frame and from a frame of
+/// several methods with a fade, as recorded (a group's `#N ` dropped, then up
+/// to the first digit, so "#2 ssg g2 horizontal" stands for every
+/// Gaussian's pass of every group, and "mix merge #1" for every merge).
 #[test]
 fn no_code_compares_a_pass_label() {
     let ctx = common::ctx();
     let scene = egg_scene();
+    let small = || RenderSettings {
+        width: 64,
+        height: 40,
+        shadow_size: 64,
+        ..RenderSettings::study()
+    };
+    let mut frames: Vec<RenderSettings> = METHODS
+        .iter()
+        .map(|m| small().with(m, &[("density", "1")]))
+        .collect();
+    let fade = r#"{"version":1,"characters":3,"assignments":[
+        {"character":0,"method":"separable","fade":{"method":"ssg","weight":0.5}},
+        {"character":1,"method":"poisson"},{"character":2,"method":"ss-jittered"}]}"#;
+    frames.push(RenderSettings {
+        heads: 3,
+        assignment: Some(dermis::render::settings::Assignment::Plan(
+            serde_json::from_str(fade).unwrap(),
+        )),
+        ..small()
+    });
     let mut labels = std::collections::BTreeSet::new();
-    for m in METHODS {
-        let s = RenderSettings {
-            width: 64,
-            height: 40,
-            shadow_size: 64,
-            ..RenderSettings::study()
-        }
-        .with(m, &[("density", "1")]);
-        let r = Renderer::new(&ctx, &scene, &s).unwrap();
+    for s in &frames {
+        let r = Renderer::new(&ctx, &scene, s).unwrap();
         for p in r.passes() {
-            let label: String = p.name.chars().take_while(|c| !c.is_ascii_digit()).collect();
-            labels.insert(label.trim_end().to_string());
+            let name = p.name.as_str();
+            let name = match name.strip_prefix('#') {
+                Some(rest) => rest.trim_start_matches(|c: char| c.is_ascii_digit()).trim_start(),
+                None => name,
+            };
+            let label: String = name.chars().take_while(|c| !c.is_ascii_digit()).collect();
+            labels.insert(label.trim_end_matches([' ', '#']).to_string());
         }
     }
     labels.extend([
@@ -184,7 +204,10 @@ fn no_code_compares_a_pass_label() {
         "fill".to_string(),
     ]);
     assert!(
-        labels.contains("sss horizontal") && labels.contains("ssg g"),
+        labels.contains("sss horizontal")
+            && labels.contains("ssg g")
+            && labels.contains("mix merge")
+            && labels.contains("fade blend"),
         "{labels:?}"
     );
     let mut files = Vec::new();

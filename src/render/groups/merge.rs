@@ -144,14 +144,9 @@ impl Merge {
     ) -> Option<Pass<'a>> {
         let (_, set) = self.sets.iter().find(|(i, _)| *i == g)?;
         let name = format!("mix merge #{g}");
-        Some(draw_into_diffuse(
-            f,
-            g,
-            name,
-            (&self.pipeline, set),
-            output,
-            None,
-        ))
+        let mut p = draw_into_diffuse(f, g, name, (&self.pipeline, set), output, None);
+        p.merge = true;
+        Some(p)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

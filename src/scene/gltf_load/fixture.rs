@@ -99,19 +99,45 @@ pub fn write_gltf(dir: &Path, name: &str, mut json: Value, buffer: &[u8]) -> Pat
     path
 }
 
-/// A fresh empty directory under the system temp dir, unique to this process
-/// and call.
-pub fn temp_dir(tag: &str) -> PathBuf {
-    use std::sync::atomic::{AtomicU32, Ordering};
-    static N: AtomicU32 = AtomicU32::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "dermis-scene-{tag}-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
+/// A fresh empty directory under the system temporary folder, removed with
+/// everything in it when dropped, so a test run leaves nothing behind; it
+/// reads as its path (`dir.join(...)`, `&dir` where a `&Path` is taken).
+pub struct TempDir(tempfile::TempDir);
+
+impl TempDir {
+    pub fn path(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<Path> for TempDir {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for TempDir {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.path().as_os_str()
+    }
+}
+
+/// A fresh empty directory for a test (named `dermis-TAG-...`), gone when
+/// the value is dropped.
+pub fn temp_dir(tag: &str) -> TempDir {
+    TempDir(
+        tempfile::Builder::new()
+            .prefix(&format!("dermis-{tag}-"))
+            .tempdir()
+            .expect("a temporary directory"),
+    )
 }
 
 impl Model {
