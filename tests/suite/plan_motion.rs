@@ -300,7 +300,8 @@ fn plan_motion_cross_fades_a_switch_over_three_frames() {
 /// each, exit status 1, with no Vulkan driver to be found.
 #[test]
 fn plan_motion_errors_are_one_line_and_need_no_device() {
-    let out = tmp("errors");
+    let dir = tmp("errors");
+    let out = dir.join("out");
     let o = out.to_str().unwrap();
     for (args, want) in [
         (vec!["--frames", "1"], "--frames"),
