@@ -179,11 +179,7 @@ fn time_sss(ctx: &Context, scene: &Scene, s: &RenderSettings, n: usize) -> Resul
     for f in &frames {
         let on = f.iter().filter(|p| p.role == PassRole::Sss);
         sss.push(on.clone().map(|p| p.gpu_ms).sum());
-        merge.push(
-            on.filter(|p| p.merge)
-                .map(|p| p.gpu_ms)
-                .sum(),
-        );
+        merge.push(on.filter(|p| p.merge).map(|p| p.gpu_ms).sum());
     }
     let med = |v: &mut Vec<f64>| {
         v.sort_by(f64::total_cmp);

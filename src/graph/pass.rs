@@ -49,6 +49,17 @@ pub(super) enum Cost {
         groups: [u32; 3],
         group_size: u32,
     },
+    /// Workgroups counted on the GPU: the executor dispatches from `args`
+    /// (three u32 at `offset`, written by an earlier pass) after the record
+    /// closure; the declared work is priced at `most` workgroups, the count's
+    /// bound (as a shader's branches are priced at their bounds).
+    DispatchIndirect {
+        shader: ShaderWork,
+        args: BufferId,
+        offset: u64,
+        most: [u32; 3],
+        group_size: u32,
+    },
     /// Copies and clears: their work as written.
     Other(Work),
 }
@@ -254,6 +265,40 @@ impl<'a> Pass<'a> {
         self
     }
 
+    /// A compute dispatch whose workgroup counts a GPU pass wrote into the
+    /// tracked buffer `args` (three u32 at byte `offset`: the indirect
+    /// arguments, read with their own access kind, so the barrier from their
+    /// writer is derived as every other), at most `most` workgroups of
+    /// `group_size` invocations (what the declared work counts). The
+    /// executor dispatches after the record closure binds and pushes.
+    pub fn dispatch_indirect(
+        mut self,
+        shader: ShaderWork,
+        (args, offset): (BufferId, u64),
+        most: [u32; 3],
+        group_size: u32,
+    ) -> Self {
+        assert!(
+            self.cost.is_none(),
+            "pass '{}' declares work twice",
+            self.name
+        );
+        assert!(
+            offset % 4 == 0,
+            "pass '{}': indirect arguments at byte {offset}, not a multiple of 4",
+            self.name
+        );
+        self.buffer(args, AccessKind::IndirectCommandRead);
+        self.cost = Some(Cost::DispatchIndirect {
+            shader,
+            args,
+            offset,
+            most,
+            group_size,
+        });
+        self
+    }
+
     /// The work of a copy or clear (raster and compute work is derived from
     /// their declarations).
     pub fn work(mut self, work: Work) -> Self {
@@ -285,6 +330,12 @@ impl<'a> Pass<'a> {
                 shader,
                 groups,
                 group_size,
+            }
+            | Cost::DispatchIndirect {
+                shader,
+                most: groups,
+                group_size,
+                ..
             } => Work::Compute {
                 shader: shader.clone(),
                 invocations: groups.iter().map(|&g| g as u64).product::<u64>() * *group_size as u64,
@@ -518,6 +569,23 @@ mod tests {
             c.declared_work(&res),
             Some(Work::Compute {
                 invocations: 384,
+                ..
+            })
+        ));
+        // An indirect dispatch declares its arguments' read (so the barrier
+        // from the pass that wrote them is derived) and counts its bound.
+        let args = res.add_buffer("args", vk::Buffer::null());
+        let i = Pass::new("i", PassRole::Sss).dispatch_indirect(
+            ShaderWork::default(),
+            (args, 0),
+            [4, 4, 1],
+            64,
+        );
+        assert_eq!(i.buffers, [(args, AccessKind::IndirectCommandRead)]);
+        assert!(matches!(
+            i.declared_work(&res),
+            Some(Work::Compute {
+                invocations: 1024,
                 ..
             })
         ));

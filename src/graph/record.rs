@@ -193,6 +193,13 @@ fn record_one(ctx: &Context, cmd: vk::CommandBuffer, res: &Resources, pass: &Pas
                     .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
             };
         }
+        Some(Cost::DispatchIndirect { args, offset, .. }) => {
+            (pass.record)(&pc(0));
+            unsafe {
+                ctx.device
+                    .cmd_dispatch_indirect(cmd, res.buffer(*args), *offset)
+            };
+        }
         Some(Cost::Other(_)) | None => (pass.record)(&pc(0)),
     }
 }

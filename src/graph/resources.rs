@@ -396,9 +396,11 @@ impl Resources {
                     | AccessKind::TransferWritePartial
                     | AccessKind::ClearWrite => ImageUseKind::CopyDestination,
                     AccessKind::HostRead | AccessKind::HostWrite => ImageUseKind::Host,
-                    AccessKind::Nothing | AccessKind::UniformRead | AccessKind::VertexInputRead => {
-                        return None
-                    }
+                    // Buffer-only accesses: no image is used so.
+                    AccessKind::Nothing
+                    | AccessKind::UniformRead
+                    | AccessKind::VertexInputRead
+                    | AccessKind::IndirectCommandRead => return None,
                 };
                 let e = self.extent(id);
                 Some(ImageUse {

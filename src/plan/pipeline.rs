@@ -15,8 +15,7 @@ use serde::Deserialize;
 use super::character::{estimate, CharacterInput};
 use super::choose::{narrow_reach_mm, plan, scatter_reach_mm, Accuracy, Ask, Plan, SettingCosts};
 use super::cost::{reference_counts, CostModel, Reference, Sample, SettingModel};
-use super::dolly::{DollyTable, Point};
-use crate::budget::frames::{check_frame, frames_dir, perf_dir};
+use crate::budget::frames::check_frame;
 use crate::budget::input::FrameInput;
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
@@ -119,7 +118,7 @@ struct Index {
 /// `profiles/frames/plan/` in the source tree (the tools that store frames;
 /// the planner reads the copies built into the binary, [`load_models`]).
 pub fn plan_frames_dir() -> PathBuf {
-    frames_dir().join("plan")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/frames/plan")
 }
 
 /// The planner's stored frames as the binary holds them.
@@ -229,64 +228,6 @@ pub fn load_models() -> Result<(Vec<SettingModel>, Vec<String>)> {
         );
     }
     Ok((models, notes))
-}
-
-/// The stand-in accuracy model (`dolly`): the H100 dolly's err/none.
-pub fn dolly_accuracy() -> Result<DollyTable> {
-    let path = perf_dir().join("h100/dolly/eval.json");
-    #[derive(Deserialize)]
-    struct Row {
-        method: String,
-        setting: String,
-        scene: String,
-        error: f64,
-    }
-    #[derive(Deserialize)]
-    struct SceneRow {
-        name: String,
-        distance_heads: f64,
-    }
-    #[derive(Deserialize)]
-    struct Eval {
-        command: String,
-        rows: Vec<Row>,
-        scenes: Vec<SceneRow>,
-    }
-    let text = crate::files::read_text(&path, "eval results", crate::files::MAX_TEXT_FILE)?;
-    let e: Eval = serde_json::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{e}"))
-        .with_context(|| format!("{}: not an eval.json", path.display()))?;
-    // The dolly's frame: 1280x720 at the default field of view.
-    let (h, fovy) = (720, f64::from(RenderSettings::default().fovy_deg));
-    let none = Choice::none().method;
-    let mut points = Vec::new();
-    for s in &e.scenes {
-        let Some(z) = e
-            .rows
-            .iter()
-            .find(|r| r.scene == s.name && r.method == none)
-            .map(|r| r.error)
-            .filter(|z| *z > 0.0)
-        else {
-            continue;
-        };
-        for r in e
-            .rows
-            .iter()
-            .filter(|r| r.scene == s.name && r.method != none)
-        {
-            points.push(Point {
-                method: r.method.clone(),
-                setting: r.setting.clone(),
-                px_per_mm: stored_px_per_mm(h, fovy, s.distance_heads),
-                err_over_none: r.error / z,
-            });
-        }
-    }
-    Ok(DollyTable {
-        points,
-        source: format!("err/none of {} ({})", path.display(), e.command),
-    })
 }
 
 /// Millimetres of skin per unit of the texture-space atlas (area-weighted

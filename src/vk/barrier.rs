@@ -75,6 +75,9 @@ pub enum AccessKind {
     UniformRead,
     /// Read as vertex/index data by the input assembler.
     VertexInputRead,
+    /// Read as the arguments of an indirect dispatch or draw (buffers only):
+    /// a compute pass's workgroup counts written on the GPU by an earlier one.
+    IndirectCommandRead,
 }
 
 /// Stage, access and layout of one access kind.
@@ -177,6 +180,9 @@ impl AccessKind {
                 A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ,
                 L::UNDEFINED,
             ),
+            AccessKind::IndirectCommandRead => {
+                (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ, L::UNDEFINED)
+            }
         };
         AccessInfo {
             stage,
@@ -246,7 +252,8 @@ impl AccessKind {
             | AccessKind::HostRead
             | AccessKind::HostWrite
             | AccessKind::UniformRead
-            | AccessKind::VertexInputRead => U::empty(),
+            | AccessKind::VertexInputRead
+            | AccessKind::IndirectCommandRead => U::empty(),
         }
     }
 
@@ -405,7 +412,7 @@ impl ResourceState {
 mod tests {
     use super::*;
 
-    const ALL: [AccessKind; 23] = [
+    const ALL: [AccessKind; 24] = [
         AccessKind::ColorResolveWrite,
         AccessKind::DepthStencilResolveWrite,
         AccessKind::FragmentStorageReadWrite,
@@ -429,6 +436,7 @@ mod tests {
         AccessKind::HostWrite,
         AccessKind::UniformRead,
         AccessKind::VertexInputRead,
+        AccessKind::IndirectCommandRead,
     ];
 
     /// The barrier the renderer's planner emits for `next` on an image whose
@@ -628,6 +636,29 @@ mod tests {
         .unwrap();
         assert_eq!(c.src_access, A::COLOR_ATTACHMENT_WRITE);
         assert_eq!(c.new_layout, L::SHADER_READ_ONLY_OPTIMAL);
+    }
+
+    // Khronos synchronization examples: "Compute write to storage buffer,
+    // Dispatch-indirect read": the compute write made visible to the
+    // draw-indirect stage's indirect command read.
+    #[test]
+    fn compute_write_then_indirect_dispatch_read() {
+        let b = buffer_after(
+            &[AccessKind::ComputeStorageWrite],
+            AccessKind::IndirectCommandRead,
+        )
+        .unwrap();
+        assert_eq!(b.src_stage, S::COMPUTE_SHADER);
+        assert_eq!(b.src_access, A::SHADER_STORAGE_WRITE);
+        assert_eq!(b.dst_stage, S::DRAW_INDIRECT);
+        assert_eq!(b.dst_access, A::INDIRECT_COMMAND_READ);
+        // The next write of the arguments waits for the indirect read.
+        let mut st = ResourceState::default();
+        st.plan(AccessKind::ComputeStorageWrite, false);
+        st.plan(AccessKind::IndirectCommandRead, false);
+        let w = st.plan(AccessKind::ComputeStorageWrite, false).unwrap();
+        assert_eq!(w.src_stage, S::DRAW_INDIRECT);
+        assert_eq!(w.dst_stage, S::COMPUTE_SHADER);
     }
 
     // "Copy to a buffer, then read it on the host"; reads of a never-written

@@ -12,8 +12,8 @@
 //!     DERMIS_FUZZ_ITERS=50000 DERMIS_FUZZ_SEED=7 cargo test --release --test suite gltf_fuzz -- --nocapture
 //! DERMIS_FUZZ_RENDER=0 skips the rendering part (no Vulkan needed).
 
-use dermis::scene::gltf_load::fixture::TempDir;
 use crate::common;
+use dermis::scene::gltf_load::fixture::TempDir;
 
 use dermis::render::RenderSettings;
 use dermis::run::{run, FrameCounts, RunOptions};

@@ -569,3 +569,88 @@ fn messages_name_the_real_cause() {
     );
     one_error(&o, &["depth.exr", "NaN or infinite", "(5, 0)"]);
 }
+
+/// A binary that runs anywhere (issue 27): no code a command runs reads the
+/// source tree. The functions that name it (`CARGO_MANIFEST_DIR`) serve the
+/// tools and the tests only: outside tests, only the calibration's and the
+/// porting tables' modules (run by `tools/examples/`) call them; the
+/// commands read the copies built into the binary (`dermis::embedded`).
+#[test]
+fn no_command_reads_the_source_tree() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let readers = [
+        "frames_dir()",
+        "perf_dir()",
+        "profiles_dir()",
+        "default_dir()",
+        "plan_frames_dir()",
+    ];
+    let tools = [
+        "budget/points.rs",
+        "budget/porting.rs",
+        "budget/calibration.rs",
+    ];
+    let mut files = Vec::new();
+    let mut stack = vec![src.clone()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    let mut found = Vec::new();
+    for f in &files {
+        let rel = f
+            .strip_prefix(&src)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        // A test module's own file (`mod tests;`) runs in the source tree.
+        if rel.ends_with("/tests.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(f).unwrap();
+        // Unit tests read the source tree: they run in it.
+        let code = text.split("#[cfg(test)]").next().unwrap_or_default();
+        let mut in_fn = String::new();
+        for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
+            if let Some(name) = line
+                .split("fn ")
+                .nth(1)
+                .and_then(|r| r.split('(').next())
+                .filter(|_| {
+                    line.trim_start().starts_with("pub fn ") || line.trim_start().starts_with("fn ")
+                })
+            {
+                in_fn = format!("{name}()");
+            }
+            // The source tree is named only inside the readers themselves.
+            if line.contains("CARGO_MANIFEST_DIR") && !readers.contains(&in_fn.as_str()) {
+                found.push(format!("{rel}: {} (in {in_fn})", line.trim()));
+            }
+            // A call: the name not part of a longer one, and not its definition.
+            let calls = readers.iter().any(|r| {
+                line.match_indices(r).any(|(i, _)| {
+                    let before = &line[..i];
+                    let joined = before
+                        .chars()
+                        .last()
+                        .is_some_and(|c| c.is_alphanumeric() || c == '_');
+                    !joined && !before.ends_with("fn ")
+                })
+            });
+            if calls && !tools.contains(&rel.as_str()) {
+                found.push(format!("{rel}: {}", line.trim()));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "the source tree read at run time:\n{}",
+        found.join("\n")
+    );
+}

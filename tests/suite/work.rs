@@ -191,7 +191,9 @@ fn no_code_compares_a_pass_label() {
         for p in r.passes() {
             let name = p.name.as_str();
             let name = match name.strip_prefix('#') {
-                Some(rest) => rest.trim_start_matches(|c: char| c.is_ascii_digit()).trim_start(),
+                Some(rest) => rest
+                    .trim_start_matches(|c: char| c.is_ascii_digit())
+                    .trim_start(),
                 None => name,
             };
             let label: String = name.chars().take_while(|c| !c.is_ascii_digit()).collect();
