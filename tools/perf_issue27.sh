@@ -14,9 +14,10 @@
 # Carried (ignored folders): .gl (the Vulkan loader debs), .bin (dermis after,
 # dermis-before: the release build of 4543ad7, both stripped).
 set -uo pipefail
-OUT=${OUT:-out}
 ROOT=$PWD
+OUT=$(realpath -m "${OUT:-out}")
 R=/tmp/issue27
+rm -rf "$R"
 mkdir -p "$R" "$OUT"
 for f in .gl/*.deb; do dpkg -x "$f" /; done
 ldconfig
@@ -25,6 +26,8 @@ O=$ROOT/.bin/dermis-before
 if ! "$N" devices 2>&1 | grep -qi nvidia; then
   export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 fi
+# The charts need a TrueType font; the device machine has none.
+export DERMIS_FONT=$ROOT/.bin/DejaVuSans.ttf
 cd /tmp
 log() { echo "+ $*" >> "$R/commands.txt"; }
 {
@@ -32,7 +35,9 @@ log() { echo "+ $*" >> "$R/commands.txt"; }
   "$N" devices
 } > "$R/gpu.txt" 2>&1
 
-# 1. Runs anywhere.
+# 1. Runs anywhere: the source tree's data hidden while both binaries run (the
+# device's copy of the checkout sits where this one was built).
+mv "$ROOT/profiles" "$ROOT/profiles.hidden"
 log dermis plan --profile nvidia-h100 --budget-ms 0.5 --heads 16 --out "$R/plan"
 "$N" plan --profile nvidia-h100 --budget-ms 0.5 --heads 16 --out "$R/plan" > "$R/plan.txt" 2>&1
 echo "after: plan exit $?" >> "$R/anywhere.txt"
@@ -43,6 +48,7 @@ echo "after: budget exit $?" >> "$R/anywhere.txt"
 "$O" budget --profile nvidia-h100 --width 1920 --height 1080 --shot close \
   --out "$R/budget-before" > "$R/budget-before.txt" 2>&1
 echo "before: budget exit $?" >> "$R/anywhere.txt"
+mv "$ROOT/profiles.hidden" "$ROOT/profiles"
 
 # 2. A report renders its frame again, bit for bit, on the GPU.
 for c in "single|--width 1920 --height 1080 --shot close" \
@@ -70,5 +76,5 @@ for round in 1 2 3; do
     "$bin" bench $B --report "$R/bench-$who-$round.json" > "$R/bench-$who-$round.txt" 2>&1
   done
 done
-cd "$R" && tar czf "$ROOT/$OUT/issue27.tgz" --exclude='*.exr' --exclude='*.png' . && cd "$ROOT"
+cd "$R" && tar czf "$OUT/issue27.tgz" --exclude='*.exr' --exclude='*.png' . && cd "$ROOT"
 ls -la "$OUT"
