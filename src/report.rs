@@ -286,6 +286,10 @@ pub struct PassReport {
     pub barrier_ms: Stats,
     /// Fragment shader invocations (pipeline statistics) of the last measured frame.
     pub fragment_invocations: Option<u64>,
+    /// Compute shader invocations, last measured frame (`None` in reports
+    /// from before they were counted, and for passes that dispatch nothing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compute_invocations: Option<u64>,
     /// Samples that passed depth and stencil tests (occlusion query), last measured frame.
     pub samples_passed: u64,
     /// Lower bound from the measured device ceilings (bench only).
@@ -345,6 +349,10 @@ pub fn aggregate(
                 gpu_ms: Stats::of(&gpu).expect("non-empty"),
                 barrier_ms: Stats::of(&bar).expect("non-empty"),
                 fragment_invocations: frames.last().and_then(|f| f[i].fragment_invocations),
+                compute_invocations: frames
+                    .last()
+                    .and_then(|f| f[i].compute_invocations)
+                    .filter(|&n| n > 0),
                 samples_passed: frames.last().map(|f| f[i].samples_passed).unwrap_or(0),
                 floor_ms: None,
                 floor_ratio: None,
@@ -503,6 +511,7 @@ mod tests {
                     barrier_ms: 0.0,
                     gpu_ms: a,
                     fragment_invocations: Some(5),
+                    compute_invocations: None,
                     samples_passed: 5,
                 },
                 PassSample {
@@ -512,6 +521,7 @@ mod tests {
                     barrier_ms: 0.5,
                     gpu_ms: b,
                     fragment_invocations: None,
+                    compute_invocations: None,
                     samples_passed: 0,
                 },
             ]

@@ -84,6 +84,16 @@ pub const BLOOM_BLUR_RADIUS: u32 = 3;
 /// tests read every compute module's workgroup size back from its SPIR-V.
 pub const COMPUTE_GROUP_SIDE: u32 = 8;
 
+/// Side of the compute path's SSS tiles (sss_tiles.comp, separable_blur.comp):
+/// one workgroup of SSS_TILE_SIDE^2 invocations per tile, HDRP's 16x16.
+pub const SSS_TILE_SIDE: u32 = 16;
+
+/// Texels the compute blurs load on each side of a tile along their
+/// direction (shared memory: the tile and its apron, 16 x 80 texels of 12
+/// bytes, 15 KiB, under the 16 KiB every Vulkan device has). Wider kernels
+/// read the texels beyond from the images (`method::tiles` says when).
+pub const SSS_APRON_PX: u32 = 32;
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -153,6 +163,8 @@ pub fn glsl() -> String {
     def("BLOOM_LEVELS", BLOOM_LEVELS.to_string());
     def("BLOOM_BLUR_RADIUS", BLOOM_BLUR_RADIUS.to_string());
     def("COMPUTE_GROUP_SIDE", COMPUTE_GROUP_SIDE.to_string());
+    def("SSS_TILE_SIDE", SSS_TILE_SIDE.to_string());
+    def("SSS_APRON_PX", SSS_APRON_PX.to_string());
     s.push_str("#endif\n");
     s
 }
@@ -177,6 +189,8 @@ mod tests {
             "TSD_MAX_ISLANDS",
             "PCF_TAPS",
             "COMPUTE_GROUP_SIDE",
+            "SSS_TILE_SIDE",
+            "SSS_APRON_PX",
         ] {
             assert!(h.contains(&format!("#define {name} ")), "{name}");
         }

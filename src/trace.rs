@@ -200,6 +200,7 @@ mod tests {
             barrier_ms,
             gpu_ms,
             fragment_invocations: Some(7),
+            compute_invocations: None,
             samples_passed: 5,
         }
     }

@@ -24,6 +24,7 @@ pub struct PassSample {
     pub barrier_ms: f64,
     pub gpu_ms: f64,
     pub fragment_invocations: Option<u64>,
+    pub compute_invocations: Option<u64>,
     pub samples_passed: u64,
 }
 
@@ -36,6 +37,7 @@ impl PassSample {
             barrier_ms: t.barrier_ms,
             gpu_ms: t.gpu_ms,
             fragment_invocations: t.fragment_invocations,
+            compute_invocations: t.compute_invocations,
             samples_passed: t.samples_passed,
         }
     }

@@ -290,6 +290,17 @@ impl Resources {
         })
     }
 
+    /// The stencil-only view of a sampled depth/stencil image; binding one
+    /// of an image without a stencil (or never sampled) is a programmer error.
+    pub(super) fn stencil_view(&self, id: ImageId) -> vk::ImageView {
+        self.image(id).stencil_view.unwrap_or_else(|| {
+            panic!(
+                "image '{}' has no stencil view (not a sampled depth/stencil image)",
+                self.name(id)
+            )
+        })
+    }
+
     /// The mip level `id` names.
     pub fn level_of(&self, id: ImageId) -> u32 {
         self.images[id.0].level

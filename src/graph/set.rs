@@ -35,6 +35,9 @@ pub enum Binding {
     /// An sRGB frame image sampled through its UNORM view (its encoded
     /// values; `Resources::request_unorm_view`).
     SampledUnorm(ImageId),
+    /// The stencil aspect of a depth/stencil frame image, sampled (a
+    /// `utexture2D`: the compute path's skin mask).
+    SampledStencil(ImageId),
     /// A frame image as a storage image.
     StorageImage(ImageId, Storage),
     /// `size` bytes from `offset` of a tracked buffer, as a storage buffer.
@@ -76,7 +79,7 @@ impl GraphSet {
         let mut buffers = Vec::new();
         for &(_, b) in &binds {
             match b {
-                Binding::Sampled(id) | Binding::SampledUnorm(id) => {
+                Binding::Sampled(id) | Binding::SampledUnorm(id) | Binding::SampledStencil(id) => {
                     images.push((id, sampled(compute)));
                 }
                 Binding::SampledLevels(id) => {
@@ -132,6 +135,7 @@ impl GraphSet {
                     }
                     Binding::SampledLevels(id) => Bind::Texture(res.image(id).chain_view),
                     Binding::SampledUnorm(id) => Bind::Texture(res.unorm_view(id)),
+                    Binding::SampledStencil(id) => Bind::Texture(res.stencil_view(id)),
                     Binding::StorageBuffer {
                         id, offset, size, ..
                     } => Bind::Range {

@@ -13,12 +13,14 @@
 pub mod jittered;
 pub mod none;
 pub mod options;
+pub mod path;
 pub mod poisson;
 pub mod reference;
 pub mod region;
 pub mod screen;
 pub mod separable;
 pub mod ssg;
+pub mod tiles;
 pub mod tsd;
 
 use std::any::Any;

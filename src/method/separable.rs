@@ -2,27 +2,36 @@
 //! target into an intermediate, a horizontal pass diffuse -> intermediate and a
 //! vertical pass intermediate -> diffuse, both stencil-tested on the skin bit.
 //! The kernel (eq. 6.1) is `skin::kernel`.
+//!
+//! `--path compute` runs the same two blurs as compute dispatches over the
+//! listed skin tiles (`tiles`, separable_blur.comp): no seed copy, the tile
+//! and its apron in shared memory.
 
 use std::any::Any;
 
 use anyhow::{bail, Result};
 use ash::vk;
 
+use super::path::Path;
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
-use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, Masked};
+use super::screen::{declare_intermediate, fetch, fetch_at_most, masked_pass, seed_copy, Masked};
+use super::tiles::SkinTiles;
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::work::Filter;
-use crate::graph::{Binding, GraphSet, ImageId, Pass};
+use crate::graph::work::{Filter, PassRole, ShaderWork};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
+use crate::shader_constants::{SSS_APRON_PX, SSS_TILE_SIDE};
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
 use crate::vk::context::Context;
-use crate::vk::guard::Guard;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::shader_stats::alu_estimate;
 
 const SHADER: &str = "separable_blur.frag";
+const COMPUTE_SHADER: &str = "separable_blur.comp";
 
 const OPTIONS: &[OptSpec] = &[
     OptSpec {
@@ -60,6 +69,12 @@ const OPTIONS: &[OptSpec] = &[
         kind: OptKind::NoFlag,
         default: "true",
         help: "turn off following the surface (taps across depth steps are kept)",
+    },
+    OptSpec {
+        key: "path",
+        kind: OptKind::Value,
+        default: "fragment",
+        help: "fragment (stencil-tested full-screen passes) | compute (dispatches over skin tiles)",
     },
 ];
 
@@ -109,6 +124,7 @@ pub struct Config {
     pub preset: Preset,
     pub params: SssParams,
     pub follow_surface: bool,
+    pub path: Path,
 }
 
 impl Config {
@@ -137,6 +153,7 @@ impl Config {
             preset,
             params,
             follow_surface: o.flag("follow-surface")?,
+            path: o.parse("path")?,
         })
     }
 }
@@ -152,6 +169,16 @@ struct SssPush {
     follow_tol_mm: f32,
     n_samples: i32,
     follow_surface: i32,
+}
+
+/// Push constants of separable_blur.comp: the fragment shader's, then the
+/// group's stencil code and the direction as a switch.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ComputePush {
+    base: SssPush,
+    code: u32,
+    vertical: i32,
 }
 
 /// How far the kernel's taps reach from a pixel at view depth `depth`: the
@@ -179,6 +206,9 @@ pub struct Separable {
     /// vertical's (reading the intermediate).
     sets: [GraphSet; 2],
     push: [SssPush; 2],
+    /// The compute path's tile list (`pipeline` and `sets` are then the
+    /// compute blur's).
+    tiles: Option<SkinTiles>,
 }
 
 impl Separable {
@@ -187,12 +217,28 @@ impl Separable {
         let kernel = SeparableKernel::build(config.params, config.samples)?;
         let diffuse = s.targets.diffuse;
         let tmp = declare_intermediate(s.res, diffuse, "sss intermediate");
-        let mut desc = GraphicsDesc::fullscreen("sss blur", SHADER, s.res.format(diffuse));
-        desc.depth_format = Some(s.depth_stencil_format);
-        desc.stencil_format = Some(s.depth_stencil_format);
-        desc.stencil = Some(skin_stencil_test());
         // Guarded until the method holds them: an error frees what exists.
-        let pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &desc)?);
+        let pipeline = Guard::new(
+            s.ctx,
+            match config.path {
+                Path::Fragment => {
+                    let mut desc =
+                        GraphicsDesc::fullscreen("sss blur", SHADER, s.res.format(diffuse));
+                    desc.depth_format = Some(s.depth_stencil_format);
+                    desc.stencil_format = Some(s.depth_stencil_format);
+                    desc.stencil = Some(skin_stencil_test());
+                    Pipeline::graphics(s.ctx, &desc)?
+                }
+                Path::Compute => Pipeline::compute(s.ctx, "sss blur", COMPUTE_SHADER)?,
+            },
+        );
+        let tiles = Guard::new(
+            s.ctx,
+            match config.path {
+                Path::Fragment => None,
+                Path::Compute => Some(SkinTiles::new(s)?),
+            },
+        );
         let mut data = kernel.gpu_data();
         data.resize(SeparableKernel::MAX_SAMPLES, [0.0; 4]);
         let kernel_buffer = Guard::new(
@@ -216,29 +262,42 @@ impl Separable {
             follow_surface: (config.follow_surface && tol > 0.0) as i32,
         };
         let size = (SeparableKernel::MAX_SAMPLES * 16) as u64;
-        let set = |color: ImageId| {
-            GraphSet::new(
-                s.res,
-                &pipeline,
-                0,
-                vec![
-                    ("colorTex", Binding::Sampled(color)),
-                    ("depthTex", Binding::Sampled(s.targets.linear_depth)),
+        let kernel_bind = (
+            "kernel",
+            Binding::Fixed(Bind::Uniform {
+                buffer: kernel_buffer.raw,
+                size,
+            }),
+        );
+        let depth = ("depthTex", Binding::Sampled(s.targets.linear_depth));
+        let set = |color: ImageId, out: Option<(ImageId, Storage)>| {
+            let mut binds = vec![("colorTex", Binding::Sampled(color)), depth, kernel_bind];
+            match (&*tiles, out) {
+                (Some(t), Some((out, storage))) => binds.extend([
                     (
-                        "linearClamp",
-                        Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                        "stencilTex",
+                        Binding::SampledStencil(s.targets.depth_stencil),
                     ),
-                    (
-                        "kernel",
-                        Binding::Fixed(Bind::Uniform {
-                            buffer: kernel_buffer.raw,
-                            size,
-                        }),
-                    ),
-                ],
-            )
+                    ("Tiles", t.list_binding(Storage::Read)),
+                    ("outImage", Binding::StorageImage(out, storage)),
+                ]),
+                _ => binds.push((
+                    "linearClamp",
+                    Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                )),
+            }
+            GraphSet::new(s.res, &pipeline, 0, binds)
         };
-        let sets = [set(diffuse), set(tmp)];
+        let sets = match config.path {
+            Path::Fragment => [set(diffuse, None), set(tmp, None)],
+            // The horizontal blur writes the intermediate at skin pixels (no
+            // texel of it is read elsewhere); the vertical one reads the
+            // diffuse target at other texels and writes it at skin pixels.
+            Path::Compute => [
+                set(diffuse, Some((tmp, Storage::Write))),
+                set(tmp, Some((diffuse, Storage::ReadWrite))),
+            ],
+        };
         Ok(Separable {
             pipeline: pipeline.keep(),
             push: [push([1.0, 0.0]), push([0.0, 1.0])],
@@ -248,7 +307,97 @@ impl Separable {
             tmp,
             diffuse,
             sets,
+            tiles: tiles.keep(),
         })
+    }
+
+    /// The compute path's passes: the tile list, then the two blurs over it.
+    fn compute_passes<'a>(&'a self, f: &FrameView<'a, '_>, tiles: &'a SkinTiles) -> Vec<Pass<'a>> {
+        let t = f.targets;
+        let n = self.kernel.samples.len();
+        // Shared memory holds the tile and SSS_APRON_PX texels each side:
+        // taps reaching further (a kernel that wide on screen at the
+        // nearest skin) read their texels from the images.
+        let side = SSS_TILE_SIDE as f64;
+        let loads = (side + 2.0 * SSS_APRON_PX as f64) / side;
+        let reach = f
+            .depths
+            .iter()
+            .map(|&(_, d)| self.kernel_reach_px(d, f))
+            .fold(0.0, f64::max);
+        let beyond = if reach > SSS_APRON_PX as f64 {
+            2.0 * (n - 1) as f64
+        } else {
+            0.0
+        };
+        let blur = |name: &str, src: ImageId, pass: usize| {
+            let vertical = pass == 1;
+            let mut fetches = vec![
+                fetch_at_most(f.res, src, "colorTex", Filter::Point, loads + beyond),
+                fetch(f.res, t.linear_depth, "depthTex", Filter::Point, loads),
+                fetch_at_most(
+                    f.res,
+                    t.depth_stencil,
+                    "stencilTex",
+                    Filter::Point,
+                    1.0 + if vertical { loads + beyond } else { 0.0 },
+                ),
+            ];
+            if beyond > 0.0 {
+                fetches[1] = fetch_at_most(
+                    f.res,
+                    t.linear_depth,
+                    "depthTex",
+                    Filter::Point,
+                    loads + beyond,
+                );
+            }
+            let work = ShaderWork {
+                shader: COMPUTE_SHADER.into(),
+                fetches,
+                alu: alu_estimate(COMPUTE_SHADER, &[loads.ceil() as u32, n as u32 - 1, 2]),
+                // The tile's list entry, the diffuse target at texels that are
+                // not skin (vertical), the store at skin pixels.
+                storage_read_bytes: 4.0 / (side * side) + if vertical { 8.0 * loads } else { 0.0 },
+                storage_write_bytes: 8.0,
+            };
+            let push = ComputePush {
+                base: self.push[pass],
+                code: f.stencil,
+                vertical: vertical as i32,
+            };
+            let mut p = Pass::new(name, PassRole::Sss);
+            let set = p.set(&self.sets[pass]);
+            let pipeline = &self.pipeline;
+            tiles
+                .dispatch_indirect(p, f, work)
+                .record(move |pc: &PassContext| {
+                    pc.bind(pipeline, &[set]);
+                    pipeline.push(pc.ctx, pc.cmd, &push);
+                })
+        };
+        let mut passes: Vec<Pass<'a>> = tiles.passes(f).into();
+        passes.push(blur("sss horizontal", self.diffuse, 0));
+        passes.push(blur("sss vertical", self.tmp, 1));
+        passes
+    }
+
+    /// How far (pixels) the kernel reaches at view depth `depth` at full
+    /// strength, without the bilinear margin.
+    fn kernel_reach_px(&self, depth: f32, f: &FrameView) -> f64 {
+        let widest_mm = self
+            .kernel
+            .samples
+            .iter()
+            .map(|s| s.offset_mm.abs())
+            .fold(0.0, f32::max);
+        let px_per_mm = crate::view::ViewScale {
+            height_px: f.extent.height,
+            tan_half_fovy: self.push[0].tan_half_fovy,
+            mm_per_unit: self.push[0].mm_per_unit,
+        }
+        .px_per_mm(depth);
+        f64::from(widest_mm * px_per_mm) + 1.0
     }
 
     fn follows_surface(&self) -> bool {
@@ -258,6 +407,9 @@ impl Separable {
 
 impl SssMethod for Separable {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
+        if let Some(tiles) = &self.tiles {
+            return self.compute_passes(f, tiles);
+        }
         let t = f.targets;
         let n = self.kernel.samples.len();
         let taps = (n - 1) as f64;
@@ -312,11 +464,18 @@ impl SssMethod for Separable {
         for set in &mut self.sets {
             b.write(set, &self.pipeline)?;
         }
+        if let Some(t) = &mut self.tiles {
+            t.bind(b)?;
+        }
         Ok(())
     }
 
     fn intermediates(&self) -> Vec<ImageId> {
-        vec![self.tmp]
+        match self.config.path {
+            Path::Fragment => vec![self.tmp],
+            // No seed copy fills it: every texel read is written first.
+            Path::Compute => Vec::new(),
+        }
     }
 
     fn details(&self) -> serde_json::Value {
@@ -325,12 +484,14 @@ impl SssMethod for Separable {
             "preset": self.config.preset.name(),
             "sss_params": self.config.params,
             "follow_surface": self.follows_surface(),
+            "path": self.config.path.name(),
         })
     }
 
     fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
         self.kernel_buffer.destroy(ctx);
+        self.tiles.destroy(ctx);
     }
 
     fn as_any(&self) -> &dyn Any {

@@ -32,6 +32,9 @@ pub struct Image {
     pub aspect: vk::ImageAspectFlags,
     /// A depth-only view of a depth/stencil image, for sampling.
     pub depth_view: Option<vk::ImageView>,
+    /// A stencil-only view of a sampled depth/stencil image (the compute
+    /// path reads the skin mask through it, as the fragment path tests it).
+    pub stencil_view: Option<vk::ImageView>,
     /// An sRGB image's level 0 read as UNORM (its encoded values, no
     /// decode), made only when asked for (`with_unorm_view`).
     pub unorm_view: Option<vk::ImageView>,
@@ -260,6 +263,7 @@ impl Image {
             && usage.contains(vk::ImageUsageFlags::SAMPLED)
         {
             self.depth_view = Some(make_view(vk::ImageAspectFlags::DEPTH, 0, 1)?);
+            self.stencil_view = Some(make_view(vk::ImageAspectFlags::STENCIL, 0, 1)?);
         }
         ctx.name(raw, &name);
         ctx.name(self.view, &format!("{name} view"));
@@ -296,6 +300,9 @@ impl Image {
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             if let Some(v) = self.depth_view.take() {
+                ctx.device.destroy_image_view(v, None);
+            }
+            if let Some(v) = self.stencil_view.take() {
                 ctx.device.destroy_image_view(v, None);
             }
             if let Some(v) = self.unorm_view.take() {

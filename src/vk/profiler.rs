@@ -31,6 +31,9 @@ pub struct PassTiming {
     pub barrier_ms: f64,
     pub gpu_ms: f64,
     pub fragment_invocations: Option<u64>,
+    /// Compute-shader invocations (the compute path's proof that only the
+    /// listed tiles ran, as the fragment count is the stencil's).
+    pub compute_invocations: Option<u64>,
     pub samples_passed: u64,
 }
 
@@ -66,11 +69,13 @@ impl Profiler {
                 .pipeline_statistics
                 .then(|| {
                     pool(
-                        "pass fragment invocations",
+                        "pass shader invocations",
                         vk::QueryPoolCreateInfo::default()
                             .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                            // Results come in the flags' bit order: fragment, then compute.
                             .pipeline_statistics(
-                                vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS,
+                                vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS
+                                    | vk::QueryPipelineStatisticFlags::COMPUTE_SHADER_INVOCATIONS,
                             )
                             .query_count(max_passes),
                     )
@@ -163,7 +168,8 @@ impl Profiler {
         }
         .map_err(Error::from)
         .context("reading timestamps")?;
-        let mut inv = vec![0u64; n as usize];
+        // One query's two statistics per element (ash strides by the element).
+        let mut inv = vec![[0u64; 2]; n as usize];
         if let Some(s) = self.stats {
             unsafe {
                 ctx.device.get_query_pool_results(
@@ -195,7 +201,8 @@ impl Profiler {
             .map(|i| PassTiming {
                 barrier_ms: ms(ts[i * 3], ts[i * 3 + 1]),
                 gpu_ms: ms(ts[i * 3 + 1], ts[i * 3 + 2]),
-                fragment_invocations: self.stats.map(|_| inv[i]),
+                fragment_invocations: self.stats.map(|_| inv[i][0]),
+                compute_invocations: self.stats.map(|_| inv[i][1]),
                 samples_passed: occ[i],
             })
             .collect())

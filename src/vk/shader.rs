@@ -265,16 +265,22 @@ mod tests {
 
     /// Every compute module's workgroup, read back from its SPIR-V (naga's
     /// reflection), is the side the Rust dispatches divide by
-    /// (`shader_constants::COMPUTE_GROUP_SIDE`): a shader that wrote its own
-    /// local size, or a dispatch sized by another, fails here.
+    /// (`shader_constants::COMPUTE_GROUP_SIDE` for the ground truth's,
+    /// `SSS_TILE_SIDE` for the compute path's tiles): a shader that wrote its
+    /// own local size, or a dispatch sized by another, fails here.
     #[test]
     fn compute_workgroups_are_the_shared_side() {
-        let side = crate::shader_constants::COMPUTE_GROUP_SIDE;
+        use crate::shader_constants::{COMPUTE_GROUP_SIDE, SSS_TILE_SIDE};
         let mut seen = 0;
         for (name, bytes) in SHADERS {
             let module =
                 naga::front::spv::parse_u8_slice(bytes, &naga::front::spv::Options::default())
                     .unwrap();
+            let side = if name.starts_with("reference_") {
+                COMPUTE_GROUP_SIDE
+            } else {
+                SSS_TILE_SIDE
+            };
             for e in &module.entry_points {
                 if e.stage == naga::ShaderStage::Compute {
                     assert_eq!(e.workgroup_size, [side, side, 1], "{name}");
@@ -282,8 +288,9 @@ mod tests {
                 }
             }
         }
-        // Three shaders, each also in its fetch-counting build.
-        assert_eq!(seen, 6);
+        // Five shaders (three of the ground truth, two of the compute path),
+        // each also in its fetch-counting build.
+        assert_eq!(seen, 10);
     }
 
     #[test]

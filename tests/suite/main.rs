@@ -27,6 +27,7 @@ mod aa_eval;
 mod accuracy;
 mod accuracy_model;
 mod bloom;
+mod compute;
 mod budget_cli;
 mod fade;
 mod harness;

@@ -1,0 +1,268 @@
+//! The compute path (`--path compute`): its images against the fragment
+//! path's on the same inputs, its tile list by counts (the tiles dispatched
+//! are the tiles that hold skin, predicted here from the mask), and a kernel
+//! wider than the shared-memory apron.
+
+use crate::common;
+
+use dermis::graph::PassSample;
+use dermis::method::tiles::{skin_tiles, TILE_INVOCATIONS};
+use dermis::render::{RenderSettings, Renderer};
+use dermis::scene::egg_scene;
+use dermis::skin::texel::round_f16;
+
+const W: usize = 100;
+const H: usize = 70;
+
+/// A smooth diffuse image with sharp albedo steps (where a filter's
+/// rounding shows), per-pixel strength, a depth step and a skin mask with
+/// holes and a separate island; the frame is not a whole number of tiles.
+fn inputs() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
+    let mut diffuse = Vec::with_capacity(W * H);
+    let mut depth = Vec::with_capacity(W * H);
+    let mut skin = Vec::with_capacity(W * H);
+    for y in 0..H {
+        for x in 0..W {
+            let (fx, fy) = (x as f32, y as f32);
+            let step = if (x / 7 + y / 5) % 2 == 0 { 0.25 } else { 0.0 };
+            let r = 0.45 + 0.30 * (fx / 6.0).sin() * (fy / 9.0).cos() + step;
+            let g = 0.30 + 0.20 * (fx / 11.0 + fy / 7.0).cos() + step * 0.5;
+            let b = 0.20 + 0.15 * (fy / 5.0).sin();
+            let strength = if x < W / 3 { 1.0 } else { 0.7 };
+            let (dx, dy) = (fx - 45.0, fy - 32.0);
+            let face = dx * dx / (40.0 * 40.0) + dy * dy / (26.0 * 26.0) < 1.0;
+            let hole = (fx - 30.0).abs() < 4.0 && (fy - 20.0).abs() < 3.0;
+            let island = (fx - 93.0).abs() < 3.0 && (fy - 64.0).abs() < 3.0;
+            let is_skin = (face && !hole) || island;
+            diffuse.push(round_f16([r, g, b, if is_skin { strength } else { 0.0 }]));
+            depth.push(if y > 40 { 8.2 } else { 8.0 });
+            skin.push(is_skin);
+        }
+    }
+    (diffuse, depth, skin)
+}
+
+fn settings() -> RenderSettings {
+    RenderSettings {
+        width: W as u32,
+        height: H as u32,
+        shadow_size: 64,
+        ..RenderSettings::study()
+    }
+}
+
+fn run(options: &[(&str, &str)], path: &str) -> (Vec<[f32; 4]>, Vec<PassSample>) {
+    let ctx = common::ctx();
+    let scene = egg_scene();
+    let mut o = options.to_vec();
+    o.push(("path", path));
+    let s = settings().with(common::m("separable"), &o);
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    let (diffuse, depth, skin) = inputs();
+    common::sss_only(&mut r, &diffuse, &depth, &skin)
+}
+
+/// One half-float ulp of `v` (normal range).
+fn ulp16(v: f32) -> f32 {
+    2f32.powi(v.abs().max(6.1e-5).log2().floor() as i32 - 10)
+}
+
+/// The compute image against the fragment one: every channel within one
+/// half-float ulp; returns the share of pixels equal bit for bit.
+fn within_one_ulp(name: &str, compute: &[[f32; 4]], fragment: &[[f32; 4]]) -> f64 {
+    let _diff = common::DiffOnFailure::new(name, W, H, compute, fragment);
+    let (mut worst, mut over) = (0.0f32, 0);
+    for i in 0..W * H {
+        for c in 0..4 {
+            let d = (compute[i][c] - fragment[i][c]).abs() / ulp16(fragment[i][c]);
+            worst = worst.max(d);
+            over += (d > 1.0) as usize;
+        }
+    }
+    println!("{name}: worst {worst} ulp, {over} channels over one");
+    let mut same = 0;
+    for i in 0..W * H {
+        for c in 0..4 {
+            let (a, b) = (compute[i][c], fragment[i][c]);
+            assert!(
+                (a - b).abs() <= ulp16(b),
+                "{name}: pixel ({}, {}) channel {c}: compute {a} fragment {b}",
+                i % W,
+                i / W
+            );
+        }
+        same += (compute[i] == fragment[i]) as usize;
+    }
+    same as f64 / (W * H) as f64
+}
+
+#[test]
+fn compute_matches_fragment_within_one_half_ulp() {
+    let (diffuse, _, skin) = inputs();
+    for follow in ["true", "false"] {
+        for samples in ["9", "17", "33"] {
+            let o = [("follow-surface", follow), ("samples", samples)];
+            let (frag, _) = run(&o, "fragment");
+            let (comp, passes) = run(&o, "compute");
+            let name = format!("compute-vs-fragment-follow-{follow}-{samples}");
+            let same = within_one_ulp(&name, &comp, &frag);
+            println!("{name}: {:.4} of pixels bit for bit", same);
+            for i in 0..W * H {
+                if !skin[i] {
+                    assert_eq!(comp[i], diffuse[i], "{name}: non-skin pixel {i} changed");
+                }
+            }
+            // The blur did something.
+            let changed = (0..W * H).filter(|&i| skin[i] && comp[i] != diffuse[i]).count();
+            assert!(changed > skin.iter().filter(|&&s| s).count() / 2, "{name}");
+            // No seed copy on the compute path.
+            assert!(passes.iter().all(|p| p.name != "sss seed copy"), "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_kernel_wider_than_the_apron_reads_beyond_it() {
+    // 40 mm at 0.58 mm a pixel: taps reach about 70 px, past the 32-texel
+    // apron, where the compute blur reads the images themselves.
+    let o = [("sss-width-mm", "40"), ("samples", "33")];
+    let (frag, _) = run(&o, "fragment");
+    let (comp, _) = run(&o, "compute");
+    let same = within_one_ulp("compute-vs-fragment-wide", &comp, &frag);
+    println!("wide kernel: {same:.4} of pixels bit for bit");
+}
+
+#[test]
+fn tiles_dispatched_are_the_tiles_that_hold_skin() {
+    let ctx = common::ctx();
+    let (_, _, skin) = inputs();
+    let (_, passes) = run(&[], "compute");
+    let find = |name: &str| {
+        passes
+            .iter()
+            .find(|p| p.name == name)
+            .unwrap_or_else(|| panic!("no pass {name}"))
+    };
+    let Some(inv) = find("sss horizontal").compute_invocations else {
+        assert!(!ctx.facts.pipeline_statistics, "statistics on, yet none counted");
+        return;
+    };
+    let tiles = skin_tiles(&skin, W, H) as u64;
+    let all = (W.div_ceil(16) * H.div_ceil(16)) as u64;
+    assert!(tiles > 0 && tiles < all, "the input leaves tiles without skin");
+    let per_tile = TILE_INVOCATIONS as u64;
+    assert_eq!(inv, tiles * per_tile, "horizontal: invocations");
+    assert_eq!(
+        find("sss vertical").compute_invocations,
+        Some(tiles * per_tile),
+        "vertical: invocations"
+    );
+    // The classification runs over the region's box (here the whole frame).
+    assert_eq!(find("sss tiles").compute_invocations, Some(all * per_tile));
+    // No fragment work at all.
+    for name in ["sss tiles", "sss horizontal", "sss vertical"] {
+        assert_eq!(find(name).fragment_invocations, Some(0), "{name}");
+    }
+}
+
+#[test]
+fn no_skin_dispatches_no_tile() {
+    let ctx = common::ctx();
+    let scene = egg_scene();
+    let s = settings().with(common::m("separable"), &[("path", "compute")]);
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    let (diffuse, depth, _) = inputs();
+    let skin = vec![false; W * H];
+    let diffuse: Vec<[f32; 4]> = diffuse.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
+    let (gpu, passes) = common::sss_only(&mut r, &diffuse, &depth, &skin);
+    assert_eq!(gpu, diffuse, "with no skin the image is untouched");
+    for name in ["sss horizontal", "sss vertical"] {
+        let p = passes.iter().find(|p| p.name == name).unwrap();
+        if let Some(inv) = p.compute_invocations {
+            assert_eq!(inv, 0, "{name}");
+        }
+    }
+}
+
+/// The post-SSS diffuse light of one frame of `s` (validation on).
+fn frame(s: &RenderSettings) -> (Vec<[f32; 4]>, Vec<PassSample>) {
+    let ctx = common::ctx();
+    let scene = dermis::scene::default_scene();
+    let mut r = Renderer::new(&ctx, &scene, s).expect("renderer");
+    let cap = r.capture(false).expect("frame");
+    (cap.diffuse, cap.samples)
+}
+
+/// Every channel of two frames within one half-float ulp; the share of
+/// pixels equal bit for bit.
+fn frames_within_one_ulp(name: &str, a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let mut same = 0;
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        for c in 0..4 {
+            assert!(
+                (x[c] - y[c]).abs() <= ulp16(y[c]),
+                "{name}: pixel {i} channel {c}: compute {} fragment {}",
+                x[c],
+                y[c]
+            );
+        }
+        same += (x == y) as usize;
+    }
+    same as f64 / a.len() as f64
+}
+
+#[test]
+fn the_default_head_is_the_same_on_both_paths() {
+    let base = RenderSettings {
+        width: 192,
+        height: 108,
+        shadow_size: 256,
+        ..RenderSettings::study()
+    };
+    let (frag, _) = frame(&base.clone().with(common::m("separable"), &[]));
+    let (comp, passes) = frame(
+        &base
+            .clone()
+            .with(common::m("separable"), &[("path", "compute")]),
+    );
+    let skin = frag.iter().filter(|p| p[3] > 0.0).count();
+    assert!(skin > 1000, "{skin} skin pixels");
+    let same = frames_within_one_ulp("head", &comp, &frag);
+    println!("head: {same:.4} of pixels bit for bit, {skin} skin pixels");
+    let names: Vec<&str> = passes.iter().map(|p| p.name.as_str()).collect();
+    for n in ["sss tiles reset", "sss tiles", "sss horizontal", "sss vertical"] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+}
+
+#[test]
+fn a_mixed_frame_takes_the_compute_path_per_group() {
+    use dermis::mix::assign::Rules;
+    use dermis::render::settings::Assignment;
+    use dermis::scene::layout::Layout;
+    let mixed = |rules: &str| {
+        let rules: Rules = rules.parse().expect("rules");
+        RenderSettings {
+            width: 160,
+            height: 90,
+            heads: 5,
+            layout: Layout::Crowd,
+            distance_heads: 3.0,
+            shadow_size: 256,
+            assignment: Some(Assignment::Rules(rules)),
+            ..RenderSettings::study()
+        }
+    };
+    // Only group 0's path differs: every pixel, its neighbours' included,
+    // within one ulp.
+    let (frag, _) = frame(&mixed("0=separable,1=separable:preset=physical,*=ssg"));
+    let (comp, passes) = frame(&mixed(
+        "0=separable:path=compute,1=separable:preset=physical:path=compute,*=ssg",
+    ));
+    let same = frames_within_one_ulp("mixed", &comp, &frag);
+    println!("mixed frame: {same:.4} of pixels bit for bit");
+    // Each compute group lists its own tiles.
+    let lists = passes.iter().filter(|p| p.name.ends_with("sss tiles")).count();
+    assert_eq!(lists, 2, "{:?}", passes.iter().map(|p| &p.name).collect::<Vec<_>>());
+}
