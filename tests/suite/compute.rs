@@ -266,3 +266,40 @@ fn a_mixed_frame_takes_the_compute_path_per_group() {
     let lists = passes.iter().filter(|p| p.name.ends_with("sss tiles")).count();
     assert_eq!(lists, 2, "{:?}", passes.iter().map(|p| &p.name).collect::<Vec<_>>());
 }
+
+/// The teardown sweep (tests/teardown.rs) for the compute path: set-up made
+/// to fail at each of its creation steps in turn leaves no memory and no
+/// object behind (the tile list's pipeline and buffers, the stencil views).
+#[test]
+fn every_failed_setup_step_of_the_compute_path_tears_down_clean() {
+    let ctx = common::ctx();
+    let scene = dermis::scene::default_scene();
+    let s = RenderSettings {
+        width: 64,
+        height: 36,
+        shadow_size: 256,
+        ..Default::default()
+    }
+    .with(common::m("separable"), &[("path", "compute")]);
+    let live = |ctx: &dermis::vk::context::Context| {
+        ctx.allocator().generate_report().allocations.len()
+    };
+    let base = live(&ctx);
+    let before = ctx.creations();
+    drop(Renderer::new(&ctx, &scene, &s).expect("a clean set-up"));
+    let steps = ctx.creations() - before;
+    for k in 0..steps {
+        ctx.fail_creation_after(Some(k));
+        let e = match Renderer::new(&ctx, &scene, &s) {
+            Ok(_) => panic!("step {k} of {steps} did not fail"),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(e.contains("injected failure"), "step {k}: {e}");
+        assert_eq!(live(&ctx), base, "step {k} ({e}) left memory allocated");
+        ctx.check_validation(&format!("after set-up failed at step {k}"))
+            .unwrap();
+    }
+    ctx.fail_creation_after(None);
+    ctx.finish().expect("teardown after every failure");
+    println!("compute path: {steps} creation steps, each failed in turn, clean");
+}
