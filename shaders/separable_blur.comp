@@ -5,7 +5,7 @@
 #include "shader_constants.glsl"
 #include "view_scale.glsl"
 // Separable SSS on the compute path: the arithmetic of separable_blur.frag,
-// one workgroup per listed skin tile (sss_tiles.comp), one invocation a pixel.
+// one workgroup per listed skin tile (tiles_classify.comp), one invocation a pixel.
 // The tile and an apron of SSS_APRON_PX texels on both sides along the blur's
 // direction are loaded into shared memory once; each tap then filters its two
 // neighbouring texels there (beyond the apron, from the images: the same

@@ -84,7 +84,7 @@ pub const BLOOM_BLUR_RADIUS: u32 = 3;
 /// tests read every compute module's workgroup size back from its SPIR-V.
 pub const COMPUTE_GROUP_SIDE: u32 = 8;
 
-/// Side of the compute path's SSS tiles (sss_tiles.comp, separable_blur.comp):
+/// Side of the compute path's SSS tiles (tiles_classify.comp, separable_blur.comp):
 /// one workgroup of SSS_TILE_SIDE^2 invocations per tile, HDRP's 16x16.
 pub const SSS_TILE_SIDE: u32 = 16;
 

@@ -325,6 +325,7 @@ mod tests {
             gpu_ms: stats,
             barrier_ms: stats,
             fragment_invocations: Some(4000),
+            compute_invocations: None,
             samples_passed: 3000,
             floor_ms: None,
             floor_ratio: None,

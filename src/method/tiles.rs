@@ -43,7 +43,7 @@ use crate::vk::memory::Buffer;
 use crate::vk::pipeline::Pipeline;
 use crate::vk::shader_stats::alu_estimate;
 
-const SHADER: &str = "sss_tiles.comp";
+const SHADER: &str = "tiles_classify.comp";
 
 /// Invocations of one tile's workgroup.
 pub const TILE_INVOCATIONS: u32 = SSS_TILE_SIDE * SSS_TILE_SIDE;
@@ -81,7 +81,7 @@ pub fn skin_tiles(mask: &[bool], width: usize, height: usize) -> usize {
     n
 }
 
-/// Push constants of sss_tiles.comp.
+/// Push constants of tiles_classify.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct TilesPush {
