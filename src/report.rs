@@ -380,17 +380,19 @@ pub fn table(passes: &[PassReport], frame: Option<&FrameReport>) -> String {
     let _ = write!(
         s,
         "{:<18} {:>10} {:>10} {:>10} {:>11} {:>14} {:>13}",
-        "pass", "median ms", "min ms", "p95 ms", "barrier ms", "frag invocs", "samples pass"
+        "pass", "median ms", "min ms", "p95 ms", "barrier ms", "invocations", "samples pass"
     );
     if has_floor {
         let _ = write!(s, " {:>10} {:>9}", "floor ms", "x floor");
     }
     s.push('\n');
     for p in passes {
-        let inv = p
-            .fragment_invocations
-            .map(|v| v.to_string())
-            .unwrap_or_else(|| "n/a".into());
+        // A dispatch's compute invocations (marked), else the fragments.
+        let inv = match (p.compute_invocations, p.fragment_invocations) {
+            (Some(c), _) => format!("{c} cs"),
+            (None, Some(f)) => f.to_string(),
+            (None, None) => "n/a".into(),
+        };
         let _ = write!(
             s,
             "{:<18} {:>10.4} {:>10.4} {:>10.4} {:>11.4} {:>14} {:>13}",
