@@ -34,7 +34,7 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::{FrameView, MethodBind, MethodSetup};
-use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
 use crate::graph::{Binding, BufferId, GraphSet, Pass, PassContext, Storage};
 use crate::shader_constants::SSS_TILE_SIDE;
 use crate::vk::context::Context;
@@ -168,7 +168,14 @@ impl SkinTiles {
     pub fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> [Pass<'a>; 2] {
         let mut reset = Pass::new("sss tiles reset", PassRole::Sss);
         let args = reset.transfer_dst_buffer(self.args_id);
-        let reset = reset.record(move |pc: &PassContext| pc.fill_buffer(args, 0));
+        // A fill of the four argument words: priced as a clear of four
+        // 4-byte texels (the work vocabulary's nearest kind; it is tiny).
+        let reset = reset
+            .work(Work::Clear {
+                texels: 4,
+                bytes_per_texel: 4,
+            })
+            .record(move |pc: &PassContext| pc.fill_buffer(args, 0));
 
         let (first, groups) = region_tiles(f.region).unwrap_or(([0, 0], [0, 0]));
         let work = ShaderWork {
