@@ -16,7 +16,7 @@ layout(push_constant) uniform Push {
     float stdMm;      // ssg: incremental standard deviation of this Gaussian (mm)
     float quadDepth;  // ssg: LOD depth of the full-screen triangle (1 = no LOD)
     int maskBranch;   // ssg: 1 = skip non-skin by a branch instead of the stencil test
-    float pad0;
+    uint code;        // the compute path: the group's stencil code
     float pad1;
     vec4 center;      // ss-jittered kernel: rgb weights
     vec4 mid;         // rgb total of the 6 mid samples

@@ -8,20 +8,25 @@ use std::any::Any;
 use anyhow::Result;
 
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
+use super::path::{self, Path};
 use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, source_set, Masked};
 use super::ssg::ScreenPush;
+use super::tiles::SkinTiles;
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     SssMethod,
 };
-use crate::graph::work::{Fetch, Filter, Spread};
-use crate::graph::{GraphSet, ImageId, Pass};
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Spread};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
 use crate::vk::context::Context;
-use crate::vk::pipeline::{GraphicsDesc, Pipeline};
+use crate::vk::guard::{Destroy, Guard};
+use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
+use crate::vk::shader_stats::alu_estimate;
 
 const SHADER: &str = "jittered.frag";
+const COMPUTE_SHADER: &str = "jittered_tiles.comp";
 /// Samples per ring (the loop of the shader takes one mid and one wide per turn).
 const RING: u32 = 6;
 
@@ -29,7 +34,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     name: "ss-jittered",
     aliases: &["jittered"],
     summary: "Hable et al.'s 13-tap jittered kernel in screen space (thesis ch. 4)",
-    options: &[],
+    options: &[path::OPTION],
     eval: &[EvalSetting {
         label: "13 taps",
         options: &[],
@@ -37,7 +42,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     ground_truth: false,
     dolly: &["13 taps"],
     needs: |_, _| Needs::PLAIN,
-    check: |_| Ok(()),
+    check: |o| o.parse::<Path>("path").map(|_| ()),
     build: |s| Ok(Box::new(Jittered::new(s)?)),
     no_msaa: None,
     no_mix: |_| None,
@@ -47,8 +52,13 @@ pub static ENTRY: MethodEntry = MethodEntry {
 pub struct Jittered {
     pipeline: Pipeline,
     set: GraphSet,
-    /// The seed the pass reads (the diffuse target is written).
+    /// The seed the pass reads (the diffuse target is written); on the
+    /// compute path, the blur's output at skin pixels (the pass reads the
+    /// diffuse target, and `sss merge` writes these pixels back into it).
     src: ImageId,
+    /// The compute path's tile list and merge (`pipeline` and `set` are
+    /// then the compute blur's).
+    tiles: Option<SkinTiles>,
     diffuse: ImageId,
     pub kernel: JitteredKernel,
     pub stretch: Stretch,
@@ -58,15 +68,52 @@ impl Jittered {
     fn new(s: &mut MethodSetup) -> Result<Self> {
         let diffuse = s.targets.diffuse;
         let src = declare_intermediate(s.res, diffuse, "sss intermediate");
-        let mut d = GraphicsDesc::fullscreen("ss-jittered", SHADER, s.res.format(diffuse));
-        d.depth_format = Some(s.depth_stencil_format);
-        d.stencil_format = Some(s.depth_stencil_format);
-        d.stencil = Some(skin_stencil_test());
-        let pipeline = Pipeline::graphics(s.ctx, &d)?;
+        let path: Path = s.options.parse("path")?;
+        let (pipeline, set, tiles) = match path {
+            Path::Fragment => {
+                let mut d = GraphicsDesc::fullscreen("ss-jittered", SHADER, s.res.format(diffuse));
+                d.depth_format = Some(s.depth_stencil_format);
+                d.stencil_format = Some(s.depth_stencil_format);
+                d.stencil = Some(skin_stencil_test());
+                let pipeline = Pipeline::graphics(s.ctx, &d)?;
+                let set = source_set(s, &pipeline, src);
+                (pipeline, set, None)
+            }
+            Path::Compute => {
+                // Guarded until the method holds them: an error frees what exists.
+                let pipeline = Guard::new(
+                    s.ctx,
+                    Pipeline::compute(s.ctx, "ss-jittered", COMPUTE_SHADER)?,
+                );
+                let mut tiles = Guard::new(s.ctx, SkinTiles::new(s)?);
+                tiles.add_merge(s, src, diffuse)?;
+                let set = GraphSet::new(
+                    s.res,
+                    &pipeline,
+                    0,
+                    vec![
+                        ("colorTex", Binding::Sampled(diffuse)),
+                        ("depthTex", Binding::Sampled(s.targets.linear_depth)),
+                        (
+                            "linearClamp",
+                            Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                        ),
+                        (
+                            "stencilTex",
+                            Binding::SampledStencil(s.targets.depth_stencil),
+                        ),
+                        ("Tiles", tiles.list_binding(Storage::Read)),
+                        ("outImage", Binding::StorageImage(src, Storage::Write)),
+                    ],
+                );
+                (pipeline.keep(), set, Some(tiles.keep()))
+            }
+        };
         Ok(Jittered {
-            set: source_set(s, &pipeline, src),
+            set,
             pipeline,
             src,
+            tiles,
             diffuse,
             kernel: hable_kernel(),
             stretch: Stretch::for_view(
@@ -75,6 +122,58 @@ impl Jittered {
                 s.view.mm_per_unit,
             ),
         })
+    }
+}
+
+impl Jittered {
+    /// The compute path's passes: the tile list, the blur over it into the
+    /// intermediate, the merge back into the diffuse target.
+    fn compute_passes<'a>(
+        &'a self,
+        f: &FrameView<'a, '_>,
+        tiles: &'a SkinTiles,
+        push: ScreenPush,
+    ) -> Vec<Pass<'a>> {
+        let t = f.targets;
+        let push = ScreenPush {
+            code: f.stencil,
+            ..push
+        };
+        let fetches = vec![
+            fetch(f.res, t.diffuse, "colorTex", Filter::Point, 1.0),
+            fetch(f.res, t.linear_depth, "depthTex", Filter::Point, 5.0),
+            Fetch {
+                coherent: false,
+                spread: ring_spread(&self.kernel, &self.stretch, f.depths),
+                ..fetch(f.res, t.diffuse, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
+            },
+            fetch(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0),
+        ];
+        // Invocations outside the image or the skin fetch nothing.
+        let fetches = fetches
+            .into_iter()
+            .map(|f| Fetch { exact: false, ..f })
+            .collect();
+        let work = ShaderWork {
+            shader: COMPUTE_SHADER.into(),
+            fetches,
+            alu: alu_estimate(COMPUTE_SHADER, &[RING]),
+            storage_read_bytes: 4.0 / super::tiles::TILE_INVOCATIONS as f64,
+            storage_write_bytes: 8.0,
+        };
+        let mut blur = Pass::new("ss-jittered", PassRole::Sss);
+        let set = blur.set(&self.set);
+        let pipeline = &self.pipeline;
+        let blur = tiles
+            .dispatch_indirect(blur, f, work)
+            .record(move |pc: &PassContext| {
+                pc.bind(pipeline, &[set]);
+                pipeline.push(pc.ctx, pc.cmd, &push);
+            });
+        let mut passes: Vec<Pass<'a>> = tiles.passes(f).into();
+        passes.push(blur);
+        passes.extend(tiles.merge_pass(f));
+        passes
     }
 }
 
@@ -112,6 +211,9 @@ impl SssMethod for Jittered {
             ..Default::default()
         };
         let (t, src, diffuse, pipeline) = (f.targets, self.src, self.diffuse, &self.pipeline);
+        if let Some(tiles) = &self.tiles {
+            return self.compute_passes(f, tiles, push);
+        }
         // Centre colour and depth and two depth texels per stretch axis by
         // texel fetch, then both rings bilinear.
         let fetches = vec![
@@ -156,11 +258,19 @@ impl SssMethod for Jittered {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        b.write(&mut self.set, &self.pipeline)
+        b.write(&mut self.set, &self.pipeline)?;
+        if let Some(t) = &mut self.tiles {
+            t.bind(b)?;
+        }
+        Ok(())
     }
 
     fn intermediates(&self) -> Vec<ImageId> {
-        vec![self.src]
+        match self.tiles {
+            None => vec![self.src],
+            // Only written and read at skin pixels.
+            Some(_) => Vec::new(),
+        }
     }
 
     fn details(&self) -> serde_json::Value {
@@ -170,11 +280,13 @@ impl SssMethod for Jittered {
                 "mid_radius_mm": self.kernel.mid_radius_mm, "wide_radius_mm": self.kernel.wide_radius_mm,
             },
             "stretch": { "alpha": self.stretch.alpha, "beta": self.stretch.beta, "gamma": self.stretch.gamma },
+            "path": if self.tiles.is_some() { Path::Compute } else { Path::Fragment }.name(),
         })
     }
 
     fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
+        self.tiles.destroy(ctx);
     }
 
     fn as_any(&self) -> &dyn Any {

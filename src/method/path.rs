@@ -7,6 +7,16 @@ use std::str::FromStr;
 
 use anyhow::{bail, Result};
 
+use super::{OptKind, OptSpec};
+
+/// The option every method with a compute path takes (`--path`).
+pub const OPTION: OptSpec = OptSpec {
+    key: "path",
+    kind: OptKind::Value,
+    default: "fragment",
+    help: "fragment (stencil-tested full-screen passes) | compute (dispatches over skin tiles)",
+};
+
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Path {

@@ -70,12 +70,7 @@ const OPTIONS: &[OptSpec] = &[
         default: "true",
         help: "turn off following the surface (taps across depth steps are kept)",
     },
-    OptSpec {
-        key: "path",
-        kind: OptKind::Value,
-        default: "fragment",
-        help: "fragment (stencil-tested full-screen passes) | compute (dispatches over skin tiles)",
-    },
+    super::path::OPTION,
 ];
 
 pub static ENTRY: MethodEntry = MethodEntry {

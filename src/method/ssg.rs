@@ -149,7 +149,9 @@ pub struct ScreenPush {
     pub std_mm: f32,
     pub quad_depth: f32,
     pub mask_branch: i32,
-    pub pad: [f32; 2],
+    /// The compute path's stencil code (screen_common.glsl's `code`).
+    pub code: u32,
+    pub pad: f32,
     pub center: [f32; 4],
     pub mid: [f32; 4],
     pub wide: [f32; 4],

@@ -18,6 +18,12 @@
 //! (separable_blur.comp), so the copy (0.157 ms of the 1.656 ms separable
 //! SSS at 1080p on the H100) has no counterpart.
 //!
+//! A blur whose taps read the diffuse target (ss-jittered, poisson) cannot
+//! write it in the same dispatch (a workgroup would read texels another has
+//! written): it writes an intermediate at skin pixels, and `sss merge`
+//! copies those pixels into the diffuse target (16 bytes a skin pixel,
+//! against the fragment path's seed copy of the whole region).
+//!
 //! Where the two paths differ: each tap filters its two texels in shared
 //! memory in float, at the fraction the sampler computes, and the sums are
 //! the fragment shader's, in its order. On lavapipe, whose sampler filters
@@ -44,6 +50,7 @@ use crate::vk::pipeline::Pipeline;
 use crate::vk::shader_stats::alu_estimate;
 
 const SHADER: &str = "tiles_classify.comp";
+const MERGE_SHADER: &str = "tiles_merge.comp";
 
 /// Invocations of one tile's workgroup.
 pub const TILE_INVOCATIONS: u32 = SSS_TILE_SIDE * SSS_TILE_SIDE;
@@ -101,6 +108,9 @@ pub struct SkinTiles {
     set: GraphSet,
     /// Tiles of the whole frame: the list's capacity and the blurs' bound.
     capacity: u32,
+    /// The merge of a blur's intermediate into the diffuse target, where
+    /// the method asked for one ([`SkinTiles::add_merge`]).
+    merge: Option<(Pipeline, GraphSet)>,
 }
 
 impl SkinTiles {
@@ -152,6 +162,66 @@ impl SkinTiles {
             ],
         );
         Ok(t.keep())
+    }
+
+    /// Adds the merge of `src` (a blur's output at skin pixels) into `dst`
+    /// (on an error, what exists is the caller's to destroy: hold the tiles
+    /// in a guard).
+    pub fn add_merge(
+        &mut self,
+        s: &MethodSetup,
+        src: crate::graph::ImageId,
+        dst: crate::graph::ImageId,
+    ) -> Result<()> {
+        let pipeline = Guard::new(s.ctx, Pipeline::compute(s.ctx, "sss merge", MERGE_SHADER)?);
+        let set = GraphSet::new(
+            s.res,
+            &pipeline,
+            0,
+            vec![
+                ("stencilTex", Binding::SampledStencil(s.targets.depth_stencil)),
+                ("Tiles", self.list_binding(Storage::Read)),
+                ("srcTex", Binding::Sampled(src)),
+                // Written at skin pixels only: the rest keeps the diffuse light.
+                ("outImage", Binding::StorageImage(dst, Storage::ReadWrite)),
+            ],
+        );
+        self.merge = Some((pipeline.keep(), set));
+        Ok(())
+    }
+
+    /// The merge pass (after the blur that wrote its source).
+    pub fn merge_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Option<Pass<'a>> {
+        let (pipeline, set) = self.merge.as_ref()?;
+        let fetch = |texture: &str, image| Fetch {
+            texture: texture.into(),
+            format: f.res.texel_format(image),
+            filter: Filter::Point,
+            count: 1.0,
+            exact: false,
+            coherent: true,
+            spread: Vec::new(),
+        };
+        let work = ShaderWork {
+            shader: MERGE_SHADER.into(),
+            fetches: vec![
+                fetch("stencilTex", f.targets.depth_stencil),
+                fetch("srcTex", f.targets.diffuse),
+            ],
+            alu: alu_estimate(MERGE_SHADER, &[]),
+            storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
+            storage_write_bytes: 8.0,
+        };
+        let push = f.stencil;
+        let mut pass = Pass::new("sss merge", PassRole::Sss);
+        let set = pass.set(set);
+        Some(
+            self.dispatch_indirect(pass, f, work)
+                .record(move |pc: &PassContext| {
+                    pc.bind(pipeline, &[set]);
+                    pipeline.push(pc.ctx, pc.cmd, &push);
+                }),
+        )
     }
 
     /// The list as a blur's set binds it (`Tiles`).
@@ -223,7 +293,11 @@ impl SkinTiles {
     }
 
     pub fn bind(&mut self, b: &MethodBind) -> Result<()> {
-        b.write(&mut self.set, &self.pipeline)
+        b.write(&mut self.set, &self.pipeline)?;
+        if let Some((pipeline, set)) = &mut self.merge {
+            b.write(set, pipeline)?;
+        }
+        Ok(())
     }
 }
 
@@ -232,6 +306,9 @@ impl Destroy for SkinTiles {
         self.pipeline.destroy(ctx);
         self.args.destroy(ctx);
         self.list.destroy(ctx);
+        if let Some((p, _)) = &mut self.merge {
+            p.destroy(ctx);
+        }
     }
 }
 

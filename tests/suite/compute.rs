@@ -52,11 +52,19 @@ fn settings() -> RenderSettings {
 }
 
 fn run(options: &[(&str, &str)], path: &str) -> (Vec<[f32; 4]>, Vec<PassSample>) {
+    run_method("separable", options, path)
+}
+
+fn run_method(
+    method: &str,
+    options: &[(&str, &str)],
+    path: &str,
+) -> (Vec<[f32; 4]>, Vec<PassSample>) {
     let ctx = common::ctx();
     let scene = egg_scene();
     let mut o = options.to_vec();
     o.push(("path", path));
-    let s = settings().with(common::m("separable"), &o);
+    let s = settings().with(common::m(method), &o);
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     let (diffuse, depth, skin) = inputs();
     common::sss_only(&mut r, &diffuse, &depth, &skin)
@@ -117,6 +125,32 @@ fn compute_matches_fragment_within_one_half_ulp() {
             assert!(changed > skin.iter().filter(|&&s| s).count() / 2, "{name}");
             // No seed copy on the compute path.
             assert!(passes.iter().all(|p| p.name != "sss seed copy"), "{name}");
+        }
+    }
+}
+
+/// ss-jittered: the same arithmetic (jittered_body.glsl) through the same
+/// sampler, so the same bits but for the store's rounding; its merge writes
+/// the skin pixels back.
+#[test]
+fn jittered_compute_matches_fragment() {
+    let (diffuse, _, skin) = inputs();
+    let (frag, _) = run_method("ss-jittered", &[], "fragment");
+    let (comp, passes) = run_method("ss-jittered", &[], "compute");
+    let same = within_one_ulp("jittered-compute-vs-fragment", &comp, &frag);
+    println!("ss-jittered: {same:.4} of pixels bit for bit");
+    for i in 0..W * H {
+        if !skin[i] {
+            assert_eq!(comp[i], diffuse[i], "non-skin pixel {i} changed");
+        }
+    }
+    let names: Vec<&str> = passes.iter().map(|p| p.name.as_str()).collect();
+    assert!(names.contains(&"sss merge") && !names.contains(&"ss-jittered seed copy"), "{names:?}");
+    let tiles = skin_tiles(&skin, W, H) as u64 * TILE_INVOCATIONS as u64;
+    for name in ["ss-jittered", "sss merge"] {
+        let p = passes.iter().find(|p| p.name == name).unwrap();
+        if let Some(inv) = p.compute_invocations {
+            assert_eq!(inv, tiles, "{name}: invocations");
         }
     }
 }
