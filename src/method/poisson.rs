@@ -6,29 +6,38 @@
 //! The pass reads every level of the diffuse chain, so it writes into an
 //! intermediate (seeded with a copy of level 0, so non-skin pixels keep their
 //! colour) and the composite reads the intermediate.
+//!
+//! `--path compute`: the pass is a dispatch over the skin tiles
+//! (poisson_tiles.comp, the arithmetic shared in poisson_body.glsl) writing
+//! the intermediate at skin pixels only, and `sss merge` copies them into
+//! level 0 of the diffuse chain, which the composite then reads: no seed
+//! copy of the screen.
 
 use std::any::Any;
 
 use anyhow::{Context as _, Result};
 use ash::vk;
 
+use super::path::{self, Path};
 use super::region::ReachScale;
 use super::screen::{declare_intermediate, fetch, fetch_at_most, masked_pass, seed_copy, Masked};
+use super::tiles::{SkinTiles, TILE_INVOCATIONS};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     SssMethod,
 };
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Filter, PassRole, ShaderWork};
-use crate::graph::{Binding, ColorTarget, GraphSet, ImageId, Load, Pass, PassContext};
+use crate::graph::{Binding, ColorTarget, GraphSet, ImageId, Load, Pass, PassContext, Storage};
 use crate::skin::poisson::{poisson_disk_32, PoissonParams};
 use crate::vk::context::Context;
-use crate::vk::guard::Guard;
+use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::{Bind, GraphicsDesc, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
 
 const SHADER: &str = "poisson.frag";
+const COMPUTE_SHADER: &str = "poisson_tiles.comp";
 const MIP_SHADER: &str = "poisson_mip_down.frag";
 /// Mip levels of the chains: enough for radii of 16 x 2^4 = 256 pixels.
 pub const MAX_LEVELS: u32 = 5;
@@ -39,7 +48,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     name: "poisson",
     aliases: &[],
     summary: "Poisson-disk screen-space SSS over mip chains (seed 003, Agni's Philosophy)",
-    options: &[],
+    options: &[path::OPTION],
     eval: &[EvalSetting {
         label: "8-32 taps",
         options: &[],
@@ -51,7 +60,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         mip_levels: levels_for(extent),
         geometry_transmittance: true,
     },
-    check: |_| Ok(()),
+    check: |o| o.parse::<Path>("path").map(|_| ()),
     build: |s| Ok(Box::new(Poisson::new(s)?)),
     no_msaa: None,
     no_mix: |_| None,
@@ -64,7 +73,7 @@ pub fn levels_for(extent: vk::Extent2D) -> u32 {
     full.min(MAX_LEVELS)
 }
 
-/// Push constants of poisson.frag (std430, 80 bytes).
+/// Push constants of poisson_body.glsl (std430, 84 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct PoissonPush {
@@ -77,6 +86,8 @@ struct PoissonPush {
     depth_sensitivity: f32,
     normal_sensitivity: f32,
     max_level: i32,
+    /// The compute path's stencil code (0 on the fragment path).
+    code: u32,
 }
 
 pub struct Poisson {
@@ -89,8 +100,13 @@ pub struct Poisson {
     /// Every level of the three chains.
     set: GraphSet,
     disk_buffer: Buffer,
-    /// The output (seeded with the diffuse target's level 0).
+    /// The output (seeded with the diffuse target's level 0); on the compute
+    /// path written at skin pixels only, then merged into the diffuse target.
     out: ImageId,
+    diffuse: ImageId,
+    /// The compute path's tile list and merge (`pipeline` and `set` are then
+    /// the compute pass's).
+    tiles: Option<SkinTiles>,
     push: PoissonPush,
     pub params: PoissonParams,
     pub levels: u32,
@@ -109,11 +125,30 @@ impl Poisson {
         mip.color_formats = vec![format, s.res.format(t.linear_depth), s.res.format(normals)];
         // Guarded until the method holds them: an error frees what exists.
         let mip_pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &mip)?);
-        let mut d = GraphicsDesc::fullscreen("poisson", SHADER, format);
-        d.depth_format = Some(s.depth_stencil_format);
-        d.stencil_format = Some(s.depth_stencil_format);
-        d.stencil = Some(skin_stencil_test());
-        let pipeline = Guard::new(s.ctx, Pipeline::graphics(s.ctx, &d)?);
+        let path: Path = s.options.parse("path")?;
+        let pipeline = Guard::new(
+            s.ctx,
+            match path {
+                Path::Fragment => {
+                    let mut d = GraphicsDesc::fullscreen("poisson", SHADER, format);
+                    d.depth_format = Some(s.depth_stencil_format);
+                    d.stencil_format = Some(s.depth_stencil_format);
+                    d.stencil = Some(skin_stencil_test());
+                    Pipeline::graphics(s.ctx, &d)?
+                }
+                Path::Compute => Pipeline::compute(s.ctx, "poisson", COMPUTE_SHADER)?,
+            },
+        );
+        let mut tiles = Guard::new(
+            s.ctx,
+            match path {
+                Path::Fragment => None,
+                Path::Compute => Some(SkinTiles::new(s)?),
+            },
+        );
+        if let Some(t) = tiles.as_mut() {
+            t.add_merge(s, out, s.targets.diffuse)?;
+        }
         let disk: Vec<[f32; 4]> = poisson_disk_32()
             .iter()
             .map(|p| [p[0], p[1], 0.0, 0.0])
@@ -137,6 +172,7 @@ impl Poisson {
             depth_sensitivity: p.depth_sensitivity,
             normal_sensitivity: p.normal_sensitivity,
             max_level: levels as i32 - 1,
+            code: 0,
         };
         let chains = [t.diffuse, t.linear_depth, normals].map(|c| s.res.levels(c));
         let [color, depth, normal] = &chains;
@@ -154,11 +190,7 @@ impl Poisson {
                 )
             })
             .collect();
-        let set = GraphSet::new(
-            s.res,
-            &pipeline,
-            0,
-            vec![
+        let mut binds = vec![
                 ("colorChain", Binding::SampledLevels(t.diffuse)),
                 ("depthChain", Binding::SampledLevels(t.linear_depth)),
                 ("normalChain", Binding::SampledLevels(normals)),
@@ -173,8 +205,18 @@ impl Poisson {
                         size: (MAX_TAPS * 16) as u64,
                     }),
                 ),
-            ],
-        );
+            ];
+        if let Some(tl) = tiles.as_ref() {
+            binds.extend([
+                (
+                    "stencilTex",
+                    Binding::SampledStencil(t.depth_stencil),
+                ),
+                ("Tiles", tl.list_binding(Storage::Read)),
+                ("outImage", Binding::StorageImage(out, Storage::Write)),
+            ]);
+        }
+        let set = GraphSet::new(s.res, &pipeline, 0, binds);
         Ok(Poisson {
             mip_pipeline: mip_pipeline.keep(),
             pipeline: pipeline.keep(),
@@ -183,6 +225,8 @@ impl Poisson {
             set,
             disk_buffer: disk_buffer.keep(),
             out,
+            diffuse: t.diffuse,
+            tiles: tiles.keep(),
             push,
             params: p,
             levels,
@@ -193,14 +237,17 @@ impl Poisson {
 impl SssMethod for Poisson {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
         let t = f.targets;
-        // The composite reads the output on every pixel: seed all of it.
-        let mut passes = vec![seed_copy(
-            "poisson seed copy",
-            f,
-            t.diffuse,
-            f.screen,
-            &[self.out],
-        )];
+        let mut passes = match &self.tiles {
+            // The composite reads the output on every pixel: seed all of it.
+            None => vec![seed_copy(
+                "poisson seed copy",
+                f,
+                t.diffuse,
+                f.screen,
+                &[self.out],
+            )],
+            Some(tiles) => tiles.passes(f).into(),
+        };
         let chains = &self.chains;
         for l in 1..self.levels as usize {
             let mut fetches = Vec::new();
@@ -241,6 +288,34 @@ impl SssMethod for Poisson {
             fetches.push(fetch_at_most(f.res, c[0], texture, Filter::Bilinear, taps));
         }
         let (push, pipeline) = (self.push, &self.pipeline);
+        if let Some(tiles) = &self.tiles {
+            fetches.push(fetch(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0));
+            // Invocations outside the image or the skin fetch nothing.
+            for x in &mut fetches {
+                x.exact = false;
+            }
+            let work = ShaderWork {
+                shader: COMPUTE_SHADER.into(),
+                fetches,
+                alu: alu_estimate(COMPUTE_SHADER, &[MAX_TAPS]),
+                storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
+                storage_write_bytes: 8.0,
+            };
+            let push = PoissonPush {
+                code: f.stencil,
+                ..push
+            };
+            let mut pass = Pass::new("poisson", PassRole::Sss);
+            let set = pass.set(&self.set);
+            passes.push(tiles.dispatch_indirect(pass, f, work).record(
+                move |pc: &PassContext| {
+                    pc.bind(pipeline, &[set]);
+                    pipeline.push(pc.ctx, pc.cmd, &push);
+                },
+            ));
+            passes.extend(tiles.merge_pass(f));
+            return passes;
+        }
         passes.push(masked_pass(
             f,
             Masked {
@@ -260,7 +335,11 @@ impl SssMethod for Poisson {
     }
 
     fn output(&self) -> ImageId {
-        self.out
+        match self.tiles {
+            None => self.out,
+            // The merge wrote the skin pixels into the diffuse target.
+            Some(_) => self.diffuse,
+        }
     }
 
     /// Poisson reads the complete diffuse chain, never a seed: its region only
@@ -273,21 +352,31 @@ impl SssMethod for Poisson {
         for set in &mut self.mip_sets {
             b.write(set, &self.mip_pipeline)?;
         }
-        b.write(&mut self.set, &self.pipeline)
+        b.write(&mut self.set, &self.pipeline)?;
+        if let Some(t) = &mut self.tiles {
+            t.bind(b)?;
+        }
+        Ok(())
     }
 
     fn intermediates(&self) -> Vec<ImageId> {
-        vec![self.out]
+        match self.tiles {
+            None => vec![self.out],
+            // Only written and read at skin pixels.
+            Some(_) => Vec::new(),
+        }
     }
 
     fn details(&self) -> serde_json::Value {
-        serde_json::json!({ "params": self.params, "levels": self.levels })
+        let path = if self.tiles.is_some() { Path::Compute } else { Path::Fragment };
+        serde_json::json!({ "params": self.params, "levels": self.levels, "path": path.name() })
     }
 
     fn destroy(&mut self, ctx: &Context) {
         self.mip_pipeline.destroy(ctx);
         self.pipeline.destroy(ctx);
         self.disk_buffer.destroy(ctx);
+        self.tiles.destroy(ctx);
     }
 
     fn as_any(&self) -> &dyn Any {

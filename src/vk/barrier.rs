@@ -371,10 +371,14 @@ impl ResourceState {
                 new_layout,
             })
         } else if layout_change
-            || (self.last_write.is_some() && !self.visible_stages.contains(n.stage))
+            || ((self.last_write.is_some() || !self.visible_stages.is_empty())
+                && !self.visible_stages.contains(n.stage))
         {
             // Make the write visible to this stage; a transition also waits for
-            // the reads in the old layout.
+            // the reads in the old layout. A layout transition is a write too:
+            // an image never written but moved into a read layout for one
+            // stage (visible there) is ordered before a read in another (the
+            // barrier waits on the first reads, which waited on it).
             Some(BarrierPlan {
                 src_stage: w_stage | self.read_stages,
                 src_access: w_access,

@@ -192,6 +192,26 @@ fn read_after_read_same_layout_is_free() {
     assert_eq!(b.new_layout, L::TRANSFER_SRC_OPTIMAL);
 }
 
+// A layout transition is a write (synchronization validation's
+// SYNC_IMAGE_LAYOUT_TRANSITION): an image never written, moved into the
+// sampled layout for the fragment stage, then sampled by a compute shader,
+// needs the compute read ordered after the transition (the chain through the
+// fragment reads); a second fragment read does not.
+#[test]
+fn a_transition_for_one_stage_is_ordered_before_reads_in_another() {
+    let f = AccessKind::FragmentSampledRead;
+    let c = AccessKind::ComputeSampledRead;
+    assert_eq!(image_after(&[f], f), None);
+    let b = image_after(&[f], c).expect("the compute read waits");
+    assert_eq!(b.src_stage, S::FRAGMENT_SHADER);
+    assert_eq!(b.src_access, A::NONE);
+    assert_eq!(b.dst_stage, S::COMPUTE_SHADER);
+    assert_eq!((b.old_layout, b.new_layout), (L::SHADER_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL));
+    // Once both stages have seen it, reads in either are free.
+    assert_eq!(image_after(&[f, c], f), None);
+    assert_eq!(image_after(&[f, c], c), None);
+}
+
 // Geometry pass writes depth+stencil; the SSS passes stencil-test against it.
 #[test]
 fn depth_write_then_stencil_test() {
