@@ -181,19 +181,15 @@ pub struct BurleyParams {
 impl BurleyParams {
     /// Checks ranges so that `s` is finite and positive.
     pub fn validate(&self) -> Result<()> {
-        for c in 0..3 {
-            let (a, l) = (self.albedo[c], self.mfp_mm[c]);
+        let channels = CHANNELS.iter().zip(&self.albedo).zip(&self.mfp_mm);
+        for ((name, &a), &l) in channels {
             if !a.is_finite() || a <= 0.0 || a > 1.0 {
-                bail!(
-                    "Burley albedo ({}) must be a finite value in (0, 1], got {a}",
-                    CHANNELS[c]
-                );
+                bail!("Burley albedo ({name}) must be a finite value in (0, 1], got {a}");
             }
             if !l.is_finite() || l <= 0.0 {
                 bail!(
-                    "Burley {} ({}) must be finite and > 0 mm, got {l}",
-                    self.fit.length(),
-                    CHANNELS[c]
+                    "Burley {} ({name}) must be finite and > 0 mm, got {l}",
+                    self.fit.length()
                 );
             }
         }
@@ -202,10 +198,7 @@ impl BurleyParams {
 
     /// The parameters whose scaling factor is `s` (1/mm) at albedo `albedo`.
     pub fn from_s(albedo: [f64; 3], s: [f64; 3], fit: SFit) -> Self {
-        let mut mfp_mm = [0.0; 3];
-        for c in 0..3 {
-            mfp_mm[c] = fit.s_times_length(albedo[c]) / s[c];
-        }
+        let mfp_mm = std::array::from_fn(|c| fit.s_times_length(albedo[c]) / s[c]);
         Self {
             albedo,
             mfp_mm,
@@ -242,11 +235,7 @@ impl BurleyParams {
 
     /// Scaling factor `s = fit(A) / l` per channel (1/mm).
     pub fn s(&self) -> [f64; 3] {
-        let mut out = [0.0; 3];
-        for c in 0..3 {
-            out[c] = self.fit.s_times_length(self.albedo[c]) / self.mfp_mm[c];
-        }
-        out
+        std::array::from_fn(|c| self.fit.s_times_length(self.albedo[c]) / self.mfp_mm[c])
     }
 
     /// Mean radius `E[r] = 2.5 / s` per channel (mm).
@@ -262,21 +251,13 @@ impl BurleyParams {
     /// `R(r)` per channel (per mm^2), albedo included.
     pub fn profile(&self, r_mm: f64) -> [f64; 3] {
         let s = self.s();
-        let mut out = [0.0; 3];
-        for c in 0..3 {
-            out[c] = self.albedo[c] * radial_pdf(s[c], r_mm) / (2.0 * PI * r_mm);
-        }
-        out
+        std::array::from_fn(|c| self.albedo[c] * radial_pdf(s[c], r_mm) / (2.0 * PI * r_mm))
     }
 
     /// The marginal `m(x)` per channel (per mm), albedo included.
     pub fn marginal(&self, x_mm: f64) -> [f64; 3] {
         let s = self.s();
-        let mut out = [0.0; 3];
-        for c in 0..3 {
-            out[c] = self.albedo[c] * marginal_pdf(s[c], x_mm);
-        }
-        out
+        std::array::from_fn(|c| self.albedo[c] * marginal_pdf(s[c], x_mm))
     }
 
     /// The card's exitance at `x` under unit irradiance with albedo `a_l`
@@ -284,12 +265,10 @@ impl BurleyParams {
     /// profile normalised to 1, as [`super::card::Card::exitance`]).
     pub fn edge_response(&self, x_mm: f64, a_l: [f64; 3], a_r: [f64; 3]) -> [f64; 3] {
         let s = self.s();
-        let mut out = [0.0; 3];
-        for c in 0..3 {
+        std::array::from_fn(|c| {
             let left = marginal_tail(s[c], x_mm);
-            out[c] = a_l[c] * left + a_r[c] * (1.0 - left);
-        }
-        out
+            a_l[c] * left + a_r[c] * (1.0 - left)
+        })
     }
 
     /// Energy moved across an edge of unit contrast under unit irradiance,
@@ -538,14 +517,14 @@ mod tests {
         ),
         (
             0.1,
-            2.427_069_024_702_016_6,
+            2.427_069_024_702_017,
             9.853_844_780_870_606,
             1.228_631_883_036_922_2,
         ),
         (
             0.5,
             0.924_419_071_227_665_9,
-            1.656_441_120_003_300_9,
+            1.656_441_120_003_301,
             0.643_693_805_863_747_5,
         ),
         (
@@ -582,7 +561,7 @@ mod tests {
             600.0,
             1.355_828_530_994_852_4e-262,
             1.356_957_918_112_806e-262,
-            1.354_701_954_484_534_9e-262,
+            1.354_701_954_484_535e-262,
         ),
     ];
 
@@ -678,9 +657,8 @@ mod tests {
 
     #[test]
     fn profile_integrates_to_its_albedo() {
-        let s = SKIN.s();
-        for c in 0..3 {
-            let top = 120.0 / s[c]; // e^(-40): nothing left
+        for (c, s) in SKIN.s().into_iter().enumerate() {
+            let top = 120.0 / s; // e^(-40): nothing left
             let total = midpoint(0.0, top, 400_000, |r| 2.0 * PI * r * SKIN.profile(r)[c]);
             let rel = total / SKIN.albedo[c] - 1.0;
             assert!(rel.abs() < 1e-6, "channel {c}: {total} ({rel:e})");
@@ -797,7 +775,8 @@ mod tests {
             r.sort_by(f64::total_cmp);
             r
         };
-        let inverses: [(&str, fn(f64, f64) -> f64); 2] = [
+        type Inverse = fn(f64, f64) -> f64;
+        let inverses: [(&str, Inverse); 2] = [
             ("inverse cdf", radial_inverse_cdf),
             ("inverse tail", radial_inverse_tail),
         ];
