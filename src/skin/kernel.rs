@@ -49,6 +49,26 @@
 //! not a radial mixture), so the choice is which error to keep: the
 //! marginal keeps edges exact and errs only at features small in both axes.
 //!
+//! # The Burley preset
+//!
+//! [`Preset::Burley`] ([`KernelShape::Burley`]) is the same construction
+//! on Burley's normalized diffusion instead of the six Gaussians: each
+//! channel's marginal `s / (4 pi) [K0(s|x|) + K0(s|x|/3)]` (see
+//! [`super::burley`]), with `s` matched to the six-Gaussian skin by the
+//! mean radius ([`burley_profile`]), the same tap positions and the same
+//! mass- and first-moment-keeping weights. Its half-extent is where the
+//! widest channel's (red's) marginal keeps 99.7% of its mass, 5.97 mm (HDRP
+//! sizes its filter by the 99.7% point). Burley's tail is exponential, not
+//! Gaussian: the 0.3% beyond that point carries 3% of red's edge energy,
+//! which dropping it would lose. So the tail `[w, inf)` is assigned like
+//! any interval, linearly between two taps, here the centre and the
+//! outermost one (`T - G / w` and `G / w`, for tail mass `T` and first
+//! moment `G`): mass and edge energy stay exact for any width and tap
+//! count, the centre tap gives up a little weight to pay for it. Like the
+//! physical preset it is exact only for what varies along one axis: a
+//! separable product of a radial profile's marginals is not the radial
+//! profile.
+//!
 //! Over 800 lines because its tests (about 500 lines: the kernel against the
 //! profile's closed forms, the presets, the rank-1 study) sit beside the 380
 //! lines of code they check.
@@ -57,6 +77,7 @@ use std::str::FromStr;
 
 use anyhow::{bail, Context, Result};
 
+use super::burley::{self, BurleyParams, SFit};
 use super::profile::{
     marginal_first_moment, marginal_integral, red_profile_line_integral, SIX_GAUSSIAN_VARIANCES_MM2,
 };
@@ -75,6 +96,17 @@ const CHANNELS: [&str; 3] = ["red", "green", "blue"];
 /// 3-sigma tail beyond holds 0.27% of that Gaussian's mass, 0.02% of red's.
 pub const PHYSICAL_WIDTH_SIGMAS: f32 = 3.0;
 
+/// Share of the widest channel's marginal mass within the Burley kernel's
+/// half-extent (HDRP's 99.7% point).
+pub const BURLEY_KEPT_MASS: f64 = 0.997;
+
+/// The Burley profile [`KernelShape::Burley`] samples: matched to the
+/// six-Gaussian skin by the mean radius (and so the edge spread), with the
+/// default fit (which sets only the mean free path, not the shape).
+pub fn burley_profile() -> BurleyParams {
+    BurleyParams::matching_six_gaussians(SFit::default())
+}
+
 /// Which 1D profile the kernel's cells integrate.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub enum KernelShape {
@@ -85,6 +117,9 @@ pub enum KernelShape {
     /// The per-channel marginal of the 2D profile, at its true scale; the
     /// falloff does not apply (it must be 0). See the module docs.
     Marginal,
+    /// The per-channel marginal of Burley's profile ([`burley_profile`]);
+    /// the falloff must be 0. See the module docs.
+    Burley,
 }
 
 impl KernelShape {
@@ -125,11 +160,21 @@ pub enum Preset {
     /// own narrow Gaussians are the light that barely moves). Beyond the
     /// sources; see the module docs.
     Physical,
+    /// Burley's normalized diffusion matched to the same skin (same total
+    /// reflectance and mean radius per channel), its per-channel marginal,
+    /// half-extent where red's keeps 99.7% of its mass (5.97 mm), strength
+    /// 1. See the module docs.
+    Burley,
 }
 
 impl Preset {
     /// Every preset, for listings and exhaustive tests.
-    pub const ALL: [Preset; 3] = [Preset::Table61, Preset::Demo, Preset::Physical];
+    pub const ALL: [Preset; 4] = [
+        Preset::Table61,
+        Preset::Demo,
+        Preset::Physical,
+        Preset::Burley,
+    ];
 
     /// Canonical name, accepted back by `FromStr`.
     pub fn name(self) -> &'static str {
@@ -137,6 +182,7 @@ impl Preset {
             Preset::Table61 => "table6.1",
             Preset::Demo => "demo",
             Preset::Physical => "physical",
+            Preset::Burley => "burley",
         }
     }
 
@@ -161,6 +207,19 @@ impl Preset {
                 falloff: [0.0; 3],
                 shape: KernelShape::Marginal,
             },
+            Preset::Burley => {
+                let s = burley_profile().s();
+                let width = s
+                    .iter()
+                    .map(|&s| burley::marginal_quantile_half_width(s, BURLEY_KEPT_MASS))
+                    .fold(0.0, f64::max);
+                SssParams {
+                    width_mm: width as f32,
+                    strength: [1.0; 3],
+                    falloff: [0.0; 3],
+                    shape: KernelShape::Burley,
+                }
+            }
         }
     }
 }
@@ -173,8 +232,10 @@ impl FromStr for Preset {
             "table6.1" | "table61" => Ok(Preset::Table61),
             "demo" => Ok(Preset::Demo),
             "physical" => Ok(Preset::Physical),
+            "burley" => Ok(Preset::Burley),
             _ => bail!(
-                "unknown SSS preset {s:?}; valid presets: table6.1 (or table61), demo, physical"
+                "unknown SSS preset {s:?}; valid presets: table6.1 (or table61), demo, physical, \
+                 burley"
             ),
         }
     }
@@ -212,10 +273,10 @@ impl SssParams {
                     Self::MAX_FALLOFF
                 );
             }
-            if self.shape == KernelShape::Marginal && f != 0.0 {
+            if self.shape != KernelShape::RedSlice && f != 0.0 {
                 bail!(
                     "SSS falloff ({name}) reshapes eq. 6.1's red slice and must be 0 for the \
-                     physical (marginal) kernel, got {f}"
+                     marginal kernels (physical, burley), got {f}"
                 );
             }
         }
@@ -235,6 +296,26 @@ pub struct KernelSample {
 pub struct SeparableKernel {
     pub params: SssParams,
     pub samples: Vec<KernelSample>,
+}
+
+/// Weights of the non-negative taps `offsets` (from 0 up) for a symmetric
+/// density given by its `mass(a, b)` and `first(a, b)` (first moment) over
+/// intervals: each interval's mass goes to its two taps linearly, so that
+/// the mass and the first moment of every interval stay exact. Tap 0 gets
+/// only its `[0, x_1]` share (the caller doubles it for `[-x_1, x_1]`).
+fn moment_keeping_weights(
+    offsets: &[f64],
+    mass: impl Fn(f64, f64) -> f64,
+    first: impl Fn(f64, f64) -> f64,
+) -> Vec<f64> {
+    let mut raw = vec![0.0; offsets.len()];
+    for j in 0..offsets.len() - 1 {
+        let (a, b) = (offsets[j], offsets[j + 1]);
+        let (m, f) = (mass(a, b), first(a, b));
+        raw[j] += (b * m - f) / (b - a);
+        raw[j + 1] += (f - a * m) / (b - a);
+    }
+    raw
 }
 
 impl SeparableKernel {
@@ -315,15 +396,24 @@ impl SeparableKernel {
                 // (blue) of the edge energy at 17 taps. The mass beyond
                 // +-width (0.02% of red at 3 sigma) is dropped by the
                 // normalisation below.
-                KernelShape::Marginal => {
-                    let mut raw = vec![0.0; half + 1];
-                    for j in 0..half {
-                        let (a, b) = (offsets[j], offsets[j + 1]);
-                        let mass = marginal_integral(c, a, b);
-                        let first = marginal_first_moment(c, a, b);
-                        raw[j] += (b * mass - first) / (b - a);
-                        raw[j + 1] += (first - a * mass) / (b - a);
-                    }
+                KernelShape::Marginal => moment_keeping_weights(
+                    &offsets,
+                    |a, b| marginal_integral(c, a, b),
+                    |a, b| marginal_first_moment(c, a, b),
+                ),
+                // The same on Burley's marginal, plus its tail beyond the
+                // outermost tap (see the module docs).
+                KernelShape::Burley => {
+                    let s = burley_profile().s()[c];
+                    let mut raw = moment_keeping_weights(
+                        &offsets,
+                        |a, b| burley::marginal_integral(s, a, b),
+                        |a, b| burley::marginal_first_moment(s, a, b),
+                    );
+                    let tail_mass = burley::marginal_tail(s, width);
+                    let tail_first = burley::marginal_first_moment(s, width, f64::INFINITY);
+                    raw[half] += tail_first / width;
+                    raw[0] += tail_mass - tail_first / width;
                     raw
                 }
             };
@@ -403,7 +493,10 @@ mod tests {
         assert_eq!(" Demo ".parse::<Preset>().unwrap(), Preset::Demo);
         let err = "skin".parse::<Preset>().unwrap_err().to_string();
         assert!(
-            err.contains("table6.1") && err.contains("demo") && err.contains("physical"),
+            err.contains("table6.1")
+                && err.contains("demo")
+                && err.contains("physical")
+                && err.contains("burley"),
             "{err}"
         );
         assert!((Preset::Table61.params().width_mm - 3.22).abs() < 1e-5);
@@ -595,7 +688,61 @@ mod tests {
         move |x: f64| match params.shape {
             KernelShape::RedSlice => red_profile((s * x).abs()),
             KernelShape::Marginal => marginal_density(c, x),
+            KernelShape::Burley => unreachable!("see burley_reference"),
         }
+    }
+
+    /// Burley's marginal for channel `c` as a fine kernel: taps at `k h`,
+    /// `k = 0..=20000`, out to `40 / s` (the tail beyond holds ~1e-7), with
+    /// the moment-keeping weights (the log singularity at 0 rules out
+    /// Simpson there). Halves `(offset, weight)`, the centre's weight
+    /// already doubled. Computed once.
+    fn burley_reference(c: usize) -> &'static [(f64, f64)] {
+        static FINE: std::sync::OnceLock<[Vec<(f64, f64)>; 3]> = std::sync::OnceLock::new();
+        &FINE.get_or_init(|| {
+            let s = burley_profile().s();
+            [0, 1, 2].map(|c| {
+                let n = 20_000;
+                let h = 40.0 / s[c] / n as f64;
+                let x: Vec<f64> = (0..=n).map(|k| k as f64 * h).collect();
+                let mut w = moment_keeping_weights(
+                    &x,
+                    |a, b| burley::marginal_integral(s[c], a, b),
+                    |a, b| burley::marginal_first_moment(s[c], a, b),
+                );
+                w[0] *= 2.0;
+                x.into_iter().zip(w).collect()
+            })
+        })[c]
+    }
+
+    /// The continuous convolution `integral shape(x) g(x + x0) dx` over the
+    /// shape's mass, with the preset's strength: the exact kernel, truncated
+    /// to the preset's width for the six-Gaussian shapes (which drop the
+    /// rest), the whole line for Burley's (which keeps it).
+    fn continuous_convolution(params: SssParams, c: usize, g: &dyn Fn(f64) -> f64, x0: f64) -> f64 {
+        let w = f64::from(params.width_mm);
+        let (num, den) = match params.shape {
+            KernelShape::Burley => {
+                burley_reference(c)
+                    .iter()
+                    .fold((0.0, 0.0), |(num, den), &(x, wt)| {
+                        let (v, m) = if x == 0.0 {
+                            (g(x0), 1.0)
+                        } else {
+                            (g(x0 + x) + g(x0 - x), 2.0)
+                        };
+                        (num + wt * v, den + wt * m)
+                    })
+            }
+            _ => {
+                let shape = continuous_shape(params, c);
+                let num = simpson(-w, w, 40_000, |x| shape(x) * g(x + x0));
+                (num, simpson(-w, w, 40_000, shape))
+            }
+        };
+        let t = f64::from(params.strength[c]);
+        (1.0 - t) * g(x0) + t * num / den
     }
 
     /// `sum_i w_ic N(x; 0, v_i)`.
@@ -619,11 +766,7 @@ mod tests {
             let x0 = frac * w;
             let got = k.apply_1d(|x| [g(x + x0); 3]);
             for (c, &got_c) in got.iter().enumerate() {
-                let shape = continuous_shape(params, c);
-                let num = simpson(-w, w, 40_000, |x| shape(x) * g(x + x0));
-                let den = simpson(-w, w, 40_000, shape);
-                let t = f64::from(params.strength[c]);
-                let want = (1.0 - t) * g(x0) + t * num / den;
+                let want = continuous_convolution(params, c, g, x0);
                 worst = worst.max((got_c - want).abs());
             }
         }
@@ -638,6 +781,11 @@ mod tests {
     /// The physical kernel is 2.5x wider with the same taps, so the 0.3 mm
     /// tanh step is coarser for it (worst observed 5.6e-2, 1.3e-2, 2.9e-3).
     const PHYSICAL_ERROR_BOUNDS: [f64; 3] = [7e-2, 1.7e-2, 4e-3];
+
+    /// Burley's kernel, 5.97 mm wide, against the whole line (its tail is
+    /// folded onto the outer taps, not dropped): worst observed 4.4e-2,
+    /// 7.9e-3, 2.1e-3 (tanh).
+    const BURLEY_ERROR_BOUNDS: [f64; 3] = [6e-2, 1.1e-2, 2.8e-3];
 
     #[test]
     fn matches_continuous_convolution() {
@@ -661,6 +809,7 @@ mod tests {
                 );
                 let bounds = match p {
                     Preset::Physical => PHYSICAL_ERROR_BOUNDS,
+                    Preset::Burley => BURLEY_ERROR_BOUNDS,
                     _ => ERROR_BOUNDS,
                 };
                 for (err, bound) in errs.iter().zip(bounds) {
@@ -717,14 +866,63 @@ mod tests {
         }
     }
 
+    /// The Burley kernel against its profile's closed forms: the energy a
+    /// step moves (the card's edge spread, `2.5 / (pi s)`) and the mass, at
+    /// every tap count; the variance only converges (the tail folded onto
+    /// the outermost tap carries less of it). Also what dropping the tail,
+    /// as the physical kernel does, would cost at this width.
+    #[test]
+    fn burley_kernel_matches_its_edge_spread() {
+        let profile = burley_profile();
+        let (spread, var) = (profile.edge_spread_mm(), profile.marginal_variance_mm2());
+        // Same-mean-radius match: the six Gaussians' edge spread (to the
+        // f32 weights' sum, 1 only to ~1e-7, which the match divides out).
+        let six = crate::skin::card::edge_spread_mm();
+        for c in 0..3 {
+            assert!(
+                (spread[c] / six[c] - 1.0).abs() < 1e-6,
+                "{spread:?} {six:?}"
+            );
+        }
+        let width = f64::from(Preset::Burley.params().width_mm);
+        assert!((width - 5.9671).abs() < 1e-4, "{width}");
+        for n in [9, 17, 33, 63] {
+            let k = build(Preset::Burley, n);
+            let mut line = format!("burley n={n}:");
+            for c in 0..3 {
+                let (v, plus) = moments(&k, c);
+                let ee = plus / spread[c] - 1.0;
+                line += &format!(
+                    " {}: var {v:.4} (profile {:.4}) edge {ee:+.2e};",
+                    CHANNELS[c], var[c]
+                );
+                // f32 weights: exact to rounding.
+                assert!(ee.abs() < 1e-5, "{line}");
+            }
+            println!("{line}");
+        }
+        // Dropping the tail beyond the width instead: red's edge energy
+        // short by the tail's first moment, less the renormalisation.
+        let s = profile.s()[0];
+        let (tail, first) = (
+            burley::marginal_tail(s, width),
+            burley::marginal_first_moment(s, width, f64::INFINITY),
+        );
+        let dropped = (spread[0] - first) / (1.0 - 2.0 * tail) / spread[0] - 1.0;
+        println!("burley red without the tail: edge {dropped:+.4} (tail mass {tail:.2e} a side)");
+        assert!(dropped < -0.02, "{dropped}");
+    }
+
     #[test]
     fn marginal_shape_rejects_a_falloff() {
-        let p = SssParams {
-            falloff: [0.0, 0.2, 0.0],
-            ..Preset::Physical.params()
-        };
-        let msg = format!("{:#}", SeparableKernel::build(p, 17).unwrap_err());
-        assert!(msg.contains("falloff (green)"), "{msg}");
+        for preset in [Preset::Physical, Preset::Burley] {
+            let p = SssParams {
+                falloff: [0.0, 0.2, 0.0],
+                ..preset.params()
+            };
+            let msg = format!("{:#}", SeparableKernel::build(p, 17).unwrap_err());
+            assert!(msg.contains("falloff (green)"), "{msg}");
+        }
     }
 
     #[test]
@@ -733,6 +931,8 @@ mod tests {
         assert!(t.get("shape").is_none(), "{t}");
         let p = serde_json::to_value(Preset::Physical.params()).unwrap();
         assert_eq!(p["shape"], "Marginal");
+        let b = serde_json::to_value(Preset::Burley.params()).unwrap();
+        assert_eq!(b["shape"], "Burley");
     }
 
     /// Why the marginal and not the rank-1 least-squares fit: both as 1D

@@ -10,6 +10,7 @@
 //! the GPU to it per pixel; "reference" names only the ground truth).
 
 pub mod beckmann;
+pub mod burley;
 pub mod card;
 pub mod jittered;
 pub mod kernel;
