@@ -49,6 +49,12 @@ for res in "1080|--width 1920 --height 1080" "2160|--width 3840 --height 2160"; 
     done
   done
 done
+# ss-jittered and poisson on both paths, 1080p close-up.
+for m in ss-jittered poisson; do
+  for path in fragment compute; do
+    bench "1080-close-1-$m-$path" --width 1920 --height 1080 --shot close --method $m --path $path $F
+  done
+done
 for path in fragment compute; do
   bench "lps-1080-close-$path" --scene "$LPS" --width 1920 --height 1080 --shot close \
     --method separable --path $path $F

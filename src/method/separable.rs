@@ -44,7 +44,7 @@ const OPTIONS: &[OptSpec] = &[
         key: "preset",
         kind: OptKind::Value,
         default: "table6.1",
-        help: "kernel preset: table6.1 | demo (the sources' artists' presets) | physical (the profile's per-channel marginal)",
+        help: "kernel preset: table6.1 | demo (the sources' artists' presets) | physical (the profile's per-channel marginal) | burley (Burley's normalized diffusion matched to the profile, its marginal)",
     },
     OptSpec {
         key: "sss-width-mm",
