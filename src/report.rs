@@ -204,14 +204,35 @@ pub struct Ceilings {
     /// RGBA16F with constant-factor blending (read-modify-write); `None` as above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blend_rgba16f_gpix: Option<f64>,
+    /// The compute path's rates (probe_fetch.comp, 16x16 groups): fetches
+    /// as the fragment probes make them, and RGBA16F storage-image stores;
+    /// `None` in reports from before they were probed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compute: Option<ComputeCeilings>,
+}
+
+/// The compute path's measured rates (giga-taps or giga-stores a second).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComputeCeilings {
+    pub bilinear_rgba16f_gtaps: f64,
+    pub point_rgba16f_gtaps: f64,
+    pub bilinear_r32f_gtaps: f64,
+    pub point_r32f_gtaps: f64,
+    pub store_rgba16f_gpix: f64,
 }
 
 impl Ceilings {
     /// One line of the measured rates, for the bench printout.
     pub fn summary(&self) -> String {
         let rate = |v: Option<f64>| v.map_or("not measured".into(), |v| format!("{v:.2}"));
+        let compute = self.compute.map_or(String::new(), |c| {
+            format!(
+                "; compute: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, store rgba16f {:.2} Gpix/s",
+                c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.store_rgba16f_gpix
+            )
+        });
         format!(
-            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}",
+            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}{compute}",
             self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, rate(self.fill_rgba8_gpix), rate(self.blend_rgba16f_gpix)
         )
     }

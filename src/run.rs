@@ -7,8 +7,8 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 
 use crate::bench::ceilings;
-use crate::bench::floor::floor_ms;
-use crate::graph::work::PassRole;
+use crate::bench::floor::{compute_floor_ms, floor_ms};
+use crate::graph::work::{PassRole, Work};
 use crate::graph::PassSample;
 use crate::header::RunHeader;
 use crate::output::{
@@ -188,11 +188,20 @@ pub fn run_request(ctx: &Context, request: &FrameRequest, opts: &RunOptions) -> 
     let (ceilings, probes) = if opts.ceilings {
         let (c, p) = ceilings::measure(ctx, extent, 7).context("measuring device ceilings")?;
         for pass in &mut passes {
-            if let (Some(work), Some(inv)) = (&pass.work, pass.fragment_invocations) {
-                if let Some(f) = floor_ms(work, inv, &c) {
-                    pass.floor_ms = Some(f);
-                    pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
-                }
+            // A dispatch is floored by its compute invocations at the compute
+            // rates, a raster pass by its fragments at the fragment rates.
+            let floor = match (
+                &pass.work,
+                pass.compute_invocations,
+                pass.fragment_invocations,
+            ) {
+                (Some(w @ Work::Compute { .. }), Some(inv), _) => compute_floor_ms(w, inv, &c),
+                (Some(w), _, Some(inv)) => floor_ms(w, inv, &c),
+                _ => None,
+            };
+            if let Some(f) = floor {
+                pass.floor_ms = Some(f);
+                pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
             }
         }
         (Some(c), Some(p))

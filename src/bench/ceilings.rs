@@ -1,19 +1,24 @@
-//! Micro-passes that measure the device's own fragment-shader ceilings in the
-//! same run as the benchmark: bilinear and point fetch rates for each format the
-//! SSS passes read (RGBA16F colour, R32F depth), and the fill rates of the writes
-//! the frame makes (RGBA16F, RGBA16F blended, RGBA8).
+//! Micro-passes that measure the device's own ceilings in the same run as the
+//! benchmark: bilinear and point fetch rates for each format the SSS passes
+//! read (RGBA16F colour, R32F depth), and the fill rates of the writes the
+//! frame makes (RGBA16F, RGBA16F blended, RGBA8), on the fragment path; the
+//! same fetches and RGBA16F storage stores on the compute path
+//! (probe_fetch.comp, in the compute blurs' 16x16 groups).
 
 use anyhow::Result;
 use ash::vk;
 
-use super::floor::Ceilings;
+use super::floor::{Ceilings, ComputeCeilings};
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
 use crate::graph::{
     record_passes, Binding, ColorTarget, GraphSet, ImageDesc, Load, Pass, PassContext, Resources,
+    Storage,
 };
 use crate::render::targets::LDR_FORMAT;
 use crate::report::Stats;
+use crate::shader_constants::SSS_TILE_SIDE;
+use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Image;
@@ -33,15 +38,19 @@ struct ProbePush {
 }
 
 /// One probe: a pipeline drawn full-screen into a target, reading a source
-/// texture (fetch probes) or nothing (fill probes).
+/// texture (fetch probes) or nothing (fill probes), or dispatched over the
+/// target (compute probes: their set binds it as a storage image).
 struct Probe<'p> {
     pipeline: &'p Pipeline,
     /// The source's set, and what a fetch of it is (the uploaded sources are
     /// not frame images: their barriers were made by the upload, and the set
     /// declares nothing).
     src: Option<(&'p GraphSet, (Format, Filter))>,
-    /// The target as the probe's pass declares it (load op, blending).
-    target: ColorTarget,
+    /// The target as the probe's pass declares it (load op, blending);
+    /// `None`: a dispatch.
+    target: Option<ColorTarget>,
+    /// Fetches per invocation (0: a fill or store probe).
+    taps: i32,
 }
 
 // report.json's type: the schema lives in `report`.
@@ -113,6 +122,7 @@ fn probe_all(
     let overwrite_ldr = ColorTarget::new(id_ldr, Load::DontCare);
     let blended = ColorTarget::new(id_target, Load::Keep).blended();
     res.allow(&[overwrite, blended, overwrite_ldr].map(|c| (c.image, c.access())));
+    res.allow(&[(id_target, AccessKind::ComputeStorageWrite)]);
     res.create(ctx)?;
     let mut owned = Owned {
         ctx,
@@ -134,9 +144,12 @@ fn probe_all(
         let p = Pipeline::graphics(ctx, &d)?;
         owned.pipelines.push(p);
     }
+    let p = Pipeline::compute(ctx, "probe fetch compute", "probe_fetch.comp")?;
+    owned.pipelines.push(p);
     let samplers = owned.samplers.as_ref().expect("created above");
     let pool = owned.pool.as_ref().expect("created above");
-    let [fetch, fill, fill_ldr, fill_blend] = [0, 1, 2, 3].map(|i| &owned.pipelines[i]);
+    let [fetch, fill, fill_ldr, fill_blend, fetch_cs] =
+        [0, 1, 2, 3, 4].map(|i| &owned.pipelines[i]);
     let set = |img: &Image, sampler| -> Result<GraphSet> {
         let binds = vec![
             ("srcTex", Binding::Fixed(Bind::Texture(img.view))),
@@ -154,15 +167,39 @@ fn probe_all(
         set(r32, linear)?,
         set(r32, nearest)?,
     ];
+    let cs_set = |img: &Image, sampler| -> Result<GraphSet> {
+        let binds = vec![
+            ("srcTex", Binding::Fixed(Bind::Texture(img.view))),
+            ("srcSampler", Binding::Fixed(Bind::Sampler(sampler))),
+            ("outImage", Binding::StorageImage(id_target, Storage::Write)),
+        ];
+        let mut set = GraphSet::new(res, fetch_cs, 0, binds);
+        set.write(ctx, pool, res, fetch_cs)?;
+        Ok(set)
+    };
+    let cs_sets = [
+        cs_set(rgba, linear)?,
+        cs_set(rgba, nearest)?,
+        cs_set(r32, linear)?,
+        cs_set(r32, nearest)?,
+    ];
     let fetch_probe = |s, format| Probe {
         pipeline: fetch,
         src: Some((s, format)),
-        target: overwrite,
+        target: Some(overwrite),
+        taps: PROBE_TAPS,
     };
     let fill_probe = |pipeline, target| Probe {
         pipeline,
         src: None,
-        target,
+        target: Some(target),
+        taps: 0,
+    };
+    let compute_probe = |s, format, taps| Probe {
+        pipeline: fetch_cs,
+        src: Some((s, format)),
+        target: None,
+        taps,
     };
     let probes: Vec<(&str, Probe)> = vec![
         (
@@ -184,13 +221,45 @@ fn probe_all(
         ("fill rgba16f", fill_probe(fill, overwrite)),
         ("fill rgba8", fill_probe(fill_ldr, overwrite_ldr)),
         ("blend rgba16f", fill_probe(fill_blend, blended)),
+        (
+            "compute bilinear rgba16f",
+            compute_probe(
+                &cs_sets[0],
+                (Format::Rgba16Float, Filter::Bilinear),
+                PROBE_TAPS,
+            ),
+        ),
+        (
+            "compute point rgba16f",
+            compute_probe(
+                &cs_sets[1],
+                (Format::Rgba16Float, Filter::Point),
+                PROBE_TAPS,
+            ),
+        ),
+        (
+            "compute bilinear r32f",
+            compute_probe(
+                &cs_sets[2],
+                (Format::R32Float, Filter::Bilinear),
+                PROBE_TAPS,
+            ),
+        ),
+        (
+            "compute point r32f",
+            compute_probe(&cs_sets[3], (Format::R32Float, Filter::Point), PROBE_TAPS),
+        ),
+        (
+            "compute store rgba16f",
+            compute_probe(&cs_sets[1], (Format::Rgba16Float, Filter::Point), 0),
+        ),
     ];
     let texel = [1.0 / extent.width as f32, 1.0 / extent.height as f32];
     let mut passes = Vec::new();
     // One warm-up round, then `reps` measured rounds.
     for round in 0..=reps {
         for (name, probe) in &probes {
-            passes.push(probe.pass(&format!("{name} #{round}"), texel));
+            passes.push(probe.pass(&format!("{name} #{round}"), texel, extent));
         }
     }
     let profiler = Profiler::new(ctx, passes.len() as u32)?;
@@ -201,7 +270,7 @@ fn probe_all(
     profiler.destroy(ctx);
     let samples = samples?;
     ctx.check_validation("during the ceiling probes")?;
-    let with_src: Vec<(&str, bool)> = probes.iter().map(|(n, p)| (*n, p.src.is_some())).collect();
+    let with_src: Vec<(&str, bool)> = probes.iter().map(|(n, p)| (*n, p.taps > 0)).collect();
     Ok(ceilings_from(&samples, &with_src, reps, n))
 }
 
@@ -239,6 +308,13 @@ fn ceilings_from(
             fill_rgba16f_gpix: r(4),
             fill_rgba8_gpix: Some(r(5)),
             blend_rgba16f_gpix: Some(r(6)),
+            compute: Some(ComputeCeilings {
+                bilinear_rgba16f_gtaps: r(7),
+                point_rgba16f_gtaps: r(8),
+                bilinear_r32f_gtaps: r(9),
+                point_r32f_gtaps: r(10),
+                store_rgba16f_gpix: r(11),
+            }),
         },
         results,
     )
@@ -270,19 +346,43 @@ impl Drop for Owned<'_> {
 }
 
 impl<'p> Probe<'p> {
-    fn pass(&self, name: &str, texel: [f32; 2]) -> Pass<'p> {
+    fn pass(&self, name: &str, texel: [f32; 2], extent: vk::Extent2D) -> Pass<'p> {
         let (pipeline, set) = (self.pipeline, self.src.map(|(s, _)| s));
         let fetches = match self.src {
-            Some((_, (format, filter))) => vec![Fetch {
+            Some((_, (format, filter))) if self.taps > 0 => vec![Fetch {
                 texture: "srcTex".into(),
                 format,
                 filter,
-                count: PROBE_TAPS as f64,
+                count: self.taps as f64,
                 exact: true,
                 coherent: true,
                 spread: Vec::new(),
             }],
-            None => Vec::new(),
+            _ => Vec::new(),
+        };
+        let push = ProbePush {
+            texel,
+            taps: self.taps,
+            pad: 0,
+        };
+        let Some(target) = self.target else {
+            let set = set.expect("a compute probe binds its target");
+            let work = ShaderWork {
+                shader: "probe_fetch.comp".into(),
+                fetches,
+                storage_write_bytes: 8.0,
+                ..Default::default()
+            };
+            let mut pass = Pass::new(name, PassRole::Probe);
+            let set = pass.set(set);
+            let side = SSS_TILE_SIDE;
+            let groups = [extent.width.div_ceil(side), extent.height.div_ceil(side), 1];
+            return pass
+                .dispatch(work, groups, side * side)
+                .record(move |pc: &PassContext| {
+                    pc.bind(pipeline, &[set]);
+                    pipeline.push(pc.ctx, pc.cmd, &push);
+                });
         };
         let work = ShaderWork {
             shader: if set.is_some() {
@@ -296,7 +396,7 @@ impl<'p> Probe<'p> {
         };
         let mut pass = Pass::new(name, PassRole::Probe);
         let set = set.map(|s| pass.set(s));
-        pass.color(self.target)
+        pass.color(target)
             .draws(Some(work), 1)
             .record(move |pc: &PassContext| {
                 fullscreen(pc, pipeline, set.as_slice(), |c, cmd| {
@@ -306,15 +406,7 @@ impl<'p> Probe<'p> {
                         }
                     }
                     if set.is_some() {
-                        pipeline.push(
-                            c,
-                            cmd,
-                            &ProbePush {
-                                texel,
-                                taps: PROBE_TAPS,
-                                pad: 0,
-                            },
-                        );
+                        pipeline.push(c, cmd, &push);
                     }
                 })
             })

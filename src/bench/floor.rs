@@ -1,11 +1,43 @@
 //! The floor of a pass: the time its texture fetches and pixel writes would take
 //! at the device's measured ceilings. Fetch units and ROPs work concurrently, so
-//! the floor is the larger of the two, not their sum. Pure arithmetic.
+//! the floor is the larger of the two, not their sum. A dispatch's floor is its
+//! fetches at the compute path's probed rates (`compute_floor_ms`). Pure
+//! arithmetic.
 
 use crate::graph::work::{ColorWrite, Fetch, Filter, Format, Work};
 
-// report.json's type: the schema lives in `report`.
-pub use crate::report::Ceilings;
+// report.json's types: the schema lives in `report`.
+pub use crate::report::{Ceilings, ComputeCeilings};
+
+/// A compute shader's fetch rate of a declared fetch, if a probe measured it.
+fn compute_fetch_rate(c: &ComputeCeilings, f: &Fetch) -> Option<f64> {
+    Some(match (f.format, f.filter) {
+        (Format::Rgba16Float, Filter::Bilinear) => c.bilinear_rgba16f_gtaps,
+        (Format::Rgba16Float, Filter::Point) => c.point_rgba16f_gtaps,
+        (Format::R32Float, Filter::Bilinear) => c.bilinear_r32f_gtaps,
+        (Format::R32Float, Filter::Point) => c.point_r32f_gtaps,
+        _ => return None,
+    })
+}
+
+/// Floor in milliseconds of a dispatch that ran `invocations` invocations:
+/// its exactly declared fetches at the compute path's probed rates. Fetches
+/// declared as bounds (behind a branch) and kinds no probe measured (the
+/// stencil) are left out, so it stays a floor; `None` when nothing is left
+/// to count or the compute rates were not probed.
+pub fn compute_floor_ms(work: &Work, invocations: u64, c: &Ceilings) -> Option<f64> {
+    let (Work::Compute { shader, .. }, Some(rates)) = (work, c.compute.as_ref()) else {
+        return None;
+    };
+    let n = invocations as f64;
+    let mut fetch_s = 0.0;
+    for f in shader.fetches.iter().filter(|f| f.exact) {
+        if let Some(rate) = compute_fetch_rate(rates, f) {
+            fetch_s += n * f.count / (rate * 1e9);
+        }
+    }
+    (fetch_s > 0.0).then_some(fetch_s * 1e3)
+}
 
 /// Fetch rate of a declared fetch, if a probe measured that kind.
 fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
@@ -74,7 +106,53 @@ mod tests {
             fill_rgba16f_gpix: 7.0,
             fill_rgba8_gpix: Some(14.0),
             blend_rgba16f_gpix: Some(3.5),
+            compute: Some(ComputeCeilings {
+                bilinear_rgba16f_gtaps: 500.0,
+                point_rgba16f_gtaps: 500.0,
+                bilinear_r32f_gtaps: 500.0,
+                point_r32f_gtaps: 1000.0,
+                store_rgba16f_gpix: 200.0,
+            }),
         }
+    }
+
+    #[test]
+    fn a_dispatch_is_floored_by_its_exact_fetches_at_the_compute_rates() {
+        let shader = |fetches| ShaderWork {
+            shader: "c".into(),
+            fetches,
+            ..Default::default()
+        };
+        let mut bound = fetch(Format::Rgba16Float, Filter::Bilinear, 100.0);
+        bound.exact = false;
+        let work = Work::Compute {
+            shader: shader(vec![
+                fetch(Format::Rgba16Float, Filter::Point, 5.0),
+                fetch(Format::R32Float, Filter::Point, 5.0),
+                bound,
+            ]),
+            invocations: 1_000_000,
+        };
+        // 5 M at 500 G/s and 5 M at 1000 G/s: 0.015 ms; the bound is left out.
+        let f = compute_floor_ms(&work, 1_000_000, &h100_like()).unwrap();
+        assert!((f - 0.015).abs() < 1e-12, "{f}");
+        // No compute rates, or only bounds: no floor.
+        let old = Ceilings {
+            compute: None,
+            ..h100_like()
+        };
+        assert_eq!(compute_floor_ms(&work, 1_000_000, &old), None);
+        let only_bounds = Work::Compute {
+            shader: shader(vec![Fetch {
+                exact: false,
+                ..fetch(Format::Rgba16Float, Filter::Point, 5.0)
+            }]),
+            invocations: 1,
+        };
+        assert_eq!(compute_floor_ms(&only_bounds, 10, &h100_like()), None);
+        // A raster pass has no compute floor.
+        let r = raster(vec![fetch(Format::Rgba16Float, Filter::Point, 1.0)], vec![]);
+        assert_eq!(compute_floor_ms(&r, 10, &h100_like()), None);
     }
 
     fn fetch(format: Format, filter: Filter, count: f64) -> Fetch {

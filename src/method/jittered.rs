@@ -7,8 +7,8 @@ use std::any::Any;
 
 use anyhow::Result;
 
-use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::path::{self, Path};
+use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{declare_intermediate, fetch, masked_pass, seed_copy, source_set, Masked};
 use super::ssg::ScreenPush;
 use super::tiles::SkinTiles;
@@ -145,7 +145,13 @@ impl Jittered {
             Fetch {
                 coherent: false,
                 spread: ring_spread(&self.kernel, &self.stretch, f.depths),
-                ..fetch(f.res, t.diffuse, "colorTex", Filter::Bilinear, 2.0 * RING as f64)
+                ..fetch(
+                    f.res,
+                    t.diffuse,
+                    "colorTex",
+                    Filter::Bilinear,
+                    2.0 * RING as f64,
+                )
             },
             fetch(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0),
         ];

@@ -191,27 +191,24 @@ impl Poisson {
             })
             .collect();
         let mut binds = vec![
-                ("colorChain", Binding::SampledLevels(t.diffuse)),
-                ("depthChain", Binding::SampledLevels(t.linear_depth)),
-                ("normalChain", Binding::SampledLevels(normals)),
-                (
-                    "mipClamp",
-                    Binding::Fixed(Bind::Sampler(s.samplers.mip_clamp)),
-                ),
-                (
-                    "disk",
-                    Binding::Fixed(Bind::Uniform {
-                        buffer: disk_buffer.raw,
-                        size: (MAX_TAPS * 16) as u64,
-                    }),
-                ),
-            ];
+            ("colorChain", Binding::SampledLevels(t.diffuse)),
+            ("depthChain", Binding::SampledLevels(t.linear_depth)),
+            ("normalChain", Binding::SampledLevels(normals)),
+            (
+                "mipClamp",
+                Binding::Fixed(Bind::Sampler(s.samplers.mip_clamp)),
+            ),
+            (
+                "disk",
+                Binding::Fixed(Bind::Uniform {
+                    buffer: disk_buffer.raw,
+                    size: (MAX_TAPS * 16) as u64,
+                }),
+            ),
+        ];
         if let Some(tl) = tiles.as_ref() {
             binds.extend([
-                (
-                    "stencilTex",
-                    Binding::SampledStencil(t.depth_stencil),
-                ),
+                ("stencilTex", Binding::SampledStencil(t.depth_stencil)),
                 ("Tiles", tl.list_binding(Storage::Read)),
                 ("outImage", Binding::StorageImage(out, Storage::Write)),
             ]);
@@ -289,7 +286,13 @@ impl SssMethod for Poisson {
         }
         let (push, pipeline) = (self.push, &self.pipeline);
         if let Some(tiles) = &self.tiles {
-            fetches.push(fetch(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0));
+            fetches.push(fetch(
+                f.res,
+                t.depth_stencil,
+                "stencilTex",
+                Filter::Point,
+                1.0,
+            ));
             // Invocations outside the image or the skin fetch nothing.
             for x in &mut fetches {
                 x.exact = false;
@@ -307,12 +310,14 @@ impl SssMethod for Poisson {
             };
             let mut pass = Pass::new("poisson", PassRole::Sss);
             let set = pass.set(&self.set);
-            passes.push(tiles.dispatch_indirect(pass, f, work).record(
-                move |pc: &PassContext| {
-                    pc.bind(pipeline, &[set]);
-                    pipeline.push(pc.ctx, pc.cmd, &push);
-                },
-            ));
+            passes.push(
+                tiles
+                    .dispatch_indirect(pass, f, work)
+                    .record(move |pc: &PassContext| {
+                        pc.bind(pipeline, &[set]);
+                        pipeline.push(pc.ctx, pc.cmd, &push);
+                    }),
+            );
             passes.extend(tiles.merge_pass(f));
             return passes;
         }
@@ -368,7 +373,11 @@ impl SssMethod for Poisson {
     }
 
     fn details(&self) -> serde_json::Value {
-        let path = if self.tiles.is_some() { Path::Compute } else { Path::Fragment };
+        let path = if self.tiles.is_some() {
+            Path::Compute
+        } else {
+            Path::Fragment
+        };
         serde_json::json!({ "params": self.params, "levels": self.levels, "path": path.name() })
     }
 

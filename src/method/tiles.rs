@@ -61,7 +61,10 @@ pub fn region_tiles(region: &[vk::Rect2D]) -> Option<([u32; 2], [u32; 2])> {
     let side = SSS_TILE_SIDE;
     let mut lo = [u32::MAX; 2];
     let mut hi = [0u32; 2];
-    for r in region.iter().filter(|r| r.extent.width > 0 && r.extent.height > 0) {
+    for r in region
+        .iter()
+        .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+    {
         let (x, y) = (r.offset.x.max(0) as u32, r.offset.y.max(0) as u32);
         lo = [lo[0].min(x / side), lo[1].min(y / side)];
         hi = [
@@ -79,9 +82,8 @@ pub fn skin_tiles(mask: &[bool], width: usize, height: usize) -> usize {
     let mut n = 0;
     for ty in 0..height.div_ceil(side) {
         for tx in 0..width.div_ceil(side) {
-            let any = (ty * side..((ty + 1) * side).min(height)).any(|y| {
-                (tx * side..((tx + 1) * side).min(width)).any(|x| mask[y * width + x])
-            });
+            let any = (ty * side..((ty + 1) * side).min(height))
+                .any(|y| (tx * side..((tx + 1) * side).min(width)).any(|x| mask[y * width + x]));
             n += any as usize;
         }
     }
@@ -148,7 +150,10 @@ impl SkinTiles {
             &t.pipeline,
             0,
             vec![
-                ("stencilTex", Binding::SampledStencil(s.targets.depth_stencil)),
+                (
+                    "stencilTex",
+                    Binding::SampledStencil(s.targets.depth_stencil),
+                ),
                 (
                     "Args",
                     Binding::StorageBuffer {
@@ -179,7 +184,10 @@ impl SkinTiles {
             &pipeline,
             0,
             vec![
-                ("stencilTex", Binding::SampledStencil(s.targets.depth_stencil)),
+                (
+                    "stencilTex",
+                    Binding::SampledStencil(s.targets.depth_stencil),
+                ),
                 ("Tiles", self.list_binding(Storage::Read)),
                 ("srcTex", Binding::Sampled(src)),
                 // Written at skin pixels only: the rest keeps the diffuse light.

@@ -206,7 +206,10 @@ fn a_transition_for_one_stage_is_ordered_before_reads_in_another() {
     assert_eq!(b.src_stage, S::FRAGMENT_SHADER);
     assert_eq!(b.src_access, A::NONE);
     assert_eq!(b.dst_stage, S::COMPUTE_SHADER);
-    assert_eq!((b.old_layout, b.new_layout), (L::SHADER_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL));
+    assert_eq!(
+        (b.old_layout, b.new_layout),
+        (L::SHADER_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL)
+    );
     // Once both stages have seen it, reads in either are free.
     assert_eq!(image_after(&[f, c], f), None);
     assert_eq!(image_after(&[f, c], c), None);

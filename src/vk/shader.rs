@@ -288,9 +288,9 @@ mod tests {
                 }
             }
         }
-        // Five shaders (three of the ground truth, two of the compute path),
-        // each also in its fetch-counting build.
-        assert_eq!(seen, 10);
+        // Nine shaders (three of the ground truth, five of the compute path,
+        // the compute ceiling probe), each also in its fetch-counting build.
+        assert_eq!(seen, 18);
     }
 
     #[test]

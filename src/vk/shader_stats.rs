@@ -300,7 +300,10 @@ mod tests {
             let counted = stats(name).unwrap();
             // The shader's own atomics (the compute path's tile list) stay.
             let own = normal.atomic_adds;
-            assert!(own == 0 || base == "tiles_classify.comp", "{base}: {own} atomics");
+            assert!(
+                own == 0 || base == "tiles_classify.comp",
+                "{base}: {own} atomics"
+            );
             let expected = own
                 + if normal.image_reads > 0 {
                     normal.image_reads + 1

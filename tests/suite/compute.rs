@@ -135,7 +135,9 @@ fn compute_matches_fragment_within_one_half_ulp() {
                 }
             }
             // The blur did something.
-            let changed = (0..W * H).filter(|&i| skin[i] && comp[i] != diffuse[i]).count();
+            let changed = (0..W * H)
+                .filter(|&i| skin[i] && comp[i] != diffuse[i])
+                .count();
             assert!(changed > skin.iter().filter(|&&s| s).count() / 2, "{name}");
             // No seed copy on the compute path.
             assert!(passes.iter().all(|p| p.name != "sss seed copy"), "{name}");
@@ -198,12 +200,18 @@ fn tiles_dispatched_are_the_tiles_that_hold_skin() {
             .unwrap_or_else(|| panic!("no pass {name}"))
     };
     let Some(inv) = find("sss horizontal").compute_invocations else {
-        assert!(!ctx.facts.pipeline_statistics, "statistics on, yet none counted");
+        assert!(
+            !ctx.facts.pipeline_statistics,
+            "statistics on, yet none counted"
+        );
         return;
     };
     let tiles = skin_tiles(&skin, W, H) as u64;
     let all = (W.div_ceil(16) * H.div_ceil(16)) as u64;
-    assert!(tiles > 0 && tiles < all, "the input leaves tiles without skin");
+    assert!(
+        tiles > 0 && tiles < all,
+        "the input leaves tiles without skin"
+    );
     let per_tile = TILE_INVOCATIONS as u64;
     assert_eq!(inv, tiles * per_tile, "horizontal: invocations");
     assert_eq!(
@@ -285,7 +293,12 @@ fn the_default_head_is_the_same_on_both_paths() {
     let same = frames_within_one_ulp("head", &comp, &frag);
     println!("head: {same:.4} of pixels bit for bit, {skin} skin pixels");
     let names: Vec<&str> = passes.iter().map(|p| p.name.as_str()).collect();
-    for n in ["sss tiles reset", "sss tiles", "sss horizontal", "sss vertical"] {
+    for n in [
+        "sss tiles reset",
+        "sss tiles",
+        "sss horizontal",
+        "sss vertical",
+    ] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
 }
@@ -317,8 +330,16 @@ fn a_mixed_frame_takes_the_compute_path_per_group() {
     let same = frames_within_one_ulp("mixed", &comp, &frag);
     println!("mixed frame: {same:.4} of pixels bit for bit");
     // Each compute group lists its own tiles.
-    let lists = passes.iter().filter(|p| p.name.ends_with("sss tiles")).count();
-    assert_eq!(lists, 2, "{:?}", passes.iter().map(|p| &p.name).collect::<Vec<_>>());
+    let lists = passes
+        .iter()
+        .filter(|p| p.name.ends_with("sss tiles"))
+        .count();
+    assert_eq!(
+        lists,
+        2,
+        "{:?}",
+        passes.iter().map(|p| &p.name).collect::<Vec<_>>()
+    );
 }
 
 /// The teardown sweep (tests/teardown.rs) for the compute path: set-up made
@@ -335,9 +356,8 @@ fn every_failed_setup_step_of_the_compute_path_tears_down_clean() {
         ..Default::default()
     }
     .with(common::m("separable"), &[("path", "compute")]);
-    let live = |ctx: &dermis::vk::context::Context| {
-        ctx.allocator().generate_report().allocations.len()
-    };
+    let live =
+        |ctx: &dermis::vk::context::Context| ctx.allocator().generate_report().allocations.len();
     let base = live(&ctx);
     let before = ctx.creations();
     drop(Renderer::new(&ctx, &scene, &s).expect("a clean set-up"));
