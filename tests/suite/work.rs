@@ -39,6 +39,14 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                 RenderSettings::study().with(m, &[("density", "2")]),
             ));
         }
+        // The compute path's dispatches (tiles, blurs, merge) where the
+        // method has one.
+        if m.options.iter().any(|o| o.key == "path") {
+            settings.push((
+                format!("{} --path compute", m.name),
+                RenderSettings::study().with(m, &[("path", "compute")]),
+            ));
+        }
         // The post chain's stages, once (they follow every method alike).
         if std::ptr::eq(*m, METHODS[0]) {
             for aa in [AaMode::Mlaa, AaMode::Fxaa, AaMode::Smaa] {
