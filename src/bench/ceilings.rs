@@ -102,6 +102,10 @@ pub fn measure(
 }
 
 /// The probes proper, on the uploaded sources (rgba16f, r32f).
+///
+/// Long because every probe is stated here, once: its pipeline, its set and
+/// its name beside the others of its kind (fragment fetches, fills, compute
+/// fetches and stores), so the table of ceilings reads off one list.
 fn probe_all(
     ctx: &Context,
     res: &mut Resources,
