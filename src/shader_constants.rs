@@ -94,6 +94,10 @@ pub const SSS_TILE_SIDE: u32 = 16;
 /// read the texels beyond from the images (`method::tiles` says when).
 pub const SSS_APRON_PX: u32 = 32;
 
+/// Tile lists one classification writes (ssg's Gaussians after the first,
+/// each skipped per tile by depth: at most the six-Gaussian fit's five).
+pub const SSS_MAX_TILE_LISTS: usize = 6;
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -165,6 +169,7 @@ pub fn glsl() -> String {
     def("COMPUTE_GROUP_SIDE", COMPUTE_GROUP_SIDE.to_string());
     def("SSS_TILE_SIDE", SSS_TILE_SIDE.to_string());
     def("SSS_APRON_PX", SSS_APRON_PX.to_string());
+    def("SSS_MAX_TILE_LISTS", SSS_MAX_TILE_LISTS.to_string());
     s.push_str("#endif\n");
     s
 }

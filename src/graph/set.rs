@@ -38,6 +38,10 @@ pub enum Binding {
     /// The stencil aspect of a depth/stencil frame image, sampled (a
     /// `utexture2D`: the compute path's skin mask).
     SampledStencil(ImageId),
+    /// The depth aspect of a depth/stencil frame image, sampled (the
+    /// compute path's depth-based Gaussian skipping reads the depth the
+    /// fragment path's depth test compares).
+    SampledDepth(ImageId),
     /// A frame image as a storage image.
     StorageImage(ImageId, Storage),
     /// `size` bytes from `offset` of a tracked buffer, as a storage buffer.
@@ -79,7 +83,10 @@ impl GraphSet {
         let mut buffers = Vec::new();
         for &(_, b) in &binds {
             match b {
-                Binding::Sampled(id) | Binding::SampledUnorm(id) | Binding::SampledStencil(id) => {
+                Binding::Sampled(id)
+                | Binding::SampledUnorm(id)
+                | Binding::SampledStencil(id)
+                | Binding::SampledDepth(id) => {
                     images.push((id, sampled(compute)));
                 }
                 Binding::SampledLevels(id) => {
@@ -136,6 +143,7 @@ impl GraphSet {
                     Binding::SampledLevels(id) => Bind::Texture(res.image(id).chain_view),
                     Binding::SampledUnorm(id) => Bind::Texture(res.unorm_view(id)),
                     Binding::SampledStencil(id) => Bind::Texture(res.stencil_view(id)),
+                    Binding::SampledDepth(id) => Bind::Texture(res.image(id).sampled_view()),
                     Binding::StorageBuffer {
                         id, offset, size, ..
                     } => Bind::Range {

@@ -102,7 +102,7 @@ impl Jittered {
                             "stencilTex",
                             Binding::SampledStencil(s.targets.depth_stencil),
                         ),
-                        ("Tiles", tiles.list_binding(Storage::Read)),
+                        ("Tiles", tiles.list_binding(Storage::Read, 0)),
                         ("outImage", Binding::StorageImage(src, Storage::Write)),
                     ],
                 );

@@ -209,7 +209,7 @@ impl Poisson {
         if let Some(tl) = tiles.as_ref() {
             binds.extend([
                 ("stencilTex", Binding::SampledStencil(t.depth_stencil)),
-                ("Tiles", tl.list_binding(Storage::Read)),
+                ("Tiles", tl.list_binding(Storage::Read, 0)),
                 ("outImage", Binding::StorageImage(out, Storage::Write)),
             ]);
         }

@@ -273,7 +273,7 @@ impl Separable {
                         "stencilTex",
                         Binding::SampledStencil(s.targets.depth_stencil),
                     ),
-                    ("Tiles", t.list_binding(Storage::Read)),
+                    ("Tiles", t.list_binding(Storage::Read, 0)),
                     ("outImage", Binding::StorageImage(out, storage)),
                 ]),
                 _ => binds.push((

@@ -6,26 +6,37 @@
 //! triangle is drawn at the projected depth beyond which it spans under a
 //! pixel, with depth test GREATER and early tests forced, so far pixels run no
 //! shader. RT1 and RT2 are seeded with a copy of the diffuse target.
+//!
+//! `--path compute`: each pass a dispatch over its Gaussian's tile list
+//! (`tiles`: one list per Gaussian, of the skin tiles holding a surface
+//! nearer than its LOD depth, so the skipping is per tile), each pixel
+//! tested as the fragment path's stencil and depth tests test it
+//! (ssg_tiles_*.comp, the arithmetic shared in ssg_blur.glsl). The seed
+//! copy stays: every Gaussian reads both intermediates at skin texels that
+//! earlier Gaussians may have skipped, which hold what came before.
 
 use std::any::Any;
 
 use anyhow::{bail, Result};
 use ash::vk;
 
+use super::path::{self, Path};
 use super::region::{ReachScale, BILINEAR_MARGIN_PX};
 use super::screen::{
     declare_intermediate, fetch, fetch_at_most, masked_pass, seed_copy, source_set, Masked,
 };
+use super::tiles::{SkinTiles, TILE_INVOCATIONS};
 use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::work::{Fetch, Filter};
-use crate::graph::{GraphSet, ImageId, Pass};
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
 use crate::vk::context::Context;
-use crate::vk::guard::Guard;
-use crate::vk::pipeline::{Blend, GraphicsDesc, Pipeline};
+use crate::vk::guard::{Destroy, Guard};
+use crate::vk::pipeline::{Bind, Blend, GraphicsDesc, Pipeline};
+use crate::vk::shader_stats::alu_estimate;
 
 /// Taps per 1D Gaussian (Listing 4.1).
 const TAPS: u32 = 7;
@@ -49,6 +60,7 @@ const OPTIONS: &[OptSpec] = &[
         default: "stencil",
         help: "keep non-skin pixels out with the stencil test or a shader branch: stencil | branch",
     },
+    path::OPTION,
 ];
 
 pub static ENTRY: MethodEntry = MethodEntry {
@@ -124,15 +136,24 @@ pub struct Config {
     pub fit: GaussianFit,
     pub lod: bool,
     pub mask: MaskMode,
+    pub path: Path,
 }
 
 impl Config {
     pub fn parse(o: &Opts) -> Result<Self> {
-        Ok(Config {
+        let c = Config {
             fit: o.parse("fit")?,
             lod: o.flag("lod")?,
             mask: o.parse("mask")?,
-        })
+            path: o.parse("path")?,
+        };
+        if c.mask == MaskMode::Branch && c.path == Path::Compute {
+            bail!(
+                "--mask branch is the fragment path's alternative to the stencil test; \
+                 the compute path tests each pixel's stencil (--mask stencil)"
+            );
+        }
+        Ok(c)
     }
 }
 
@@ -162,6 +183,11 @@ pub struct Ssg {
     vertical: Pipeline,
     set_rt1: GraphSet,
     set_rt2: GraphSet,
+    /// The compute path's tile lists (one per Gaussian) and each
+    /// Gaussian's sets (horizontal, vertical: their lists differ);
+    /// `horizontal` and `vertical` are then compute pipelines.
+    tiles: Option<SkinTiles>,
+    compute_sets: Vec<[GraphSet; 2]>,
     rt1: ImageId,
     rt2: ImageId,
     diffuse: ImageId,
@@ -177,7 +203,7 @@ pub struct Ssg {
 impl Ssg {
     fn new(s: &mut MethodSetup) -> Result<Self> {
         let config = Config::parse(&s.options)?;
-        if !s.ctx.facts.independent_blend {
+        if config.path == Path::Fragment && !s.ctx.facts.independent_blend {
             bail!(
                 "device '{}' lacks independentBlend, which ssg's MRT pass needs",
                 s.ctx.facts.name
@@ -205,13 +231,22 @@ impl Ssg {
             d
         };
         // Guarded until the method holds them: an error frees what exists.
+        let compute = config.path == Path::Compute;
         let horizontal = Guard::new(
             s.ctx,
-            Pipeline::graphics(s.ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?,
+            if compute {
+                Pipeline::compute(s.ctx, "ssg horizontal", "ssg_tiles_horizontal.comp")?
+            } else {
+                Pipeline::graphics(s.ctx, &desc("ssg horizontal", "ssg_horizontal.frag", 1))?
+            },
         );
         let vertical = Guard::new(
             s.ctx,
-            Pipeline::graphics(s.ctx, &desc("ssg vertical", "ssg_vertical.frag", 2))?,
+            if compute {
+                Pipeline::compute(s.ctx, "ssg vertical", "ssg_tiles_vertical.comp")?
+            } else {
+                Pipeline::graphics(s.ctx, &desc("ssg vertical", "ssg_vertical.frag", 2))?
+            },
         );
         let stretch = Stretch::for_view(
             s.view.extent.height,
@@ -223,7 +258,7 @@ impl Ssg {
             .iter()
             .map(|g| lod_depth(g.incremental_std_mm, stretch.alpha))
             .collect();
-        let quad_depths = lod_distances
+        let quad_depths: Vec<f32> = lod_distances
             .iter()
             .map(|&d| {
                 if config.lod {
@@ -233,9 +268,57 @@ impl Ssg {
                 }
             })
             .collect();
+        let tiles = Guard::new(
+            s.ctx,
+            if compute {
+                Some(SkinTiles::by_depth(s, &quad_depths)?)
+            } else {
+                None
+            },
+        );
+        let mut compute_sets = Vec::new();
+        if let Some(t) = tiles.as_ref() {
+            let t_ = s.targets;
+            for g in 0..gaussians.len() {
+                let set = |pipeline: &Pipeline, src, out, final_image: Option<ImageId>| {
+                    let mut binds = vec![
+                        ("colorTex", Binding::Sampled(src)),
+                        ("depthTex", Binding::Sampled(t_.linear_depth)),
+                        (
+                            "linearClamp",
+                            Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
+                        ),
+                        ("stencilTex", Binding::SampledStencil(t_.depth_stencil)),
+                        ("dsDepthTex", Binding::SampledDepth(t_.depth_stencil)),
+                        ("Tiles", t.list_binding(Storage::Read, g)),
+                        // Written where this Gaussian shades: the rest keeps
+                        // the seed or an earlier Gaussian's result.
+                        ("outImage", Binding::StorageImage(out, Storage::ReadWrite)),
+                    ];
+                    if let Some(f) = final_image {
+                        binds.push(("finalImage", Binding::StorageImage(f, Storage::ReadWrite)));
+                    }
+                    GraphSet::new(s.res, pipeline, 0, binds)
+                };
+                compute_sets.push([
+                    set(&horizontal, rt1, rt2, None),
+                    set(&vertical, rt2, rt1, Some(diffuse)),
+                ]);
+            }
+        }
+        let (set_rt1, set_rt2) = if compute {
+            (GraphSet::default(), GraphSet::default())
+        } else {
+            (
+                source_set(s, &horizontal, rt1),
+                source_set(s, &vertical, rt2),
+            )
+        };
         Ok(Ssg {
-            set_rt1: source_set(s, &horizontal, rt1),
-            set_rt2: source_set(s, &vertical, rt2),
+            set_rt1,
+            set_rt2,
+            tiles: tiles.keep(),
+            compute_sets,
             horizontal: horizontal.keep(),
             vertical: vertical.keep(),
             rt1,
@@ -282,7 +365,10 @@ impl SssMethod for Ssg {
         )];
         let extent = f.extent;
         let stencil = self.config.mask == MaskMode::Stencil;
-        for (g, &quad_depth) in self.gaussians.iter().zip(&self.quad_depths) {
+        if let Some(tiles) = &self.tiles {
+            passes.extend(tiles.passes(f));
+        }
+        for (gi, (g, &quad_depth)) in self.gaussians.iter().zip(&self.quad_depths).enumerate() {
             let base = ScreenPush {
                 texel: [1.0 / extent.width as f32, 1.0 / extent.height as f32],
                 alpha: self.stretch.alpha,
@@ -302,6 +388,52 @@ impl SssMethod for Ssg {
                 ..base
             };
             let blend = [g.blend[0], g.blend[1], g.blend[2], 1.0];
+            if let Some(tiles) = &self.tiles {
+                for (k, (name, push)) in
+                    [("horizontal", h), ("vertical", v)].into_iter().enumerate()
+                {
+                    let push = ScreenPush {
+                        code: f.stencil,
+                        // The blend constants of the fragment path's RTF.
+                        center: blend,
+                        ..push
+                    };
+                    let shader = ["ssg_tiles_horizontal.comp", "ssg_tiles_vertical.comp"][k];
+                    let src = [rt1, rt2][k];
+                    let mut fetches = self.fetches(f, src);
+                    for name in ["stencilTex", "dsDepthTex"] {
+                        fetches.push(fetch(
+                            f.res,
+                            f.targets.depth_stencil,
+                            name,
+                            Filter::Point,
+                            1.0,
+                        ));
+                    }
+                    // Invocations outside the image, the skin or the LOD fetch less.
+                    for x in &mut fetches {
+                        x.exact = false;
+                    }
+                    let work = ShaderWork {
+                        shader: shader.into(),
+                        fetches,
+                        alu: alu_estimate(shader, &[TAPS]),
+                        storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64
+                            + if k == 1 { 8.0 } else { 0.0 },
+                        storage_write_bytes: if k == 1 { 16.0 } else { 8.0 },
+                    };
+                    let pipeline = [&self.horizontal, &self.vertical][k];
+                    let mut pass = Pass::new(format!("ssg g{} {name}", g.index), PassRole::Sss);
+                    let set = pass.set(&self.compute_sets[gi][k]);
+                    passes.push(tiles.dispatch_list(pass, f, work, gi).record(
+                        move |pc: &PassContext| {
+                            pc.bind(pipeline, &[set]);
+                            pipeline.push(pc.ctx, pc.cmd, &push);
+                        },
+                    ));
+                }
+                continue;
+            }
             let horizontal = &self.horizontal;
             passes.push(masked_pass(
                 f,
@@ -358,6 +490,14 @@ impl SssMethod for Ssg {
     }
 
     fn bind(&mut self, b: &MethodBind) -> Result<()> {
+        if let Some(t) = &mut self.tiles {
+            t.bind(b)?;
+            for [h, v] in &mut self.compute_sets {
+                b.write(h, &self.horizontal)?;
+                b.write(v, &self.vertical)?;
+            }
+            return Ok(());
+        }
         b.write(&mut self.set_rt1, &self.horizontal)?;
         b.write(&mut self.set_rt2, &self.vertical)
     }
@@ -373,12 +513,14 @@ impl SssMethod for Ssg {
             "mask": self.config.mask,
             "stretch": { "alpha": self.stretch.alpha, "beta": self.stretch.beta, "gamma": self.stretch.gamma },
             "lod_distances_units": self.lod_distances,
+            "path": self.config.path.name(),
         })
     }
 
     fn destroy(&mut self, ctx: &Context) {
         self.horizontal.destroy(ctx);
         self.vertical.destroy(ctx);
+        self.tiles.destroy(ctx);
     }
 
     fn as_any(&self) -> &dyn Any {

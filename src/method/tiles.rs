@@ -9,7 +9,10 @@
 //! (`vkCmdFillBuffer`), `sss tiles` runs one workgroup per tile of the SSS
 //! region's bounding box (the region is the fragment path's too: every skin
 //! pixel lies in it) and appends each tile that holds skin. A blur then
-//! dispatches one workgroup per listed tile (`vkCmdDispatchIndirect`).
+//! dispatches one workgroup per listed tile (`vkCmdDispatchIndirect`). ssg
+//! asks for one list per Gaussian, each of the tiles holding skin nearer
+//! than that Gaussian's LOD depth ([`SkinTiles::by_depth`]): its depth-based
+//! Gaussian skipping, per tile.
 //!
 //! Why no seed copy: the fragment path copies the diffuse target into its
 //! intermediate so that the vertical pass's taps find the diffuse light at
@@ -42,7 +45,7 @@ use gpu_allocator::MemoryLocation;
 use super::{FrameView, MethodBind, MethodSetup};
 use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
 use crate::graph::{Binding, BufferId, GraphSet, Pass, PassContext, Storage};
-use crate::shader_constants::SSS_TILE_SIDE;
+use crate::shader_constants::{SSS_MAX_TILE_LISTS, SSS_TILE_SIDE};
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;
@@ -96,7 +99,13 @@ pub fn skin_tiles(mask: &[bool], width: usize, height: usize) -> usize {
 struct TilesPush {
     first_tile: [i32; 2],
     code: u32,
+    lists: u32,
+    capacity: u32,
+    max_depth: [f32; SSS_MAX_TILE_LISTS],
 }
+
+/// A depth bound every depth-buffer value passes (values lie in 0..=1).
+pub const EVERY_DEPTH: f32 = 2.0;
 
 /// One instance's tile list: the classification's pipeline, the indirect
 /// arguments and the list (tracked buffers: their barriers are derived).
@@ -108,22 +117,46 @@ pub struct SkinTiles {
     args_id: BufferId,
     list_id: BufferId,
     set: GraphSet,
-    /// Tiles of the whole frame: the list's capacity and the blurs' bound.
+    /// Tiles of the whole frame: each list's capacity and the blurs' bound.
     capacity: u32,
+    /// Entries from one list's start to the next: the capacity rounded up to
+    /// 256 bytes, the largest `minStorageBufferOffsetAlignment` Vulkan
+    /// allows (each blur binds its list at its start).
+    stride: u32,
+    /// List k takes the skin tiles with a depth-buffer value under
+    /// `max_depth[k]` ([`EVERY_DEPTH`]: all of them).
+    max_depth: Vec<f32>,
     /// The merge of a blur's intermediate into the diffuse target, where
     /// the method asked for one ([`SkinTiles::add_merge`]).
     merge: Option<(Pipeline, GraphSet)>,
 }
 
 impl SkinTiles {
+    /// One list of every skin tile.
     pub fn new(s: &mut MethodSetup) -> Result<Self> {
+        Self::by_depth(s, &[EVERY_DEPTH])
+    }
+
+    /// One list per bound of `max_depth` (at most `SSS_MAX_TILE_LISTS`):
+    /// list k takes the skin tiles holding a depth-buffer value under
+    /// `max_depth[k]`.
+    pub fn by_depth(s: &mut MethodSetup, max_depth: &[f32]) -> Result<Self> {
+        assert!(
+            (1..=SSS_MAX_TILE_LISTS).contains(&max_depth.len()),
+            "{} tile lists",
+            max_depth.len()
+        );
         let e = s.view.extent;
         let capacity = e.width.div_ceil(SSS_TILE_SIDE) * e.height.div_ceil(SSS_TILE_SIDE);
+        let lists = max_depth.len() as u64;
+        let stride = capacity.next_multiple_of(64);
         // Filled step by step: on an error the guard frees what exists.
         let mut t = Guard::new(
             s.ctx,
             SkinTiles {
                 capacity,
+                stride,
+                max_depth: max_depth.to_vec(),
                 ..Default::default()
             },
         );
@@ -132,14 +165,14 @@ impl SkinTiles {
         t.args = Buffer::new(
             s.ctx,
             "sss tile args",
-            16,
+            16 * lists,
             U::STORAGE_BUFFER | U::INDIRECT_BUFFER | U::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
         t.list = Buffer::new(
             s.ctx,
             "sss tile list",
-            4 * capacity as u64,
+            4 * stride as u64 * lists,
             U::STORAGE_BUFFER,
             MemoryLocation::GpuOnly,
         )?;
@@ -154,16 +187,25 @@ impl SkinTiles {
                     "stencilTex",
                     Binding::SampledStencil(s.targets.depth_stencil),
                 ),
+                ("depthTex", Binding::SampledDepth(s.targets.depth_stencil)),
                 (
                     "Args",
                     Binding::StorageBuffer {
                         id: t.args_id,
                         offset: 0,
-                        size: 16,
+                        size: 16 * lists,
                         storage: Storage::ReadWrite,
                     },
                 ),
-                ("Tiles", t.list_binding(Storage::Write)),
+                (
+                    "Tiles",
+                    Binding::StorageBuffer {
+                        id: t.list_id,
+                        offset: 0,
+                        size: 4 * stride as u64 * lists,
+                        storage: Storage::Write,
+                    },
+                ),
             ],
         );
         Ok(t.keep())
@@ -188,7 +230,7 @@ impl SkinTiles {
                     "stencilTex",
                     Binding::SampledStencil(s.targets.depth_stencil),
                 ),
-                ("Tiles", self.list_binding(Storage::Read)),
+                ("Tiles", self.list_binding(Storage::Read, 0)),
                 ("srcTex", Binding::Sampled(src)),
                 // Written at skin pixels only: the rest keeps the diffuse light.
                 ("outImage", Binding::StorageImage(dst, Storage::ReadWrite)),
@@ -233,10 +275,10 @@ impl SkinTiles {
     }
 
     /// The list as a blur's set binds it (`Tiles`).
-    pub fn list_binding(&self, storage: Storage) -> Binding {
+    pub fn list_binding(&self, storage: Storage, k: usize) -> Binding {
         Binding::StorageBuffer {
             id: self.list_id,
-            offset: 0,
+            offset: 4 * self.stride as u64 * k as u64,
             size: 4 * self.capacity as u64,
             storage,
         }
@@ -250,7 +292,7 @@ impl SkinTiles {
         // 4-byte texels (the work vocabulary's nearest kind; it is tiny).
         let reset = reset
             .work(Work::Clear {
-                texels: 4,
+                texels: 4 * self.max_depth.len() as u64,
                 bytes_per_texel: 4,
             })
             .record(move |pc: &PassContext| pc.fill_buffer(args, 0));
@@ -258,24 +300,32 @@ impl SkinTiles {
         let (first, groups) = region_tiles(f.region).unwrap_or(([0, 0], [0, 0]));
         let work = ShaderWork {
             shader: SHADER.into(),
-            fetches: vec![Fetch {
-                texture: "stencilTex".into(),
-                format: f.res.texel_format(f.targets.depth_stencil),
-                filter: Filter::Point,
-                count: 1.0,
-                // Invocations outside the image fetch nothing.
-                exact: false,
-                coherent: true,
-                spread: Vec::new(),
-            }],
-            alu: alu_estimate(SHADER, &[]),
+            // Invocations outside the image fetch nothing, and only skin
+            // pixels read their depth.
+            fetches: ["stencilTex", "depthTex"]
+                .map(|texture| Fetch {
+                    texture: texture.into(),
+                    format: f.res.texel_format(f.targets.depth_stencil),
+                    filter: Filter::Point,
+                    count: 1.0,
+                    exact: false,
+                    coherent: true,
+                    spread: Vec::new(),
+                })
+                .to_vec(),
+            alu: alu_estimate(SHADER, &[self.max_depth.len() as u32; 2]),
             // One tile in a workgroup appends itself (and its count).
             storage_read_bytes: 0.0,
             storage_write_bytes: 8.0 / TILE_INVOCATIONS as f64,
         };
+        let mut max_depth = [EVERY_DEPTH; SSS_MAX_TILE_LISTS];
+        max_depth[..self.max_depth.len()].copy_from_slice(&self.max_depth);
         let push = TilesPush {
             first_tile: [first[0] as i32, first[1] as i32],
             code: f.stencil,
+            lists: self.max_depth.len() as u32,
+            capacity: self.stride,
+            max_depth,
         };
         let mut classify = Pass::new("sss tiles", PassRole::Sss);
         let set = classify.set(&self.set);
@@ -288,16 +338,33 @@ impl SkinTiles {
         [reset, classify]
     }
 
-    /// A blur's indirect dispatch: its arguments and its bound (every tile
-    /// of the region's bounding box).
+    /// A blur's indirect dispatch over list 0: its arguments and its bound
+    /// (every tile of the region's bounding box).
     pub fn dispatch_indirect<'a>(
         &self,
         pass: Pass<'a>,
         f: &FrameView,
         shader: ShaderWork,
     ) -> Pass<'a> {
+        self.dispatch_list(pass, f, shader, 0)
+    }
+
+    /// The indirect dispatch over list `k`.
+    pub fn dispatch_list<'a>(
+        &self,
+        pass: Pass<'a>,
+        f: &FrameView,
+        shader: ShaderWork,
+        k: usize,
+    ) -> Pass<'a> {
         let most = region_tiles(f.region).map_or(0, |(_, n)| n[0] * n[1]);
-        pass.dispatch_indirect(shader, (self.args_id, 0), [most, 1, 1], TILE_INVOCATIONS)
+        let offset = 16 * k as u64;
+        pass.dispatch_indirect(
+            shader,
+            (self.args_id, offset),
+            [most, 1, 1],
+            TILE_INVOCATIONS,
+        )
     }
 
     pub fn bind(&mut self, b: &MethodBind) -> Result<()> {

@@ -288,9 +288,10 @@ mod tests {
                 }
             }
         }
-        // Nine shaders (three of the ground truth, five of the compute path,
-        // the compute ceiling probe), each also in its fetch-counting build.
-        assert_eq!(seen, 18);
+        // Eleven shaders (three of the ground truth, seven of the compute
+        // path, the compute ceiling probe), each also in its fetch-counting
+        // build.
+        assert_eq!(seen, 22);
     }
 
     #[test]

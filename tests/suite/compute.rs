@@ -347,6 +347,12 @@ fn a_mixed_frame_takes_the_compute_path_per_group() {
 /// object behind (the tile list's pipeline and buffers, the stencil views).
 #[test]
 fn every_failed_setup_step_of_the_compute_path_tears_down_clean() {
+    for method in ["separable", "ssg", "ss-jittered", "poisson"] {
+        setup_failures_tear_down_clean(method);
+    }
+}
+
+fn setup_failures_tear_down_clean(method: &str) {
     let ctx = common::ctx();
     let scene = dermis::scene::default_scene();
     let s = RenderSettings {
@@ -355,7 +361,7 @@ fn every_failed_setup_step_of_the_compute_path_tears_down_clean() {
         shadow_size: 256,
         ..Default::default()
     }
-    .with(common::m("separable"), &[("path", "compute")]);
+    .with(common::m(method), &[("path", "compute")]);
     let live =
         |ctx: &dermis::vk::context::Context| ctx.allocator().generate_report().allocations.len();
     let base = live(&ctx);
@@ -368,12 +374,59 @@ fn every_failed_setup_step_of_the_compute_path_tears_down_clean() {
             Ok(_) => panic!("step {k} of {steps} did not fail"),
             Err(e) => format!("{e:#}"),
         };
-        assert!(e.contains("injected failure"), "step {k}: {e}");
-        assert_eq!(live(&ctx), base, "step {k} ({e}) left memory allocated");
+        assert!(e.contains("injected failure"), "{method} step {k}: {e}");
+        assert_eq!(
+            live(&ctx),
+            base,
+            "{method} step {k} ({e}) left memory allocated"
+        );
         ctx.check_validation(&format!("after set-up failed at step {k}"))
             .unwrap();
     }
     ctx.fail_creation_after(None);
     ctx.finish().expect("teardown after every failure");
-    println!("compute path: {steps} creation steps, each failed in turn, clean");
+    println!("{method} on the compute path: {steps} creation steps, each failed in turn, clean");
+}
+
+/// ssg on the compute path: each Gaussian's passes over its own tile list
+/// (depth-based skipping per tile), each pixel tested as the fragment path's
+/// stencil and depth tests test it, RTF mixed as its blend mixes: within one
+/// half-float ulp of the fragment path, on synthetic inputs and on the head
+/// seen from far enough that the LOD skips Gaussians.
+#[test]
+fn ssg_compute_matches_fragment_and_skips_gaussians_by_tile() {
+    for o in [
+        vec![("fit", "6")],
+        vec![("fit", "4")],
+        vec![("fit", "6"), ("lod", "false")],
+    ] {
+        let (frag, _) = run_method("ssg", &o, "fragment");
+        let (comp, _) = run_method("ssg", &o, "compute");
+        let name = format!("ssg-{o:?}");
+        let same = within_one_ulp(&name, &comp, &frag);
+        println!("{name}: {same:.4} of pixels bit for bit");
+    }
+    let far = |path: &str| RenderSettings {
+        width: 192,
+        height: 108,
+        shadow_size: 256,
+        distance_heads: 4.0,
+        ..RenderSettings::study().with(common::m("ssg"), &[("path", path)])
+    };
+    let (frag, _) = frame(&far("fragment"));
+    let (comp, passes) = frame(&far("compute"));
+    let same = frames_within_one_ulp("ssg-far", &comp, &frag);
+    let inv = |n: &str| {
+        passes
+            .iter()
+            .find(|p| p.name == n)
+            .and_then(|p| p.compute_invocations)
+    };
+    let (first, last) = (inv("ssg g2 horizontal"), inv("ssg g6 horizontal"));
+    println!("ssg far: {same:.4} of pixels bit for bit; invocations g2 {first:?}, g6 {last:?}");
+    if let (Some(a), Some(b)) = (first, last) {
+        // The narrow Gaussian spans under a pixel on this far head: its
+        // tiles drop out of its list, the widest Gaussian keeps them.
+        assert!(b > 0 && a < b, "g2 {a} g6 {b}");
+    }
 }
