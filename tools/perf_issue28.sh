@@ -49,8 +49,11 @@ for res in "1080|--width 1920 --height 1080" "2160|--width 3840 --height 2160"; 
     done
   done
 done
-# ss-jittered and poisson on both paths, 1080p close-up.
-for m in ss-jittered poisson; do
+# ssg, ss-jittered and poisson on both paths, 1080p close-up; ssg also mid
+# (its depth-based skipping drops Gaussians by tile there).
+bench "1080-mid-1-ssg-fragment" --width 1920 --height 1080 --shot mid --method ssg --path fragment $F
+bench "1080-mid-1-ssg-compute" --width 1920 --height 1080 --shot mid --method ssg --path compute $F
+for m in ssg ss-jittered poisson; do
   for path in fragment compute; do
     bench "1080-close-1-$m-$path" --width 1920 --height 1080 --shot close --method $m --path $path $F
   done
