@@ -360,6 +360,9 @@ pub fn aggregate(
             let gpu: Vec<f64> = frames.iter().map(|f| f[i].gpu_ms).collect();
             let bar: Vec<f64> = frames.iter().map(|f| f[i].barrier_ms).collect();
             let decl = decls.get(i).cloned().unwrap_or_default();
+            // A dispatch's own count (0 included: an indirect dispatch over
+            // an empty list); none for the other passes.
+            let dispatch = matches!(decl.work, Some(crate::work::Work::Compute { .. }));
             PassReport {
                 name: s.name.clone(),
                 role: Some(s.role),
@@ -373,7 +376,7 @@ pub fn aggregate(
                 compute_invocations: frames
                     .last()
                     .and_then(|f| f[i].compute_invocations)
-                    .filter(|&n| n > 0),
+                    .filter(|_| dispatch),
                 samples_passed: frames.last().map(|f| f[i].samples_passed).unwrap_or(0),
                 floor_ms: None,
                 floor_ratio: None,

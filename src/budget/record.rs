@@ -193,6 +193,12 @@ pub fn frame_from_record(
             );
         };
         let c = counted.map(|c| &c[i]);
+        let mut work = work;
+        if let (Work::Compute { invocations, .. }, Some(n)) = (&mut work, p.compute_invocations) {
+            // An indirect dispatch is declared at its bound (the region's
+            // tiles): the run's pipeline statistics say how many it ran.
+            *invocations = n;
+        }
         let mut q = PassInput::new(&p.name, role, work);
         q.fragments = fragments(p, &q.work, counting, c);
         q.samples_passed = p.samples_passed;
