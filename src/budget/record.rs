@@ -360,6 +360,34 @@ mod tests {
     }
 
     #[test]
+    fn an_indirect_dispatch_is_priced_at_what_it_ran() {
+        let mut r = record("llvmpipe");
+        let dispatch = |compute_invocations| PassReport {
+            work: Some(Work::Compute {
+                shader: ShaderWork::default(),
+                // The declared bound: every tile of the region's box.
+                invocations: 100 * 256,
+            }),
+            compute_invocations,
+            fragment_invocations: Some(0),
+            ..r.passes[1].clone()
+        };
+        r.passes = vec![dispatch(Some(7 * 256)), dispatch(Some(0)), dispatch(None)];
+        let f = frame_from_record(&r, None, "t").unwrap();
+        let ran: Vec<u64> = f
+            .passes
+            .iter()
+            .map(|p| match p.work {
+                Work::Compute { invocations, .. } => invocations,
+                _ => panic!(),
+            })
+            .collect();
+        // Counted: what ran (none, for an empty list); not counted: the bound.
+        assert_eq!(ran, [7 * 256, 0, 100 * 256]);
+        assert_eq!(f.passes[0].fragments, 7 * 256);
+    }
+
+    #[test]
     fn fragments_follow_the_driver_rule() {
         let counted = [
             CountedPass {
