@@ -89,8 +89,9 @@ pub const COMPUTE_GROUP_SIDE: u32 = 8;
 pub const SSS_TILE_SIDE: u32 = 16;
 
 /// Texels the compute blurs load on each side of a tile along their
-/// direction (shared memory: the tile and its apron, 16 x 80 texels of 12
-/// bytes, 15 KiB, under the 16 KiB every Vulkan device has). Wider kernels
+/// direction (shared memory: the tile and its apron, 16 rows of 80 texels
+/// (81 with the bank padding) of 12 bytes, 15.2 KiB, under the 16 KiB every
+/// Vulkan device has). Wider kernels
 /// read the texels beyond from the images (`method::tiles` says when).
 pub const SSS_APRON_PX: u32 = 32;
 
