@@ -60,6 +60,17 @@ fn run_method(
     options: &[(&str, &str)],
     path: &str,
 ) -> (Vec<[f32; 4]>, Vec<PassSample>) {
+    run_on(method, options, path, inputs())
+}
+
+type Inputs = (Vec<[f32; 4]>, Vec<f32>, Vec<bool>);
+
+fn run_on(
+    method: &str,
+    options: &[(&str, &str)],
+    path: &str,
+    (diffuse, depth, skin): Inputs,
+) -> (Vec<[f32; 4]>, Vec<PassSample>) {
     let ctx = common::ctx();
     let scene = egg_scene();
     let mut o = options.to_vec();
@@ -80,8 +91,36 @@ fn run_method(
             .collect();
         r.upload_normals(&n16).unwrap();
     }
-    let (diffuse, depth, skin) = inputs();
     common::sss_only(&mut r, &diffuse, &depth, &skin)
+}
+
+/// A physical invariant no code of ours produced: every method's kernel
+/// keeps the light it moves, so uniform light on a flat, all-skin screen
+/// comes out as it went in (each channel within 2e-3, the half-float
+/// storage of the passes' chain). A compute blur that dropped a tap, read
+/// the apron at the wrong offset, or mixed RTF with the wrong weight would
+/// darken or tint it.
+#[test]
+fn uniform_light_comes_out_as_it_went_in_on_the_compute_path() {
+    let light = round_f16([0.55, 0.4, 0.3, 1.0]);
+    let uniform = || (vec![light; W * H], vec![8.0; W * H], vec![true; W * H]);
+    for method in ["separable", "ssg", "ss-jittered", "poisson"] {
+        let (out, passes) = run_on(method, &[], "compute", uniform());
+        assert!(
+            passes
+                .iter()
+                .any(|p| p.compute_invocations.unwrap_or(0) > 0),
+            "{method}: no dispatch ran"
+        );
+        let mut worst = 0.0f32;
+        for p in &out {
+            for c in 0..4 {
+                worst = worst.max((p[c] - light[c]).abs() / light[c]);
+            }
+        }
+        println!("{method} compute: uniform light, worst relative change {worst:.2e}");
+        assert!(worst <= 2e-3, "{method}: uniform light changed by {worst}");
+    }
 }
 
 /// One half-float ulp of `v` (normal range).
