@@ -362,7 +362,7 @@ pub fn aggregate(
             let decl = decls.get(i).cloned().unwrap_or_default();
             // A dispatch's own count (0 included: an indirect dispatch over
             // an empty list); none for the other passes.
-            let dispatch = matches!(decl.work, Some(crate::work::Work::Compute { .. }));
+            let dispatch = matches!(decl.work, Some(Work::Compute { .. }));
             PassReport {
                 name: s.name.clone(),
                 role: Some(s.role),

@@ -9,17 +9,6 @@ use crate::graph::work::{ColorWrite, Fetch, Filter, Format, Work};
 // report.json's types: the schema lives in `report`.
 pub use crate::report::{Ceilings, ComputeCeilings};
 
-/// A compute shader's fetch rate of a declared fetch, if a probe measured it.
-fn compute_fetch_rate(c: &ComputeCeilings, f: &Fetch) -> Option<f64> {
-    Some(match (f.format, f.filter) {
-        (Format::Rgba16Float, Filter::Bilinear) => c.bilinear_rgba16f_gtaps,
-        (Format::Rgba16Float, Filter::Point) => c.point_rgba16f_gtaps,
-        (Format::R32Float, Filter::Bilinear) => c.bilinear_r32f_gtaps,
-        (Format::R32Float, Filter::Point) => c.point_r32f_gtaps,
-        _ => return None,
-    })
-}
-
 /// Floor in milliseconds of a dispatch that ran `invocations` invocations:
 /// its exactly declared fetches at the compute path's probed rates. Fetches
 /// declared as bounds (behind a branch) and kinds no probe measured (the
@@ -39,15 +28,38 @@ pub fn compute_floor_ms(work: &Work, invocations: u64, c: &Ceilings) -> Option<f
     (fetch_s > 0.0).then_some(fetch_s * 1e3)
 }
 
-/// Fetch rate of a declared fetch, if a probe measured that kind.
-fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
+/// The rate of a declared fetch among a path's probed rates (bilinear and
+/// point RGBA16F, bilinear and point R32F), if a probe measured that kind.
+fn rate_of(f: &Fetch, [b16, p16, b32, p32]: [f64; 4]) -> Option<f64> {
     Some(match (f.format, f.filter) {
-        (Format::Rgba16Float, Filter::Bilinear) => c.bilinear_rgba16f_gtaps,
-        (Format::Rgba16Float, Filter::Point) => c.point_rgba16f_gtaps,
-        (Format::R32Float, Filter::Bilinear) => c.bilinear_r32f_gtaps,
-        (Format::R32Float, Filter::Point) => c.point_r32f_gtaps,
+        (Format::Rgba16Float, Filter::Bilinear) => b16,
+        (Format::Rgba16Float, Filter::Point) => p16,
+        (Format::R32Float, Filter::Bilinear) => b32,
+        (Format::R32Float, Filter::Point) => p32,
         _ => return None,
     })
+}
+
+/// A fragment shader's fetch rate of a declared fetch.
+fn fetch_rate(c: &Ceilings, f: &Fetch) -> Option<f64> {
+    let r = [
+        c.bilinear_rgba16f_gtaps,
+        c.point_rgba16f_gtaps,
+        c.bilinear_r32f_gtaps,
+        c.point_r32f_gtaps,
+    ];
+    rate_of(f, r)
+}
+
+/// A compute shader's fetch rate of a declared fetch.
+fn compute_fetch_rate(c: &ComputeCeilings, f: &Fetch) -> Option<f64> {
+    let r = [
+        c.bilinear_rgba16f_gtaps,
+        c.point_rgba16f_gtaps,
+        c.bilinear_r32f_gtaps,
+        c.point_r32f_gtaps,
+    ];
+    rate_of(f, r)
 }
 
 /// Fill rate of a declared colour write, if a probe measured that kind.

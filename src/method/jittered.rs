@@ -16,8 +16,8 @@ use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     SssMethod,
 };
-use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Spread};
-use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
+use crate::graph::work::{Fetch, Filter, ShaderWork, Spread};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
 use crate::skin::jittered::{hable_kernel, JitteredKernel};
 use crate::skin::ssg::Stretch;
 use crate::vk::context::Context;
@@ -167,15 +167,7 @@ impl Jittered {
             storage_read_bytes: 4.0 / super::tiles::TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
         };
-        let mut blur = Pass::new("ss-jittered", PassRole::Sss);
-        let set = blur.set(&self.set);
-        let pipeline = &self.pipeline;
-        let blur = tiles
-            .dispatch_indirect(blur, f, work)
-            .record(move |pc: &PassContext| {
-                pc.bind(pipeline, &[set]);
-                pipeline.push(pc.ctx, pc.cmd, &push);
-            });
+        let blur = tiles.pass("ss-jittered", f, 0, work, &self.pipeline, &self.set, push);
         let mut passes: Vec<Pass<'a>> = tiles.passes(f).into();
         passes.push(blur);
         passes.extend(tiles.merge_pass(f));

@@ -308,16 +308,7 @@ impl SssMethod for Poisson {
                 code: f.stencil,
                 ..push
             };
-            let mut pass = Pass::new("poisson", PassRole::Sss);
-            let set = pass.set(&self.set);
-            passes.push(
-                tiles
-                    .dispatch_indirect(pass, f, work)
-                    .record(move |pc: &PassContext| {
-                        pc.bind(pipeline, &[set]);
-                        pipeline.push(pc.ctx, pc.cmd, &push);
-                    }),
-            );
+            passes.push(tiles.pass("poisson", f, 0, work, pipeline, &self.set, push));
             passes.extend(tiles.merge_pass(f));
             return passes;
         }

@@ -20,8 +20,8 @@ use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::work::{Filter, PassRole, ShaderWork};
-use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
+use crate::graph::work::{Filter, ShaderWork};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
 use crate::shader_constants::{SSS_APRON_PX, SSS_TILE_SIDE};
 use crate::skin::kernel::{Preset, SeparableKernel, SssParams};
 use crate::vk::context::Context;
@@ -315,10 +315,17 @@ impl Separable {
         // nearest skin) read their texels from the images.
         let side = SSS_TILE_SIDE as f64;
         let loads = (side + 2.0 * SSS_APRON_PX as f64) / side;
+        // The kernel's reach at full strength, as the SSS region sizes it.
+        let scale = ReachScale {
+            height_px: f.extent.height,
+            tan_half_fovy: self.push[0].tan_half_fovy,
+            mm_per_unit: self.push[0].mm_per_unit,
+            max_strength: 1.0,
+        };
         let reach = f
             .depths
             .iter()
-            .map(|&(_, d)| self.kernel_reach_px(d, f))
+            .map(|&(_, d)| f64::from(reach_px(&self.kernel, d, &scale)))
             .fold(0.0, f64::max);
         let beyond = if reach > SSS_APRON_PX as f64 {
             2.0 * (n - 1) as f64
@@ -361,38 +368,12 @@ impl Separable {
                 code: f.stencil,
                 vertical: vertical as i32,
             };
-            let mut p = Pass::new(name, PassRole::Sss);
-            let set = p.set(&self.sets[pass]);
-            let pipeline = &self.pipeline;
-            tiles
-                .dispatch_indirect(p, f, work)
-                .record(move |pc: &PassContext| {
-                    pc.bind(pipeline, &[set]);
-                    pipeline.push(pc.ctx, pc.cmd, &push);
-                })
+            tiles.pass(name, f, 0, work, &self.pipeline, &self.sets[pass], push)
         };
         let mut passes: Vec<Pass<'a>> = tiles.passes(f).into();
         passes.push(blur("sss horizontal", self.diffuse, 0));
         passes.push(blur("sss vertical", self.tmp, 1));
         passes
-    }
-
-    /// How far (pixels) the kernel reaches at view depth `depth` at full
-    /// strength, without the bilinear margin.
-    fn kernel_reach_px(&self, depth: f32, f: &FrameView) -> f64 {
-        let widest_mm = self
-            .kernel
-            .samples
-            .iter()
-            .map(|s| s.offset_mm.abs())
-            .fold(0.0, f32::max);
-        let px_per_mm = crate::view::ViewScale {
-            height_px: f.extent.height,
-            tan_half_fovy: self.push[0].tan_half_fovy,
-            mm_per_unit: self.push[0].mm_per_unit,
-        }
-        .px_per_mm(depth);
-        f64::from(widest_mm * px_per_mm) + 1.0
     }
 
     fn follows_surface(&self) -> bool {

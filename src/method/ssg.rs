@@ -30,8 +30,8 @@ use super::{
     skin_stencil_test, EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs,
     OptKind, OptSpec, Opts, SssMethod,
 };
-use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
-use crate::graph::{Binding, GraphSet, ImageId, Pass, PassContext, Storage};
+use crate::graph::work::{Fetch, Filter, ShaderWork};
+use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
 use crate::skin::ssg::{lod_depth, ssg_gaussians, GaussianFit, SsgGaussian, Stretch};
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
@@ -423,14 +423,9 @@ impl SssMethod for Ssg {
                         storage_write_bytes: if k == 1 { 16.0 } else { 8.0 },
                     };
                     let pipeline = [&self.horizontal, &self.vertical][k];
-                    let mut pass = Pass::new(format!("ssg g{} {name}", g.index), PassRole::Sss);
-                    let set = pass.set(&self.compute_sets[gi][k]);
-                    passes.push(tiles.dispatch_list(pass, f, work, gi).record(
-                        move |pc: &PassContext| {
-                            pc.bind(pipeline, &[set]);
-                            pipeline.push(pc.ctx, pc.cmd, &push);
-                        },
-                    ));
+                    let set = &self.compute_sets[gi][k];
+                    let name = format!("ssg g{} {name}", g.index);
+                    passes.push(tiles.pass(name, f, gi, work, pipeline, set, push));
                 }
                 continue;
             }

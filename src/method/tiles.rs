@@ -42,8 +42,9 @@ use anyhow::Result;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use super::screen::fetch_at_most;
 use super::{FrameView, MethodBind, MethodSetup};
-use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
+use crate::graph::work::{Filter, PassRole, ShaderWork, Work};
 use crate::graph::{Binding, BufferId, GraphSet, Pass, PassContext, Storage};
 use crate::shader_constants::{SSS_MAX_TILE_LISTS, SSS_TILE_SIDE};
 use crate::vk::context::Context;
@@ -243,35 +244,18 @@ impl SkinTiles {
     /// The merge pass (after the blur that wrote its source).
     pub fn merge_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Option<Pass<'a>> {
         let (pipeline, set) = self.merge.as_ref()?;
-        let fetch = |texture: &str, image| Fetch {
-            texture: texture.into(),
-            format: f.res.texel_format(image),
-            filter: Filter::Point,
-            count: 1.0,
-            exact: false,
-            coherent: true,
-            spread: Vec::new(),
-        };
+        let t = f.targets;
         let work = ShaderWork {
             shader: MERGE_SHADER.into(),
             fetches: vec![
-                fetch("stencilTex", f.targets.depth_stencil),
-                fetch("srcTex", f.targets.diffuse),
+                fetch_at_most(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0),
+                fetch_at_most(f.res, t.diffuse, "srcTex", Filter::Point, 1.0),
             ],
             alu: alu_estimate(MERGE_SHADER, &[]),
             storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
         };
-        let push = f.stencil;
-        let mut pass = Pass::new("sss merge", PassRole::Sss);
-        let set = pass.set(set);
-        Some(
-            self.dispatch_indirect(pass, f, work)
-                .record(move |pc: &PassContext| {
-                    pc.bind(pipeline, &[set]);
-                    pipeline.push(pc.ctx, pc.cmd, &push);
-                }),
-        )
+        Some(self.pass("sss merge", f, 0, work, pipeline, set, f.stencil))
     }
 
     /// The list as a blur's set binds it (`Tiles`).
@@ -303,14 +287,8 @@ impl SkinTiles {
             // Invocations outside the image fetch nothing, and only skin
             // pixels read their depth.
             fetches: ["stencilTex", "depthTex"]
-                .map(|texture| Fetch {
-                    texture: texture.into(),
-                    format: f.res.texel_format(f.targets.depth_stencil),
-                    filter: Filter::Point,
-                    count: 1.0,
-                    exact: false,
-                    coherent: true,
-                    spread: Vec::new(),
+                .map(|texture| {
+                    fetch_at_most(f.res, f.targets.depth_stencil, texture, Filter::Point, 1.0)
                 })
                 .to_vec(),
             alu: alu_estimate(SHADER, &[self.max_depth.len() as u32; 2]),
@@ -338,33 +316,35 @@ impl SkinTiles {
         [reset, classify]
     }
 
-    /// A blur's indirect dispatch over list 0: its arguments and its bound
-    /// (every tile of the region's bounding box).
-    pub fn dispatch_indirect<'a>(
+    /// The pass `name` of a dispatch over list `k`, the one declaration of
+    /// every compute blur and merge: it declares `set`, binds `pipeline`,
+    /// pushes `push`, and dispatches from the list's indirect arguments,
+    /// its work counted at their bound (every tile of the region's box).
+    // Every argument is one fact of the pass that differs between callers.
+    #[allow(clippy::too_many_arguments)]
+    pub fn pass<'a, P: bytemuck::Pod>(
         &self,
-        pass: Pass<'a>,
+        name: impl Into<String>,
         f: &FrameView,
-        shader: ShaderWork,
-    ) -> Pass<'a> {
-        self.dispatch_list(pass, f, shader, 0)
-    }
-
-    /// The indirect dispatch over list `k`.
-    pub fn dispatch_list<'a>(
-        &self,
-        pass: Pass<'a>,
-        f: &FrameView,
-        shader: ShaderWork,
         k: usize,
+        work: ShaderWork,
+        pipeline: &'a Pipeline,
+        set: &GraphSet,
+        push: P,
     ) -> Pass<'a> {
         let most = region_tiles(f.region).map_or(0, |(_, n)| n[0] * n[1]);
-        let offset = 16 * k as u64;
+        let mut pass = Pass::new(name, PassRole::Sss);
+        let set = pass.set(set);
         pass.dispatch_indirect(
-            shader,
-            (self.args_id, offset),
+            work,
+            (self.args_id, 16 * k as u64),
             [most, 1, 1],
             TILE_INVOCATIONS,
         )
+        .record(move |pc: &PassContext| {
+            pc.bind(pipeline, &[set]);
+            pipeline.push(pc.ctx, pc.cmd, &push);
+        })
     }
 
     pub fn bind(&mut self, b: &MethodBind) -> Result<()> {
