@@ -62,6 +62,10 @@ for path in fragment compute; do
   bench "lps-1080-close-$path" --scene "$LPS" --width 1920 --height 1080 --shot close \
     --method separable --path $path $F
 done
+# The whole frame with bloom and SMAA (the passes without a floor yet: the
+# bloom's combine among them), on the compute path.
+bench "1080-close-1-bloom-smaa" --width 1920 --height 1080 --shot close --method separable \
+  --path compute --bloom --aa smaa $F
 # The two paths' images on the GPU (1080p close-up, the procedural head).
 for path in fragment compute; do
   log dermis render --width 1920 --height 1080 --shot close --method separable --path $path --out "$R/img-$path"

@@ -15,6 +15,7 @@ pub mod none;
 pub mod options;
 pub mod path;
 pub mod poisson;
+pub mod profile;
 pub mod reference;
 pub mod region;
 pub mod screen;
