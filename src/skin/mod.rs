@@ -12,6 +12,7 @@
 pub mod beckmann;
 pub mod burley;
 pub mod card;
+pub mod gather;
 pub mod jittered;
 pub mod kernel;
 pub mod mirror;
