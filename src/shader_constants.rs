@@ -99,6 +99,12 @@ pub const SSS_APRON_PX: u32 = 32;
 /// each skipped per tile by depth: at most the six-Gaussian fit's five).
 pub const SSS_MAX_TILE_LISTS: usize = 6;
 
+/// Intervals of the 2D gather's inverse-CDF table (`skin::gather`): its
+/// `GATHER_LUT_SIZE + 1` radii travel four to a vec4 of a uniform block.
+pub const GATHER_LUT_SIZE: usize = 256;
+/// The vec4s that hold the gather's table.
+pub const GATHER_LUT_VEC4S: usize = (GATHER_LUT_SIZE + 1).div_ceil(4);
+
 /// A float as GLSL reads it back bit for bit (Rust's shortest round-trip
 /// text always has a `.` or an exponent, so GLSL types it float).
 fn float(v: f32) -> String {
@@ -171,6 +177,7 @@ pub fn glsl() -> String {
     def("SSS_TILE_SIDE", SSS_TILE_SIDE.to_string());
     def("SSS_APRON_PX", SSS_APRON_PX.to_string());
     def("SSS_MAX_TILE_LISTS", SSS_MAX_TILE_LISTS.to_string());
+    def("GATHER_LUT_VEC4S", GATHER_LUT_VEC4S.to_string());
     s.push_str("#endif\n");
     s
 }

@@ -10,6 +10,7 @@
 //! lines), the bench matrix and the tests iterate [`METHODS`]; the scripts in
 //! `tools/` read it through `dermis methods --json` ([`listing`]).
 
+pub mod gather;
 pub mod jittered;
 pub mod none;
 pub mod options;
@@ -324,6 +325,7 @@ pub static METHODS: &[&MethodEntry] = &[
     &ssg::ENTRY,
     &jittered::ENTRY,
     &poisson::ENTRY,
+    &gather::ENTRY,
     &tsd::ENTRY,
     &tsd::OPT_ENTRY,
     &reference::ENTRY,

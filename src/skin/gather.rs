@@ -6,15 +6,27 @@
 //! channel's radial distribution, `p(r) = 2 pi r R_w(r)` (red for both
 //! profiles), truncated at its [`KEPT_MASS`] quantile (HDRP's filter radius,
 //! the widest channel's 99.7% point): sample `i` of `n` takes the quantile
-//! `u_i = (i + 1/2) / n` (stratified in radius for any `n`) and the angle `i`
-//! golden angles on from a per-pixel rotation (a Fibonacci disk, turned per
-//! pixel so that its structure becomes noise). A sample at nominal radius `r`
-//! whose pixel lies `dz` mm deeper carries the weight
+//! `u_i = (i + xi) / n` (stratified in radius for any `n`, `xi` a per-pixel
+//! offset in `[0, 1)`) and the angle `i` golden angles on from a per-pixel
+//! rotation (a Fibonacci disk, turned per pixel so that its structure
+//! becomes noise). HDRP takes `xi = 1/2`; the midpoints of the quantile
+//! function's strata underestimate its mean where it is convex (the tail);
+//! a per-pixel offset is unbiased over pixels. Samples off the screen read
+//! the edge texel (the sampler's clamp), as the separable passes do. What
+//! the truncation drops, the normalisation spreads over the kept disk: red
+//! moves 1.8% less light across an edge than the whole profile (`E[r]` of
+//! the kept mass over the whole's: 1.100 / 1.121 mm). A sample at
+//! nominal radius `r` whose pixel lies `dz` mm deeper carries the weight
 //!
 //! `w_c = R_c(sqrt(r^2 + dz^2)) / R_w(r)`
 //!
 //! (the profile at the 3D distance over the sampling density on the screen
-//! plane, HDRP's depth-bilateral term), and the pixel is `sum w_c L / sum
+//! plane, HDRP's depth-bilateral term) on the light filtered bilinearly at
+//! the sample (a tap at `d` then moves a step's light by exactly `d`; the
+//! nearest texel, HDRP's load, moves `round(d)`: taps under half a pixel
+//! moved nothing, and green's and blue's light crossed the card's edge 3-6%
+//! short),
+//! and the pixel is `sum w_c L / sum
 //! w_c`: dividing by the weights makes it exactly energy-preserving however
 //! few samples land (uniform light in, the same light out), removes the
 //! truncation's and the density's constant factors, and at a silhouette or
@@ -44,7 +56,7 @@ pub const PIXELS_PER_SAMPLE: f32 = 4.0;
 /// The fewest samples a blurred pixel takes: one sample would shift the image.
 pub const MIN_SAMPLES: u32 = 4;
 /// Intervals of the inverse-CDF table (`LUT_SIZE + 1` radii, padded to vec4s).
-pub const LUT_SIZE: usize = 256;
+pub use crate::shader_constants::{GATHER_LUT_SIZE as LUT_SIZE, GATHER_LUT_VEC4S as LUT_VEC4S};
 /// The budgets `samples=` takes.
 pub const BUDGET_RANGE: std::ops::RangeInclusive<u32> = MIN_SAMPLES..=1000;
 /// `pi (3 - sqrt 5)`, the golden angle in radians.
@@ -180,12 +192,16 @@ pub fn sample_count(radius_px: f32, budget: u32) -> u32 {
     (area.ceil() as u32).clamp(MIN_SAMPLES, budget.max(MIN_SAMPLES))
 }
 
-/// The per-pixel rotation in `[0, 2 pi)` (the shader's integer hash).
-pub fn rotation(x: u32, y: u32) -> f32 {
+/// The per-pixel rotation in `[0, 2 pi)` and offset within each radius
+/// stratum in `[0, 1)` (the shader's integer hash: its low and high 16 bits).
+pub fn jitter(x: u32, y: u32) -> (f32, f32) {
     let mut h = x.wrapping_mul(1973).wrapping_add(y.wrapping_mul(9277));
     h = (h ^ (h >> 13)).wrapping_mul(0x5bd1_e995);
     h ^= h >> 15;
-    (h & 0xffff) as f32 / 65536.0 * (2.0 * std::f32::consts::PI)
+    (
+        (h & 0xffff) as f32 / 65536.0 * (2.0 * std::f32::consts::PI),
+        (h >> 16) as f32 / 65536.0,
+    )
 }
 
 /// The images one pixel of the gather reads (row-major, `width` wide).
@@ -198,8 +214,11 @@ pub struct GatherInputs<'a> {
     pub depth: &'a [f32],
     /// Whether the pixel is this group's skin.
     pub skin: &'a [bool],
-    /// Pixels per millimetre at unit view depth.
-    pub px_per_mm_at_unit_depth: f32,
+    /// The view: its height in pixels, `tan(fovy / 2)` and millimetres per
+    /// scene unit (pixels per mm at depth `d`: `h / (2 d tan(fovy/2) mm)`,
+    /// in view_scale.glsl's order of products).
+    pub height_px: f32,
+    pub tan_half_fovy: f32,
     pub mm_per_unit: f32,
 }
 
@@ -211,35 +230,36 @@ pub fn gather_pixel(g: &GatherProfile, budget: u32, input: &GatherInputs, x: usi
     let i = y * input.width + x;
     let centre = input.color[i];
     let depth = input.depth[i];
-    let px_per_mm = input.px_per_mm_at_unit_depth / depth * centre[3];
+    let px_per_mm =
+        input.height_px / ((2.0 * depth * input.tan_half_fovy) * input.mm_per_unit) * centre[3];
     let n = sample_count(g.max_radius_mm() * px_per_mm, budget);
     if n == 0 {
         return centre;
     }
-    let theta = rotation(x as u32, y as u32);
+    let (theta, offset) = jitter(x as u32, y as u32);
     let mut sum = [0.0f32; 3];
     let mut wsum = [0.0f32; 3];
     for k in 0..n {
-        let u = (k as f32 + 0.5) / n as f32;
+        let u = (k as f32 + offset) / n as f32;
         let r = g.radius_mm(u).max(1e-6);
         let a = theta + k as f32 * GOLDEN_ANGLE;
         let off = [a.cos() * r * px_per_mm, a.sin() * r * px_per_mm];
-        let qx = (x as f32 + 0.5 + off[0]).floor();
-        let qy = (y as f32 + 0.5 + off[1]).floor();
-        if qx < 0.0 || qy < 0.0 || qx >= input.width as f32 || qy >= input.height as f32 {
-            continue;
-        }
-        let j = qy as usize * input.width + qx as usize;
+        // Off the screen, the edge texel (the shader's clamp).
+        let clamp = |v: f32, n: usize| (v.floor().max(0.0) as usize).min(n - 1);
+        let qx = clamp(x as f32 + 0.5 + off[0], input.width);
+        let qy = clamp(y as f32 + 0.5 + off[1], input.height);
+        let j = qy * input.width + qx;
         if !input.skin[j] {
             continue;
         }
+        let light = bilinear(input, x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1]);
         let dz = (input.depth[j] - depth) * input.mm_per_unit;
         let r3 = (r * r + dz * dz).sqrt();
         let num = g.eval(r3);
         let den = g.eval(r)[g.widest];
         for c in 0..3 {
             let w = num[c] / den;
-            sum[c] += w * input.color[j][c];
+            sum[c] += w * light[c];
             wsum[c] += w;
         }
     }
@@ -250,6 +270,25 @@ pub fn gather_pixel(g: &GatherProfile, budget: u32, input: &GatherInputs, x: usi
         }
     }
     out
+}
+
+/// The light filtered bilinearly at `(px, py)` (pixels, centres at `+ 0.5`),
+/// edges clamped, as the shader's sampler filters it.
+fn bilinear(input: &GatherInputs, px: f32, py: f32) -> [f32; 3] {
+    let (fx, fy) = (px - 0.5, py - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - x0, fy - y0);
+    let at = |x: f32, y: f32| {
+        let xi = (x.max(0.0) as usize).min(input.width - 1);
+        let yi = (y.max(0.0) as usize).min(input.height - 1);
+        input.color[yi * input.width + xi]
+    };
+    let (a, b, c, d) = (at(x0, y0), at(x0 + 1.0, y0), at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0));
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * tx;
+        let bottom = c[k] + (d[k] - c[k]) * tx;
+        top + (bottom - top) * ty
+    })
 }
 
 #[cfg(test)]
@@ -347,7 +386,8 @@ mod tests {
             color: &color,
             depth: &depth,
             skin: &skin,
-            px_per_mm_at_unit_depth: 8.0,
+            height_px: 400.0,
+            tan_half_fovy: 0.2,
             mm_per_unit: 10.0,
         };
         for p in Profile::ALL {

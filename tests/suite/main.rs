@@ -30,6 +30,7 @@ mod bloom;
 mod budget_cli;
 mod compute;
 mod fade;
+mod gather;
 mod harness;
 mod mix;
 mod msaa;
