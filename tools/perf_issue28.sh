@@ -62,6 +62,15 @@ for path in fragment compute; do
   bench "lps-1080-close-$path" --scene "$LPS" --width 1920 --height 1080 --shot close \
     --method separable --path $path $F
 done
+# The 2D gather of the exact profile (compute only), both profiles, three
+# budgets, close-up and mid.
+for shot in close mid; do
+  for n in 20 40 80; do
+    bench "1080-$shot-1-gather-$n" --width 1920 --height 1080 --shot $shot --method gather --samples $n $F
+  done
+  bench "1080-$shot-1-gather-burley-40" --width 1920 --height 1080 --shot $shot --method gather \
+    --samples 40 --profile burley $F
+done
 # The whole frame with bloom and SMAA (the passes without a floor yet: the
 # bloom's combine among them), on the compute path.
 bench "1080-close-1-bloom-smaa" --width 1920 --height 1080 --shot close --method separable \
