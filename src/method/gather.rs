@@ -64,7 +64,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
         },
         EvalSetting {
             label: "burley, 40 samples",
-            options: &[("samples", "40"), ("profile", "burley")],
+            options: &[("samples", "40"), (profile::KEY, "burley")],
         },
     ],
     ground_truth: false,
@@ -96,7 +96,7 @@ impl Config {
         }
         Ok(Config {
             budget,
-            profile: o.parse("profile")?,
+            profile: o.parse(profile::KEY)?,
         })
     }
 }
@@ -218,19 +218,19 @@ impl Gather {
 impl SssMethod for Gather {
     fn passes<'a>(&'a self, f: &FrameView<'a, '_>) -> Vec<Pass<'a>> {
         let t = f.targets;
-        // Samples a skin pixel takes on average, from the skin's depths at
-        // full strength; each sample reads stencil, colour and depth.
+        // The most samples a skin pixel takes: the count at each skin
+        // cluster's nearest depth (full strength), doubled for the pixels of
+        // a cluster nearer than its box says (the count grows with the square
+        // of the scale), within the budget. Each sample reads stencil, colour
+        // and depth.
         let clusters: Vec<(f64, f32)> = f.depths.iter().copied().filter(|&(_, d)| d > 0.0).collect();
         let total: f64 = clusters.iter().map(|c| c.0).sum();
-        let mean = if total > 0.0 {
-            clusters
-                .iter()
-                .map(|&(share, d)| share * f64::from(self.samples_at(d)))
-                .sum::<f64>()
-                / total
-        } else {
-            0.0
-        };
+        let nearest = clusters
+            .iter()
+            .map(|&(_, d)| self.samples_at(d))
+            .max()
+            .unwrap_or(0);
+        let mean = f64::from((2 * nearest).min(self.config.budget.max(MIN_SAMPLES)));
         let spread: Vec<Spread> = clusters
             .iter()
             .map(|&(share, d)| Spread {
@@ -260,7 +260,7 @@ impl SssMethod for Gather {
         let work = ShaderWork {
             shader: SHADER.into(),
             fetches,
-            alu: alu_estimate(SHADER, &[mean.ceil() as u32, 3]),
+            alu: alu_estimate(SHADER, &[mean as u32, 3]),
             storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
         };

@@ -5,11 +5,15 @@
 //! option that names it.
 
 use super::{OptKind, OptSpec};
-pub use crate::skin::profile::Profile;
+pub use crate::skin::diffusion::Profile;
 
-/// The option every method that can take either profile reads (`profile=`).
+/// The option's key (`--sss-profile`: `--profile` is `budget`'s profile of a
+/// GPU).
+pub const KEY: &str = "sss-profile";
+
+/// The option every method that can take either profile reads.
 pub const OPTION: OptSpec = OptSpec {
-    key: "profile",
+    key: KEY,
     kind: OptKind::Value,
     default: "six-gaussian",
     help: "six-gaussian (d'Eon's fit, Table 4.2) | burley (Burley's normalized diffusion matched to the same skin: total reflectance and mean radius per channel)",

@@ -45,7 +45,7 @@
 
 use std::f64::consts::PI;
 
-use crate::skin::profile::Profile;
+use crate::skin::diffusion::Profile;
 use crate::shader_constants::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 use crate::skin::burley;
 

@@ -8,9 +8,10 @@ use crate::common;
 
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
+use dermis::method::profile::KEY;
 use dermis::skin::gather::{gather_pixel, GatherInputs, GatherProfile};
 use dermis::skin::kernel::burley_profile;
-use dermis::skin::profile::Profile;
+use dermis::skin::diffusion::Profile;
 use dermis::skin::texel::round_f16;
 
 const W: usize = 96;
@@ -89,7 +90,7 @@ fn gather_matches_its_cpu_mirror() {
         mm_per_unit: scene.mm_per_unit,
     };
     for (profile, budget) in [("six-gaussian", "40"), ("burley", "40"), ("six-gaussian", "80")] {
-        let out = run(&[("profile", profile), ("samples", budget)], &inputs);
+        let out = run(&[(KEY, profile), ("samples", budget)], &inputs);
         let g = GatherProfile::new(profile.parse::<Profile>().unwrap());
         let budget: u32 = budget.parse().unwrap();
         let (mut within, mut n, mut worst, mut moved) = (0usize, 0usize, 0.0f32, 0.0f32);
@@ -129,7 +130,7 @@ fn uniform_light_comes_out_as_it_went_in() {
     let light = round_f16([0.55, 0.4, 0.3, 1.0]);
     let uniform: Inputs = (vec![light; W * H], vec![1.6; W * H], vec![true; W * H]);
     for profile in ["six-gaussian", "burley"] {
-        let out = run(&[("profile", profile)], &uniform);
+        let out = run(&[(KEY, profile)], &uniform);
         let worst = out
             .iter()
             .flat_map(|p| (0..4).map(move |c| (p[c] - light[c]).abs() / light[c]))
@@ -157,7 +158,7 @@ fn the_cards_edge_moves_what_each_profile_moves() {
     ] {
         let s = base
             .clone()
-            .with(common::m("gather"), &[("profile", profile), ("samples", "80")]);
+            .with(common::m("gather"), &[(KEY, profile), ("samples", "80")]);
         let (out, mm_per_px) = render_card(&ctx, &scene, &s);
         let r = energy_ratio_against(&out, &none, s.width as usize, mm_per_px, Output::PixelFilter, spread);
         let kept = [0, 1, 2].map(|c| {
