@@ -8,9 +8,9 @@ use std::str::FromStr;
 
 use anyhow::{bail, Result};
 
-use super::{OptKind, OptSpec};
+use super::{MethodEntry, MethodOptions, OptKind, OptSpec};
 use crate::skin::burley::BurleyParams;
-use crate::skin::kernel::burley_profile;
+use crate::skin::kernel::{burley_profile, Preset};
 
 /// The option every method that can take either profile reads (`profile=`).
 pub const OPTION: OptSpec = OptSpec {
@@ -56,6 +56,34 @@ impl Profile {
     }
 }
 
+/// The one place that says which profile a method's setting approximates,
+/// and so which ground truth it is scored against: a method with the
+/// `profile` option ([`OPTION`]: the ground truth, and any method that takes
+/// either) its value; separable's `preset=burley` (Burley's marginal) Burley;
+/// everything else the six Gaussians (the sources' profile). `given` holds
+/// the setting's options (every method's keys may be present).
+pub fn approximated(method: &MethodEntry, given: &MethodOptions) -> Result<Profile> {
+    let o = method.opts(given);
+    if method.options.iter().any(|s| s.key == OPTION.key) {
+        return o.parse(OPTION.key);
+    }
+    if std::ptr::eq(method, &super::separable::ENTRY) {
+        let preset: Preset = o.parse("preset")?;
+        if preset == Preset::Burley {
+            return Ok(Profile::Burley);
+        }
+    }
+    Ok(Profile::SixGaussian)
+}
+
+impl Profile {
+    /// Whether this is the six Gaussians (eval.json leaves the profile out
+    /// then, as it did before there were two).
+    pub fn is_six_gaussian(&self) -> bool {
+        *self == Profile::SixGaussian
+    }
+}
+
 impl FromStr for Profile {
     type Err = anyhow::Error;
 
@@ -78,6 +106,27 @@ mod tests {
             assert_eq!(p.name().parse::<Profile>().unwrap(), p);
         }
         assert!("dipole".parse::<Profile>().is_err());
+    }
+
+    #[test]
+    fn each_setting_names_its_profile() {
+        let m = |name| crate::method::lookup(name).unwrap();
+        let given = |kv: &[(&str, &str)]| MethodOptions::default().with(kv);
+        let of = |name, kv: &[(&str, &str)]| approximated(m(name), &given(kv)).unwrap();
+        assert_eq!(of("separable", &[]), Profile::SixGaussian);
+        assert_eq!(of("separable", &[("preset", "physical")]), Profile::SixGaussian);
+        assert_eq!(of("separable", &[("preset", "burley")]), Profile::Burley);
+        assert_eq!(of("reference", &[]), Profile::SixGaussian);
+        assert_eq!(of("reference", &[("profile", "burley")]), Profile::Burley);
+        // A method without the option ignores another method's key.
+        assert_eq!(of("ssg", &[("profile", "burley")]), Profile::SixGaussian);
+        // Every method with the option reads it (gather2d and any to come).
+        for e in crate::method::METHODS {
+            if e.options.iter().any(|s| s.key == OPTION.key) {
+                assert_eq!(approximated(e, &given(&[("profile", "burley")])).unwrap(), Profile::Burley);
+            }
+        }
+        assert!(approximated(m("reference"), &given(&[("profile", "dipole")])).is_err());
     }
 
     #[test]
