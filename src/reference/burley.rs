@@ -167,8 +167,9 @@ mod tests {
         }
         // Blue's mean radius is 0.17 mm, red's 1.1 mm (the module doc's numbers).
         assert!((2.5 / s[2] - 0.1665).abs() < 1e-3 && (2.5 / s[0] - 1.12).abs() < 1e-2);
-        for c in 0..3 {
-            assert!((near_weight()[c] + far_weight()[c] - a[c]).abs() < 1e-12);
+        let (near, far) = (near_weight(), far_weight());
+        for (c, a) in a.iter().enumerate() {
+            assert!((near[c] + far[c] - a).abs() < 1e-12);
         }
         assert!((near_weight()[0] - 0.616).abs() < 1e-2, "{:?}", near_weight());
     }
