@@ -8,8 +8,6 @@
 
 const vec3 BURLEY_S = BURLEY_S_PER_MM;
 const float BURLEY_PI = 3.14159265359;
-// Parts per axis a near cell is cut into (reference::burley::CELL_PARTS).
-const int BURLEY_CELL_PARTS = 4;
 
 // R(r) / A per channel (per mm^2).
 vec3 burleyProfile(float r) {

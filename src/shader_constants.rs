@@ -45,6 +45,9 @@ pub const BURLEY_NEAR_MM: f32 = 1.0;
 /// (the 1/r singularity); farther ones take R(r) A (`reference::burley`).
 pub const BURLEY_CELL_REACH: i32 = 2;
 
+/// Parts per axis a near cell's integral is cut into (`reference::burley`).
+pub const BURLEY_CELL_PARTS: usize = 4;
+
 /// Burley's profile matched to the six Gaussians as `skin::kernel::burley_profile`
 /// does (mean radius per channel, `A` = the channel's weight sum, at most 1):
 /// its scaling factor `s = 2.5 / E[r]` (1/mm) and albedo per channel, in f64.
@@ -191,6 +194,7 @@ pub fn glsl() -> String {
     def("BURLEY_ALBEDO", vec3(ba.map(|x| x as f32)));
     def("BURLEY_NEAR_MM", float(BURLEY_NEAR_MM));
     def("BURLEY_CELL_REACH", BURLEY_CELL_REACH.to_string());
+    def("BURLEY_CELL_PARTS", BURLEY_CELL_PARTS.to_string());
     for (i, &x) in LISTING_4_1_WEIGHTS.iter().enumerate() {
         def(&format!("LISTING_4_1_WEIGHT_{i}"), float(x));
     }

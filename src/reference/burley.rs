@@ -52,8 +52,8 @@ use crate::skin::burley::{radial_cdf, radial_tail};
 use super::narrow::MAX_RADIUS;
 
 /// Parts per axis a near cell is cut into (shared with
-/// reference_burley_narrow.comp, which writes the same 4).
-pub const CELL_PARTS: usize = 4;
+/// reference_burley.glsl through `crate::shader_constants`).
+pub use crate::shader_constants::BURLEY_CELL_PARTS as CELL_PARTS;
 
 /// Burley's scaling factor `s` per channel (1/mm).
 pub fn s_per_mm() -> [f64; 3] {
