@@ -41,6 +41,21 @@ pub fn registry() -> Vec<Config> {
         .collect()
 }
 
+/// The settings that approximate the six Gaussians (`method::profile::approximated`):
+/// the ones the accuracy model measures and the planner chooses among (its
+/// err/none is against the six Gaussians' truth; Burley's settings answer
+/// to Burley's).
+pub fn six_gaussian_registry() -> Vec<Config> {
+    registry()
+        .into_iter()
+        .filter(|c| {
+            let given = crate::method::MethodOptions::default().with(c.setting.options);
+            crate::method::profile::approximated(c.method, &given)
+                .is_ok_and(|p| p.is_six_gaussian())
+        })
+        .collect()
+}
+
 /// A view of the scene set.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SceneSpec {

@@ -12,10 +12,12 @@ use super::{MethodEntry, MethodOptions, OptKind, OptSpec};
 use crate::skin::burley::BurleyParams;
 use crate::skin::kernel::{burley_profile, Preset};
 
-/// The option every method that can take either profile reads (`profile=`).
+/// The option every method that can take either profile reads (`profile=`
+/// in settings and `METHOD:profile=...` rules; `--diffusion-profile` on the
+/// command line, where budget and plan have a hardware `--profile`).
 pub const OPTION: OptSpec = OptSpec {
     key: "profile",
-    kind: OptKind::Value,
+    kind: OptKind::Flagged("diffusion-profile"),
     default: "six-gaussian",
     help: "six-gaussian (d'Eon's fit, Table 4.2) | burley (Burley's normalized diffusion matched to the same skin: total reflectance and mean radius per channel)",
 };
