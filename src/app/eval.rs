@@ -221,8 +221,8 @@ pub fn plan_sweep<'s>(
                 .map(|c| {
                     let what = format!("{} {}", c.method.name, c.setting.label);
                     let s = view.clone().with(c.method, c.setting.options);
-                    let p = profile::approximated(c.method, &s.options)
-                        .with_context(|| on(&what))?;
+                    let p =
+                        profile::approximated(c.method, &s.options).with_context(|| on(&what))?;
                     Ok((*c, p, frame(s, &what)?))
                 })
                 .collect::<Result<_>>()?;

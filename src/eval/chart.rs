@@ -516,7 +516,10 @@ mod tests {
         cost_error_chart(&points, "Both profiles", "GPU ms", &png, &svg).unwrap();
         assert_png_has_content(&png);
         let text = fs::read_to_string(&svg).unwrap();
-        assert!(text.contains("separable [burley]"), "no legend entry for Burley");
+        assert!(
+            text.contains("separable [burley]"),
+            "no legend entry for Burley"
+        );
         assert!(text.contains("<polyline"), "no hollow marker");
         fs::remove_dir_all(&dir).unwrap();
     }

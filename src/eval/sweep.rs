@@ -293,11 +293,7 @@ pub fn summary_table(summary: &[SummaryRow]) -> String {
     }
     let mut s = String::new();
     for p in Profile::ALL {
-        let mine: Vec<SummaryRow> = summary
-            .iter()
-            .filter(|r| r.profile == p)
-            .cloned()
-            .collect();
+        let mine: Vec<SummaryRow> = summary.iter().filter(|r| r.profile == p).cloned().collect();
         if mine.is_empty() {
             continue;
         }
@@ -616,7 +612,10 @@ mod tests {
         assert_eq!(s[1].profile, Profile::Burley);
         let table = summary_table(&s);
         let (six, burley) = table.split_once("profile burley").unwrap();
-        assert!(six.contains("profile six-gaussian") && six.contains(" s "), "{table}");
+        assert!(
+            six.contains("profile six-gaussian") && six.contains(" s "),
+            "{table}"
+        );
         assert!(burley.contains(" t ") && !burley.contains(" s "), "{table}");
         let json = serde_json::to_string(&s[1]).unwrap();
         assert!(json.contains("\"profile\":\"burley\""), "{json}");

@@ -22,7 +22,9 @@ pub const OPTION: OptSpec = OptSpec {
     help: "six-gaussian (d'Eon's fit, Table 4.2) | burley (Burley's normalized diffusion matched to the same skin: total reflectance and mean radius per channel)",
 };
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Profile {
     #[default]
@@ -116,7 +118,10 @@ mod tests {
         let given = |kv: &[(&str, &str)]| MethodOptions::default().with(kv);
         let of = |name, kv: &[(&str, &str)]| approximated(m(name), &given(kv)).unwrap();
         assert_eq!(of("separable", &[]), Profile::SixGaussian);
-        assert_eq!(of("separable", &[("preset", "physical")]), Profile::SixGaussian);
+        assert_eq!(
+            of("separable", &[("preset", "physical")]),
+            Profile::SixGaussian
+        );
         assert_eq!(of("separable", &[("preset", "burley")]), Profile::Burley);
         assert_eq!(of("reference", &[]), Profile::SixGaussian);
         assert_eq!(of("reference", &[("profile", "burley")]), Profile::Burley);
@@ -125,7 +130,10 @@ mod tests {
         // Every method with the option reads it (gather2d and any to come).
         for e in crate::method::METHODS {
             if e.options.iter().any(|s| s.key == OPTION.key) {
-                assert_eq!(approximated(e, &given(&[("profile", "burley")])).unwrap(), Profile::Burley);
+                assert_eq!(
+                    approximated(e, &given(&[("profile", "burley")])).unwrap(),
+                    Profile::Burley
+                );
             }
         }
         assert!(approximated(m("reference"), &given(&[("profile", "dipole")])).is_err());

@@ -67,14 +67,14 @@ pub fn registered() -> Vec<Registered> {
                         .is_ok_and(|p| p.is_six_gaussian())
                 })
                 .map(move |e| Registered {
-                method: m.name,
-                setting: e.label,
-                options: e
-                    .options
-                    .iter()
-                    .map(|(k, v)| (k.to_string(), v.to_string()))
-                    .collect(),
-            })
+                    method: m.name,
+                    setting: e.label,
+                    options: e
+                        .options
+                        .iter()
+                        .map(|(k, v)| (k.to_string(), v.to_string()))
+                        .collect(),
+                })
         })
         .collect()
 }

@@ -42,7 +42,7 @@
 //! distance, times their share of the ring ([`ring_weight`]; `R(r) A_q` alone
 //! falls short by `(s h)^2 / 24`, 3% of blue's at the 720p close-up).
 //!
-//! The f64 mirror of both passes is `super::mirror`'s (`Profile::Burley`).
+//! The f64 mirror of both passes is `super::mirror::gather_f64_burley`.
 
 use std::f64::consts::PI;
 
@@ -90,8 +90,16 @@ pub fn radius(px_per_mm: f32, s: u32) -> u32 {
 /// quadrant, which it is not without the absolute values).
 pub fn rect_inv_r(x1: f64, x2: f64, y1: f64, y2: f64) -> f64 {
     let f = |x: f64, y: f64| {
-        let a = if x != 0.0 { x * (y / x.abs()).asinh() } else { 0.0 };
-        let b = if y != 0.0 { y * (x / y.abs()).asinh() } else { 0.0 };
+        let a = if x != 0.0 {
+            x * (y / x.abs()).asinh()
+        } else {
+            0.0
+        };
+        let b = if y != 0.0 {
+            y * (x / y.abs()).asinh()
+        } else {
+            0.0
+        };
         a + b
     };
     f(x2, y2) - f(x1, y2) - f(x2, y1) + f(x1, y1)
@@ -171,7 +179,11 @@ mod tests {
         for (c, a) in a.iter().enumerate() {
             assert!((near[c] + far[c] - a).abs() < 1e-12);
         }
-        assert!((near_weight()[0] - 0.616).abs() < 1e-2, "{:?}", near_weight());
+        assert!(
+            (near_weight()[0] - 0.616).abs() < 1e-2,
+            "{:?}",
+            near_weight()
+        );
     }
 
     #[test]
@@ -229,7 +241,10 @@ mod tests {
             // Blue is within the square: its sum is its total within 0.6%
             // (measured 0.995 at s h = 0.9, the 720p close-up's 2x grid: the
             // 4x4 parts' midpoint in g; normalised away in the truth).
-            assert!((sum[2] - 1.0).abs() < 6e-3, "h {h}, offset {offset}: {sum:?}");
+            assert!(
+                (sum[2] - 1.0).abs() < 6e-3,
+                "h {h}, offset {offset}: {sum:?}"
+            );
         }
     }
 
@@ -279,7 +294,10 @@ mod edge_tests {
             // and 99.5% near) are the near part's to match (measured 0.7100
             // against 0.7044, 0.7610 against 0.7603).
             if c > 0 {
-                assert!((got - want).abs() < 0.01, "channel {c}: {got:.4}, want {want:.4}");
+                assert!(
+                    (got - want).abs() < 0.01,
+                    "channel {c}: {got:.4}, want {want:.4}"
+                );
             }
         }
     }

@@ -290,9 +290,10 @@ fn burley_truth_edge_response_against_its_closed_form() {
     let scene = card_scene();
     let base = card_settings(&scene, 8.5);
     let (none, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
-    let s = base
-        .clone()
-        .with(common::m("reference"), &[("density", "16"), ("profile", "burley")]);
+    let s = base.clone().with(
+        common::m("reference"),
+        &[("density", "16"), ("profile", "burley")],
+    );
     let (out, mm_per_px) = render_card(&ctx, &scene, &s);
     let w = s.width as usize;
     let rows = out.len() / w;
@@ -489,4 +490,3 @@ fn uniform_light_comes_out_as_it_went_in_on_the_head_scan() {
     println!("head scan, uniform light: |out/in - 1| median {median:.4}, p99 {p99:.4} over {n} pixels; thin parts (ears) median {thin:.4}");
     assert!(median < 0.02 && p99 < 0.10, "median {median}, p99 {p99}");
 }
-

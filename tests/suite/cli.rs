@@ -444,7 +444,10 @@ fn eval_writes_csv_json_and_chart() {
         .all(|p| p.get("profile").is_none() == (p["profile"] != "burley")));
     // (Not held below 1: at 96x64 a pixel is 4 mm of the face, and Burley's
     // separable kernel scores 1.15 against Burley's truth there.)
-    assert!(error("separable", "burley, 17 samples") > 0.0, "{summary:?}");
+    assert!(
+        error("separable", "burley, 17 samples") > 0.0,
+        "{summary:?}"
+    );
     assert!(std::fs::read_to_string(d.join("chart.svg"))
         .unwrap()
         .contains("separable [burley]"));

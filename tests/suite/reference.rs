@@ -130,13 +130,8 @@ fn compare_with_mirror(run: &Run, mirror: Mirror, name: &str, bound: f64) {
         &run.radiance,
     );
     let cpu32: Vec<[f32; 4]> = cpu.iter().map(|c| c.map(|v| v as f32)).collect();
-    let _diff = common::DiffOnFailure::new(
-        name,
-        run.view.width,
-        run.view.height,
-        &run.output,
-        &cpu32,
-    );
+    let _diff =
+        common::DiffOnFailure::new(name, run.view.width, run.view.height, &run.output, &cpu32);
     let mut worst = (0.0f64, 0usize);
     let mut skin = 0;
     let mut off = 0;

@@ -5,9 +5,9 @@
 use ash::vk;
 
 use super::{Reference, GROUP, SURFACE_SHADER};
-use crate::method::profile::Profile;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext, SetRef};
+use crate::method::profile::Profile;
 use crate::method::screen::fetch;
 use crate::method::FrameView;
 use crate::reference::chunks::RADIANCE_WIDTH;

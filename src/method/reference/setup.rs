@@ -9,8 +9,8 @@ use super::{
     sample_budget, Chunk, Reference, Surface, IRRADIANCE_SHADER, SURFACE_DEPTH, SURFACE_FORMAT,
     SURFACE_SHADER,
 };
-use crate::method::profile::Profile;
 use crate::graph::ImageDesc;
+use crate::method::profile::Profile;
 use crate::method::MethodSetup;
 use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
