@@ -35,6 +35,40 @@ pub const NARROW_GAUSSIANS: usize = 3;
 /// The rest of the six: the Gaussians the ground truth gathers from samples.
 pub const WIDE_GAUSSIANS: usize = SIX_GAUSSIAN_VARIANCES_MM2.len() - NARROW_GAUSSIANS;
 
+/// Radius (mm) splitting Burley's profile in the ground truth: the
+/// supersampled screen pass integrates `r < BURLEY_NEAR_MM`, the surface
+/// samples `r >= BURLEY_NEAR_MM` (`reference::burley` says why 1 mm).
+pub const BURLEY_NEAR_MM: f32 = 1.0;
+
+/// Subsamples (per axis, each side of the pixel's point) whose weights the
+/// ground truth's Burley screen pass integrates over the subsample's cell
+/// (the 1/r singularity); farther ones take R(r) A (`reference::burley`).
+pub const BURLEY_CELL_REACH: i32 = 2;
+
+/// Parts per axis a near cell's integral is cut into (`reference::burley`).
+pub const BURLEY_CELL_PARTS: usize = 4;
+
+/// Burley's profile matched to the six Gaussians as `skin::kernel::burley_profile`
+/// does (mean radius per channel, `A` = the channel's weight sum, at most 1):
+/// its scaling factor `s = 2.5 / E[r]` (1/mm) and albedo per channel, in f64.
+/// Written here from the table (this file names no other module); the
+/// reference's tests hold it to `burley_profile()`.
+pub fn burley_s_albedo() -> ([f64; 3], [f64; 3]) {
+    let (mut total, mut mean) = ([0.0f64; 3], [0.0f64; 3]);
+    for (&v, w) in SIX_GAUSSIAN_VARIANCES_MM2
+        .iter()
+        .zip(SIX_GAUSSIAN_WEIGHTS_RGB.iter())
+    {
+        let r = (std::f64::consts::PI * f64::from(v) / 2.0).sqrt();
+        for c in 0..3 {
+            total[c] += f64::from(w[c]);
+            mean[c] += f64::from(w[c]) * r;
+        }
+    }
+    let s = std::array::from_fn(|c| 2.5 / (mean[c] / total[c]));
+    (s, total.map(|a| a.min(1.0)))
+}
+
 /// The 7 tap weights of Listing 4.1 (a Gaussian of one tap-step standard
 /// deviation, taps at -3..=3 steps).
 pub const LISTING_4_1_WEIGHTS: [f32; 7] = [0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006];
@@ -161,6 +195,12 @@ pub fn glsl() -> String {
         "WIDE_WEIGHTS",
         array("vec3", w[n..].iter().map(|&x| vec3(x))),
     );
+    let (bs, ba) = burley_s_albedo();
+    def("BURLEY_S_PER_MM", vec3(bs.map(|x| x as f32)));
+    def("BURLEY_ALBEDO", vec3(ba.map(|x| x as f32)));
+    def("BURLEY_NEAR_MM", float(BURLEY_NEAR_MM));
+    def("BURLEY_CELL_REACH", BURLEY_CELL_REACH.to_string());
+    def("BURLEY_CELL_PARTS", BURLEY_CELL_PARTS.to_string());
     for (i, &x) in LISTING_4_1_WEIGHTS.iter().enumerate() {
         def(&format!("LISTING_4_1_WEIGHT_{i}"), float(x));
     }
@@ -204,6 +244,10 @@ mod tests {
             "COMPUTE_GROUP_SIDE",
             "SSS_TILE_SIDE",
             "SSS_APRON_PX",
+            "BURLEY_S_PER_MM",
+            "BURLEY_ALBEDO",
+            "BURLEY_NEAR_MM",
+            "BURLEY_CELL_REACH",
         ] {
             assert!(h.contains(&format!("#define {name} ")), "{name}");
         }

@@ -69,7 +69,7 @@ for shot in close mid; do
     bench "1080-$shot-1-gather-$n" --width 1920 --height 1080 --shot $shot --method gather --samples $n $F
   done
   bench "1080-$shot-1-gather-burley-40" --width 1920 --height 1080 --shot $shot --method gather \
-    --samples 40 --profile burley $F
+    --samples 40 --diffusion-profile burley $F
 done
 # The whole frame with bloom and SMAA (the passes without a floor yet: the
 # bloom's combine among them), on the compute path.

@@ -495,6 +495,11 @@ impl clap::FromArgMatches for MethodArgs {
                         o.set(spec.key, "false");
                     }
                 }
+                OptKind::Flagged(flag) => {
+                    if let Some(v) = m.get_one::<String>(flag) {
+                        o.set(spec.key, v.clone());
+                    }
+                }
             }
         }
         Ok(MethodArgs(o))
@@ -510,9 +515,14 @@ impl Args for MethodArgs {
     fn augment_args(mut cmd: clap::Command) -> clap::Command {
         for (method, spec) in all_options() {
             let help = format!("[{}] {}", method.name, spec.help);
-            let arg = Arg::new(spec.key).long(spec.flag()).help(help);
+            // A flagged option's id is its flag: its key is some command's own.
+            let id = match spec.kind {
+                OptKind::Flagged(flag) => flag,
+                _ => spec.key,
+            };
+            let arg = Arg::new(id).long(spec.flag()).help(help);
             cmd = cmd.arg(match spec.kind {
-                OptKind::Value => arg
+                OptKind::Value | OptKind::Flagged(_) => arg
                     .action(ArgAction::Set)
                     .allow_negative_numbers(true)
                     .value_name("VALUE"),

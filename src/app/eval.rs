@@ -4,6 +4,13 @@
 //! the cost/error charts, for a dolly the error against distance, for the
 //! accuracy sets the accuracy model's data.
 //!
+//! Each setting is scored against the ground truth of the profile it
+//! approximates (`method::profile::approximated`): the six Gaussians' truth
+//! always (its skin mask and bands serve every setting), Burley's too when a
+//! setting needs it; eval.json's rows and summary then name the profile, the
+//! summary prints each profile's settings apart and the chart draws Burley's
+//! hollow, "[burley]" in the legend.
+//!
 //! Every view's every frame is checked before the first renders: the scenes
 //! are loaded once each, and each (view, setting) is a `FrameRequest` made
 //! up front, so a setting the sweep cannot render is one line before any
@@ -22,6 +29,7 @@ use crate::eval::pareto::{self, EvalPoint};
 use crate::eval::sweep::{self, Config, EvalReport, EvalRow, SceneSpec};
 use crate::eval::{accuracy_set, chart};
 use crate::header::{command_line, RunHeader};
+use crate::method::profile::{self, Profile};
 use crate::method::{ground_truth, lookup, none};
 use crate::output::paths::OutputPaths;
 use crate::output::write_json;
@@ -152,11 +160,15 @@ pub fn load_scenes(
 /// One view of the sweep, every frame of it checked.
 pub struct ViewPlan<'s> {
     pub spec: &'s SceneSpec,
+    /// The six Gaussians' ground truth (its mask and bands serve every setting).
     pub reference: FrameRequest<'s>,
+    /// Burley's ground truth, when a setting approximates Burley's profile.
+    pub burley: Option<FrameRequest<'s>>,
     /// The no-SSS frame every err/none is relative to, when `none` is not
     /// among the configs (whose measured run is used then).
     pub none: Option<FrameRequest<'s>>,
-    pub configs: Vec<(Config, FrameRequest<'s>)>,
+    /// Each setting, the profile whose truth scores it, its frame.
+    pub configs: Vec<(Config, Profile, FrameRequest<'s>)>,
 }
 
 /// Every view's frames as checked requests (each a one-line error naming
@@ -186,13 +198,12 @@ pub fn plan_sweep<'s>(
             let frame = |s: RenderSettings, what: &str| {
                 FrameRequest::new(scene, s).with_context(|| on(what))
             };
-            let reference = frame(
-                RenderSettings {
-                    method: ground_truth(),
-                    ..view.clone()
-                },
-                "the ground truth",
-            )?;
+            let truth = |p: Profile| RenderSettings {
+                method: ground_truth(),
+                options: view.options.with(&[(profile::OPTION.key, p.name())]),
+                ..view.clone()
+            };
+            let reference = frame(truth(Profile::SixGaussian), "the ground truth")?;
             let swept_none = configs.iter().any(|c| std::ptr::eq(c.method, none()));
             let none_frame = if swept_none {
                 None
@@ -205,19 +216,25 @@ pub fn plan_sweep<'s>(
                     "no SSS",
                 )?)
             };
-            let configs = configs
+            let configs: Vec<(Config, Profile, FrameRequest)> = configs
                 .iter()
                 .map(|c| {
                     let what = format!("{} {}", c.method.name, c.setting.label);
-                    Ok((
-                        *c,
-                        frame(view.clone().with(c.method, c.setting.options), &what)?,
-                    ))
+                    let s = view.clone().with(c.method, c.setting.options);
+                    let p =
+                        profile::approximated(c.method, &s.options).with_context(|| on(&what))?;
+                    Ok((*c, p, frame(s, &what)?))
                 })
                 .collect::<Result<_>>()?;
+            let burley = configs
+                .iter()
+                .any(|(_, p, _)| *p == Profile::Burley)
+                .then(|| frame(truth(Profile::Burley), "Burley's ground truth"))
+                .transpose()?;
             Ok(ViewPlan {
                 spec,
                 reference,
+                burley,
                 none: none_frame,
                 configs,
             })
@@ -232,7 +249,10 @@ pub fn sweep(
     counts: FrameCounts,
     progress: bool,
 ) -> Result<Vec<EvalRow>> {
-    let total: usize = plan.iter().map(|v| v.configs.len() + 1).sum();
+    let total: usize = plan
+        .iter()
+        .map(|v| v.configs.len() + 1 + v.burley.is_some() as usize)
+        .sum();
     let bar = progress.then(|| {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
@@ -258,6 +278,19 @@ pub fn sweep(
         let reference = run_request(ctx, &view.reference, &once)?;
         let (fovy, mm_per_unit) = (reference.report.fovy_deg, reference.report.mm_per_unit);
         let reference = reference.capture.context("reference capture")?;
+        let burley = match &view.burley {
+            Some(f) => {
+                step("reference profile=burley");
+                let c = run_request(ctx, f, &once)?
+                    .capture
+                    .context("Burley's reference capture")?;
+                if let Some(b) = &bar {
+                    b.inc(1);
+                }
+                Some(c)
+            }
+            None => None,
+        };
         let measure = |c: &Config, f: &FrameRequest| {
             step(&format!("{} {}", c.method.name, c.setting.label));
             run_request(ctx, f, &measured).with_context(|| {
@@ -270,9 +303,9 @@ pub fn sweep(
         let none_at = view
             .configs
             .iter()
-            .position(|(c, _)| std::ptr::eq(c.method, none()));
+            .position(|(c, ..)| std::ptr::eq(c.method, none()));
         let mut none_run = none_at
-            .map(|i| measure(&view.configs[i].0, &view.configs[i].1))
+            .map(|i| measure(&view.configs[i].0, &view.configs[i].2))
             .transpose()?;
         let none_diffuse = match (&none_run, &view.none) {
             (Some(out), _) => out
@@ -301,12 +334,19 @@ pub fn sweep(
         if let Some(b) = &bar {
             b.inc(1);
         }
-        for (i, (c, f)) in view.configs.iter().enumerate() {
+        for (i, (c, p, f)) in view.configs.iter().enumerate() {
             let out = match (none_at == Some(i)).then(|| none_run.take()).flatten() {
                 Some(out) => out,
                 None => measure(c, f)?,
             };
             let cap = out.capture.context("capture")?;
+            // The truth of the setting's own profile (planned with it).
+            let reference = match p {
+                Profile::SixGaussian => &reference,
+                Profile::Burley => burley
+                    .as_ref()
+                    .context("no Burley ground truth was planned")?,
+            };
             let flip = flip_ldr(&cap.ldr, &reference.ldr, cap.width, cap.height)?;
             let band_errors = BandErrors::of(
                 &cap.diffuse,
@@ -333,6 +373,7 @@ pub fn sweep(
                 frame_ms: out.report.frame.map_or(0.0, |f| f.gpu_ms.median),
                 rel_rmse_all_skin: rel_rmse,
                 bands: band_errors,
+                profile: *p,
             });
             if let Some(b) = &bar {
                 b.inc(1);
@@ -393,7 +434,15 @@ pub fn sweep_and_write(
             points: summary
                 .iter()
                 .filter(|r| r.band(band).scenes > 0)
-                .map(|r| r.point(band))
+                .map(|r| {
+                    let mut p = r.point(band);
+                    // Burley's settings (scored against Burley's truth) are
+                    // their own legend entries, drawn hollow.
+                    if !r.profile.is_six_gaussian() {
+                        p.method = chart::profile_label(&p.method, r.profile.name());
+                    }
+                    p
+                })
                 .collect(),
             front: band == Band::Interior,
         })

@@ -59,6 +59,18 @@ pub fn cost_error_chart(
     write_png_svg(&plot, SIZE, png_path, svg_path)
 }
 
+/// The legend label of a method's settings scored against another profile's
+/// ground truth than the six Gaussians' (`separable [burley]`): its own
+/// legend entry, its markers drawn hollow ([`is_profile_label`]).
+pub fn profile_label(method: &str, profile: &str) -> String {
+    format!("{method} [{profile}]")
+}
+
+/// Whether a point's method label is a [`profile_label`].
+pub fn is_profile_label(label: &str) -> bool {
+    label.ends_with(']') && label.contains(" [")
+}
+
 /// One panel of a [`panel_chart`].
 pub struct Panel {
     pub title: String,
@@ -257,10 +269,28 @@ where
         }
     }
     for (m, method) in methods.iter().enumerate() {
-        let fill = COLOURS[m % COLOURS.len()].filled();
+        let colour = COLOURS[m % COLOURS.len()];
         let shape = outline(SHAPES[m % SHAPES.len()]);
-        let legend_shape = shape.clone();
         let mine = points.iter().filter(|p| p.method == *method);
+        if is_profile_label(method) {
+            // Another profile's settings: the same shapes, hollow.
+            let mut ring = shape.clone();
+            ring.push(shape[0]);
+            let stroke = colour.stroke_width(2);
+            let legend_ring = ring.clone();
+            chart
+                .draw_series(mine.map(|p| {
+                    EmptyElement::at((p.gpu_ms, p.error)) + PathElement::new(ring.clone(), stroke)
+                }))
+                .map_err(plot_err)?
+                .label(*method)
+                .legend(move |c| {
+                    EmptyElement::at(c) + PathElement::new(legend_ring.clone(), stroke)
+                });
+            continue;
+        }
+        let fill = colour.filled();
+        let legend_shape = shape.clone();
         chart
             .draw_series(
                 mine.map(|p| {
@@ -466,6 +496,32 @@ mod tests {
             caption_dark > 100,
             "no caption text drawn ({caption_dark} dark pixels)"
         );
+    }
+
+    // Both profiles in one chart: Burley's settings are their own legend
+    // entry, drawn hollow (a polyline, where the six Gaussians' are filled
+    // polygons).
+    #[test]
+    fn both_profiles_share_one_chart() {
+        let dir = temp_dir("profiles");
+        let burley = profile_label("separable", "burley");
+        assert!(is_profile_label(&burley) && !is_profile_label("separable"));
+        let points = vec![
+            pt("separable", 0.4, 0.08),
+            pt("separable", 0.7, 0.03),
+            pt(&burley, 0.45, 0.06),
+            pt(&burley, 0.75, 0.02),
+        ];
+        let (png, svg) = (dir.join("c.png"), dir.join("c.svg"));
+        cost_error_chart(&points, "Both profiles", "GPU ms", &png, &svg).unwrap();
+        assert_png_has_content(&png);
+        let text = fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.contains("separable [burley]"),
+            "no legend entry for Burley"
+        );
+        assert!(text.contains("<polyline"), "no hollow marker");
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::bands::{Band, BandErrors};
 use super::pareto::EvalPoint;
 use crate::header::RunHeader;
+use crate::method::profile::Profile;
 use crate::method::{EvalSetting, MethodEntry, METHODS};
 use crate::render::RenderSettings;
 use crate::scene::gltf_load::TextureOverrides;
@@ -36,6 +37,21 @@ pub fn registry() -> Vec<Config> {
                 method: m,
                 setting: s,
             })
+        })
+        .collect()
+}
+
+/// The settings that approximate the six Gaussians (`method::profile::approximated`):
+/// the ones the accuracy model measures and the planner chooses among (its
+/// err/none is against the six Gaussians' truth; Burley's settings answer
+/// to Burley's).
+pub fn six_gaussian_registry() -> Vec<Config> {
+    registry()
+        .into_iter()
+        .filter(|c| {
+            let given = crate::method::MethodOptions::default().with(c.setting.options);
+            crate::method::profile::approximated(c.method, &given)
+                .is_ok_and(|p| p.is_six_gaussian())
         })
         .collect()
 }
@@ -149,6 +165,10 @@ pub struct EvalRow {
     pub rel_rmse_all_skin: f64,
     /// err/none, gain, FLIP and relative RMSE per band.
     pub bands: BandErrors,
+    /// The profile the setting approximates, whose ground truth it was scored
+    /// against (`method::profile::approximated`); absent: the six Gaussians.
+    #[serde(default, skip_serializing_if = "Profile::is_six_gaussian")]
+    pub profile: Profile,
 }
 
 impl EvalRow {
@@ -217,10 +237,26 @@ fn band_key(band: Band) -> &'static str {
     }
 }
 
-/// Writes eval.csv: one line per row, every column of eval.json's rows.
+/// Writes eval.csv: one line per row, every column of eval.json's rows; a
+/// last column `profile` when a row was scored against another truth than
+/// the six Gaussians' (as eval.json writes the key only then).
 pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
-    let fields: Vec<Vec<String>> = rows.iter().map(EvalRow::csv_fields).collect();
-    super::pareto::write_table(path, &EvalRow::csv_header(), &fields)
+    let profiles = rows.iter().any(|r| !r.profile.is_six_gaussian());
+    let mut header = EvalRow::csv_header();
+    let fields: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let mut f = r.csv_fields();
+            if profiles {
+                f.push(r.profile.name().to_string());
+            }
+            f
+        })
+        .collect();
+    if profiles {
+        header.push("profile".into());
+    }
+    super::pareto::write_table(path, &header, &fields)
 }
 
 /// What `err/none` means in eval.json.
@@ -248,8 +284,31 @@ pub fn load(spec: &SceneSpec) -> Result<Scene> {
 }
 
 /// The summary as the CLI prints it: cost, then err/none per band and the
-/// interior's per-channel gain and FLIP.
+/// interior's per-channel gain and FLIP; when some setting approximates
+/// another profile than the six Gaussians, each profile's settings apart under
+/// a line naming the truth they were scored against.
 pub fn summary_table(summary: &[SummaryRow]) -> String {
+    if summary.iter().all(|r| r.profile.is_six_gaussian()) {
+        return summary_rows(summary);
+    }
+    let mut s = String::new();
+    for p in Profile::ALL {
+        let mine: Vec<SummaryRow> = summary.iter().filter(|r| r.profile == p).cloned().collect();
+        if mine.is_empty() {
+            continue;
+        }
+        s.push_str(&format!(
+            "profile {}: err/none against its own ground truth (reference profile={})\n",
+            p.name(),
+            p.name()
+        ));
+        s.push_str(&summary_rows(&mine));
+    }
+    s
+}
+
+/// [`summary_table`]'s table of `summary`'s rows.
+fn summary_rows(summary: &[SummaryRow]) -> String {
     let mut s = format!(
         "{:<12} {:<26} {:>8} {:>9} {:>9} {:>9} {:>17} {:>7}\n",
         "method", "setting", "SSS ms", "interior", "silhou.", "d.step", "gain R/G/B", "FLIP"
@@ -289,6 +348,10 @@ pub struct SummaryRow {
     pub interior: BandMean,
     pub silhouette: BandMean,
     pub depth_step: BandMean,
+    /// The profile whose truth the setting was scored against (absent: the
+    /// six Gaussians).
+    #[serde(default, skip_serializing_if = "Profile::is_six_gaussian")]
+    pub profile: Profile,
 }
 
 impl SummaryRow {
@@ -350,6 +413,7 @@ pub fn summarise(rows: &[EvalRow]) -> Vec<SummaryRow> {
                 interior: mean_band(Band::Interior),
                 silhouette: mean_band(Band::Silhouette),
                 depth_step: mean_band(Band::DepthStep),
+                profile: sel.first().map_or(Profile::SixGaussian, |r| r.profile),
                 method,
                 setting,
             }
@@ -415,6 +479,7 @@ mod tests {
                 silhouette: band(0.2),
                 depth_step: band(0.4),
             },
+            profile: Profile::SixGaussian,
         };
         let mut json_keys = Vec::new();
         leaves(&serde_json::to_value(&row).unwrap(), "", &mut json_keys);
@@ -522,6 +587,7 @@ mod tests {
                 silhouette: band(3, 2.0 * e),
                 depth_step: band(depth_step_pixels, 5.0),
             },
+            profile: Profile::SixGaussian,
         };
         let s = summarise(&[row("a", 1.0, 0.1, 0), row("b", 3.0, 0.3, 2)]);
         assert_eq!(s.len(), 1);
@@ -534,5 +600,26 @@ mod tests {
         assert_eq!(s[0].depth_step.scenes, 1);
         assert!((s[0].depth_step.err_none - 5.0).abs() < 1e-12);
         assert!(summary_table(&s).contains("interior"));
+        // Only the six Gaussians: the table and eval.json are as before
+        // there were two profiles.
+        assert!(!summary_table(&s).contains("profile"));
+        assert!(!serde_json::to_string(&s[0]).unwrap().contains("profile"));
+        // A Burley setting: each profile's rows apart, eval.json says which.
+        let mut b = row("a", 1.0, 0.1, 0);
+        b.point.setting = "t".into();
+        b.profile = Profile::Burley;
+        let s = summarise(&[row("a", 1.0, 0.1, 0), b]);
+        assert_eq!(s[1].profile, Profile::Burley);
+        let table = summary_table(&s);
+        let (six, burley) = table.split_once("profile burley").unwrap();
+        assert!(
+            six.contains("profile six-gaussian") && six.contains(" s "),
+            "{table}"
+        );
+        assert!(burley.contains(" t ") && !burley.contains(" s "), "{table}");
+        let json = serde_json::to_string(&s[1]).unwrap();
+        assert!(json.contains("\"profile\":\"burley\""), "{json}");
+        let back: SummaryRow = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.profile, Profile::Burley);
     }
 }

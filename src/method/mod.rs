@@ -385,7 +385,7 @@ pub fn listing() -> Vec<MethodListing> {
                     key: o.key,
                     flag: o.flag(),
                     kind: match o.kind {
-                        OptKind::Value => "value",
+                        OptKind::Value | OptKind::Flagged(_) => "value",
                         OptKind::NoFlag => "switch",
                     },
                     default: o.default,

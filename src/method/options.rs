@@ -15,6 +15,10 @@ pub enum OptKind {
     Value,
     /// A switch that turns a default-on feature off: `--no-key` sets "false".
     NoFlag,
+    /// A value whose long flag (and clap id) is not its key, where the key
+    /// would clash with a command's own flag (`profile` against budget's and
+    /// plan's hardware `--profile`): `--FLAG value` sets the key.
+    Flagged(&'static str),
 }
 
 /// One knob of a method.
@@ -35,6 +39,7 @@ impl OptSpec {
         match self.kind {
             OptKind::Value => self.key.to_string(),
             OptKind::NoFlag => format!("no-{}", self.key),
+            OptKind::Flagged(flag) => flag.to_string(),
         }
     }
 }

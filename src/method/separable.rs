@@ -101,6 +101,20 @@ pub static ENTRY: MethodEntry = MethodEntry {
             label: "physical, 33 samples",
             options: &[("preset", "physical"), ("samples", "33")],
         },
+        // Burley's marginal, scored against Burley's own truth
+        // (`profile::approximated`).
+        EvalSetting {
+            label: "burley, 9 samples",
+            options: &[("preset", "burley"), ("samples", "9")],
+        },
+        EvalSetting {
+            label: "burley, 17 samples",
+            options: &[("preset", "burley"), ("samples", "17")],
+        },
+        EvalSetting {
+            label: "burley, 33 samples",
+            options: &[("preset", "burley"), ("samples", "33")],
+        },
     ],
     ground_truth: false,
     dolly: &["17 samples", "physical, 17 samples"],

@@ -2,10 +2,12 @@
 //! force over every sample (no grid), an independent check of the GPU passes
 //! (the narrow part's windowed sum over the supersampled surface, the wide
 //! part's grid, cut-off, profile, position reconstruction, the tissue test) on
-//! a tiny scene.
+//! a tiny scene. Both profiles: the six Gaussians ([`gather_f64`]) and
+//! Burley's ([`gather_f64_burley`], split as `super::burley` says).
 
 use glam::{DMat4, DVec3, Mat4};
 
+use super::burley;
 use super::narrow::radius;
 use super::sampling::{cutoff_mm, SurfaceSample, NARROW_GAUSSIANS};
 use super::tissue::through_tissue;
@@ -170,6 +172,147 @@ pub fn gather_f64(
                     }
                 }
             }
+            [acc[0], acc[1], acc[2], d0[3] as f64]
+        })
+        .collect()
+}
+
+/// [`gather_f64`] under Burley's profile: the near part (`r < r_c`, each
+/// subsample weighted by its cell's integral within reach of the point, by
+/// `R(r) A_q` beyond) from `surface`, the far part (`R(r) dA_j` out to the
+/// cut-off) from `samples`, each normalised per channel (`super::burley`).
+// Long because it is the whole integral (both parts) written out once, as the
+// GPU passes compute it, so that each step can be compared with them.
+pub fn gather_f64_burley(
+    view: &GatherView,
+    diffuse: &[[f32; 4]],
+    linear_depth: &[f32],
+    surface: &SurfaceImages,
+    samples: &[SurfaceSample],
+    radiance: &[[f32; 4]],
+) -> Vec<[f64; 4]> {
+    let inv = DMat4::from_cols_array(&view.inv_view.to_cols_array().map(|v| v as f64));
+    let mm = view.mm_per_unit as f64;
+    let cutoff2 = (cutoff_mm() as f64).powi(2);
+    let near2 = f64::from(burley::BURLEY_NEAR_MM).powi(2);
+    let (bs, w_near, w_far) = (
+        burley::s_per_mm(),
+        burley::near_weight(),
+        burley::far_weight(),
+    );
+    let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
+    let sh = view.height * s;
+    let scale = ViewScale {
+        height_px: view.height as u32,
+        tan_half_fovy: view.tan_half_fovy,
+        mm_per_unit: view.mm_per_unit,
+    };
+    (0..view.width * view.height)
+        .map(|i| {
+            let d0 = diffuse[i];
+            if d0[3] <= 0.0 {
+                return d0.map(|v| v as f64);
+            }
+            let (x, y) = (i % view.width, i / view.width);
+            let z = linear_depth[i] as f64;
+            let ndc_x = (x as f64 + 0.5) / view.width as f64 * 2.0 - 1.0;
+            let ndc_y = (y as f64 + 0.5) / view.height as f64 * 2.0 - 1.0;
+            let t = view.tan_half_fovy as f64;
+            let vp = DVec3::new(ndc_x * t * view.aspect as f64 * z, -ndc_y * t * z, -z);
+            let xo = inv.transform_point3(vp);
+            let xo32 = xo.as_vec3().to_array();
+            let (cx, cy) = ((x * s + s / 2), (y * s + s / 2));
+            let c = cy * sw + cx;
+            let no = [
+                surface.normal[c][0],
+                surface.normal[c][1],
+                surface.normal[c][2],
+            ];
+            // The pixel's point on the subsample grid (continuous coordinates).
+            let (gx, gy) = ((x as f64 + 0.5) * s as f64, (y as f64 + 0.5) * s as f64);
+            let px_per_mm = scale.px_per_mm(linear_depth[i]);
+            let r = burley::radius(px_per_mm, surface.s) as i64;
+            let mut sum = [0.0f64; 3];
+            let mut norm = [0.0f64; 3];
+            for qy in (cy as i64 - r)..=(cy as i64 + r) {
+                for qx in (cx as i64 - r)..=(cx as i64 + r) {
+                    if qx < 0 || qy < 0 || qx >= sw as i64 || qy >= sh as i64 {
+                        continue;
+                    }
+                    let q = qy as usize * sw + qx as usize;
+                    let p = surface.position[q];
+                    let nq = [
+                        surface.normal[q][0],
+                        surface.normal[q][1],
+                        surface.normal[q][2],
+                    ];
+                    if p[3] <= 0.0
+                        || !through_tissue(xo32, no, [p[0], p[1], p[2]], nq, view.mm_per_unit)
+                    {
+                        continue;
+                    }
+                    let r2 = ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - xo) * mm)
+                        .length_squared();
+                    if r2 >= near2 {
+                        continue;
+                    }
+                    let (du, dv) = (qx as f64 + 0.5 - gx, qy as f64 + 0.5 - gy);
+                    let area = p[3] as f64;
+                    let w = if burley::in_cell_reach(du, dv) {
+                        burley::cell_weight(bs, du, dv, area.sqrt())
+                    } else {
+                        burley::ring_weight(bs, r2.sqrt(), area.sqrt())
+                    };
+                    for ch in 0..3 {
+                        norm[ch] += w[ch];
+                        sum[ch] += w[ch] * surface.radiance[q][ch] as f64;
+                    }
+                }
+            }
+            let near: [f64; 3] = std::array::from_fn(|ch| {
+                if norm[ch] > 0.0 {
+                    sum[ch] / norm[ch]
+                } else {
+                    surface.radiance[c][ch] as f64
+                }
+            });
+            // Far part: every sample from r_c to the cut-off, through tissue.
+            let mut far = [0.0f64; 3];
+            let mut far_norm = [0.0f64; 3];
+            for (j, smp) in samples.iter().enumerate() {
+                let pa = smp.pos_area;
+                let p = DVec3::new(pa[0] as f64, pa[1] as f64, pa[2] as f64);
+                let r2 = ((p - xo) * mm).length_squared();
+                let n = smp.normal;
+                if r2 < near2
+                    || r2 > cutoff2
+                    || !through_tissue(
+                        xo32,
+                        no,
+                        p.as_vec3().to_array(),
+                        [n[0], n[1], n[2]],
+                        view.mm_per_unit,
+                    )
+                {
+                    continue;
+                }
+                let w = burley::profile(bs, r2.sqrt());
+                for ch in 0..3 {
+                    let e = pa[3] as f64 * w[ch];
+                    far_norm[ch] += e;
+                    far[ch] += e * radiance[j][ch] as f64;
+                }
+            }
+            // A channel with no far sample takes the near part's light for it
+            // (the GPU's resolve does the same): nothing is lost.
+            let acc: [f64; 3] = std::array::from_fn(|ch| {
+                let f = if far_norm[ch] > 0.0 {
+                    far[ch] / far_norm[ch]
+                } else {
+                    near[ch]
+                };
+                w_near[ch] * near[ch] + w_far[ch] * f
+            });
             [acc[0], acc[1], acc[2], d0[3] as f64]
         })
         .collect()

@@ -42,6 +42,12 @@ impl Profile {
         }
     }
 
+    /// Whether this is the six Gaussians (eval.json leaves the profile out
+    /// then, as it did before there were two).
+    pub fn is_six_gaussian(&self) -> bool {
+        *self == Profile::SixGaussian
+    }
+
     /// Burley's parameters when this is Burley's profile.
     pub fn burley(self) -> Option<BurleyParams> {
         match self {

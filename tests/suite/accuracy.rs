@@ -4,8 +4,11 @@
 //!   ground truth's edge response against the profile's closed form (the energy
 //!   moved across the edge, E (a_L - a_R) sum_i w_i sigma_i / sqrt(2 pi), sampled
 //!   at the pixel centres as any image is);
+//! - the same card under Burley's truth (`profile=burley`) against Burley's
+//!   closed form (`BurleyParams::edge_response`, Bickley-Naylor functions):
+//!   its energy moved and its row pointwise;
 //! - uniform light (white skin, ambient only): the ground truth must return its
-//!   input (what light goes in comes out), thin parts apart.
+//!   input (what light goes in comes out), thin parts apart; both profiles.
 
 use crate::common;
 
@@ -300,6 +303,86 @@ fn edge_response_of_every_method_against_the_closed_form() {
     }
 }
 
+// Burley's truth on the card at the close-up scale, against Burley's own
+// closed form (src/skin/burley.rs: the marginal's tail by Bickley-Naylor
+// functions, which no code of the truth uses): the energy each channel moves
+// across the edge within 3% (the six Gaussians' bound), the row within 2% of
+// the contrast at every pixel, and the card's light kept.
+#[test]
+fn burley_truth_edge_response_against_its_closed_form() {
+    let ctx = common::ctx();
+    let scene = card_scene();
+    let base = card_settings(&scene, 8.5);
+    let (none, _) = render_card(&ctx, &scene, &base.clone().with(common::m("none"), &[]));
+    let s = base.clone().with(
+        common::m("reference"),
+        &[("density", "16"), ("profile", "burley")],
+    );
+    let (out, mm_per_px) = render_card(&ctx, &scene, &s);
+    let w = s.width as usize;
+    let rows = out.len() / w;
+    let burley = dermis::skin::kernel::burley_profile();
+    let mut ratio = [0.0; 3];
+    let mut worst = [0.0f64; 3];
+    for c in 0..3 {
+        let left = none[rows / 2 * w + 2][c] as f64;
+        let right = none[rows / 2 * w + w - 3][c] as f64;
+        // The closed form at the pixel centres, with the unscattered levels
+        // (irradiance times albedo) as the card's albedos under unit light.
+        // Burley's A (the six Gaussians' total, 1 - 1e-8) scales both.
+        let exact: Vec<f64> = (0..w)
+            .map(|x| {
+                let xm = (x as f64 + 0.5 - (w / 2) as f64) * mm_per_px;
+                burley.edge_response(xm, [left; 3], [right; 3])[c] * burley.albedo[c]
+            })
+            .collect();
+        let want = Row {
+            values: &exact,
+            edge_px: w / 2,
+            mm_per_px,
+        }
+        .energy_moved(right * burley.albedo[c]);
+        for y in 0..rows {
+            let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
+            let mean =
+                |r: std::ops::Range<usize>| r.clone().map(|x| row[x]).sum::<f64>() / r.len() as f64;
+            let (own_left, own_right) = (mean(2..6), mean(w - 6..w - 2));
+            let moved = Row {
+                values: &row,
+                edge_px: w / 2,
+                mm_per_px,
+            }
+            .energy_moved(own_right)
+                * (left - right)
+                / (own_left - own_right);
+            ratio[c] += moved / want / rows as f64;
+            // Pointwise, on rows away from the frame's top and bottom (where
+            // the screen pass's window is cut off, as the six Gaussians' is):
+            // the row over its own levels against the closed form.
+            if y < rows / 4 || y >= 3 * rows / 4 {
+                continue;
+            }
+            for x in w / 4..3 * w / 4 {
+                let got = (row[x] - own_right) / (own_left - own_right);
+                let ex = (exact[x] - exact[w - 3]) / (exact[2] - exact[w - 3]);
+                worst[c] = worst[c].max((got - ex).abs());
+            }
+        }
+    }
+    let kept = [0, 1, 2].map(|c| {
+        out.iter().map(|p| p[c] as f64).sum::<f64>() / none.iter().map(|p| p[c] as f64).sum::<f64>()
+    });
+    println!(
+        "reference profile=burley: energy moved / Burley's closed form = {ratio:.4?}, worst pointwise |difference| / contrast {worst:.4?} ({:.2} px/mm), out / in {kept:.5?}",
+        1.0 / mm_per_px
+    );
+    for c in 0..3 {
+        assert!((ratio[c] - 1.0).abs() < 0.03, "energy moved {ratio:?}");
+        assert!(worst[c] < 0.02, "pointwise {worst:?}");
+        assert!((kept[c] - 1.0).abs() < 0.005, "out / in {kept:?}");
+    }
+}
+
 /// Uniform light: white skin, ambient light only, no key light. Every surface
 /// point is lit alike and the profile loses no light (its weights sum to one),
 /// so the ground truth must return its input at every point, folds and thin
@@ -395,6 +478,23 @@ fn uniform_light_comes_out_as_it_went_in_on_the_face() {
         ears.iter().any(|e| (p - e.center).length() * mm < 40.0)
     });
     println!("face, uniform light: |out/in - 1| median {median:.4}, p99 {p99:.4} over {n} pixels; thin parts (ears) median {thin:.4}");
+    assert!(median < 0.02 && p99 < 0.10, "median {median}, p99 {p99}");
+}
+
+// Burley's truth under uniform light (its near and far parts each normalised
+// per channel, A = 1 - 1e-8): the same bounds as the six Gaussians'.
+#[test]
+fn uniform_light_comes_out_as_it_went_in_under_burley() {
+    let mut scene = default_scene();
+    let mut s = white_ambient(&mut scene);
+    s.options.set("profile", "burley");
+    s.distance_heads = dermis::scene::camera::Camera::close_up_distance_heads(20.0);
+    let ears = dermis::scene::face::ears();
+    let mm = scene.mm_per_unit;
+    let (median, p99, thin, n) = uniform_light(&scene, &s, |p| {
+        ears.iter().any(|e| (p - e.center).length() * mm < 40.0)
+    });
+    println!("face, uniform light, profile=burley: |out/in - 1| median {median:.4}, p99 {p99:.4} over {n} pixels; thin parts (ears) median {thin:.4}");
     assert!(median < 0.02 && p99 < 0.10, "median {median}, p99 {p99}");
 }
 

@@ -5,7 +5,7 @@
 
 use dermis::accuracy::{AccuracyModel, Asset};
 use dermis::eval::accuracy_set::{scales, SCALE_RANGE};
-use dermis::eval::sweep::registry;
+use dermis::eval::sweep::six_gaussian_registry as registry;
 
 #[test]
 fn the_projects_data_covers_every_registered_setting_on_both_heads() {

@@ -431,6 +431,26 @@ fn eval_writes_csv_json_and_chart() {
     // scattering moves the frame toward the ground truth inside the face.
     assert_eq!(error("none", "-"), 1.0, "{summary:?}");
     assert!(error("separable", "33 samples") < 1.0, "{summary:?}");
+    // Burley's settings were scored against Burley's truth, and say so; the
+    // six Gaussians' rows carry no profile key (as before there were two).
+    use dermis::method::profile::Profile;
+    for r in &typed.rows {
+        let burley = r.point.setting.starts_with("burley");
+        assert_eq!(r.profile == Profile::Burley, burley, "{}", r.point.setting);
+    }
+    assert!(typed.rows.iter().any(|r| r.profile == Profile::Burley));
+    assert!(summary
+        .iter()
+        .all(|p| p.get("profile").is_none() == (p["profile"] != "burley")));
+    // (Not held below 1: at 96x64 a pixel is 4 mm of the face, and Burley's
+    // separable kernel scores 1.15 against Burley's truth there.)
+    assert!(
+        error("separable", "burley, 17 samples") > 0.0,
+        "{summary:?}"
+    );
+    assert!(std::fs::read_to_string(d.join("chart.svg"))
+        .unwrap()
+        .contains("separable [burley]"));
     assert!(!v["pareto_front"].as_array().unwrap().is_empty());
     // The interior panel and each band that has pixels, side by side.
     let png = image::open(d.join("chart.png")).unwrap();

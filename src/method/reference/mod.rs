@@ -12,6 +12,13 @@
 //! through the integral itself, because samples on the far side of an ear are as
 //! close in 3D as they really are.
 //!
+//! Either profile (`profile=`, `method::profile`): the six Gaussians split by
+//! Gaussian (1-3 on the screen, 4-6 from the samples), Burley's by distance
+//! (`r < 1 mm` on the screen, the rest from the samples; `crate::reference::burley`
+//! says why), each part normalised by its sampled weights. Burley's passes are
+//! shaders of their own with the six Gaussians' bindings, so the six Gaussians'
+//! truth runs the very code it ran before.
+//!
 //! The sample set is split into chunks of whole radiance rows so that every
 //! binding stays within the device's storage-buffer range and every radiance
 //! image within its largest image: the default density works on any conforming
@@ -29,6 +36,7 @@ use std::any::Any;
 use anyhow::{bail, Result};
 use ash::vk;
 
+use super::profile::{self, Profile};
 use super::region::ReachScale;
 use super::{
     FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod,
@@ -50,6 +58,9 @@ const SURFACE_SHADER: &str = "reference_surface.frag";
 const NARROW_SHADER: &str = "reference_narrow.comp";
 const GATHER_SHADER: &str = "reference_gather.comp";
 const RESOLVE_SHADER: &str = "reference_resolve.comp";
+const BURLEY_NARROW_SHADER: &str = "reference_burley_narrow.comp";
+const BURLEY_GATHER_SHADER: &str = "reference_burley_gather.comp";
+const BURLEY_RESOLVE_SHADER: &str = "reference_burley_resolve.comp";
 /// The surface pass's targets: radiance, position + area, normal.
 const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const SURFACE_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
@@ -59,12 +70,15 @@ const GROUP: u32 = crate::shader_constants::COMPUTE_GROUP_SIDE;
 /// cells each: llvmpipe cuts shader loops after 65,535 iterations.
 const SLABS: i32 = 9;
 
-const OPTIONS: &[OptSpec] = &[OptSpec {
-    key: "density",
-    kind: OptKind::Value,
-    default: "32",
-    help: "surface samples per mm^2, within (0, 256] (32 is converged: doubling it changes the image by 1e-4 relative RMSE)",
-}];
+const OPTIONS: &[OptSpec] = &[
+    OptSpec {
+        key: "density",
+        kind: OptKind::Value,
+        default: "32",
+        help: "surface samples per mm^2, within (0, 256] (32 is converged: doubling it changes the image by 1e-4 relative RMSE)",
+    },
+    profile::OPTION,
+];
 
 pub static ENTRY: MethodEntry = MethodEntry {
     name: "reference",
@@ -78,7 +92,10 @@ pub static ENTRY: MethodEntry = MethodEntry {
         geometry_transmittance: false,
         ..Needs::PLAIN
     },
-    check: |o| density(o).map(|_| ()),
+    check: |o| {
+        density(o)?;
+        o.parse::<Profile>("profile").map(|_| ())
+    },
     build: |s| Ok(Box::new(Reference::new(s)?)),
     no_msaa: Some("the ground truth renders its own single-sample surface and gathers over it, so its frame would alias whatever --msaa says; it is the reference, not a mode to antialias"),
     no_mix: |_| None,
@@ -182,9 +199,23 @@ pub struct Reference {
     /// The samples in grid order (for CPU checks).
     pub surface: Vec<SurfaceSample>,
     pub density: f32,
+    /// The profile integrated.
+    pub profile: Profile,
 }
 
 impl Reference {
+    /// The narrow, gather and resolve shaders of the profile.
+    fn shaders(&self) -> [&'static str; 3] {
+        match self.profile {
+            Profile::SixGaussian => [NARROW_SHADER, GATHER_SHADER, RESOLVE_SHADER],
+            Profile::Burley => [
+                BURLEY_NARROW_SHADER,
+                BURLEY_GATHER_SHADER,
+                BURLEY_RESOLVE_SHADER,
+            ],
+        }
+    }
+
     /// Subsamples per pixel per axis of the narrow part's surface.
     pub fn supersampling(&self) -> u32 {
         self.surf.s
@@ -193,6 +224,7 @@ impl Reference {
     fn new(s: &mut MethodSetup) -> Result<Self> {
         let r = Reference {
             density: density(&s.options)?,
+            profile: s.options.parse("profile")?,
             instances: s.instances.to_vec(),
             ..Default::default()
         };
@@ -243,6 +275,7 @@ impl SssMethod for Reference {
             "supersampling": self.surf.s,
             "narrow_window_radius": self.surf.max_radius,
             "tissue_tolerance": TISSUE_TOLERANCE,
+            "profile": self.profile.name(),
         })
     }
 

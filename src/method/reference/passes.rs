@@ -4,9 +4,10 @@
 
 use ash::vk;
 
-use super::{Reference, GATHER_SHADER, GROUP, NARROW_SHADER, RESOLVE_SHADER, SURFACE_SHADER};
+use super::{Reference, GROUP, SURFACE_SHADER};
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext, SetRef};
+use crate::method::profile::Profile;
 use crate::method::screen::fetch;
 use crate::method::FrameView;
 use crate::reference::chunks::RADIANCE_WIDTH;
@@ -196,10 +197,16 @@ impl Reference {
     pub(super) fn resolve_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let t = f.targets;
         let extent = f.extent;
+        let shader = self.shaders()[2];
+        // The six Gaussians' resolve loops over the wide ones; Burley's has no loop.
+        let trips: &[u32] = match self.profile {
+            Profile::SixGaussian => &[WIDE_GAUSSIANS as u32],
+            Profile::Burley => &[],
+        };
         let work = ShaderWork {
-            shader: RESOLVE_SHADER.into(),
+            shader: shader.into(),
             fetches: vec![fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0)],
-            alu: alu_estimate(RESOLVE_SHADER, &[WIDE_GAUSSIANS as u32]),
+            alu: alu_estimate(shader, trips),
             storage_read_bytes: 64.0,
             storage_write_bytes: 16.0,
         };
@@ -221,8 +228,16 @@ impl Reference {
             exact: false,
             ..fetch(f.res, image, texture, Filter::Point, count)
         };
+        let shader = self.shaders()[0];
+        // Burley's weight of a cell near the point loops over its 4x4 parts
+        // (counted for every subsample of the window: a bound).
+        let parts = crate::reference::burley::CELL_PARTS as u32;
+        let trips = match self.profile {
+            Profile::SixGaussian => vec![side as u32, side as u32, NARROW as u32, NARROW as u32],
+            Profile::Burley => vec![side as u32, side as u32, parts, parts],
+        };
         let work = ShaderWork {
-            shader: NARROW_SHADER.into(),
+            shader: shader.into(),
             fetches: vec![
                 fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
                 bound(t.linear_depth, "depthTex", 1.0),
@@ -230,10 +245,7 @@ impl Reference {
                 bound(sf.position, "surfPosition", window),
                 bound(sf.radiance, "surfRadiance", window + 1.0),
             ],
-            alu: alu_estimate(
-                NARROW_SHADER,
-                &[side as u32, side as u32, NARROW as u32, NARROW as u32],
-            ),
+            alu: alu_estimate(shader, &trips),
             storage_write_bytes: 16.0,
             ..Default::default()
         };
@@ -262,8 +274,14 @@ impl Reference {
             )
         };
         let candidates = self.max_candidates as f64;
+        let shader = self.shaders()[1];
+        let per_slab = self.max_candidates.div_ceil(3);
+        let trips = match self.profile {
+            Profile::SixGaussian => vec![3, per_slab, WIDE_GAUSSIANS as u32],
+            Profile::Burley => vec![3, per_slab],
+        };
         let work = ShaderWork {
-            shader: GATHER_SHADER.into(),
+            shader: shader.into(),
             fetches: vec![
                 fetch(f.res, t.diffuse, "diffuseTex", Filter::Point, 1.0),
                 Fetch {
@@ -279,10 +297,7 @@ impl Reference {
                     ..fetch(f.res, c.radiance, "radianceTex", Filter::Point, candidates)
                 },
             ],
-            alu: alu_estimate(
-                GATHER_SHADER,
-                &[3, self.max_candidates.div_ceil(3), WIDE_GAUSSIANS as u32],
-            ),
+            alu: alu_estimate(shader, &trips),
             // Positions and normals of the candidates, cell ranges, the output.
             storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
             storage_write_bytes: 48.0,

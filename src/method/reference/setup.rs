@@ -6,10 +6,11 @@ use anyhow::{bail, Result};
 use ash::vk;
 
 use super::{
-    sample_budget, Chunk, Reference, Surface, GATHER_SHADER, IRRADIANCE_SHADER, NARROW_SHADER,
-    RESOLVE_SHADER, SURFACE_DEPTH, SURFACE_FORMAT, SURFACE_SHADER,
+    sample_budget, Chunk, Reference, Surface, IRRADIANCE_SHADER, SURFACE_DEPTH, SURFACE_FORMAT,
+    SURFACE_SHADER,
 };
 use crate::graph::ImageDesc;
+use crate::method::profile::Profile;
 use crate::method::MethodSetup;
 use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
@@ -101,9 +102,10 @@ impl Reference {
                 blend: crate::vk::pipeline::Blend::None,
             },
         )?;
-        self.narrow = Pipeline::compute(s.ctx, "reference narrow", NARROW_SHADER)?;
-        self.gather = Pipeline::compute(s.ctx, "reference gather", GATHER_SHADER)?;
-        self.resolve = Pipeline::compute(s.ctx, "reference resolve", RESOLVE_SHADER)?;
+        let [narrow, gather, resolve] = self.shaders();
+        self.narrow = Pipeline::compute(s.ctx, "reference narrow", narrow)?;
+        self.gather = Pipeline::compute(s.ctx, "reference gather", gather)?;
+        self.resolve = Pipeline::compute(s.ctx, "reference resolve", resolve)?;
         let inv_view = s.view.camera.view().inverse().to_cols_array_2d();
         let view = [s.view.tan_half_fovy(), s.view.aspect(), mm, cutoff_mm()];
         let p = GatherParams {
@@ -261,7 +263,10 @@ impl Reference {
             position: s.res.declare(desc("position", SURFACE_FORMAT)),
             normal: s.res.declare(desc("normal", SURFACE_FORMAT)),
             depth: s.res.declare(desc("depth", SURFACE_DEPTH)),
-            max_radius: radius(px_per_mm, ss),
+            max_radius: match self.profile {
+                Profile::SixGaussian => radius(px_per_mm, ss),
+                Profile::Burley => crate::reference::burley::radius(px_per_mm, ss),
+            },
             mm_per_subsample_per_depth: crate::view::ViewScale {
                 height_px: extent.height,
                 ..s.view.scale()

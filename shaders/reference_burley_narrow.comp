@@ -1,0 +1,81 @@
+#version 450
+#extension GL_EXT_samplerless_texture_functions : require
+#extension GL_GOOGLE_include_directive : require
+// Ground truth of Burley's profile, the near part: R(r) for r < BURLEY_NEAR_MM
+// summed over the supersampled visible skin surface, through tissue only,
+// normalised per channel by its weights, times A F(r_c) (src/reference/burley.rs;
+// src/reference/mirror.rs's gather_f64_burley mirrors this). Subsamples near
+// the pixel's point weigh their cell's integral of R (the 1/r singularity).
+// Writes every pixel: skin gets the near part (the gather passes add the far
+// part), other pixels the diffuse light.
+#include "fetch_count.glsl"
+#include "shader_constants.glsl"
+#include "view_scale.glsl"
+layout(local_size_x = COMPUTE_GROUP_SIDE, local_size_y = COMPUTE_GROUP_SIDE) in;
+layout(set = 0, binding = 0) uniform texture2D diffuseTex;   // alpha = SSS strength
+layout(set = 0, binding = 1) uniform texture2D depthTex;     // linear view depth
+layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D outImage;
+layout(set = 0, binding = 3) uniform texture2D surfRadiance;
+layout(set = 0, binding = 4) uniform texture2D surfPosition;  // xyz, w: area (mm^2), 0: none
+layout(set = 0, binding = 5) uniform texture2D surfNormal;
+layout(set = 0, binding = 6) uniform NarrowParams {
+    mat4 invView;
+    vec4 view;      // x: tan(fovy/2), y: aspect, z: mm per unit, w: tissue tolerance
+    uvec4 surface;  // x: subsamples per pixel per axis, y: largest window radius
+} params;
+
+#include "reference_burley.glsl"
+
+#define TISSUE_MM_PER_UNIT params.view.z
+#define TISSUE_TOLERANCE_VALUE params.view.w
+#include "tissue.glsl"
+
+void main() {
+    COUNT_INVOCATION();
+    ivec2 size = textureSize(diffuseTex, 0);
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= size.x || p.y >= size.y) return;
+    vec4 d0 = COUNTED(SITE(0, 0, FK_POINT), texelFetch(diffuseTex, p, 0));
+    if (d0.a <= 0.0) {
+        imageStore(outImage, p, d0);
+        return;
+    }
+    float z = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, p, 0)).r;
+    vec2 ndc = (vec2(p) + 0.5) / vec2(size) * 2.0 - 1.0;
+    vec3 viewPos = vec3(ndc.x * params.view.x * params.view.y * z, -ndc.y * params.view.x * z, -z);
+    vec3 xo = (params.invView * vec4(viewPos, 1.0)).xyz;
+    int s = int(params.surface.x);
+    ivec2 c = p * s + s / 2;
+    ivec2 ssize = textureSize(surfPosition, 0);
+    vec3 no = COUNTED(SITE(0, 5, FK_POINT), texelFetch(surfNormal, c, 0)).xyz;
+    float mm = params.view.z;
+    float pxPerMm = PX_PER_MM(float(size.y), z, params.view.x, mm);
+    int r = int(min(max(ceil(BURLEY_NEAR_MM * pxPerMm * float(s)), 1.0), float(params.surface.y)));
+    // The pixel's point on the subsample grid.
+    vec2 g = (vec2(p) + 0.5) * float(s);
+    vec3 sum = vec3(0.0);
+    vec3 norm = vec3(0.0);
+    for (int qy = c.y - r; qy <= c.y + r; qy++) {
+        for (int qx = c.x - r; qx <= c.x + r; qx++) {
+            ivec2 q = ivec2(qx, qy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ssize))) continue;
+            vec4 pa = COUNTED(SITE(0, 4, FK_POINT), texelFetch(surfPosition, q, 0));
+            if (pa.w <= 0.0) continue;
+            vec3 nq = COUNTED(SITE(0, 5, FK_POINT), texelFetch(surfNormal, q, 0)).xyz;
+            if (!throughTissue(xo, no, pa.xyz, nq)) continue;
+            vec3 dv = (pa.xyz - xo) * mm;
+            float r2 = dot(dv, dv);
+            if (r2 >= BURLEY_NEAR_MM * BURLEY_NEAR_MM) continue;
+            vec3 L = COUNTED(SITE(0, 3, FK_POINT), texelFetch(surfRadiance, q, 0)).rgb;
+            vec2 o = vec2(q) + 0.5 - g;
+            float h = sqrt(pa.w);
+            vec3 e = burleyInCellReach(o.x, o.y) ? burleyCellWeight(o.x, o.y, h) : burleyRingWeight(sqrt(r2), h);
+            norm += e;
+            sum += e * L;
+        }
+    }
+    vec3 Lc = COUNTED(SITE(0, 3, FK_POINT), texelFetch(surfRadiance, c, 0)).rgb;
+    vec3 nearW = BURLEY_ALBEDO * (1.0 - (0.25 * exp(-BURLEY_S * BURLEY_NEAR_MM) + 0.75 * exp(-BURLEY_S * BURLEY_NEAR_MM / 3.0)));
+    vec3 near = mix(Lc, sum / max(norm, vec3(1e-30)), greaterThan(norm, vec3(0.0)));
+    imageStore(outImage, p, vec4(nearW * near, d0.a));
+}
