@@ -155,6 +155,12 @@ pub struct ShaderWork {
     /// Bytes read from and written to storage buffers/images per invocation.
     pub storage_read_bytes: f64,
     pub storage_write_bytes: f64,
+    /// Bytes of workgroup shared memory every invocation reads or writes
+    /// (a compute blur loading its tile and apron; the taps' reads behind
+    /// the skin test are not in it, so a floor built on it stays a floor;
+    /// 0 in reports from before issue 28).
+    #[serde(default)]
+    pub shared_bytes: f64,
 }
 
 /// The work of a pass.

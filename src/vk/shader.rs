@@ -288,10 +288,10 @@ mod tests {
                 }
             }
         }
-        // Eleven shaders (three of the ground truth, seven of the compute
-        // path, the compute ceiling probe), each also in its fetch-counting
-        // build.
-        assert_eq!(seen, 22);
+        // Twelve shaders (three of the ground truth, seven of the compute
+        // path, the compute ceiling probes of fetches and of shared memory),
+        // each also in its fetch-counting build.
+        assert_eq!(seen, 24);
     }
 
     #[test]
