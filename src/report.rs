@@ -235,6 +235,10 @@ pub struct Ceilings {
     pub triangles_depth_gtris: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub triangles_geometry_gtris: Option<f64>,
+    /// Bytes a second of a whole-image RGBA16F copy (`vkCmdCopyImage`, as
+    /// the seed copies and MLAA's copy), giga-bytes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub copy_gbytes: Option<f64>,
 }
 
 /// The compute path's measured rates (giga-taps or giga-stores a second).
@@ -263,9 +267,9 @@ impl Ceilings {
         });
         format!(
             "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}{compute}\n\
-             raster: bilinear rgba8 {} Gtap/s, point rgba8 {}, pcf d32 {}; depth-only fill d32 {} Gpix/s, geometry MRT fill {}; triangles depth-only {} Gtri/s, geometry attachments {}",
+             raster: bilinear rgba8 {} Gtap/s, point rgba8 {}, pcf d32 {}; depth-only fill d32 {} Gpix/s, geometry MRT fill {}; triangles depth-only {} Gtri/s, geometry attachments {}; copy {} GB/s",
             self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, rate(self.fill_rgba8_gpix), rate(self.blend_rgba16f_gpix),
-            rate(self.bilinear_rgba8_gtaps), rate(self.point_rgba8_gtaps), rate(self.pcf_d32_gtaps), rate(self.fill_depth_d32_gpix), rate(self.fill_geometry_mrt_gpix), rate(self.triangles_depth_gtris), rate(self.triangles_geometry_gtris)
+            rate(self.bilinear_rgba8_gtaps), rate(self.point_rgba8_gtaps), rate(self.pcf_d32_gtaps), rate(self.fill_depth_d32_gpix), rate(self.fill_geometry_mrt_gpix), rate(self.triangles_depth_gtris), rate(self.triangles_geometry_gtris), rate(self.copy_gbytes)
         )
     }
 }

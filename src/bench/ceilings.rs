@@ -5,7 +5,7 @@
 //! writes the frame makes (RGBA16F, RGBA16F blended, RGBA8, the geometry
 //! pass's attachments at once, the shadow map's depth alone), on the fragment
 //! path; the rasteriser's triangle rate in the shadow and the geometry pass's
-//! states (probe_triangles.vert); the same fetches, RGBA16F storage stores and
+//! states (probe_triangles.vert); the copy rate of an RGBA16F image; the same fetches, RGBA16F storage stores and
 //! shared-memory loads on the compute path (probe_fetch.comp,
 //! probe_shared.comp, in the compute blurs' 16x16 groups).
 
@@ -14,7 +14,7 @@ use ash::vk;
 
 use super::floor::{Ceilings, ComputeCeilings};
 use crate::graph::draw::fullscreen;
-use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
+use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
 use crate::graph::DepthStencil;
 use crate::graph::{
     record_passes, Binding, ColorTarget, GraphSet, ImageDesc, ImageId, Load, Pass, PassContext,
@@ -58,6 +58,8 @@ enum Draw {
     Triangles(Vec<ColorTarget>, DepthStencil),
     /// One invocation per pixel in 16x16 groups (its set binds the target).
     Dispatch,
+    /// A copy of the whole first image into the second (as a seed copy).
+    Copy(ImageId, ImageId),
 }
 
 /// What a probe's rate counts per pixel of the extent.
@@ -208,6 +210,8 @@ fn probe_all(
         (id_ds, AccessKind::DepthStencilWrite),
         (id_depth, AccessKind::DepthStencilWrite),
         (id_depth, AccessKind::FragmentSampledRead),
+        (id_target, AccessKind::TransferRead),
+        (id_specular, AccessKind::TransferWrite),
     ]);
     res.allow(&allowed);
     res.create(ctx)?;
@@ -462,6 +466,10 @@ fn probe_all(
             },
         ),
         (
+            "copy rgba16f",
+            fill_probe(fill, "", Draw::Copy(id_target, id_specular), Unit::Taps),
+        ),
+        (
             "compute shared loads",
             Probe {
                 pipeline: shared_cs,
@@ -536,7 +544,7 @@ fn ceilings_from(
                 bilinear_r32f_gtaps: r(9),
                 point_r32f_gtaps: r(10),
                 store_rgba16f_gpix: r(11),
-                shared_load_gbytes: Some(r(19)),
+                shared_load_gbytes: Some(r(20)),
             }),
             bilinear_rgba8_gtaps: Some(r(12)),
             point_rgba8_gtaps: Some(r(13)),
@@ -545,6 +553,8 @@ fn ceilings_from(
             triangles_geometry_gtris: Some(r(16)),
             triangles_depth_gtris: Some(r(17)),
             pcf_d32_gtaps: Some(r(18)),
+            // Texels of 8 bytes a second, as bytes.
+            copy_gbytes: Some(8.0 * r(19)),
         },
         results,
     )
@@ -653,6 +663,29 @@ impl<'p> Probe<'p> {
         };
         let shaded = (!self.shader.is_empty()).then_some(work.clone());
         match &self.draw {
+            &Draw::Copy(from, to) => {
+                let src = pass.transfer_src(from);
+                let dst = pass.transfer_dst(to);
+                pass.work(Work::Copy {
+                    texels: u64::from(extent.width) * u64::from(extent.height),
+                    bytes_per_texel: 8,
+                    rects: 1,
+                })
+                .record(move |pc: &PassContext| {
+                    let layers = vk::ImageSubresourceLayers::default()
+                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .layer_count(1);
+                    let copy = vk::ImageCopy::default()
+                        .src_subresource(layers)
+                        .dst_subresource(layers)
+                        .extent(vk::Extent3D {
+                            width: extent.width,
+                            height: extent.height,
+                            depth: 1,
+                        });
+                    pc.copy_image(src, dst, &[copy]);
+                })
+            }
             Draw::Dispatch => {
                 let set = set.expect("a compute probe binds its target");
                 let side = SSS_TILE_SIDE;

@@ -11,7 +11,8 @@
 //!   attachment after another), and its triangles at the probed set-up rate;
 //! - a dispatch: its exact fetches at the compute path's rates and the
 //!   shared memory every invocation moves at the probed shared-memory
-//!   bandwidth.
+//!   bandwidth;
+//! - a copy: its bytes at the probed copy bandwidth.
 //!
 //! Work no probe measured, and fetches declared as bounds (behind a branch),
 //! are left out, so the floor stays a floor; a pass where nothing is left
@@ -48,9 +49,19 @@ pub fn pass_floor(work: Option<&Work>, counts: Counts, c: &Ceilings) -> Result<f
         Some(w @ Work::Raster { .. }) => raster_floor_ms(w, counts, c).ok_or_else(|| {
             "none of its work is of a probed kind (unprobed formats, or fetches only behind branches)".into()
         }),
-        Some(Work::Copy { .. }) => Err(
-            "a copy: no probe measures the copy path (its bytes at the fill or store rate would not bound it)".into(),
-        ),
+        Some(Work::Copy {
+            texels,
+            bytes_per_texel,
+            ..
+        }) => match c.copy_gbytes {
+            // Its bytes at the probed RGBA16F copy's bandwidth (a smaller
+            // texel copies no faster per byte; each rectangle's fixed cost
+            // is left out).
+            Some(rate) if rate > 0.0 => {
+                Ok(*texels as f64 * f64::from(*bytes_per_texel) / (rate * 1e9) * 1e3)
+            }
+            _ => Err("a copy, and the copy rate was not probed".into()),
+        },
         Some(Work::Clear {
             texels,
             bytes_per_texel,
@@ -450,6 +461,14 @@ mod tests {
         assert_eq!(floor_ms(&copy, 100, &h100_like()), None);
         let why = pass_floor(Some(&copy), Counts::default(), &h100_like()).unwrap_err();
         assert!(why.contains("copy"), "{why}");
+        // With the copy probed: its bytes at the copy bandwidth, 80 B at
+        // 400 GB/s.
+        let probed = Ceilings {
+            copy_gbytes: Some(400.0),
+            ..h100_like()
+        };
+        let ms = pass_floor(Some(&copy), Counts::default(), &probed).unwrap();
+        assert!((ms - 80.0 / 400e9 * 1e3).abs() < 1e-15, "{ms}");
         let clear = Work::Clear {
             texels: 4,
             bytes_per_texel: 4,
