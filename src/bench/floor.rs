@@ -288,6 +288,7 @@ mod tests {
             fill_geometry_mrt_gpix: Some(2.0),
             triangles_depth_gtris: Some(4.0),
             triangles_geometry_gtris: Some(2.0),
+            copy_gbytes: None,
         }
     }
 
