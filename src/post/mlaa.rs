@@ -111,7 +111,7 @@ impl Variant for Mlaa {
             } else {
                 EdgeInput::Frame
             },
-            edges_fetches: (5.0, true),
+            edges_fetches: (5.0, 0.0),
             weights_shader: WEIGHTS_SHADER,
             weights_bilinear: 2.0 * per_edgel,
             // Four searches (two per edgel), each loop at most `steps` trips.

@@ -83,8 +83,10 @@ pub struct Spec {
     pub name: &'static str,
     pub edges_shader: &'static str,
     pub edges_input: EdgeInput,
-    /// Pass 1's point fetches per pixel, and whether every pixel makes them all.
-    pub edges_fetches: (f64, bool),
+    /// Pass 1's point fetches per pixel: those every pixel makes, and at
+    /// most how many more the pixels it keeps make (declared apart, so the
+    /// first count floors the pass: `bench::floor`).
+    pub edges_fetches: (f64, f64),
     pub weights_shader: &'static str,
     /// The most bilinear edge fetches pass 2 makes per pixel (its searches).
     pub weights_bilinear: f64,
@@ -253,18 +255,23 @@ impl Morphological {
             EdgeInput::Depth => ("depthTex", res.texel_format(self.depth)),
             EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm),
         };
-        let (count, exact) = self.spec.edges_fetches;
+        let (every, more) = self.spec.edges_fetches;
+        let point = |count, exact| Fetch {
+            texture: texture.into(),
+            format,
+            filter: Filter::Point,
+            count,
+            exact,
+            coherent: true,
+            spread: Vec::new(),
+        };
+        let mut fetches = vec![point(every, true)];
+        if more > 0.0 {
+            fetches.push(point(more, false));
+        }
         let work = ShaderWork {
             shader: self.spec.edges_shader.into(),
-            fetches: vec![Fetch {
-                texture: texture.into(),
-                format,
-                filter: Filter::Point,
-                count,
-                exact,
-                coherent: true,
-                spread: Vec::new(),
-            }],
+            fetches,
             alu: alu_estimate(self.spec.edges_shader, &[]),
             ..Default::default()
         };

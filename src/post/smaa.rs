@@ -131,7 +131,7 @@ impl Variant for Smaa {
                 EDGES_SHADER
             },
             edges_input: EdgeInput::Frame,
-            edges_fetches: (7.0, false),
+            edges_fetches: (3.0, 4.0),
             weights_shader: WEIGHTS_SHADER,
             weights_bilinear: weights_bilinear_bound(self.preset),
             weights_loops: loop_trips(self.preset).to_vec(),
