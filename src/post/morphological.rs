@@ -103,7 +103,16 @@ pub struct Spec {
 /// pass's pipeline is bound.
 pub trait Variant {
     fn spec(&self) -> Spec;
-    fn push_edges(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: &Pipeline);
+    /// Pass 1's push constants; `last` is its input's last texel (size - 1),
+    /// pushed rather than queried per fetch: a size query is a texture-unit
+    /// instruction on NVIDIA (docs/perf/issue28/floors.md).
+    fn push_edges(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        last: [i32; 2],
+    );
     fn push_weights(&self, _ctx: &Context, _cmd: vk::CommandBuffer, _pipeline: &Pipeline) {}
 }
 
@@ -251,10 +260,12 @@ impl Morphological {
 
     /// Pass 1: every pixel runs, edge pixels are written (colour and stencil).
     fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let (texture, format) = match self.spec.edges_input {
-            EdgeInput::Depth => ("depthTex", res.texel_format(self.depth)),
-            EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm),
+        let (texture, format, input) = match self.spec.edges_input {
+            EdgeInput::Depth => ("depthTex", res.texel_format(self.depth), self.depth),
+            EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm, self.input),
         };
+        let e = res.extent(input);
+        let last = [e.width as i32 - 1, e.height as i32 - 1];
         let (every, more) = self.spec.edges_fetches;
         let point = |count, exact| Fetch {
             texture: texture.into(),
@@ -296,7 +307,7 @@ impl Morphological {
                             STENCIL_EDGE,
                         )
                     };
-                    variant.push_edges(c, cmd, pipeline);
+                    variant.push_edges(c, cmd, pipeline, last);
                 })
             })
     }
