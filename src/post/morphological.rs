@@ -413,8 +413,14 @@ impl Morphological {
                 .depth_stencil(self.stencil_test()),
             BlendOn::Every => pass.color(ColorTarget::new(self.output, Load::DontCare)),
         };
-        pass.draws(Some(work), 1)
-            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
+        // The frame's last texel, pushed rather than queried per pixel (see
+        // `Variant::push_edges`); the weights have the frame's size.
+        let e = res.extent(self.input);
+        debug_assert_eq!(e, res.extent(self.weights));
+        let last = [e.width as i32 - 1, e.height as i32 - 1];
+        pass.draws(Some(work), 1).record(move |pc: &PassContext| {
+            fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &last))
+        })
     }
 
     fn stencil_test(&self) -> DepthStencil {
