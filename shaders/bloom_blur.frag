@@ -10,6 +10,8 @@ layout(set = 0, binding = 0) uniform texture2D srcTex;
 layout(push_constant) uniform Push {
     float weights[BLOOM_BLUR_RADIUS + 1];  // offsets 0..R, the same either side
     ivec2 dir;                             // (1, 0) horizontal, (0, 1) vertical
+    ivec2 hi;                              // the level's last texel (size - 1): pushed,
+                                           // not queried (see bloom_combine.frag)
 } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
@@ -17,7 +19,7 @@ layout(location = 0) out vec4 outColor;
 void main() {
     COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    ivec2 hi = textureSize(srcTex, 0) - 1;
+    ivec2 hi = pc.hi;
     vec4 acc = vec4(0.0);
     for (int i = -BLOOM_BLUR_RADIUS; i <= BLOOM_BLUR_RADIUS; i++) {
         ivec2 q = clamp(p + i * pc.dir, ivec2(0), hi);

@@ -9,6 +9,10 @@
 // the CPU mirror does.
 layout(set = 0, binding = 0) uniform texture2D srcTex;
 layout(set = 0, binding = 1) uniform sampler linearClamp;
+// The source's size in texels (textureSize's, as floats): pushed, not
+// queried, since a size query costs a texture-unit instruction per pixel on
+// NVIDIA (see bloom_combine.frag).
+layout(push_constant) uniform Push { vec2 srcSize; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
@@ -18,7 +22,7 @@ vec4 at(vec2 texel, vec2 size) {
 
 void main() {
     COUNT_INVOCATION();
-    vec2 size = vec2(textureSize(sampler2D(srcTex, linearClamp), 0));
+    vec2 size = pc.srcSize;
     // The centre of texel 2m below, in texel units (centres at i + 0.5).
     vec2 c = 2.0 * floor(gl_FragCoord.xy) + 0.5;
     vec4 s = (at(c + vec2(-0.5, -0.5), size) + at(c + vec2(0.5, -0.5), size))

@@ -34,6 +34,9 @@ const int STEPS = 5;
 const float STEP_LENGTH[STEPS] = float[](1.0, 1.5, 2.0, 4.0, 12.0);
 
 ivec2 lastTexel;
+// The frame's last texel (its size - 1), pushed: a size query is a
+// texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
+layout(push_constant) uniform Push { ivec2 last; } pc;
 
 float lumaAtTexel(ivec2 p) {
     ivec2 q = clamp(p, ivec2(0), lastTexel);
@@ -49,7 +52,7 @@ float lumaAt(vec2 pixel) {
 
 void main() {
     COUNT_INVOCATION();
-    lastTexel = textureSize(colorTex, 0) - 1;
+    lastTexel = pc.last;
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec4 colorM = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, p, 0));
     float m = lumaAtTexel(p);

@@ -15,18 +15,21 @@ layout(early_fragment_tests) in;
 layout(set = 0, binding = 0) uniform texture2D colorTex;    // tone-mapped frame, sRGB
 layout(set = 0, binding = 1) uniform texture2D weightsTex;  // pass 2's areas
 layout(set = 0, binding = 2) uniform sampler linearClamp;
+// The frame's (and the weights') last texel, pushed: a size query is a
+// texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
+layout(push_constant) uniform Push { ivec2 last; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 vec4 colorAt(vec2 pixel) {
-    vec2 uv = pixel / vec2(textureSize(colorTex, 0));
+    vec2 uv = pixel / vec2(pc.last + 1);
     return COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorTex, linearClamp), uv, 0.0));
 }
 
 void main() {
     COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    ivec2 last = textureSize(weightsTex, 0) - 1;
+    ivec2 last = pc.last;
     vec4 topLeft = COUNTED(SITE(0, 1, FK_POINT), texelFetch(weightsTex, p, 0));
     float bottom = COUNTED(SITE(0, 1, FK_POINT), texelFetch(weightsTex, min(p + ivec2(0, 1), last), 0)).g;
     float right = COUNTED(SITE(0, 1, FK_POINT), texelFetch(weightsTex, min(p + ivec2(1, 0), last), 0)).a;

@@ -10,12 +10,14 @@
 // fragment must not write the stencil. Reads clamp at the border (as
 // src/aa/edges.rs does), so a border pixel never has an edgel toward outside.
 layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, its UNORM view: encoded values
-layout(push_constant) uniform Push { float threshold; } pc;
+layout(push_constant) uniform Push { float threshold; ivec2 last; } pc;
+// `last` is the input's last texel (textureSize - 1), pushed: a size query per
+// fetch is a texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outEdges;
 
 float lumaAt(ivec2 p) {
-    ivec2 q = clamp(p, ivec2(0), textureSize(colorTex, 0) - 1);
+    ivec2 q = clamp(p, ivec2(0), pc.last);
     return lumaOf(COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb);
 }
 

@@ -9,12 +9,14 @@
 // a pixel none of whose four boundaries is an edge is discarded, so the
 // stencil marks the pixels passes 2 and 3 run on; reads clamp at the border.
 layout(set = 0, binding = 0) uniform texture2D depthTex;  // linear view depth, R32F
-layout(push_constant) uniform Push { float threshold; } pc;
+layout(push_constant) uniform Push { float threshold; ivec2 last; } pc;
+// `last` is the input's last texel (textureSize - 1), pushed: a size query per
+// fetch is a texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outEdges;
 
 float depthAt(ivec2 p) {
-    ivec2 q = clamp(p, ivec2(0), textureSize(depthTex, 0) - 1);
+    ivec2 q = clamp(p, ivec2(0), pc.last);
     return COUNTED(SITE(0, 0, FK_POINT), texelFetch(depthTex, q, 0)).r;
 }
 

@@ -10,13 +10,16 @@
 layout(set = 0, binding = 0) uniform texture2D colorTex;    // tone-mapped frame, sRGB
 layout(set = 0, binding = 1) uniform texture2D weightsTex;  // pass 2's weights
 layout(set = 0, binding = 2) uniform sampler linearClamp;
+// The frame's (and the weights') last texel, pushed: a size query is a
+// texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
+layout(push_constant) uniform Push { ivec2 last; } pc;
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 void main() {
     COUNT_INVOCATION();
     ivec2 p = ivec2(gl_FragCoord.xy);
-    ivec2 last = textureSize(weightsTex, 0) - 1;
+    ivec2 last = pc.last;
     vec2 size = vec2(last + 1);
     vec4 a;
     a.x = COUNTED(SITE(0, 1, FK_POINT), texelFetch(weightsTex, min(p + ivec2(1, 0), last), 0)).a;  // right

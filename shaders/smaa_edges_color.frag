@@ -9,12 +9,14 @@
 // with neither a left nor a top edgel (the stencil marks the rest), and the
 // local contrast adaptation against the largest of the six deltas around.
 layout(set = 0, binding = 0) uniform texture2D colorTex;  // tone-mapped frame, its UNORM view: encoded values
-layout(push_constant) uniform Push { float threshold; float adaptation; } pc;
+layout(push_constant) uniform Push { float threshold; float adaptation; ivec2 last; } pc;
+// `last` is the input's last texel (textureSize - 1), pushed: a size query per
+// fetch is a texture-unit instruction on NVIDIA (docs/perf/issue28/floors.md).
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outEdges;
 
 vec3 colorAt(ivec2 p) {
-    ivec2 q = clamp(p, ivec2(0), textureSize(colorTex, 0) - 1);
+    ivec2 q = clamp(p, ivec2(0), pc.last);
     return COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, q, 0)).rgb;
 }
 

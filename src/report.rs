@@ -191,7 +191,9 @@ impl Report {
 
 /// Rates measured by the ceiling probes, in giga-operations per second
 /// (`bench::ceilings` measures them, `bench::floor` prices passes with them).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// Fields added after the first reports are `Option`s: `None` in a report
+/// from before their probe (or on a device without the feature).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Ceilings {
     pub bilinear_rgba16f_gtaps: f64,
     pub point_rgba16f_gtaps: f64,
@@ -209,31 +211,65 @@ pub struct Ceilings {
     /// `None` in reports from before they were probed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compute: Option<ComputeCeilings>,
+    /// Fetches of an RGBA8 texture (the AA passes' and the geometry pass's
+    /// maps), bilinear and point (issue 28).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bilinear_rgba8_gtaps: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_rgba8_gtaps: Option<f64>,
+    /// Depth-compare (2x2 PCF) fetches of a D32 depth image, the geometry
+    /// pass's shadow taps (probe_pcf.frag).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pcf_d32_gtaps: Option<f64>,
+    /// Depth-only fill of the shadow map's D32 format (no fragment shader).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fill_depth_d32_gpix: Option<f64>,
+    /// Pixels a second written with the geometry pass's attachments at once
+    /// (RGBA16F, RGBA16F, R32F and depth/stencil written; probe_fill_mrt.frag).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fill_geometry_mrt_gpix: Option<f64>,
+    /// Triangles a second that cover no sample (set-up and rasteriser alone;
+    /// probe_triangles.vert), into a D32 attachment with no fragment shader
+    /// (the shadow pass's state) and into the geometry pass's attachments.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles_depth_gtris: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles_geometry_gtris: Option<f64>,
+    /// Bytes a second of a whole-image RGBA16F copy (`vkCmdCopyImage`, as
+    /// the seed copies and MLAA's copy), giga-bytes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub copy_gbytes: Option<f64>,
 }
 
 /// The compute path's measured rates (giga-taps or giga-stores a second).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ComputeCeilings {
     pub bilinear_rgba16f_gtaps: f64,
     pub point_rgba16f_gtaps: f64,
     pub bilinear_r32f_gtaps: f64,
     pub point_r32f_gtaps: f64,
     pub store_rgba16f_gpix: f64,
+    /// Shared-memory reads, giga-bytes a second (probe_shared.comp: 16-byte
+    /// loads, conflict-free, in 16x16 groups); `None` before issue 28.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shared_load_gbytes: Option<f64>,
 }
 
 impl Ceilings {
-    /// One line of the measured rates, for the bench printout.
+    /// The measured rates, for the bench printout.
     pub fn summary(&self) -> String {
         let rate = |v: Option<f64>| v.map_or("not measured".into(), |v| format!("{v:.2}"));
         let compute = self.compute.map_or(String::new(), |c| {
             format!(
-                "; compute: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, store rgba16f {:.2} Gpix/s",
-                c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.store_rgba16f_gpix
+                "; compute: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, store rgba16f {:.2} Gpix/s, shared loads {} GB/s",
+                c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.store_rgba16f_gpix, rate(c.shared_load_gbytes)
             )
         });
         format!(
-            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}{compute}",
-            self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, rate(self.fill_rgba8_gpix), rate(self.blend_rgba16f_gpix)
+            "ceilings: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}; fill rgba16f {:.2} Gpix/s, rgba8 {}, blended rgba16f {}{compute}\n\
+             raster: bilinear rgba8 {} Gtap/s, point rgba8 {}, pcf d32 {}; depth-only fill d32 {} Gpix/s, geometry MRT fill {}; triangles depth-only {} Gtri/s, geometry attachments {}; copy {} GB/s",
+            self.bilinear_rgba16f_gtaps, self.point_rgba16f_gtaps, self.bilinear_r32f_gtaps, self.point_r32f_gtaps, self.fill_rgba16f_gpix, rate(self.fill_rgba8_gpix), rate(self.blend_rgba16f_gpix),
+            rate(self.bilinear_rgba8_gtaps), rate(self.point_rgba8_gtaps), rate(self.pcf_d32_gtaps), rate(self.fill_depth_d32_gpix), rate(self.fill_geometry_mrt_gpix), rate(self.triangles_depth_gtris), rate(self.triangles_geometry_gtris), rate(self.copy_gbytes)
         )
     }
 }
@@ -318,6 +354,9 @@ pub struct PassReport {
     pub floor_ms: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floor_ratio: Option<f64>,
+    /// Why a benched pass has no floor (bench only; `floor::no_floor_reason`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_floor: Option<String>,
     /// The pass's declared work per unit (see `graph::work`).
     #[serde(default)]
     pub work: Option<Work>,
@@ -380,6 +419,7 @@ pub fn aggregate(
                 samples_passed: frames.last().map(|f| f[i].samples_passed).unwrap_or(0),
                 floor_ms: None,
                 floor_ratio: None,
+                no_floor: None,
             }
         })
         .collect();
@@ -452,6 +492,12 @@ pub fn table(passes: &[PassReport], frame: Option<&FrameReport>) -> String {
                 "{:<18} {:>10.4} {:>10.4} {:>10.4}",
                 "cpu recording", c.median, c.min, c.p95
             );
+        }
+    }
+    // Every pass without a floor says why (issue 28: a floor for every pass).
+    for p in passes {
+        if let Some(why) = &p.no_floor {
+            let _ = writeln!(s, "no floor: {}: {why}", p.name);
         }
     }
     s

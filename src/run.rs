@@ -7,8 +7,8 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 
 use crate::bench::ceilings;
-use crate::bench::floor::{compute_floor_ms, floor_ms};
-use crate::graph::work::{PassRole, Work};
+use crate::bench::floor::{pass_floor, Counts};
+use crate::graph::work::PassRole;
 use crate::graph::PassSample;
 use crate::header::RunHeader;
 use crate::output::{
@@ -189,19 +189,20 @@ pub fn run_request(ctx: &Context, request: &FrameRequest, opts: &RunOptions) -> 
         let (c, p) = ceilings::measure(ctx, extent, 7).context("measuring device ceilings")?;
         for pass in &mut passes {
             // A dispatch is floored by its compute invocations at the compute
-            // rates, a raster pass by its fragments at the fragment rates.
-            let floor = match (
-                &pass.work,
-                pass.compute_invocations,
-                pass.fragment_invocations,
-            ) {
-                (Some(w @ Work::Compute { .. }), Some(inv), _) => compute_floor_ms(w, inv, &c),
-                (Some(w), _, Some(inv)) => floor_ms(w, inv, &c),
-                _ => None,
+            // rates, a raster pass by its fragments, samples and triangles at
+            // the fragment path's and the rasteriser's rates; a pass with no
+            // floor says why.
+            let counts = Counts {
+                fragments: pass.fragment_invocations,
+                compute: pass.compute_invocations,
+                samples_passed: pass.samples_passed,
             };
-            if let Some(f) = floor {
-                pass.floor_ms = Some(f);
-                pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
+            match pass_floor(pass.work.as_ref(), counts, &c) {
+                Ok(f) => {
+                    pass.floor_ms = Some(f);
+                    pass.floor_ratio = (f > 0.0).then(|| pass.gpu_ms.median / f);
+                }
+                Err(why) => pass.no_floor = Some(why),
             }
         }
         (Some(c), Some(p))

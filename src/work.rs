@@ -120,6 +120,10 @@ fn yes() -> bool {
     true
 }
 
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
 fn one() -> u32 {
     1
 }
@@ -155,6 +159,13 @@ pub struct ShaderWork {
     /// Bytes read from and written to storage buffers/images per invocation.
     pub storage_read_bytes: f64,
     pub storage_write_bytes: f64,
+    /// Bytes of workgroup shared memory every invocation reads or writes
+    /// (a compute blur loading its tile and apron; the taps' reads behind
+    /// the skin test are not in it, so a floor built on it stays a floor;
+    /// 0 in reports from before issue 28, and left out of a report when 0,
+    /// so older reports write back as they were).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shared_bytes: f64,
 }
 
 /// The work of a pass.

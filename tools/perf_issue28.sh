@@ -66,10 +66,10 @@ done
 # budgets, close-up and mid.
 for shot in close mid; do
   for n in 20 40 80; do
-    bench "1080-$shot-1-gather-$n" --width 1920 --height 1080 --shot $shot --method gather --samples $n $F
+    bench "1080-$shot-1-gather-$n" --width 1920 --height 1080 --shot $shot --method gather --sample-budget $n $F
   done
   bench "1080-$shot-1-gather-burley-40" --width 1920 --height 1080 --shot $shot --method gather \
-    --samples 40 --diffusion-profile burley $F
+    --sample-budget 40 --diffusion-profile burley $F
 done
 # The whole frame with bloom and SMAA (the passes without a floor yet: the
 # bloom's combine among them), on the compute path.

@@ -335,6 +335,7 @@ mod tests {
             samples_passed: 3000,
             floor_ms: None,
             floor_ratio: None,
+            no_floor: None,
             work: Some(work),
             images: vec![],
             group: None,

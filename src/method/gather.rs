@@ -36,7 +36,7 @@ const SHADER: &str = "gather.comp";
 
 const OPTIONS: &[OptSpec] = &[
     OptSpec {
-        key: "samples",
+        key: "sample-budget",
         kind: OptKind::Value,
         default: "40",
         help: "the most samples a pixel takes, 4..=1000 (HDRP's budgets: 20 low, 40 medium, 80 high); fewer where the profile covers few pixels (pi r_px^2 / 4)",
@@ -52,19 +52,19 @@ pub static ENTRY: MethodEntry = MethodEntry {
     eval: &[
         EvalSetting {
             label: "20 samples",
-            options: &[("samples", "20")],
+            options: &[("sample-budget", "20")],
         },
         EvalSetting {
             label: "40 samples",
-            options: &[("samples", "40")],
+            options: &[("sample-budget", "40")],
         },
         EvalSetting {
             label: "80 samples",
-            options: &[("samples", "80")],
+            options: &[("sample-budget", "80")],
         },
         EvalSetting {
             label: "burley, 40 samples",
-            options: &[("samples", "40"), (profile::KEY, "burley")],
+            options: &[("sample-budget", "40"), (profile::KEY, "burley")],
         },
     ],
     ground_truth: false,
@@ -86,10 +86,10 @@ pub struct Config {
 
 impl Config {
     pub fn parse(o: &Opts) -> Result<Self> {
-        let budget: u32 = o.parse("samples")?;
+        let budget: u32 = o.parse("sample-budget")?;
         if !BUDGET_RANGE.contains(&budget) {
             bail!(
-                "samples must be within {}..={}, got {budget}",
+                "sample-budget must be within {}..={}, got {budget}",
                 BUDGET_RANGE.start(),
                 BUDGET_RANGE.end()
             );
@@ -263,6 +263,8 @@ impl SssMethod for Gather {
             alu: alu_estimate(SHADER, &[mean as u32, 3]),
             storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
+            // No shared memory: the taps go through the texture units.
+            shared_bytes: 0.0,
         };
         let push = GatherPush {
             code: f.stencil,

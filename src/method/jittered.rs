@@ -166,6 +166,7 @@ impl Jittered {
             alu: alu_estimate(COMPUTE_SHADER, &[RING]),
             storage_read_bytes: 4.0 / super::tiles::TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
+            shared_bytes: 0.0,
         };
         let blur = tiles.pass("ss-jittered", f, 0, work, &self.pipeline, &self.set, push);
         let mut passes: Vec<Pass<'a>> = tiles.passes(f).into();

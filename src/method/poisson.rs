@@ -303,6 +303,7 @@ impl SssMethod for Poisson {
                 alu: alu_estimate(COMPUTE_SHADER, &[MAX_TAPS]),
                 storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
                 storage_write_bytes: 8.0,
+                shared_bytes: 0.0,
             };
             let push = PoissonPush {
                 code: f.stencil,

@@ -421,6 +421,7 @@ impl SssMethod for Ssg {
                         storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64
                             + if k == 1 { 8.0 } else { 0.0 },
                         storage_write_bytes: if k == 1 { 16.0 } else { 8.0 },
+                        shared_bytes: 0.0,
                     };
                     let pipeline = [&self.horizontal, &self.vertical][k];
                     let set = &self.compute_sets[gi][k];

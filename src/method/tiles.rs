@@ -254,6 +254,7 @@ impl SkinTiles {
             alu: alu_estimate(MERGE_SHADER, &[]),
             storage_read_bytes: 4.0 / TILE_INVOCATIONS as f64,
             storage_write_bytes: 8.0,
+            shared_bytes: 0.0,
         };
         Some(self.pass("sss merge", f, 0, work, pipeline, set, f.stencil))
     }
@@ -295,6 +296,7 @@ impl SkinTiles {
             // One tile in a workgroup appends itself (and its count).
             storage_read_bytes: 0.0,
             storage_write_bytes: 8.0 / TILE_INVOCATIONS as f64,
+            shared_bytes: 0.0,
         };
         let mut max_depth = [EVERY_DEPTH; SSS_MAX_TILE_LISTS];
         max_depth[..self.max_depth.len()].copy_from_slice(&self.max_depth);

@@ -44,13 +44,34 @@ const BLUR_TAPS: u32 = 2 * BLUR_RADIUS as u32 + 1;
 struct BlurPush {
     weights: [f32; BLUR_RADIUS + 1],
     dir: [i32; 2],
+    /// The source's last texel (its size - 1).
+    hi: [i32; 2],
+}
+
+/// The reduction's source size in texels.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DownPush {
+    src_size: [f32; 2],
 }
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct CombinePush {
     level_weights: [f32; LEVELS],
+    /// Each level's size in texels, two levels a vec4.
+    sizes: [[f32; 2]; LEVELS],
     strength: f32,
+}
+
+// Every shader here is handed its images' sizes rather than asking
+// `textureSize` per pixel: a size query runs on the texture unit on NVIDIA
+// (TXQ) and four of them cost the combine more than its fetches (issue 28;
+// docs/perf/issue28/floors.md). The pushed values are the queried ones, so
+// no coordinate changes.
+fn size_of(res: &Resources, id: ImageId) -> [f32; 2] {
+    let e = res.extent(id);
+    [e.width as f32, e.height as f32]
 }
 
 /// One level: its reduction, the horizontal pass's result and the blurred level.
@@ -181,13 +202,18 @@ impl Bloom {
                 ..Default::default()
             };
             let pipeline = &self.down_pipeline;
+            let push = DownPush {
+                src_size: size_of(res, below),
+            };
             let mut pass = Pass::new(format!("bloom down {}", i + 1), PassRole::Post);
             // Reads the level below (the composite for the first).
             let set = pass.set(&self.level_sets[i][0]);
             passes.push(
                 pass.color(ColorTarget::new(l.down, Load::DontCare))
                     .draws(Some(work), 1)
-                    .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {})),
+                    .record(move |pc: &PassContext| {
+                        fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &push))
+                    }),
             );
             below = l.down;
         }
@@ -211,7 +237,9 @@ impl Bloom {
                     ..Default::default()
                 };
                 let pipeline = &self.blur_pipeline;
-                let push = BlurPush { weights, dir };
+                let e = res.extent(src);
+                let hi = [e.width as i32 - 1, e.height as i32 - 1];
+                let push = BlurPush { weights, dir, hi };
                 let mut pass = Pass::new(format!("bloom blur {axis} {}", i + 1), PassRole::Post);
                 // Reads `src`.
                 let set = pass.set(set);
@@ -237,6 +265,7 @@ impl Bloom {
         };
         let push = CombinePush {
             level_weights: LEVEL_WEIGHTS,
+            sizes: std::array::from_fn(|k| size_of(res, self.levels[k].blurred)),
             strength: STRENGTH,
         };
         let pipeline = &self.combine_pipeline;

@@ -79,7 +79,8 @@ impl AaStage for Fxaa {
             shader: SHADER.into(),
             fetches: vec![
                 f("colorTex", srgb, Filter::Point, 1.0, true),
-                f("lumaTex", unorm, Filter::Point, 9.0, false),
+                f("lumaTex", unorm, Filter::Point, 5.0, true),
+                f("lumaTex", unorm, Filter::Point, 4.0, false),
                 f("lumaTex", unorm, Filter::Bilinear, 2.0 * steps, false),
                 f("colorTex", srgb, Filter::Bilinear, 1.0, false),
             ],
@@ -87,13 +88,19 @@ impl AaStage for Fxaa {
             ..Default::default()
         };
         let pipeline = &self.pipeline;
+        // The frame's last texel, pushed rather than queried per pixel (a
+        // texture-unit instruction on NVIDIA: docs/perf/issue28/floors.md).
+        let e = res.extent(self.input);
+        let last = [e.width as i32 - 1, e.height as i32 - 1];
         let mut pass = Pass::new("fxaa", PassRole::Post);
         // Reads the tone-mapped frame (and its UNORM view).
         let set = pass.set(&self.set);
         vec![pass
             .color(ColorTarget::new(self.output, Load::DontCare))
             .draws(Some(work), 1)
-            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))]
+            .record(move |pc: &PassContext| {
+                fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &last))
+            })]
     }
 
     fn output(&self) -> ImageId {

@@ -61,6 +61,9 @@ pub fn depth_threshold(mm_per_unit: f32) -> f32 {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct EdgesPush {
     threshold: f32,
+    /// std430 puts the ivec2 at offset 8.
+    pad: f32,
+    last: [i32; 2],
 }
 
 /// MLAA as the stage runs it: luma or depth edges and their threshold.
@@ -111,7 +114,7 @@ impl Variant for Mlaa {
             } else {
                 EdgeInput::Frame
             },
-            edges_fetches: (5.0, true),
+            edges_fetches: (5.0, 0.0),
             weights_shader: WEIGHTS_SHADER,
             weights_bilinear: 2.0 * per_edgel,
             // Four searches (two per edgel), each loop at most `steps` trips.
@@ -133,9 +136,17 @@ impl Variant for Mlaa {
         }
     }
 
-    fn push_edges(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: &Pipeline) {
+    fn push_edges(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        last: [i32; 2],
+    ) {
         let push = EdgesPush {
             threshold: self.threshold,
+            pad: 0.0,
+            last,
         };
         pipeline.push(ctx, cmd, &push);
     }

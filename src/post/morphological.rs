@@ -83,8 +83,10 @@ pub struct Spec {
     pub name: &'static str,
     pub edges_shader: &'static str,
     pub edges_input: EdgeInput,
-    /// Pass 1's point fetches per pixel, and whether every pixel makes them all.
-    pub edges_fetches: (f64, bool),
+    /// Pass 1's point fetches per pixel: those every pixel makes, and at
+    /// most how many more the pixels it keeps make (declared apart, so the
+    /// first count floors the pass: `bench::floor`).
+    pub edges_fetches: (f64, f64),
     pub weights_shader: &'static str,
     /// The most bilinear edge fetches pass 2 makes per pixel (its searches).
     pub weights_bilinear: f64,
@@ -101,7 +103,16 @@ pub struct Spec {
 /// pass's pipeline is bound.
 pub trait Variant {
     fn spec(&self) -> Spec;
-    fn push_edges(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: &Pipeline);
+    /// Pass 1's push constants; `last` is its input's last texel (size - 1),
+    /// pushed rather than queried per fetch: a size query is a texture-unit
+    /// instruction on NVIDIA (docs/perf/issue28/floors.md).
+    fn push_edges(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        last: [i32; 2],
+    );
     fn push_weights(&self, _ctx: &Context, _cmd: vk::CommandBuffer, _pipeline: &Pipeline) {}
 }
 
@@ -249,22 +260,29 @@ impl Morphological {
 
     /// Pass 1: every pixel runs, edge pixels are written (colour and stencil).
     fn edges_pass<'a>(&'a self, res: &Resources) -> Pass<'a> {
-        let (texture, format) = match self.spec.edges_input {
-            EdgeInput::Depth => ("depthTex", res.texel_format(self.depth)),
-            EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm),
+        let (texture, format, input) = match self.spec.edges_input {
+            EdgeInput::Depth => ("depthTex", res.texel_format(self.depth), self.depth),
+            EdgeInput::Frame => ("colorTex", Format::Rgba8Unorm, self.input),
         };
-        let (count, exact) = self.spec.edges_fetches;
+        let e = res.extent(input);
+        let last = [e.width as i32 - 1, e.height as i32 - 1];
+        let (every, more) = self.spec.edges_fetches;
+        let point = |count, exact| Fetch {
+            texture: texture.into(),
+            format,
+            filter: Filter::Point,
+            count,
+            exact,
+            coherent: true,
+            spread: Vec::new(),
+        };
+        let mut fetches = vec![point(every, true)];
+        if more > 0.0 {
+            fetches.push(point(more, false));
+        }
         let work = ShaderWork {
             shader: self.spec.edges_shader.into(),
-            fetches: vec![Fetch {
-                texture: texture.into(),
-                format,
-                filter: Filter::Point,
-                count,
-                exact,
-                coherent: true,
-                spread: Vec::new(),
-            }],
+            fetches,
             alu: alu_estimate(self.spec.edges_shader, &[]),
             ..Default::default()
         };
@@ -289,7 +307,7 @@ impl Morphological {
                             STENCIL_EDGE,
                         )
                     };
-                    variant.push_edges(c, cmd, pipeline);
+                    variant.push_edges(c, cmd, pipeline, last);
                 })
             })
     }
@@ -395,8 +413,14 @@ impl Morphological {
                 .depth_stencil(self.stencil_test()),
             BlendOn::Every => pass.color(ColorTarget::new(self.output, Load::DontCare)),
         };
-        pass.draws(Some(work), 1)
-            .record(move |pc: &PassContext| fullscreen(pc, pipeline, &[set], |_, _| {}))
+        // The frame's last texel, pushed rather than queried per pixel (see
+        // `Variant::push_edges`); the weights have the frame's size.
+        let e = res.extent(self.input);
+        debug_assert_eq!(e, res.extent(self.weights));
+        let last = [e.width as i32 - 1, e.height as i32 - 1];
+        pass.draws(Some(work), 1).record(move |pc: &PassContext| {
+            fullscreen(pc, pipeline, &[set], |c, cmd| pipeline.push(c, cmd, &last))
+        })
     }
 
     fn stencil_test(&self) -> DepthStencil {

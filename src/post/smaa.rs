@@ -83,6 +83,7 @@ impl WeightsPush {
 struct EdgesPush {
     threshold: f32,
     adaptation: f32,
+    last: [i32; 2],
 }
 
 /// SMAA as the stage runs it: the preset and luma or colour edges.
@@ -131,7 +132,7 @@ impl Variant for Smaa {
                 EDGES_SHADER
             },
             edges_input: EdgeInput::Frame,
-            edges_fetches: (7.0, false),
+            edges_fetches: (3.0, 4.0),
             weights_shader: WEIGHTS_SHADER,
             weights_bilinear: weights_bilinear_bound(self.preset),
             weights_loops: loop_trips(self.preset).to_vec(),
@@ -165,10 +166,17 @@ impl Variant for Smaa {
         }
     }
 
-    fn push_edges(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: &Pipeline) {
+    fn push_edges(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        last: [i32; 2],
+    ) {
         let push = EdgesPush {
             threshold: self.preset.threshold(),
             adaptation: LOCAL_CONTRAST_FACTOR,
+            last,
         };
         pipeline.push(ctx, cmd, &push);
     }

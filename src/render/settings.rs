@@ -273,18 +273,13 @@ impl RenderSettings {
         }
         // An option of another method is ignored (the CLI says so), but its
         // value must still be one it would accept: no NaN slips through unread.
-        // An option the chosen method also takes is its, and checked as its
-        // (`--samples 80` is gather's, not an odd count for separable).
-        let own = |key: &str| self.method.options.iter().any(|o| o.key == key);
         for m in crate::method::METHODS {
-            let mut foreign = MethodOptions::default();
-            for o in m.options.iter().filter(|o| !own(o.key)) {
-                if let Some(v) = self.options.given(o.key) {
-                    foreign.set(o.key, v);
-                }
-            }
-            if m.name != self.method.name && foreign.keys().next().is_some() {
-                (m.check)(&m.opts(&foreign))
+            let given = m
+                .options
+                .iter()
+                .any(|o| self.options.given(o.key).is_some());
+            if m.name != self.method.name && given {
+                (m.check)(&m.opts(&self.options))
                     .with_context(|| format!("method {} (an option of it was given)", m.name))?;
             }
         }

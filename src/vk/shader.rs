@@ -288,10 +288,11 @@ mod tests {
                 }
             }
         }
-        // Fourteen shaders (three of the ground truth per profile, seven of
-        // the compute path, the compute ceiling probe), each also in its
-        // fetch-counting build.
-        assert_eq!(seen, 28);
+        // Sixteen shaders (three of the ground truth per profile, seven of
+        // the compute path, the 2D gather, the compute ceiling probes of
+        // fetches and of shared memory), each also in its fetch-counting
+        // build.
+        assert_eq!(seen, 32);
     }
 
     #[test]

@@ -90,7 +90,7 @@ fn gather_matches_its_cpu_mirror() {
         mm_per_unit: scene.mm_per_unit,
     };
     for (profile, budget) in [("six-gaussian", "40"), ("burley", "40"), ("six-gaussian", "80")] {
-        let out = run(&[(KEY, profile), ("samples", budget)], &inputs);
+        let out = run(&[(KEY, profile), ("sample-budget", budget)], &inputs);
         let g = GatherProfile::new(profile.parse::<Profile>().unwrap());
         let budget: u32 = budget.parse().unwrap();
         let (mut within, mut n, mut worst, mut moved) = (0usize, 0usize, 0.0f32, 0.0f32);
@@ -158,7 +158,7 @@ fn the_cards_edge_moves_what_each_profile_moves() {
     ] {
         let s = base
             .clone()
-            .with(common::m("gather"), &[(KEY, profile), ("samples", "80")]);
+            .with(common::m("gather"), &[(KEY, profile), ("sample-budget", "80")]);
         let (out, mm_per_px) = render_card(&ctx, &scene, &s);
         let r = energy_ratio_against(&out, &none, s.width as usize, mm_per_px, Output::PixelFilter, spread);
         let kept = [0, 1, 2].map(|c| {

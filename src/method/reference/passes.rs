@@ -59,6 +59,7 @@ impl Reference {
             alu: alu_estimate(lit, &PCF_TRIPS),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
             storage_write_bytes: 0.0,
+            shared_bytes: 0.0,
         };
         let draws: u64 = self
             .chunks
@@ -209,6 +210,7 @@ impl Reference {
             alu: alu_estimate(shader, trips),
             storage_read_bytes: 64.0,
             storage_write_bytes: 16.0,
+            shared_bytes: 0.0,
         };
         let mut pass = Pass::new("reference resolve", PassRole::Sss);
         // Samples the diffuse target, reads the accumulators, adds to the output.
@@ -301,6 +303,7 @@ impl Reference {
             // Positions and normals of the candidates, cell ranges, the output.
             storage_read_bytes: 32.0 * candidates + 16.0 + 8.0,
             storage_write_bytes: 48.0,
+            shared_bytes: 0.0,
         };
         let push = GatherPush {
             dy: k % 3 - 1,
