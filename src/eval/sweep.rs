@@ -48,6 +48,7 @@ pub fn registry() -> Vec<Config> {
 pub fn six_gaussian_registry() -> Vec<Config> {
     registry()
         .into_iter()
+        .filter(|c| !UNMEASURED.iter().any(|(m, _)| *m == c.method.name))
         .filter(|c| {
             let given = crate::method::MethodOptions::default().with(c.setting.options);
             crate::method::profile::approximated(c.method, &given)
@@ -55,6 +56,15 @@ pub fn six_gaussian_registry() -> Vec<Config> {
         })
         .collect()
 }
+
+/// Methods the accuracy model (`profiles/accuracy/`, `eval --scenes
+/// accuracy`) has not measured yet, and why: it and the planner, which
+/// prices a setting's error from it, leave them out until their rows are
+/// measured.
+pub const UNMEASURED: &[(&str, &str)] = &[(
+    "gather",
+    "added in issue 28; its accuracy-set rows (`eval --scenes accuracy` on both heads, hours on lavapipe) are still to be measured",
+)];
 
 /// A view of the scene set.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -58,9 +58,8 @@ pub fn registered() -> Vec<Registered> {
     METHODS
         .iter()
         .filter(|m| !m.ground_truth && Choice::none().method != m.name)
-        // The 2D gather is not in the accuracy model yet (its accuracy-set
-        // rows are still to be measured): the planner cannot price its error.
-        .filter(|m| m.name != crate::method::gather::ENTRY.name)
+        // Not in the accuracy model yet: the planner cannot price its error.
+        .filter(|m| !crate::eval::sweep::UNMEASURED.iter().any(|(u, _)| *u == m.name))
         .flat_map(|m| {
             m.eval
                 .iter()
