@@ -10,7 +10,7 @@
 #   OUT=$OUT bash tools/perf_floors.sh
 #
 # Carried (ignored folders): .gl (the Vulkan loader debs), .bin (dermis,
-# stripped release build; optionally dermis-before, built from 41b60b8),
+# stripped release build; optionally dermis-before, built before the bloom fix: 41b60b8 or 4e5c1d2),
 # .assets (../shared/assets).
 set -uo pipefail
 ROOT=$PWD
@@ -48,6 +48,8 @@ HD="--width 1920 --height 1080"
   bench lps-portrait-bloom --scene "$LPS" $HD --bloom $F
   # A mix (merges on both paths) and the other methods' compute passes.
   bench mix-3 $HD --shot mid --heads 3 --assign "0=ssg:path=compute,1=separable:path=compute,*=poisson" $F
+  # The 2D gather's pass and its floor.
+  bench close-gather-40 $HD --shot close --method gather --sample-budget 40 $F
   # What bounds the shadow map: its 2048^2 clear (the time follows the
   # map's area) or its triangles (the time stays).
   bench close-shadow-1024 $HD --shot close --method separable --path compute --shadow-size 1024 $F
