@@ -8,7 +8,8 @@
 // share texels only by chance: the taps go through the texture units with
 // their cache (as ss-jittered's), not a shared-memory apron that would have
 // to hold the kept-mass radius around the tile. The light is filtered
-// bilinearly at the sample; its stencil and depth are the nearest texel's. Reads the diffuse target,
+// bilinearly at the sample where its four texels are this group's skin
+// (else the nearest texel's, if it is); the depth is the nearest texel's. Reads the diffuse target,
 // writes the intermediate at skin pixels (merged back by tiles_merge.comp).
 #include "shader_constants.glsl"
 #include "fetch_count.glsl"
@@ -23,6 +24,7 @@ layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D outImage;
 // four to a vec4 (std140 pads a float array to vec4 per element).
 layout(set = 0, binding = 5) uniform Lut { vec4 lut[GATHER_LUT_VEC4S]; };
 layout(set = 0, binding = 6) uniform sampler linearClamp;
+layout(set = 0, binding = 7) uniform sampler nearestClamp;
 
 layout(push_constant) uniform Push {
     vec4 burleyS;         // xyz: Burley's s per channel (1/mm); w: 1 = Burley, 0 = six Gaussians
@@ -114,14 +116,26 @@ void main() {
         // Off the screen, the edge texel (as the sampler clamps): dropping
         // those samples would drop the far tail wherever the kernel meets
         // the screen's edge (the card's rows moved 7% less light).
-        ivec2 qi = clamp(ivec2(floor(vec2(p) + 0.5 + off)), ivec2(0), size - 1);
-        // Another group's skin, or no skin: not this profile's surface.
-        if (COUNTED(SITE(0, 2, FK_POINT), texelFetch(stencilTex, qi, 0)).r != pc.code) continue;
-        // Bilinear at the sample's own position: a tap at d moves a step's
-        // light by exactly d, where the nearest texel moves round(d) (4% less
-        // of red's light across the card's edge: the narrow Gaussians' taps
-        // under half a pixel moved nothing).
-        vec3 c = COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorTex, linearClamp), (vec2(p) + 0.5 + off) / vec2(size), 0.0)).rgb;
+        vec2 at = vec2(p) + 0.5 + off;
+        ivec2 qi = clamp(ivec2(floor(at)), ivec2(0), size - 1);
+        // The stencil codes of the 2x2 texels a bilinear tap at `at` reads
+        // (one gather, the footprint's cost).
+        uvec4 codes = COUNTED(SITE(0, 2, FK_BILINEAR), textureGather(usampler2D(stencilTex, nearestClamp), at / vec2(size), 0));
+        vec3 c;
+        if (all(equal(codes, uvec4(pc.code)))) {
+            // Bilinear at the sample's own position: a tap at d moves a
+            // step's light by exactly d, where the nearest texel moves
+            // round(d) (green's and blue's light crossed the card's edge
+            // 3-6% short: their taps under half a pixel moved nothing).
+            c = COUNTED(SITE(0, 0, FK_BILINEAR), textureLod(sampler2D(colorTex, linearClamp), at / vec2(size), 0.0)).rgb;
+        } else {
+            // At the skin's edge the footprint holds other texels (the
+            // backdrop, another group): the nearest texel alone, if it is
+            // this group's skin (bilinear there bled the backdrop into the
+            // silhouette: err/none 11.8 in its band at 320x180).
+            if (COUNTED(SITE(0, 2, FK_POINT), texelFetch(stencilTex, qi, 0)).r != pc.code) continue;
+            c = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, qi, 0)).rgb;
+        }
         float dz = (COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, qi, 0)).r - depth) * pc.mmPerUnit;
         float r3 = sqrt(r * r + dz * dz);
         vec3 w = profile(r3) / profile(r)[pc.widest];

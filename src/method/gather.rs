@@ -168,6 +168,10 @@ impl Gather {
                     Binding::Fixed(Bind::Sampler(s.samplers.linear_clamp)),
                 ),
                 (
+                    "nearestClamp",
+                    Binding::Fixed(Bind::Sampler(s.samplers.nearest_clamp)),
+                ),
+                (
                     "Lut",
                     Binding::Fixed(Bind::Uniform {
                         buffer: lut.raw,
@@ -245,12 +249,18 @@ impl SssMethod for Gather {
             spread: spread.clone(),
             ..fetch(f.res, image, texture, Filter::Point, mean)
         };
-        // Invocations outside the image or the skin fetch nothing.
+        // Invocations outside the image or the skin fetch nothing. Each
+        // sample gathers the stencil of its 2x2 footprint and reads the light
+        // bilinearly there, or at the skin's edge the nearest texel's
+        // stencil and light (point: at most once a sample).
         let fetches = vec![
-            fetch_at_most(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0),
-            fetch_at_most(f.res, t.diffuse, "colorTex", Filter::Point, 1.0),
+            fetch_at_most(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0 + mean),
+            fetch_at_most(f.res, t.diffuse, "colorTex", Filter::Point, 1.0 + mean),
             fetch_at_most(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0),
-            taps(t.depth_stencil, "stencilTex"),
+            Fetch {
+                filter: Filter::Bilinear,
+                ..taps(t.depth_stencil, "stencilTex")
+            },
             Fetch {
                 filter: Filter::Bilinear,
                 ..taps(t.diffuse, "colorTex")

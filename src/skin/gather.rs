@@ -22,7 +22,9 @@
 //!
 //! (the profile at the 3D distance over the sampling density on the screen
 //! plane, HDRP's depth-bilateral term) on the light filtered bilinearly at
-//! the sample (a tap at `d` then moves a step's light by exactly `d`; the
+//! the sample where its 2x2 texels are all this group's skin, else the
+//! nearest texel's if it is (a bilinear tap at the skin's edge bled the
+//! backdrop into the silhouette) (a tap at `d` moves a step's light by exactly `d`; the
 //! nearest texel, HDRP's load, moves `round(d)`: taps under half a pixel
 //! moved nothing, and green's and blue's light crossed the card's edge 3-6%
 //! short),
@@ -249,10 +251,17 @@ pub fn gather_pixel(g: &GatherProfile, budget: u32, input: &GatherInputs, x: usi
         let qx = clamp(x as f32 + 0.5 + off[0], input.width);
         let qy = clamp(y as f32 + 0.5 + off[1], input.height);
         let j = qy * input.width + qx;
-        if !input.skin[j] {
+        let (px, py) = (x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1]);
+        // Bilinear where the 2x2 footprint is all this group's skin, else
+        // the nearest texel if it is (the shader's stencil gather).
+        let light = if footprint_is_skin(input, px, py) {
+            bilinear(input, px, py)
+        } else if !input.skin[j] {
             continue;
-        }
-        let light = bilinear(input, x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1]);
+        } else {
+            let c = input.color[j];
+            [c[0], c[1], c[2]]
+        };
         let dz = (input.depth[j] - depth) * input.mm_per_unit;
         let r3 = (r * r + dz * dz).sqrt();
         let num = g.eval(r3);
@@ -272,18 +281,28 @@ pub fn gather_pixel(g: &GatherProfile, budget: u32, input: &GatherInputs, x: usi
     out
 }
 
+/// The four texels of a bilinear tap at `(px, py)`, edges clamped.
+fn footprint(input: &GatherInputs, px: f32, py: f32) -> [usize; 4] {
+    let (x0, y0) = ((px - 0.5).floor(), (py - 0.5).floor());
+    let at = |x: f32, y: f32| {
+        let xi = (x.max(0.0) as usize).min(input.width - 1);
+        let yi = (y.max(0.0) as usize).min(input.height - 1);
+        yi * input.width + xi
+    };
+    [at(x0, y0), at(x0 + 1.0, y0), at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0)]
+}
+
+/// Whether the four texels of a bilinear tap at `(px, py)` are all skin.
+fn footprint_is_skin(input: &GatherInputs, px: f32, py: f32) -> bool {
+    footprint(input, px, py).iter().all(|&i| input.skin[i])
+}
+
 /// The light filtered bilinearly at `(px, py)` (pixels, centres at `+ 0.5`),
 /// edges clamped, as the shader's sampler filters it.
 fn bilinear(input: &GatherInputs, px: f32, py: f32) -> [f32; 3] {
     let (fx, fy) = (px - 0.5, py - 0.5);
-    let (x0, y0) = (fx.floor(), fy.floor());
-    let (tx, ty) = (fx - x0, fy - y0);
-    let at = |x: f32, y: f32| {
-        let xi = (x.max(0.0) as usize).min(input.width - 1);
-        let yi = (y.max(0.0) as usize).min(input.height - 1);
-        input.color[yi * input.width + xi]
-    };
-    let (a, b, c, d) = (at(x0, y0), at(x0 + 1.0, y0), at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0));
+    let (tx, ty) = (fx - fx.floor(), fy - fy.floor());
+    let [a, b, c, d] = footprint(input, px, py).map(|i| input.color[i]);
     std::array::from_fn(|k| {
         let top = a[k] + (b[k] - a[k]) * tx;
         let bottom = c[k] + (d[k] - c[k]) * tx;
