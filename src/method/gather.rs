@@ -18,7 +18,10 @@ use super::profile::{self, Profile};
 use super::region::ReachScale;
 use super::screen::{declare_intermediate, fetch, fetch_at_most};
 use super::tiles::{SkinTiles, TILE_INVOCATIONS};
-use super::{EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts, SssMethod};
+use super::{
+    EvalSetting, FrameView, MethodBind, MethodEntry, MethodSetup, Needs, OptKind, OptSpec, Opts,
+    SssMethod,
+};
 use crate::graph::work::{Fetch, Filter, ShaderWork, Spread};
 use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
 use crate::skin::gather::{
@@ -47,7 +50,8 @@ const OPTIONS: &[OptSpec] = &[
 pub static ENTRY: MethodEntry = MethodEntry {
     name: "gather",
     aliases: &["gather2d", "disk"],
-    summary: "2D importance-sampled gather of the exact profile (six Gaussians or Burley), compute only",
+    summary:
+        "2D importance-sampled gather of the exact profile (six Gaussians or Burley), compute only",
     options: OPTIONS,
     eval: &[
         EvalSetting {
@@ -160,7 +164,10 @@ impl Gather {
             vec![
                 ("colorTex", Binding::Sampled(diffuse)),
                 ("depthTex", Binding::Sampled(s.targets.linear_depth)),
-                ("stencilTex", Binding::SampledStencil(s.targets.depth_stencil)),
+                (
+                    "stencilTex",
+                    Binding::SampledStencil(s.targets.depth_stencil),
+                ),
                 ("Tiles", tiles.list_binding(Storage::Read, 0)),
                 ("outImage", Binding::StorageImage(out, Storage::Write)),
                 (
@@ -183,7 +190,12 @@ impl Gather {
         let scale = s.view.scale();
         let b = profile.burley_s;
         let push = GatherPush {
-            burley_s: [b[0], b[1], b[2], f32::from(u8::from(config.profile == Profile::Burley))],
+            burley_s: [
+                b[0],
+                b[1],
+                b[2],
+                f32::from(u8::from(config.profile == Profile::Burley)),
+            ],
             height_px: scale.height_px as f32,
             tan_half_fovy: scale.tan_half_fovy,
             mm_per_unit: scale.mm_per_unit,
@@ -227,7 +239,8 @@ impl SssMethod for Gather {
         // a cluster nearer than its box says (the count grows with the square
         // of the scale), within the budget. Each sample reads stencil, colour
         // and depth.
-        let clusters: Vec<(f64, f32)> = f.depths.iter().copied().filter(|&(_, d)| d > 0.0).collect();
+        let clusters: Vec<(f64, f32)> =
+            f.depths.iter().copied().filter(|&(_, d)| d > 0.0).collect();
         let total: f64 = clusters.iter().map(|c| c.0).sum();
         let nearest = clusters
             .iter()
@@ -254,7 +267,13 @@ impl SssMethod for Gather {
         // bilinearly there, or at the skin's edge the nearest texel's
         // stencil and light (point: at most once a sample).
         let fetches = vec![
-            fetch_at_most(f.res, t.depth_stencil, "stencilTex", Filter::Point, 1.0 + mean),
+            fetch_at_most(
+                f.res,
+                t.depth_stencil,
+                "stencilTex",
+                Filter::Point,
+                1.0 + mean,
+            ),
             fetch_at_most(f.res, t.diffuse, "colorTex", Filter::Point, 1.0 + mean),
             fetch_at_most(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0),
             Fetch {
@@ -281,7 +300,10 @@ impl SssMethod for Gather {
             ..self.push
         };
         let mut passes: Vec<Pass<'a>> = self.tiles.passes(f).into();
-        passes.push(self.tiles.pass("gather", f, 0, work, &self.pipeline, &self.set, push));
+        passes.push(
+            self.tiles
+                .pass("gather", f, 0, work, &self.pipeline, &self.set, push),
+        );
         passes.extend(self.tiles.merge_pass(f));
         passes
     }

@@ -59,7 +59,11 @@ pub fn registered() -> Vec<Registered> {
         .iter()
         .filter(|m| !m.ground_truth && Choice::none().method != m.name)
         // Not in the accuracy model yet: the planner cannot price its error.
-        .filter(|m| !crate::eval::sweep::UNMEASURED.iter().any(|(u, _)| *u == m.name))
+        .filter(|m| {
+            !crate::eval::sweep::UNMEASURED
+                .iter()
+                .any(|(u, _)| *u == m.name)
+        })
         .flat_map(|m| {
             m.eval
                 .iter()

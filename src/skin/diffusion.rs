@@ -15,7 +15,9 @@ use super::profile::profile_rgb;
 /// integrates: d'Eon's six Gaussians (above) or Burley's normalized diffusion
 /// matched to the same skin ([`crate::skin::kernel::burley_profile`]). Named
 /// by `profile=` (`method::profile::OPTION`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Profile {
     #[default]

@@ -47,9 +47,9 @@
 
 use std::f64::consts::PI;
 
-use crate::skin::diffusion::Profile;
 use crate::shader_constants::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 use crate::skin::burley;
+use crate::skin::diffusion::Profile;
 
 /// The mass of the widest channel's profile the samples cover (HDRP's 99.7%).
 pub const KEPT_MASS: f64 = 0.997;
@@ -131,7 +131,9 @@ impl GatherProfile {
     pub fn new(profile: Profile) -> GatherProfile {
         let widest = widest_channel(profile);
         let lut_mm = (0..=LUT_SIZE)
-            .map(|k| radial_quantile(profile, widest, k as f64 / LUT_SIZE as f64 * KEPT_MASS) as f32)
+            .map(|k| {
+                radial_quantile(profile, widest, k as f64 / LUT_SIZE as f64 * KEPT_MASS) as f32
+            })
             .collect();
         let burley_s = profile
             .burley()
@@ -228,7 +230,13 @@ pub struct GatherInputs<'a> {
 /// samples, weights and sums in f32 (the GPU's transcendental functions may
 /// differ in their last bits, and a sample on a pixel border may then land
 /// one pixel over: tests compare within a tolerance, not bit for bit).
-pub fn gather_pixel(g: &GatherProfile, budget: u32, input: &GatherInputs, x: usize, y: usize) -> [f32; 4] {
+pub fn gather_pixel(
+    g: &GatherProfile,
+    budget: u32,
+    input: &GatherInputs,
+    x: usize,
+    y: usize,
+) -> [f32; 4] {
     let i = y * input.width + x;
     let centre = input.color[i];
     let depth = input.depth[i];
@@ -289,7 +297,12 @@ fn footprint(input: &GatherInputs, px: f32, py: f32) -> [usize; 4] {
         let yi = (y.max(0.0) as usize).min(input.height - 1);
         yi * input.width + xi
     };
-    [at(x0, y0), at(x0 + 1.0, y0), at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0)]
+    [
+        at(x0, y0),
+        at(x0 + 1.0, y0),
+        at(x0, y0 + 1.0),
+        at(x0 + 1.0, y0 + 1.0),
+    ]
 }
 
 /// Whether the four texels of a bilinear tap at `(px, py)` are all skin.
@@ -328,7 +341,11 @@ mod tests {
             assert_eq!(g.lut_mm.len(), LUT_SIZE + 1);
             assert_eq!(g.lut_mm[0], 0.0);
             for k in 1..=LUT_SIZE {
-                assert!(g.lut_mm[k] > g.lut_mm[k - 1], "{} not increasing at {k}", p.name());
+                assert!(
+                    g.lut_mm[k] > g.lut_mm[k - 1],
+                    "{} not increasing at {k}",
+                    p.name()
+                );
                 let u = k as f64 / LUT_SIZE as f64 * KEPT_MASS;
                 let back = radial_cdf(p, 0, f64::from(g.lut_mm[k]));
                 assert!((back - u).abs() < 1e-5, "{} k {k}: {back} vs {u}", p.name());
@@ -386,9 +403,13 @@ mod tests {
                 }
             }
             let rmax = f64::from(g.max_radius_mm());
-            for c in 0..3 {
+            for (c, m) in mean.iter().enumerate() {
                 let expect = radial_cdf(p, c, rmax) / KEPT_MASS;
-                assert!((mean[c] / expect - 1.0).abs() < 0.01, "{} c {c}: {} vs {expect}", p.name(), mean[c]);
+                assert!(
+                    (m / expect - 1.0).abs() < 0.01,
+                    "{} c {c}: {m} vs {expect}",
+                    p.name()
+                );
             }
         }
     }

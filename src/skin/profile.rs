@@ -342,4 +342,3 @@ mod tests {
         assert!((gaussian_2d(1.0, 0.0) - 1.0 / (2.0 * PI)).abs() < 1e-15);
     }
 }
-

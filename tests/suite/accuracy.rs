@@ -256,7 +256,8 @@ fn edge_response_of_every_method_against_the_closed_form() {
     let poisson = run("poisson", base.clone().with(common::m("poisson"), &[]));
     let gather = run(
         "gather",
-        base.clone().with(common::m("gather"), &[("sample-budget", "80")]),
+        base.clone()
+            .with(common::m("gather"), &[("sample-budget", "80")]),
     );
     let none = run("none", base.clone().with(common::m("none"), &[]));
     // The card's method list is the registry's: a method added there fails

@@ -6,12 +6,12 @@
 use crate::accuracy::{card_scene, card_settings, energy_ratio_against, render_card, Output};
 use crate::common;
 
+use dermis::method::profile::KEY;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
-use dermis::method::profile::KEY;
+use dermis::skin::diffusion::Profile;
 use dermis::skin::gather::{gather_pixel, GatherInputs, GatherProfile};
 use dermis::skin::kernel::burley_profile;
-use dermis::skin::diffusion::Profile;
 use dermis::skin::texel::round_f16;
 
 const W: usize = 96;
@@ -62,7 +62,10 @@ fn run(options: &[(&str, &str)], (diffuse, depth, skin): &Inputs) -> Vec<[f32; 4
     let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
     let (out, passes) = common::sss_only(&mut r, diffuse, depth, skin);
     let skin_px = skin.iter().filter(|&&s| s).count() as u64;
-    let gather = passes.iter().find(|p| p.name == "gather").expect("a gather pass");
+    let gather = passes
+        .iter()
+        .find(|p| p.name == "gather")
+        .expect("a gather pass");
     // One invocation per pixel of every listed tile: at least the skin.
     assert!(gather.compute_invocations.unwrap_or(0) >= skin_px);
     out
@@ -89,7 +92,11 @@ fn gather_matches_its_cpu_mirror() {
         tan_half_fovy: (0.5 * s.fovy_deg.to_radians()).tan(),
         mm_per_unit: scene.mm_per_unit,
     };
-    for (profile, budget) in [("six-gaussian", "40"), ("burley", "40"), ("six-gaussian", "80")] {
+    for (profile, budget) in [
+        ("six-gaussian", "40"),
+        ("burley", "40"),
+        ("six-gaussian", "80"),
+    ] {
         let out = run(&[(KEY, profile), ("sample-budget", budget)], &inputs);
         let g = GatherProfile::new(profile.parse::<Profile>().unwrap());
         let budget: u32 = budget.parse().unwrap();
@@ -156,13 +163,22 @@ fn the_cards_edge_moves_what_each_profile_moves() {
         ("six-gaussian", dermis::skin::card::edge_spread_mm()),
         ("burley", burley_profile().edge_spread_mm()),
     ] {
-        let s = base
-            .clone()
-            .with(common::m("gather"), &[(KEY, profile), ("sample-budget", "80")]);
+        let s = base.clone().with(
+            common::m("gather"),
+            &[(KEY, profile), ("sample-budget", "80")],
+        );
         let (out, mm_per_px) = render_card(&ctx, &scene, &s);
-        let r = energy_ratio_against(&out, &none, s.width as usize, mm_per_px, Output::PixelFilter, spread);
+        let r = energy_ratio_against(
+            &out,
+            &none,
+            s.width as usize,
+            mm_per_px,
+            Output::PixelFilter,
+            spread,
+        );
         let kept = [0, 1, 2].map(|c| {
-            out.iter().map(|p| p[c] as f64).sum::<f64>() / none.iter().map(|p| p[c] as f64).sum::<f64>()
+            out.iter().map(|p| p[c] as f64).sum::<f64>()
+                / none.iter().map(|p| p[c] as f64).sum::<f64>()
         });
         println!("gather {profile}: energy moved / closed form = {r:.3?}, out / in {kept:.4?}");
         for k in kept {
