@@ -79,7 +79,7 @@ uint sampleCount(float radiusPx) {
     return clamp(uint(ceil(area)), pc.minSamples, max(pc.budget, pc.minSamples));
 }
 
-// Integer hash -> the rotation in [0, 2 pi) (its low 16 bits) and the
+// Integer hash (skin::jittered::pixel_hash) -> the rotation in [0, 2 pi) (its low 16 bits) and the
 // offset within each radius stratum in [0, 1) (its high 16 bits)
 // (skin::gather::jitter).
 vec2 jitter(uvec2 p) {

@@ -38,6 +38,119 @@ pub struct SurfaceImages<'a> {
     pub normal: &'a [[f32; 4]],
 }
 
+/// A skin pixel's point as both profiles' gathers see it: its position
+/// reconstructed from the linear depth, the normal of the subsample under
+/// its centre, and that subsample on the supersampled surface.
+struct PixelPoint {
+    x_o: DVec3,
+    x_o32: [f32; 3],
+    n_o: [f32; 3],
+    /// The subsample under the pixel's centre: its index and coordinates.
+    centre: usize,
+    cx: usize,
+    cy: usize,
+}
+
+impl PixelPoint {
+    fn new(view: &GatherView, inv: &DMat4, surface: &SurfaceImages, z: f32, i: usize) -> Self {
+        let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
+        let (x, y) = (i % view.width, i / view.width);
+        let z = z as f64;
+        let ndc_x = (x as f64 + 0.5) / view.width as f64 * 2.0 - 1.0;
+        let ndc_y = (y as f64 + 0.5) / view.height as f64 * 2.0 - 1.0;
+        let t = view.tan_half_fovy as f64;
+        let vp = DVec3::new(ndc_x * t * view.aspect as f64 * z, -ndc_y * t * z, -z);
+        let x_o = inv.transform_point3(vp);
+        let (cx, cy) = ((x * s + s / 2), (y * s + s / 2));
+        let centre = cy * sw + cx;
+        let n = surface.normal[centre];
+        PixelPoint {
+            x_o,
+            x_o32: x_o.as_vec3().to_array(),
+            n_o: [n[0], n[1], n[2]],
+            centre,
+            cx,
+            cy,
+        }
+    }
+
+    /// Calls `f(qx, qy, q, r2)` for every skin subsample within `r`
+    /// subsamples (per axis) of the centre that light reaches through
+    /// tissue, `r2` its squared distance in mm^2.
+    fn near(
+        &self,
+        view: &GatherView,
+        surface: &SurfaceImages,
+        r: i64,
+        mut f: impl FnMut(i64, i64, usize, f64),
+    ) {
+        let mm = view.mm_per_unit as f64;
+        let s = surface.s as usize;
+        let (sw, sh) = (view.width * s, view.height * s);
+        for qy in (self.cy as i64 - r)..=(self.cy as i64 + r) {
+            for qx in (self.cx as i64 - r)..=(self.cx as i64 + r) {
+                if qx < 0 || qy < 0 || qx >= sw as i64 || qy >= sh as i64 {
+                    continue;
+                }
+                let q = qy as usize * sw + qx as usize;
+                let p = surface.position[q];
+                let nq = [
+                    surface.normal[q][0],
+                    surface.normal[q][1],
+                    surface.normal[q][2],
+                ];
+                if p[3] <= 0.0
+                    || !through_tissue(
+                        self.x_o32,
+                        self.n_o,
+                        [p[0], p[1], p[2]],
+                        nq,
+                        view.mm_per_unit,
+                    )
+                {
+                    continue;
+                }
+                let r2 = ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - self.x_o) * mm)
+                    .length_squared();
+                f(qx, qy, q, r2);
+            }
+        }
+    }
+
+    /// Calls `f(j, r2)` for every surface sample within the cut-off that
+    /// light reaches through tissue, `r2` its squared distance in mm^2.
+    fn far(&self, view: &GatherView, samples: &[SurfaceSample], mut f: impl FnMut(usize, f64)) {
+        let mm = view.mm_per_unit as f64;
+        let cutoff2 = (cutoff_mm() as f64).powi(2);
+        for (j, smp) in samples.iter().enumerate() {
+            let pa = smp.pos_area;
+            let p = DVec3::new(pa[0] as f64, pa[1] as f64, pa[2] as f64);
+            let r2 = ((p - self.x_o) * mm).length_squared();
+            let n = smp.normal;
+            if r2 > cutoff2
+                || !through_tissue(
+                    self.x_o32,
+                    self.n_o,
+                    p.as_vec3().to_array(),
+                    [n[0], n[1], n[2]],
+                    view.mm_per_unit,
+                )
+            {
+                continue;
+            }
+            f(j, r2);
+        }
+    }
+}
+
+fn view_scale(view: &GatherView) -> ViewScale {
+    ViewScale {
+        height_px: view.height as u32,
+        tan_half_fovy: view.tan_half_fovy,
+        mm_per_unit: view.mm_per_unit,
+    }
+}
+
 /// M(x_o) for every pixel: skin pixels (alpha > 0) take the narrow part from
 /// `surface` and gather the wide part from `samples`, both through tissue only;
 /// others keep `diffuse`.
@@ -50,88 +163,36 @@ pub fn gather_f64(
     radiance: &[[f32; 4]],
 ) -> Vec<[f64; 4]> {
     let inv = DMat4::from_cols_array(&view.inv_view.to_cols_array().map(|v| v as f64));
-    let mm = view.mm_per_unit as f64;
-    let cutoff2 = (cutoff_mm() as f64).powi(2);
-    let pts: Vec<DVec3> = samples
-        .iter()
-        .map(|s| {
-            DVec3::new(
-                s.pos_area[0] as f64,
-                s.pos_area[1] as f64,
-                s.pos_area[2] as f64,
-            )
-        })
-        .collect();
-    let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
-    let scale = ViewScale {
-        height_px: view.height as u32,
-        tan_half_fovy: view.tan_half_fovy,
-        mm_per_unit: view.mm_per_unit,
-    };
+    let scale = view_scale(view);
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
             if d0[3] <= 0.0 {
                 return d0.map(|v| v as f64);
             }
-            let (x, y) = (i % view.width, i / view.width);
-            let z = linear_depth[i] as f64;
-            let ndc_x = (x as f64 + 0.5) / view.width as f64 * 2.0 - 1.0;
-            let ndc_y = (y as f64 + 0.5) / view.height as f64 * 2.0 - 1.0;
-            let t = view.tan_half_fovy as f64;
-            let vp = DVec3::new(ndc_x * t * view.aspect as f64 * z, -ndc_y * t * z, -z);
-            let xo = inv.transform_point3(vp);
-            let xo32 = xo.as_vec3().to_array();
-            // The normal of the subsample under the pixel's centre.
-            let (cx, cy) = ((x * s + s / 2), (y * s + s / 2));
-            let c = cy * sw + cx;
-            let no = [
-                surface.normal[c][0],
-                surface.normal[c][1],
-                surface.normal[c][2],
-            ];
+            let pt = PixelPoint::new(view, &inv, surface, linear_depth[i], i);
             // Narrow part: windowed, weight-normalised sums per Gaussian.
             let px_per_mm = scale.px_per_mm(linear_depth[i]);
             let r = radius(px_per_mm, surface.s) as i64;
             let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
             let mut norm = [0.0f64; NARROW_GAUSSIANS];
-            let sh = view.height * s;
-            for qy in (cy as i64 - r)..=(cy as i64 + r) {
-                for qx in (cx as i64 - r)..=(cx as i64 + r) {
-                    if qx < 0 || qy < 0 || qx >= sw as i64 || qy >= sh as i64 {
-                        continue;
-                    }
-                    let q = qy as usize * sw + qx as usize;
-                    let p = surface.position[q];
-                    let nq = [
-                        surface.normal[q][0],
-                        surface.normal[q][1],
-                        surface.normal[q][2],
-                    ];
-                    if p[3] <= 0.0
-                        || !through_tissue(xo32, no, [p[0], p[1], p[2]], nq, view.mm_per_unit)
-                    {
-                        continue;
-                    }
-                    let r2 = ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - xo) * mm)
-                        .length_squared();
-                    for g in 0..NARROW_GAUSSIANS {
-                        let e = (-r2 / (2.0 * SIX_GAUSSIAN_VARIANCES_MM2[g] as f64)).exp()
-                            * p[3] as f64;
-                        norm[g] += e;
-                        for (s, &l) in sum[g].iter_mut().zip(&surface.radiance[q][..3]) {
-                            *s += e * l as f64;
-                        }
+            pt.near(view, surface, r, |_, _, q, r2| {
+                let area = surface.position[q][3] as f64;
+                for g in 0..NARROW_GAUSSIANS {
+                    let e = (-r2 / (2.0 * SIX_GAUSSIAN_VARIANCES_MM2[g] as f64)).exp() * area;
+                    norm[g] += e;
+                    for (s, &l) in sum[g].iter_mut().zip(&surface.radiance[q][..3]) {
+                        *s += e * l as f64;
                     }
                 }
-            }
+            });
             let mut acc = [0.0f64; 3];
             for g in 0..NARROW_GAUSSIANS {
                 for ch in 0..3 {
                     let m = if norm[g] > 0.0 {
                         sum[g][ch] / norm[g]
                     } else {
-                        surface.radiance[c][ch] as f64
+                        surface.radiance[pt.centre][ch] as f64
                     };
                     acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[g][ch] as f64 * m;
                 }
@@ -139,20 +200,7 @@ pub fn gather_f64(
             // Wide part: every sample within the cut-off, through tissue, each
             // Gaussian over its own weight.
             let mut wide = [[0.0f64; 4]; 6 - NARROW_GAUSSIANS];
-            for (j, p) in pts.iter().enumerate() {
-                let r2 = ((*p - xo) * mm).length_squared();
-                let n = samples[j].normal;
-                if r2 > cutoff2
-                    || !through_tissue(
-                        xo32,
-                        no,
-                        p.as_vec3().to_array(),
-                        [n[0], n[1], n[2]],
-                        view.mm_per_unit,
-                    )
-                {
-                    continue;
-                }
+            pt.far(view, samples, |j, r2| {
                 for (g, w) in wide.iter_mut().enumerate() {
                     let v = SIX_GAUSSIAN_VARIANCES_MM2[NARROW_GAUSSIANS + g] as f64;
                     let e = samples[j].pos_area[3] as f64 * (-r2 / (2.0 * v)).exp()
@@ -162,7 +210,7 @@ pub fn gather_f64(
                     }
                     w[3] += e;
                 }
-            }
+            });
             for (g, w) in wide.iter().enumerate() {
                 if w[3] > 0.0 {
                     for ch in 0..3 {
@@ -181,8 +229,6 @@ pub fn gather_f64(
 /// subsample weighted by its cell's integral within reach of the point, by
 /// `R(r) A_q` beyond) from `surface`, the far part (`R(r) dA_j` out to the
 /// cut-off) from `samples`, each normalised per channel (`super::burley`).
-// Long because it is the whole integral (both parts) written out once, as the
-// GPU passes compute it, so that each step can be compared with them.
 pub fn gather_f64_burley(
     view: &GatherView,
     diffuse: &[[f32; 4]],
@@ -192,117 +238,65 @@ pub fn gather_f64_burley(
     radiance: &[[f32; 4]],
 ) -> Vec<[f64; 4]> {
     let inv = DMat4::from_cols_array(&view.inv_view.to_cols_array().map(|v| v as f64));
-    let mm = view.mm_per_unit as f64;
-    let cutoff2 = (cutoff_mm() as f64).powi(2);
     let near2 = f64::from(burley::BURLEY_NEAR_MM).powi(2);
     let (bs, w_near, w_far) = (
         burley::s_per_mm(),
         burley::near_weight(),
         burley::far_weight(),
     );
-    let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
-    let sh = view.height * s;
-    let scale = ViewScale {
-        height_px: view.height as u32,
-        tan_half_fovy: view.tan_half_fovy,
-        mm_per_unit: view.mm_per_unit,
-    };
+    let s = surface.s as usize;
+    let scale = view_scale(view);
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
             if d0[3] <= 0.0 {
                 return d0.map(|v| v as f64);
             }
+            let pt = PixelPoint::new(view, &inv, surface, linear_depth[i], i);
             let (x, y) = (i % view.width, i / view.width);
-            let z = linear_depth[i] as f64;
-            let ndc_x = (x as f64 + 0.5) / view.width as f64 * 2.0 - 1.0;
-            let ndc_y = (y as f64 + 0.5) / view.height as f64 * 2.0 - 1.0;
-            let t = view.tan_half_fovy as f64;
-            let vp = DVec3::new(ndc_x * t * view.aspect as f64 * z, -ndc_y * t * z, -z);
-            let xo = inv.transform_point3(vp);
-            let xo32 = xo.as_vec3().to_array();
-            let (cx, cy) = ((x * s + s / 2), (y * s + s / 2));
-            let c = cy * sw + cx;
-            let no = [
-                surface.normal[c][0],
-                surface.normal[c][1],
-                surface.normal[c][2],
-            ];
             // The pixel's point on the subsample grid (continuous coordinates).
             let (gx, gy) = ((x as f64 + 0.5) * s as f64, (y as f64 + 0.5) * s as f64);
             let px_per_mm = scale.px_per_mm(linear_depth[i]);
             let r = burley::radius(px_per_mm, surface.s) as i64;
             let mut sum = [0.0f64; 3];
             let mut norm = [0.0f64; 3];
-            for qy in (cy as i64 - r)..=(cy as i64 + r) {
-                for qx in (cx as i64 - r)..=(cx as i64 + r) {
-                    if qx < 0 || qy < 0 || qx >= sw as i64 || qy >= sh as i64 {
-                        continue;
-                    }
-                    let q = qy as usize * sw + qx as usize;
-                    let p = surface.position[q];
-                    let nq = [
-                        surface.normal[q][0],
-                        surface.normal[q][1],
-                        surface.normal[q][2],
-                    ];
-                    if p[3] <= 0.0
-                        || !through_tissue(xo32, no, [p[0], p[1], p[2]], nq, view.mm_per_unit)
-                    {
-                        continue;
-                    }
-                    let r2 = ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - xo) * mm)
-                        .length_squared();
-                    if r2 >= near2 {
-                        continue;
-                    }
-                    let (du, dv) = (qx as f64 + 0.5 - gx, qy as f64 + 0.5 - gy);
-                    let area = p[3] as f64;
-                    let w = if burley::in_cell_reach(du, dv) {
-                        burley::cell_weight(bs, du, dv, area.sqrt())
-                    } else {
-                        burley::ring_weight(bs, r2.sqrt(), area.sqrt())
-                    };
-                    for ch in 0..3 {
-                        norm[ch] += w[ch];
-                        sum[ch] += w[ch] * surface.radiance[q][ch] as f64;
-                    }
+            pt.near(view, surface, r, |qx, qy, q, r2| {
+                if r2 >= near2 {
+                    return;
                 }
-            }
+                let (du, dv) = (qx as f64 + 0.5 - gx, qy as f64 + 0.5 - gy);
+                let area = surface.position[q][3] as f64;
+                let w = if burley::in_cell_reach(du, dv) {
+                    burley::cell_weight(bs, du, dv, area.sqrt())
+                } else {
+                    burley::ring_weight(bs, r2.sqrt(), area.sqrt())
+                };
+                for ch in 0..3 {
+                    norm[ch] += w[ch];
+                    sum[ch] += w[ch] * surface.radiance[q][ch] as f64;
+                }
+            });
             let near: [f64; 3] = std::array::from_fn(|ch| {
                 if norm[ch] > 0.0 {
                     sum[ch] / norm[ch]
                 } else {
-                    surface.radiance[c][ch] as f64
+                    surface.radiance[pt.centre][ch] as f64
                 }
             });
             // Far part: every sample from r_c to the cut-off, through tissue.
             let mut far = [0.0f64; 3];
             let mut far_norm = [0.0f64; 3];
-            for (j, smp) in samples.iter().enumerate() {
-                let pa = smp.pos_area;
-                let p = DVec3::new(pa[0] as f64, pa[1] as f64, pa[2] as f64);
-                let r2 = ((p - xo) * mm).length_squared();
-                let n = smp.normal;
-                if r2 < near2
-                    || r2 > cutoff2
-                    || !through_tissue(
-                        xo32,
-                        no,
-                        p.as_vec3().to_array(),
-                        [n[0], n[1], n[2]],
-                        view.mm_per_unit,
-                    )
-                {
-                    continue;
+            pt.far(view, samples, |j, r2| {
+                if r2 < near2 {
+                    return;
                 }
                 let w = burley::profile(bs, r2.sqrt());
                 for ch in 0..3 {
-                    let e = pa[3] as f64 * w[ch];
+                    let e = samples[j].pos_area[3] as f64 * w[ch];
                     far_norm[ch] += e;
                     far[ch] += e * radiance[j][ch] as f64;
                 }
-            }
+            });
             // A channel with no far sample takes the near part's light for it
             // (the GPU's resolve does the same): nothing is lost.
             let acc: [f64; 3] = std::array::from_fn(|ch| {

@@ -45,8 +45,6 @@
 //! budget (HDRP's low / medium / high: 20, 40, 80); a pixel whose radius is
 //! under one pixel keeps its light (its whole profile lies in the pixel).
 
-use std::f64::consts::PI;
-
 use crate::shader_constants::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 use crate::skin::burley;
 use crate::skin::diffusion::Profile;
@@ -66,15 +64,11 @@ pub const GOLDEN_ANGLE: f32 = 2.399_963_2;
 
 /// Index of the channel with the widest profile (the largest mean radius).
 pub fn widest_channel(profile: Profile) -> usize {
-    let mean = |c: usize| match profile {
-        Profile::SixGaussian => (0..6)
-            .map(|i| {
-                f64::from(SIX_GAUSSIAN_WEIGHTS_RGB[i][c])
-                    * (PI * f64::from(SIX_GAUSSIAN_VARIANCES_MM2[i]) / 2.0).sqrt()
-            })
-            .sum::<f64>(),
-        Profile::Burley => profile.burley().map_or(0.0, |b| b.mean_radius_mm()[c]),
+    let mean = match profile {
+        Profile::SixGaussian => burley::six_gaussian_mean_radius_mm(),
+        Profile::Burley => profile.burley().map_or([0.0; 3], |b| b.mean_radius_mm()),
     };
+    let mean = |c: usize| mean[c];
     (0..3).fold(0, |best, c| if mean(c) > mean(best) { c } else { best })
 }
 
@@ -199,9 +193,7 @@ pub fn sample_count(radius_px: f32, budget: u32) -> u32 {
 /// The per-pixel rotation in `[0, 2 pi)` and offset within each radius
 /// stratum in `[0, 1)` (the shader's integer hash: its low and high 16 bits).
 pub fn jitter(x: u32, y: u32) -> (f32, f32) {
-    let mut h = x.wrapping_mul(1973).wrapping_add(y.wrapping_mul(9277));
-    h = (h ^ (h >> 13)).wrapping_mul(0x5bd1_e995);
-    h ^= h >> 15;
+    let h = super::jittered::pixel_hash(x, y);
     (
         (h & 0xffff) as f32 / 65536.0 * (2.0 * std::f32::consts::PI),
         (h >> 16) as f32 / 65536.0,

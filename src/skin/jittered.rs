@@ -89,10 +89,15 @@ pub fn hable_kernel() -> JitteredKernel {
 /// `h = (h ^ (h >> 13)) * 0x5bd1e995`; `h ^= h >> 15`;
 /// `angle = (h & 0xffff) / 65536 * (PI / 3)`, the last line in f32.
 pub fn jitter_angle(x: u32, y: u32) -> f32 {
+    (pixel_hash(x, y) & 0xffff) as f32 / 65536.0 * (PI / 3.0)
+}
+
+/// The integer hash of a pixel that turns the screen-space kernels per pixel
+/// (ss-jittered's rings, the 2D gather's disk), as their shaders compute it.
+pub fn pixel_hash(x: u32, y: u32) -> u32 {
     let mut h = x.wrapping_mul(1973).wrapping_add(y.wrapping_mul(9277));
     h = (h ^ (h >> 13)).wrapping_mul(0x5bd1_e995);
-    h ^= h >> 15;
-    (h & 0xffff) as f32 / 65536.0 * (PI / 3.0)
+    h ^ (h >> 15)
 }
 
 #[cfg(test)]

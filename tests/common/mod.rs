@@ -266,3 +266,44 @@ pub fn fail_each_creation_step(
     ctx.fail_creation_after(None);
     steps
 }
+
+/// Synthetic SSS inputs of `w` x `h` (diffuse RGBA with the strength in
+/// alpha, linear depth, skin mask): a smooth image with sharp albedo steps
+/// (where a filter's rounding shows), per-pixel strength, a depth step from
+/// `depths[0]` to `depths[1]` below row 40 and a skin mask with a hole and a
+/// separate island of 5 x 5 pixels centred on `island` (the frame need not
+/// be a whole number of tiles).
+pub fn synthetic_sss_inputs(
+    w: usize,
+    h: usize,
+    island: (f32, f32),
+    depths: [f32; 2],
+) -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
+    let mut diffuse = Vec::with_capacity(w * h);
+    let mut depth = Vec::with_capacity(w * h);
+    let mut skin = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) = (x as f32, y as f32);
+            let step = if (x / 7 + y / 5) % 2 == 0 { 0.25 } else { 0.0 };
+            let r = 0.45 + 0.30 * (fx / 6.0).sin() * (fy / 9.0).cos() + step;
+            let g = 0.30 + 0.20 * (fx / 11.0 + fy / 7.0).cos() + step * 0.5;
+            let b = 0.20 + 0.15 * (fy / 5.0).sin();
+            let strength = if x < w / 3 { 1.0 } else { 0.7 };
+            let (dx, dy) = (fx - 45.0, fy - 32.0);
+            let face = dx * dx / (40.0 * 40.0) + dy * dy / (26.0 * 26.0) < 1.0;
+            let hole = (fx - 30.0).abs() < 4.0 && (fy - 20.0).abs() < 3.0;
+            let on_island = (fx - island.0).abs() < 3.0 && (fy - island.1).abs() < 3.0;
+            let is_skin = (face && !hole) || on_island;
+            diffuse.push(dermis::skin::texel::round_f16([
+                r,
+                g,
+                b,
+                if is_skin { strength } else { 0.0 },
+            ]));
+            depth.push(if y > 40 { depths[1] } else { depths[0] });
+            skin.push(is_skin);
+        }
+    }
+    (diffuse, depth, skin)
+}

@@ -14,32 +14,10 @@ use dermis::skin::texel::round_f16;
 const W: usize = 100;
 const H: usize = 70;
 
-/// A smooth diffuse image with sharp albedo steps (where a filter's
-/// rounding shows), per-pixel strength, a depth step and a skin mask with
-/// holes and a separate island; the frame is not a whole number of tiles.
+/// The shared synthetic inputs (`common::synthetic_sss_inputs`), the
+/// island at (93, 64), the depth step from 8.0 to 8.2.
 fn inputs() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
-    let mut diffuse = Vec::with_capacity(W * H);
-    let mut depth = Vec::with_capacity(W * H);
-    let mut skin = Vec::with_capacity(W * H);
-    for y in 0..H {
-        for x in 0..W {
-            let (fx, fy) = (x as f32, y as f32);
-            let step = if (x / 7 + y / 5) % 2 == 0 { 0.25 } else { 0.0 };
-            let r = 0.45 + 0.30 * (fx / 6.0).sin() * (fy / 9.0).cos() + step;
-            let g = 0.30 + 0.20 * (fx / 11.0 + fy / 7.0).cos() + step * 0.5;
-            let b = 0.20 + 0.15 * (fy / 5.0).sin();
-            let strength = if x < W / 3 { 1.0 } else { 0.7 };
-            let (dx, dy) = (fx - 45.0, fy - 32.0);
-            let face = dx * dx / (40.0 * 40.0) + dy * dy / (26.0 * 26.0) < 1.0;
-            let hole = (fx - 30.0).abs() < 4.0 && (fy - 20.0).abs() < 3.0;
-            let island = (fx - 93.0).abs() < 3.0 && (fy - 64.0).abs() < 3.0;
-            let is_skin = (face && !hole) || island;
-            diffuse.push(round_f16([r, g, b, if is_skin { strength } else { 0.0 }]));
-            depth.push(if y > 40 { 8.2 } else { 8.0 });
-            skin.push(is_skin);
-        }
-    }
-    (diffuse, depth, skin)
+    common::synthetic_sss_inputs(W, H, (93.0, 64.0), [8.0, 8.2])
 }
 
 fn settings() -> RenderSettings {

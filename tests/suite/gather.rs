@@ -17,31 +17,11 @@ use dermis::skin::texel::round_f16;
 const W: usize = 96;
 const H: usize = 64;
 
-/// A smooth image with sharp albedo steps, per-pixel strength, a depth step
-/// and a skin mask with a hole and a separate island.
+/// The shared synthetic inputs (`common::synthetic_sss_inputs`), nearer
+/// than compute.rs's (a wider kernel on screen): the depth step from 1.6 to
+/// 1.62.
 fn inputs() -> (Vec<[f32; 4]>, Vec<f32>, Vec<bool>) {
-    let mut diffuse = Vec::with_capacity(W * H);
-    let mut depth = Vec::with_capacity(W * H);
-    let mut skin = Vec::with_capacity(W * H);
-    for y in 0..H {
-        for x in 0..W {
-            let (fx, fy) = (x as f32, y as f32);
-            let step = if (x / 7 + y / 5) % 2 == 0 { 0.25 } else { 0.0 };
-            let r = 0.45 + 0.30 * (fx / 6.0).sin() * (fy / 9.0).cos() + step;
-            let g = 0.30 + 0.20 * (fx / 11.0 + fy / 7.0).cos() + step * 0.5;
-            let b = 0.20 + 0.15 * (fy / 5.0).sin();
-            let strength = if x < W / 3 { 1.0 } else { 0.7 };
-            let (dx, dy) = (fx - 45.0, fy - 32.0);
-            let face = dx * dx / (40.0 * 40.0) + dy * dy / (26.0 * 26.0) < 1.0;
-            let hole = (fx - 30.0).abs() < 4.0 && (fy - 20.0).abs() < 3.0;
-            let island = (fx - 90.0).abs() < 3.0 && (fy - 58.0).abs() < 3.0;
-            let is_skin = (face && !hole) || island;
-            diffuse.push(round_f16([r, g, b, if is_skin { strength } else { 0.0 }]));
-            depth.push(if y > 40 { 1.62 } else { 1.6 });
-            skin.push(is_skin);
-        }
-    }
-    (diffuse, depth, skin)
+    common::synthetic_sss_inputs(W, H, (90.0, 58.0), [1.6, 1.62])
 }
 
 fn settings() -> RenderSettings {
