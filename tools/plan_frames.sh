@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The stored frames of the planner's cost model (profiles/frames/plan/): every eval setting of
-# every registered real-time method (read from `dermis methods --json`, so a new method or
-# setting is picked up), one character (the Lee Perry-Smith head, --view study, 1280x720) at
-# six camera distances, rendered on lavapipe with the fetch-counting build by `dermis budget`
+# The stored frames of the planner's cost model (profiles/frames/plan/): every setting the
+# planner chooses among (`dermis methods --planned`: each eval setting of the six Gaussians, on
+# each path of a method that has two), one character (the Lee Perry-Smith head, --view study,
+# 1280x720) at six camera distances, rendered on lavapipe with the fetch-counting build by
+# `dermis budget`
 # (counts do not depend on the device's speed). `src/plan/cost.rs` reads each pass's counts per
 # skin pixel, per region pixel and per rectangle from them, interpolated in pixels per mm.
 #
@@ -19,28 +20,26 @@ DISTANCES=(1.5 3 6 12 24 48)
 W=1280
 H=720
 mkdir -p "$D"
-# One line per eval setting: method<TAB>slug<TAB>label<TAB>flags...
-"$BIN" methods --json | python3 -c '
+# One line per planned setting (`dermis methods --planned --json`: the planner's own list, so a
+# new method, setting or path is picked up, and a method the planner leaves out is left out):
+# method<TAB>slug<TAB>label<TAB>flags...
+"$BIN" methods --json > "$D/.methods.json" || exit 1
+"$BIN" methods --planned --json | python3 -c '
 import json, re, sys
-for m in json.load(sys.stdin):
-    if m["ground_truth"] or m["name"] == "none":
-        continue
-    # Not in the accuracy model yet, so not the planner's (src/eval/sweep.rs, UNMEASURED).
-    if m["name"] == "gather":
-        continue
-    flags = {o["key"]: (o["flag"], o["kind"]) for o in m["options"]}
-    for e in m["eval"]:
-        args = []
-        for k, v in e["options"]:
-            flag, kind = flags[k]
-            if kind == "switch":
-                if v == "false":
-                    args.append("--" + flag)
-            else:
-                args += ["--" + flag, v]
-        slug = re.sub(r"[^a-z0-9]+", "-", e["label"].lower()).strip("-")
-        print("\t".join([m["name"], slug, e["label"]] + args))
-' > "$D/.settings.tsv" || exit 1
+methods = {m["name"]: m for m in json.load(open(sys.argv[1]))}
+for p in json.load(sys.stdin):
+    flags = {o["key"]: (o["flag"], o["kind"]) for o in methods[p["method"]]["options"]}
+    args = []
+    for k, v in p["options"]:
+        flag, kind = flags[k]
+        if kind == "switch":
+            if v == "false":
+                args.append("--" + flag)
+        else:
+            args += ["--" + flag, v]
+    slug = re.sub(r"[^a-z0-9]+", "-", p["setting"].lower()).strip("-")
+    print("\t".join([p["method"], slug, p["setting"]] + args))
+' "$D/.methods.json" > "$D/.settings.tsv" || exit 1
 while IFS=$'\t' read -r method slug label flags; do
   read -r -a extra <<< "$flags"
   for d in "${DISTANCES[@]}"; do
@@ -74,4 +73,4 @@ for line in open(os.path.join(d, ".settings.tsv")):
 json.dump({"command": "tools/plan_frames.sh", "frames": rows}, open(os.path.join(d, "index.json"), "w"), indent=1)
 print(f"index.json: {len(rows)} frames")
 PY
-rm -f "$D/.settings.tsv"
+rm -f "$D/.settings.tsv" "$D/.methods.json"

@@ -339,6 +339,11 @@ pub struct MethodsArgs {
     /// Print the listing as JSON (what the scripts in tools/ read).
     #[arg(long)]
     pub json: bool,
+    /// List instead the settings `dermis plan` chooses among (each eval
+    /// setting of the six Gaussians, once per path where a method has two),
+    /// with their options: what tools/plan_frames.sh stores frames for.
+    #[arg(long)]
+    pub planned: bool,
 }
 
 /// The views the shot, key light and ambient default to.

@@ -34,6 +34,17 @@ impl Path {
     }
 }
 
+/// The planner's label of an eval setting on `path`: the eval label on the
+/// fragment path (the sources' way, what the eval measured), the label and
+/// the path's name on another ("17 samples, compute"), so both twins of a
+/// setting are told apart in plans, tables and stored frames.
+pub fn planned_label(eval_label: &str, path: Path) -> String {
+    match path {
+        Path::Fragment => eval_label.to_string(),
+        other => format!("{eval_label}, {}", other.name()),
+    }
+}
+
 impl FromStr for Path {
     type Err = anyhow::Error;
 
@@ -56,5 +67,11 @@ mod tests {
             assert_eq!(p.name().parse::<Path>().unwrap(), p);
         }
         assert!("vertex".parse::<Path>().is_err());
+    }
+
+    #[test]
+    fn a_twin_s_label_names_its_path() {
+        assert_eq!(planned_label("13 taps", Path::Fragment), "13 taps");
+        assert_eq!(planned_label("13 taps", Path::Compute), "13 taps, compute");
     }
 }

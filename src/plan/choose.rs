@@ -56,6 +56,9 @@ pub fn under_a_pixel(px_per_mm: f64) -> bool {
 pub struct SettingCosts {
     pub method: String,
     pub setting: String,
+    /// The eval setting whose accuracy rows price its error
+    /// (`pipeline::Registered::eval`).
+    pub measured_as: String,
     /// The group's fixed cost (ms).
     pub fixed_ms: f64,
     /// Per character its part (ms); `None` where it cannot be priced.
@@ -151,7 +154,13 @@ pub fn plan(a: &Ask) -> Plan {
             }
             let Some(p) = a
                 .accuracy
-                .predict(&s.method, &s.setting, c.px_per_mm, c.light_deg, c.shadow_mm)
+                .predict(
+                    &s.method,
+                    &s.measured_as,
+                    c.px_per_mm,
+                    c.light_deg,
+                    c.shadow_mm,
+                )
                 .filter(|p| p.0.is_finite() && p.1.is_finite())
             else {
                 ex.push((si, Excluded::OutsideMeasuredRange));
@@ -263,6 +272,7 @@ mod tests {
             SettingCosts {
                 method: "a".into(),
                 setting: "cheap".into(),
+                measured_as: "cheap".into(),
                 fixed_ms: 0.01,
                 parts_ms: vec![Some(0.01); n],
                 texel_mm: vec![None; n],
@@ -270,6 +280,7 @@ mod tests {
             SettingCosts {
                 method: "b".into(),
                 setting: "ts".into(),
+                measured_as: "ts".into(),
                 fixed_ms: 0.01,
                 parts_ms: vec![Some(0.01); n],
                 texel_mm: vec![Some(texel_mm); n],
@@ -277,6 +288,7 @@ mod tests {
             SettingCosts {
                 method: "c".into(),
                 setting: "unmeasured".into(),
+                measured_as: "unmeasured".into(),
                 fixed_ms: 0.0,
                 parts_ms: vec![Some(0.0); n],
                 texel_mm: vec![None; n],

@@ -50,7 +50,8 @@ use crate::budget::input::{FrameInput, PassInput};
 use crate::budget::model::{price_frame, Rescale};
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
-use crate::work::{PassRole, Spread, Work};
+use crate::method::path::Path;
+use crate::work::{PassRole, ShaderWork, Spread, Work};
 
 /// One stored frame of a setting: one character at a known scale.
 #[derive(Clone, Debug, PartialEq)]
@@ -133,6 +134,23 @@ enum PassKind {
     PerCharacter,
 }
 
+/// The shader a pass runs per fragment or per invocation.
+fn shader_of(w: &Work) -> Option<&ShaderWork> {
+    match w {
+        Work::Raster { shader, .. } => shader.as_ref(),
+        Work::Compute { shader, .. } => Some(shader),
+        _ => None,
+    }
+}
+
+fn shader_of_mut(w: &mut Work) -> Option<&mut ShaderWork> {
+    match w {
+        Work::Raster { shader, .. } => shader.as_mut(),
+        Work::Compute { shader, .. } => Some(shader),
+        _ => None,
+    }
+}
+
 fn area(w: &Work) -> Option<u64> {
     match w {
         Work::Raster { width, height, .. } => Some(u64::from(*width) * u64::from(*height)),
@@ -211,6 +229,12 @@ pub struct SettingModel {
     /// Registry name and eval setting label.
     pub method: String,
     pub setting: String,
+    /// The eval setting the accuracy model measured for it (its own label but
+    /// for a compute twin: `pipeline::Registered::eval`).
+    pub eval: String,
+    /// The path its blurs take: a compute twin is unpriced on a profile
+    /// without compute ([`CostModel::fixed_ms`]).
+    pub path: Path,
     /// Ascending in px/mm; every frame has the same passes.
     samples: Vec<Sample>,
     /// The reference counts at each sample's scale.
@@ -266,10 +290,21 @@ impl SettingModel {
         Ok(SettingModel {
             method: method.to_string(),
             setting: setting.to_string(),
+            eval: setting.to_string(),
+            path: Path::Fragment,
             samples,
             refs,
             kinds,
         })
+    }
+
+    /// This setting as the twin of eval setting `eval` on `path`.
+    pub fn measured_as(self, eval: &str, path: Path) -> SettingModel {
+        SettingModel {
+            eval: eval.to_string(),
+            path,
+            ..self
+        }
     }
 
     /// The px/mm range of the stored frames.
@@ -421,6 +456,11 @@ impl SettingModel {
                                 *triangles = t;
                             }
                         }
+                        // A dispatch's invocations are its fragments (one
+                        // per listed tile's pixel): they follow the skin.
+                        Work::Compute { invocations, .. } if shade != Per::Fixed => {
+                            *invocations = q.fragments;
+                        }
                         Work::Copy {
                             texels: tx,
                             rects: rc,
@@ -492,17 +532,10 @@ impl SettingModel {
         forced: Option<usize>,
     ) {
         let fetches = |p: &PassInput| -> Vec<f64> {
-            match &p.work {
-                Work::Raster {
-                    shader: Some(s), ..
-                } => s.fetches.iter().map(|f| f.count).collect(),
-                _ => Vec::new(),
-            }
+            shader_of(&p.work)
+                .map_or_else(Vec::new, |s| s.fetches.iter().map(|f| f.count).collect())
         };
-        let Work::Raster {
-            shader: Some(sh), ..
-        } = &mut q.work
-        else {
+        let Some(sh) = shader_of_mut(&mut q.work) else {
             return;
         };
         let xs = self.xs();
@@ -528,10 +561,7 @@ impl SettingModel {
             // Where the taps land: the nearer sample's, its radii scaled to
             // this character's px/mm (a kernel's size on screen is linear in it).
             let near = forced.map_or(if t < 0.5 { i } else { j }, |n| n.min(xs.len() - 1));
-            if let Work::Raster {
-                shader: Some(s), ..
-            } = &self.samples[near].frame.passes[k].work
-            {
+            if let Some(s) = shader_of(&self.samples[near].frame.passes[k].work) {
                 let scale = l.px_per_mm / xs[near];
                 for (out, f) in spreads.iter_mut().zip(&s.fetches) {
                     out.extend(f.spread.iter().map(|x| Spread {
@@ -691,6 +721,12 @@ pub struct CostModel<'a> {
 impl CostModel<'_> {
     /// The fixed cost of a group of setting `s` (`None`: unpriceable here).
     pub fn fixed_ms(&self, s: &SettingModel) -> Option<f64> {
+        // A compute twin is no choice where there is no compute: the budget
+        // model would price its dispatches as pixel shaders, a frame no
+        // renderer of that GPU draws (its fragment twin is the choice).
+        if s.path == Path::Compute && self.profile.alu.compute_gflops.value().is_none() {
+            return None;
+        }
         s.group_ms(self.profile, &self.params, &[], self.width, self.height)
     }
 

@@ -267,6 +267,7 @@ mod tests {
         let setting = |m: &str, fixed: f64, parts: [f64; 3]| SettingCosts {
             method: m.to_string(),
             setting: "x".to_string(),
+            measured_as: "x".to_string(),
             fixed_ms: fixed,
             parts_ms: parts.iter().map(|&p| Some(p)).collect(),
             texel_mm: vec![None; 3],

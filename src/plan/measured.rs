@@ -67,20 +67,17 @@ mod tests {
             for r in super::super::pipeline::registered() {
                 let (lo, hi) = m
                     .model
-                    .range(asset, r.method, r.setting)
-                    .unwrap_or_else(|| panic!("{} {} not measured", r.method, r.setting));
+                    .range(asset, r.method, r.eval)
+                    .unwrap_or_else(|| panic!("{} {} not measured", r.method, r.eval));
                 let mid = (lo * hi).sqrt();
-                let widest = m
-                    .model
-                    .widest_shadow_mm(asset, r.method, r.setting)
-                    .unwrap();
-                let (i, s) = m.predict(r.method, r.setting, mid, 60.0, widest).unwrap();
+                let widest = m.model.widest_shadow_mm(asset, r.method, r.eval).unwrap();
+                let (i, s) = m.predict(r.method, r.eval, mid, 60.0, widest).unwrap();
                 assert!(i.is_finite() && i >= 0.0 && s.is_finite() && s >= 0.0);
                 assert!(m
-                    .predict(r.method, r.setting, hi * 1.5, 60.0, widest)
+                    .predict(r.method, r.eval, hi * 1.5, 60.0, widest)
                     .is_none());
                 assert!(m
-                    .predict(r.method, r.setting, mid, 60.0, widest * 1.01)
+                    .predict(r.method, r.eval, mid, 60.0, widest * 1.01)
                     .is_none());
             }
         }

@@ -487,6 +487,7 @@ mod tests {
         let s = |setting: &str| SettingCosts {
             method: "m".into(),
             setting: setting.into(),
+            measured_as: setting.into(),
             fixed_ms: 0.01,
             parts_ms: vec![Some(0.01)],
             texel_mm: vec![None],

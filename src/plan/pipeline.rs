@@ -19,6 +19,7 @@ use crate::budget::frames::check_frame;
 use crate::budget::input::FrameInput;
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
+use crate::method::path::{self, Path as SssPath};
 use crate::method::METHODS;
 use crate::mix::plan_file::{PlanFile, PlannedCharacter, PredictedError, PLAN_VERSION};
 use crate::mix::Choice;
@@ -45,7 +46,15 @@ pub fn parse_budget_ms(budget_ms: &str) -> Result<f64> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Registered {
     pub method: &'static str,
-    pub setting: &'static str,
+    /// The planner's label (`method::path::planned_label`): the eval
+    /// setting's, with the path named off the fragment path.
+    pub setting: String,
+    /// The eval setting whose accuracy rows price its error. A compute twin's
+    /// is its fragment twin's: the two paths' images agree within one f16 ulp
+    /// on lavapipe (`tests/suite/compute.rs`) and within a relative RMSE of
+    /// 2e-4 on the H100 (docs/perf/issue28), far under the eval's bands.
+    pub eval: &'static str,
+    pub path: SssPath,
     pub options: BTreeMap<String, String>,
 }
 
@@ -53,7 +62,10 @@ pub struct Registered {
 /// none (none is always an option, cost 0), that approximates the six
 /// Gaussians: the accuracy model the planner reads is measured against their
 /// truth (`eval::sweep::six_gaussian_registry`), so a setting of another
-/// profile (separable's Burley preset) is not the planner's to choose.
+/// profile (separable's Burley preset) is not the planner's to choose. A
+/// method with a compute path (`--path`) has each setting twice, once per
+/// path, so a plan may choose the path per group; a profile without compute
+/// leaves the compute twins unpriced (`cost::CostModel::fixed_ms`).
 pub fn registered() -> Vec<Registered> {
     METHODS
         .iter()
@@ -65,6 +77,7 @@ pub fn registered() -> Vec<Registered> {
                 .any(|(u, _)| *u == m.name)
         })
         .flat_map(|m| {
+            let has_paths = m.options.iter().any(|o| o.key == path::OPTION.key);
             m.eval
                 .iter()
                 .filter(move |e| {
@@ -72,14 +85,33 @@ pub fn registered() -> Vec<Registered> {
                     crate::method::profile::approximated(m, &given)
                         .is_ok_and(|p| p.is_six_gaussian())
                 })
-                .map(move |e| Registered {
-                    method: m.name,
-                    setting: e.label,
-                    options: e
-                        .options
-                        .iter()
-                        .map(|(k, v)| (k.to_string(), v.to_string()))
-                        .collect(),
+                .flat_map(move |e| {
+                    let pinned = e.options.iter().any(|(k, _)| *k == path::OPTION.key);
+                    let paths: &[SssPath] = if has_paths && !pinned {
+                        &[SssPath::Fragment, SssPath::Compute]
+                    } else {
+                        &[SssPath::Fragment]
+                    };
+                    paths.iter().filter_map(move |&p| {
+                        let mut options: BTreeMap<String, String> = e
+                            .options
+                            .iter()
+                            .map(|(k, v)| (k.to_string(), v.to_string()))
+                            .collect();
+                        if p != SssPath::Fragment {
+                            options.insert(path::OPTION.key.to_string(), p.name().to_string());
+                        }
+                        // A twin the method refuses (ssg's branch mask is the
+                        // fragment path's alternative to the stencil) is none.
+                        Choice::new(m.name, options.clone()).ok()?;
+                        Some(Registered {
+                            method: m.name,
+                            setting: path::planned_label(e.label, p),
+                            eval: e.label,
+                            path: p,
+                            options,
+                        })
+                    })
                 })
         })
         .collect()
@@ -230,7 +262,7 @@ pub fn load_models() -> Result<(Vec<SettingModel>, Vec<String>)> {
     let mut models = Vec::new();
     let mut notes = Vec::new();
     for r in registered() {
-        let samples = samples_of(r.method, r.setting)?;
+        let samples = samples_of(r.method, &r.setting)?;
         if samples.is_empty() {
             notes.push(format!(
                 "{} '{}' has no stored frames in {dir} (tools/plan_frames.sh): not planned",
@@ -239,7 +271,8 @@ pub fn load_models() -> Result<(Vec<SettingModel>, Vec<String>)> {
             continue;
         }
         models.push(
-            SettingModel::new(r.method, r.setting, samples, reference)
+            SettingModel::new(r.method, &r.setting, samples, reference)
+                .map(|m| m.measured_as(r.eval, r.path))
                 .map_err(|e| anyhow::anyhow!("{dir}: {e}"))?,
         );
     }
@@ -373,6 +406,7 @@ pub fn setting_costs(
             Some(SettingCosts {
                 method: m.method.clone(),
                 setting: m.setting.clone(),
+                measured_as: m.eval.clone(),
                 fixed_ms: fixed,
                 parts_ms: loads.iter().map(|l| cm.part_ms(m, fixed, l)).collect(),
                 texel_mm: chars

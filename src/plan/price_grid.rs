@@ -189,6 +189,7 @@ impl<'a> PriceGrid<'a> {
                 Some(SettingCosts {
                     method: m.method.clone(),
                     setting: m.setting.clone(),
+                    measured_as: m.eval.clone(),
                     fixed_ms: fixed,
                     parts_ms: chars.iter().map(|&(x, s)| self.part_ms(k, x, s)).collect(),
                     texel_mm,

@@ -581,3 +581,67 @@ fn plan_check_scores_plans_against_the_ground_truth() {
     );
     assert!(parse_cases("xbox360:-1").is_err() && parse_cases("xbox360").is_err());
 }
+
+/// Issue 28 item 5: each setting of a method with a compute path is offered on
+/// both paths. The compute twin is priced from its own stored frames (its
+/// dispatches, not its fragment twin's passes), takes its fragment twin's
+/// accuracy rows, and is unpriced, so never chosen, on a profile without
+/// compute; on the H100 the two twins of a setting cost differently.
+#[test]
+fn a_plan_chooses_the_path_per_group_where_the_profile_has_compute() {
+    use dermis::method::path::Path as SssPath;
+    let Some(scene) = lps_scene() else { return };
+    let models = models();
+    let twins: Vec<&SettingModel> = models
+        .iter()
+        .filter(|m| m.path == SssPath::Compute)
+        .collect();
+    // separable 5, ssg 3 (its branch mask has none), ss-jittered 1, poisson 1.
+    assert_eq!(
+        twins.len(),
+        10,
+        "{:?}",
+        twins.iter().map(|m| &m.setting).collect::<Vec<_>>()
+    );
+    for t in &twins {
+        let frag = models
+            .iter()
+            .find(|m| m.method == t.method && m.setting == t.eval)
+            .unwrap_or_else(|| panic!("{} '{}' has no fragment twin", t.method, t.setting));
+        assert_eq!(frag.path, SssPath::Fragment);
+        assert_ne!(t.setting, frag.setting);
+    }
+    let refm = reference(&models);
+    let s = RenderSettings {
+        heads: 4,
+        ..RenderSettings::study()
+    };
+    let chars = characters(&scene, &s, refm);
+    for (p, has_compute) in [
+        ("xbox360", false),
+        ("ps3", false),
+        ("nvidia-h100", true),
+        ("switch-docked", true),
+    ] {
+        let prof = Profile::load(p).unwrap();
+        let costs = setting_costs(&models, &chars, &prof, 1280, 720, 500.0);
+        let compute: Vec<_> = costs
+            .iter()
+            .filter(|c| c.setting.ends_with(", compute"))
+            .collect();
+        assert_eq!(compute.len(), if has_compute { 10 } else { 0 }, "{p}");
+        for c in &compute {
+            let frag = costs
+                .iter()
+                .find(|f| f.method == c.method && f.setting == c.measured_as)
+                .expect("the fragment twin is priced too");
+            assert_eq!(frag.measured_as, c.measured_as);
+            assert!(
+                (c.fixed_ms - frag.fixed_ms).abs() > 1e-6,
+                "{p} {} '{}': the twins cost alike, as if priced from one frame",
+                c.method,
+                c.setting
+            );
+        }
+    }
+}
