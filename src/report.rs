@@ -253,6 +253,11 @@ pub struct ComputeCeilings {
     /// loads, conflict-free, in 16x16 groups); `None` before issue 28.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shared_load_gbytes: Option<f64>,
+    /// The median time of a dispatch of one 16x16 group (the store probe's
+    /// shader) with its barriers and timestamps: what any dispatch costs
+    /// before its work (ms); `None` before it was probed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dispatch_ms: Option<f64>,
 }
 
 impl Ceilings {
@@ -261,8 +266,8 @@ impl Ceilings {
         let rate = |v: Option<f64>| v.map_or("not measured".into(), |v| format!("{v:.2}"));
         let compute = self.compute.map_or(String::new(), |c| {
             format!(
-                "; compute: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, store rgba16f {:.2} Gpix/s, shared loads {} GB/s",
-                c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.store_rgba16f_gpix, rate(c.shared_load_gbytes)
+                "; compute: bilinear rgba16f {:.1} Gtap/s, point rgba16f {:.1}, bilinear r32f {:.1}, point r32f {:.1}, store rgba16f {:.2} Gpix/s, shared loads {} GB/s, a one-group dispatch {} ms",
+                c.bilinear_rgba16f_gtaps, c.point_rgba16f_gtaps, c.bilinear_r32f_gtaps, c.point_r32f_gtaps, c.store_rgba16f_gpix, rate(c.shared_load_gbytes), c.dispatch_ms.map_or("not measured".into(), |v| format!("{v:.4}"))
             )
         });
         format!(

@@ -58,6 +58,9 @@ enum Draw {
     Triangles(Vec<ColorTarget>, DepthStencil),
     /// One invocation per pixel in 16x16 groups (its set binds the target).
     Dispatch,
+    /// One 16x16 group: a dispatch's cost before its work (launch, the
+    /// barrier's drain and the timestamps around it), [`Unit::Pass`].
+    DispatchOne,
     /// A copy of the whole first image into the second (as a seed copy).
     Copy(ImageId, ImageId),
 }
@@ -71,6 +74,8 @@ enum Unit {
     Triangles,
     /// Shared-memory bytes (`taps` loads of 16 bytes per pixel).
     SharedBytes,
+    /// Whole passes: the probe's median time is its result (ms).
+    Pass,
 }
 
 /// One probe: a pipeline drawn into its targets, reading a source texture
@@ -470,6 +475,14 @@ fn probe_all(
             fill_probe(fill, "", Draw::Copy(id_target, id_specular), Unit::Taps),
         ),
         (
+            "compute dispatch of one group",
+            Probe {
+                unit: Unit::Pass,
+                draw: Draw::DispatchOne,
+                ..compute_probe(&cs_sets[1], point16, 0)
+            },
+        ),
+        (
             "compute shared loads",
             Probe {
                 pipeline: shared_cs,
@@ -519,7 +532,12 @@ fn ceilings_from(
             .map(|r| samples[r * probes.len() + pi].gpu_ms)
             .collect();
         let stats = Stats::of(&times).expect("reps >= 1");
-        let ops = n as f64 * per_pixel;
+        // A pass probe (`per_pixel` 0) counts one operation: the pass.
+        let ops = if *per_pixel > 0.0 {
+            n as f64 * per_pixel
+        } else {
+            1.0
+        };
         results.push(ProbeResult {
             name: name.to_string(),
             taps_per_fragment: (*taps).max(1),
@@ -544,7 +562,8 @@ fn ceilings_from(
                 bilinear_r32f_gtaps: r(9),
                 point_r32f_gtaps: r(10),
                 store_rgba16f_gpix: r(11),
-                shared_load_gbytes: Some(r(20)),
+                shared_load_gbytes: Some(r(21)),
+                dispatch_ms: Some(results[20].gpu_ms.median),
             }),
             bilinear_rgba8_gtaps: Some(r(12)),
             point_rgba8_gtaps: Some(r(13)),
@@ -592,6 +611,8 @@ impl<'p> Probe<'p> {
             Unit::Taps => f64::from(self.taps.max(1)),
             Unit::Triangles => 1.0,
             Unit::SharedBytes => f64::from(self.taps) * SHARED_LOAD_BYTES,
+            // One pass, whatever the extent: its rate is passes a second.
+            Unit::Pass => 0.0,
         }
     }
 
@@ -636,7 +657,7 @@ impl<'p> Probe<'p> {
         let work = ShaderWork {
             shader: self.shader.into(),
             fetches,
-            storage_write_bytes: if matches!(self.draw, Draw::Dispatch) {
+            storage_write_bytes: if matches!(self.draw, Draw::Dispatch | Draw::DispatchOne) {
                 8.0
             } else {
                 0.0
@@ -691,6 +712,15 @@ impl<'p> Probe<'p> {
                 let side = SSS_TILE_SIDE;
                 let groups = [extent.width.div_ceil(side), extent.height.div_ceil(side), 1];
                 pass.dispatch(work, groups, side * side)
+                    .record(move |pc: &PassContext| {
+                        pc.bind(pipeline, &[set]);
+                        pipeline.push(pc.ctx, pc.cmd, &push);
+                    })
+            }
+            Draw::DispatchOne => {
+                let set = set.expect("a compute probe binds its target");
+                let side = SSS_TILE_SIDE;
+                pass.dispatch(work, [1, 1, 1], side * side)
                     .record(move |pc: &PassContext| {
                         pc.bind(pipeline, &[set]);
                         pipeline.push(pc.ctx, pc.cmd, &push);

@@ -80,8 +80,14 @@ fn compute_reason(w: &Work, c: &Ceilings) -> String {
         unreachable!("called for dispatches")
     };
     let bounds = shader.fetches.iter().any(|f| !f.exact);
+    let fixed = c
+        .compute
+        .and_then(|r| r.dispatch_ms)
+        .map_or(String::new(), |ms| {
+            format!(" (only a dispatch's fixed cost, {ms:.4} ms, is certain)")
+        });
     format!(
-        "its fetches are {} and no shared-memory traffic is certain for every invocation",
+        "its fetches are {} and no shared-memory traffic is certain for every invocation{fixed}",
         if bounds {
             "bounds behind branches"
         } else {
@@ -94,8 +100,12 @@ fn compute_reason(w: &Work, c: &Ceilings) -> String {
 /// the larger of its exactly declared fetches at the compute path's probed
 /// rates and the shared-memory bytes every invocation moves at the probed
 /// shared-memory bandwidth (writes priced as loads: both go through the
-/// same banks, one 4-byte word per bank a clock on the GPUs we know).
-/// `None` when nothing is left to count or the compute rates were not probed.
+/// same banks, one 4-byte word per bank a clock on the GPUs we know), after
+/// the probed cost of a one-group dispatch where it was probed: the launch,
+/// the barrier's drain and the timestamps every pass of the frame has around
+/// it, which come before and after the work, not beside it (0.012-0.014 ms on
+/// the H100, a third of a small pass). `None` when nothing is left to count
+/// or the compute rates were not probed.
 pub fn compute_floor_ms(work: &Work, invocations: u64, c: &Ceilings) -> Option<f64> {
     let (Work::Compute { shader, .. }, Some(rates)) = (work, c.compute.as_ref()) else {
         return None;
@@ -114,7 +124,7 @@ pub fn compute_floor_ms(work: &Work, invocations: u64, c: &Ceilings) -> Option<f
     // Storage writes are left out: the blurs declare theirs at skin pixels
     // only (at most), and a dispatch's invocations include the others.
     let s = fetch_s.max(shared_s);
-    (s > 0.0).then_some(s * 1e3)
+    (s > 0.0).then_some(s * 1e3 + rates.dispatch_ms.unwrap_or(0.0))
 }
 
 /// The rate of a declared fetch among a path's probed rates (bilinear and
@@ -280,6 +290,7 @@ mod tests {
                 point_r32f_gtaps: 1000.0,
                 store_rgba16f_gpix: 200.0,
                 shared_load_gbytes: Some(30_000.0),
+                dispatch_ms: None,
             }),
             bilinear_rgba8_gtaps: Some(31.0),
             point_rgba8_gtaps: Some(62.0),
@@ -312,6 +323,29 @@ mod tests {
         // 5 M at 500 G/s and 5 M at 1000 G/s: 0.015 ms; the bound is left out.
         let f = compute_floor_ms(&work, 1_000_000, &h100_like()).unwrap();
         assert!((f - 0.015).abs() < 1e-12, "{f}");
+        // With a probed one-group dispatch, its fixed cost comes first.
+        let mut probed = h100_like();
+        if let Some(c) = probed.compute.as_mut() {
+            c.dispatch_ms = Some(0.013);
+        }
+        let f = compute_floor_ms(&work, 1_000_000, &probed).unwrap();
+        assert!((f - 0.028).abs() < 1e-12, "{f}");
+        let why = pass_floor(
+            Some(&Work::Compute {
+                shader: shader(vec![Fetch {
+                    exact: false,
+                    ..fetch(Format::Rgba16Float, Filter::Point, 5.0)
+                }]),
+                invocations: 1,
+            }),
+            Counts {
+                compute: Some(10),
+                ..Counts::default()
+            },
+            &probed,
+        )
+        .unwrap_err();
+        assert!(why.contains("0.0130 ms"), "{why}");
         // No compute rates, or only bounds: no floor.
         let old = Ceilings {
             compute: None,

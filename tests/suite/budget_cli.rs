@@ -167,6 +167,7 @@ fn a_bench_report_reads_back_as_a_frame() {
     let o = dermis()
         .args([
             "bench",
+            "--validate",
             "--device",
             "llvmpipe",
             "--width",
@@ -192,6 +193,17 @@ fn a_bench_report_reads_back_as_a_frame() {
     assert_eq!(f.passes.len(), rec.passes.len());
     assert!(f.passes.iter().all(|p| p.measured_ms.is_some()));
     assert!(f.provenance[1].contains("declared"));
+    // Every probe ran (under validation) and gave a finite, positive figure,
+    // the one-group dispatch's time among them (what a dispatch's floor
+    // starts from, bench::floor).
+    let probes = rec.probes.as_ref().expect("bench reports its probes");
+    assert!(
+        probes.len() >= 22 && probes.iter().all(|p| p.gpu_ms.median > 0.0),
+        "{probes:?}"
+    );
+    let c = rec.ceilings.expect("bench reports its ceilings");
+    let cs = c.compute.expect("the compute rates were probed");
+    assert!(cs.dispatch_ms.is_some_and(|ms| ms > 0.0 && ms.is_finite()));
 }
 
 #[test]
