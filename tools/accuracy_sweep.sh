@@ -22,6 +22,9 @@
 #   DEADLINE   seconds after which no sweep is started, or left running
 #              (default: none)
 #   MIN_LEFT   seconds a sweep needs to be started (default 20)
+#   ONLY       settings to sweep, as `eval --only` takes them, space-separated (METHOD or
+#              METHOD/LABEL; default: the whole registry). Rows of a partial sweep are
+#              merged into the model's files by tools/accuracy_merge.py.
 #
 # Measured: NVIDIA H200 at 640x360, see docs/perf/h200-accuracy/commands.txt;
 # lavapipe on 2 cores, docs/accuracy.md.
@@ -35,13 +38,15 @@ ASSETS=${ASSETS:-scan procedural}
 SHADOWS=${SHADOWS:-2048 512 128 32}
 JOBS=${JOBS:-1}
 MIN_LEFT=${MIN_LEFT:-20}
+ONLY_ARGS=()
+for o in ${ONLY:-}; do ONLY_ARGS+=(--only "$o"); done
 START=$SECONDS
 mkdir -p "$DIR"
 sweep() { # asset size
   local asset=$1 size=$2 left=$3
   local out="$DIR/$asset-s$size"
   local cmd=("$B" eval --scene "$HEAD" --scenes "accuracy:$asset" --width "$W" --height "$H" \
-    --shadow-size "$size" --warmup 1 --frames 3 --out "$out")
+    --shadow-size "$size" --warmup 1 --frames 3 "${ONLY_ARGS[@]}" --out "$out")
   local t0=$SECONDS rc=0
   ${left:+timeout "$left"} "${cmd[@]}" > "$DIR/$asset-s$size.log" 2>&1 || rc=$?
   if (( rc == 0 )); then
