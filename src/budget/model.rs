@@ -15,9 +15,11 @@ use crate::work::PassRole;
 
 /// The combining rule, written out for reports.
 pub const COMBINING_RULE: &str = "t = fixed + k_rect rects + k_fill T_clear + max(k_tex (T_tex + \
-f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem) + k_rej T_reject + k_hiz \
-T_reject_hiz + T_geometry + T_resolve + T_restore; the k's, f_inc and the fixed costs fitted \
-per rate source (peak: the published points; probed: the benchmark GPUs' passes)";
+f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem, k_shared T_shared) + k_rej T_reject + \
+k_hiz T_reject_hiz + T_geometry + T_resolve + T_restore; a dispatch or a fill outside a render \
+pass takes its own fixed cost, k_alu and f_inc, and T_shared its shared-memory bytes at the \
+profile's rate; the k's, f_inc and the fixed costs fitted per rate source (peak: the published \
+points; probed: the benchmark GPUs' passes)";
 
 /// Per-pass result, ready for JSON.
 #[derive(Clone, Debug, PartialEq, Serialize)]
