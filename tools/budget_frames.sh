@@ -9,12 +9,16 @@
 #               directory of new-format bench reports of that matrix)
 #   porting/    docs/budget.md's frames: the head at 1280x720, 1/3/5 characters, close/mid/far,
 #               every real-time method (h{N}_{shot}_{method}.json)
+#   issue28/    the H100 runs of docs/perf/issue28/h100/ that calibrate the compute path (1080p
+#               close-up: separable, ssg, ss-jittered, Poisson on the compute path, the gather
+#               at 20/40/80 samples and Burley's at 40) and those held out of the fit (1080p
+#               mid, 4K): the default (portrait) view, as `dermis bench` ran them
 #   msaa/       the configurations of docs/perf/h200-msaa (the scan's portrait at 720p and
 #               1080p, 16 heads at 4 head heights at 720p; at 1x, with MLAA at 720p, SMAA 1x at 1080p): their
 #               counted fetches for tools/examples/msaa_score.rs (the H200's reports hold the
 #               counts of every sample count, lavapipe renders 1x and 4x only)
 #
-#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix porting msaa (default: all)
+#   tools/budget_frames.sh [BIN] [PART...]     PART: published h100 matrix porting msaa issue28 (default: all)
 #
 # BIN defaults to target/release/dermis. Existing frames are kept (delete to redo).
 set -uo pipefail
@@ -23,7 +27,9 @@ shift || true
 ASSET=${ASSET:-../shared/assets/lee-perry-smith/LeePerrySmith.glb}
 D=profiles/frames
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting msaa)
+[ ${#parts[@]} -eq 0 ] && parts=(published h100 matrix porting msaa issue28)
+# The view of frame(): the study view of the recorded runs before issue 15 (issue28 sets its own).
+VIEW=(--view study)
 
 # frame DIR NAME dermis-budget-args...: one frame on lavapipe.
 frame() {
@@ -34,7 +40,7 @@ frame() {
   mkdir -p "$D/$dir"
   local tmp
   tmp=$(mktemp -d)
-  if "$BIN" budget --view study --device llvmpipe --profile nvidia-h100 --warmup 0 --frames 1 "$@" \
+  if "$BIN" budget "${VIEW[@]}" --device llvmpipe --profile nvidia-h100 --warmup 0 --frames 1 "$@" \
       --out "$tmp" > "$tmp/log.txt" 2>&1; then
     cp "$tmp"/frames/*.json "$target"
     echo "ok: $dir/$name"
@@ -168,6 +174,36 @@ msaa() {
   done
 }
 
+# docs/perf/issue28/h100/'s runs (tools/perf_issue28.sh), by report name: the default view, as
+# bench ran them. Their reports' `settings` cannot be replayed (the gather's budget was
+# `--samples` then, `--sample-budget` now; its profile `--profile`, now `--diffusion-profile`).
+issue28() {
+  VIEW=(--view portrait)
+  local hd=(--width 1920 --height 1080) uhd=(--width 3840 --height 2160) spec name args
+  for spec in \
+      "1080-close-1-compute|${hd[*]} --shot close --method separable --path compute" \
+      "1080-close-1-ssg-compute|${hd[*]} --shot close --method ssg --path compute" \
+      "1080-close-1-ss-jittered-compute|${hd[*]} --shot close --method ss-jittered --path compute" \
+      "1080-close-1-poisson-compute|${hd[*]} --shot close --method poisson --path compute" \
+      "1080-close-1-gather-20|${hd[*]} --shot close --method gather --sample-budget 20" \
+      "1080-close-1-gather-40|${hd[*]} --shot close --method gather --sample-budget 40" \
+      "1080-close-1-gather-80|${hd[*]} --shot close --method gather --sample-budget 80" \
+      "1080-close-1-gather-burley-40|${hd[*]} --shot close --method gather --sample-budget 40 --diffusion-profile burley" \
+      "1080-mid-1-compute|${hd[*]} --shot mid --method separable --path compute" \
+      "1080-mid-1-ssg-compute|${hd[*]} --shot mid --method ssg --path compute" \
+      "1080-mid-1-gather-20|${hd[*]} --shot mid --method gather --sample-budget 20" \
+      "1080-mid-1-gather-40|${hd[*]} --shot mid --method gather --sample-budget 40" \
+      "1080-mid-1-gather-80|${hd[*]} --shot mid --method gather --sample-budget 80" \
+      "1080-mid-1-gather-burley-40|${hd[*]} --shot mid --method gather --sample-budget 40 --diffusion-profile burley" \
+      "2160-close-1-compute|${uhd[*]} --shot close --method separable --path compute" \
+      "2160-mid-1-compute|${uhd[*]} --shot mid --method separable --path compute"; do
+    name=${spec%%|*}
+    read -r -a args <<< "${spec#*|}"
+    frame issue28 "$name" "${args[@]}"
+  done
+  VIEW=(--view study)
+}
+
 for p in "${parts[@]}"; do
   case $p in
     published) published ;;
@@ -175,6 +211,7 @@ for p in "${parts[@]}"; do
     matrix) matrix ;;
     porting) porting ;;
     msaa) msaa ;;
-    *) echo "unknown part '$p' (valid: published h100 matrix porting msaa)" >&2; exit 2 ;;
+    issue28) issue28 ;;
+    *) echo "unknown part '$p' (valid: published h100 matrix porting msaa issue28)" >&2; exit 2 ;;
   esac
 done

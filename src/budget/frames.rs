@@ -299,7 +299,14 @@ pub fn with_counted_fetches(f: &FrameInput, stored: Option<&FrameInput>) -> Fram
                 Some(c),
             ) if c.len() == sh.fetches.len() => sh.fetches = c,
             (Work::Compute { shader: sh, .. }, Some(c)) if c.len() == sh.fetches.len() => {
-                sh.fetches = c
+                sh.fetches = c;
+                // A report from before `shared_bytes` was declared (0 then):
+                // the stored frame's declaration of the same shader has it.
+                if let Work::Compute { shader: st, .. } = &sp.work {
+                    if sh.shared_bytes == 0.0 && st.shader == sh.shader {
+                        sh.shared_bytes = st.shared_bytes;
+                    }
+                }
             }
             _ => continue,
         }

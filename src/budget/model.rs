@@ -15,9 +15,11 @@ use crate::work::PassRole;
 
 /// The combining rule, written out for reports.
 pub const COMBINING_RULE: &str = "t = fixed + k_rect rects + k_fill T_clear + max(k_tex (T_tex + \
-f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem) + k_rej T_reject + k_hiz \
-T_reject_hiz + T_geometry + T_resolve + T_restore; the k's, f_inc and the fixed costs fitted \
-per rate source (peak: the published points; probed: the benchmark GPUs' passes)";
+f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem, k_shared T_shared) + k_rej T_reject + \
+k_hiz T_reject_hiz + T_geometry + T_resolve + T_restore; a dispatch or a fill outside a render \
+pass takes its own fixed cost, k_alu and f_inc, and T_shared its shared-memory bytes at the \
+profile's rate; the k's, f_inc and the fixed costs fitted per rate source (peak: the published \
+points; probed: the benchmark GPUs' passes)";
 
 /// Per-pass result, ready for JSON.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -700,5 +702,127 @@ mod tests {
         p.alu.vector_ginstr = Some(Quantity::Unknown);
         let u = price_units(&p, &frame(vec![alu_only(1000, 10.0)]));
         assert_eq!(u[0].unpriced, vec!["alu.vector_ginstr".to_string()]);
+    }
+
+    /// `gather()` with `shared` bytes of workgroup memory an invocation.
+    fn staged(shared: f64) -> PassInput {
+        let mut c = gather();
+        if let Work::Compute { shader, .. } = &mut c.work {
+            shader.alu = 0.0;
+            shader.shared_bytes = shared;
+        }
+        c
+    }
+
+    #[test]
+    fn a_dispatch_and_a_fill_take_the_dispatch_fixed_cost() {
+        let p = prof("nvidia-h100");
+        let params = ModelParams {
+            fixed_kpix_per_pass: 10.0,
+            fixed_kpix_per_dispatch: 100.0,
+            ..ModelParams::PEAK
+        };
+        let fill = PassInput::new(
+            "reset",
+            PassRole::Sss,
+            Work::Clear {
+                texels: 4,
+                bytes_per_texel: 4,
+            },
+        );
+        let u = price_units(&p, &frame(vec![staged(0.0), fill, alu_only(1, 0.0)]));
+        // 100 thousand pixels at the RGBA8 fill probe's 13.97 G/s: 0.0071582 ms
+        // (the fill's own 4 texels add under 1e-6 ms).
+        for k in [0, 1] {
+            assert!(u[k].units.dispatch, "{}", u[k].name);
+            let ms = u[k].modelled_ms(&params).unwrap_or(0.0);
+            assert!(
+                (ms - 1e5 / 13.97e9 * 1e3).abs() < 1e-6,
+                "{}: {ms}",
+                u[k].name
+            );
+        }
+        // A draw keeps the per-pass cost (its one fragment's work adds 2e-6 ms).
+        assert!(!u[2].units.dispatch);
+        let ms = u[2].modelled_ms(&params).unwrap_or(0.0);
+        assert!((ms - 1e4 / 13.97e9 * 1e3).abs() < 1e-5, "{ms}");
+    }
+
+    #[test]
+    fn shared_bytes_are_priced_at_the_profile_s_shared_rate() {
+        // 1M invocations x 60 B = 60 MB.
+        let shared = |name: &str| price_units(&prof(name), &frame(vec![staged(60.0)]))[0].clone();
+        let h100 = shared("nvidia-h100");
+        assert!(h100.unpriced.is_empty());
+        // At the H100's probed 24 200 GB/s: 0.0024793 ms; the Switch docked's
+        // 2 SMs x 128 B x 0.768 GHz = 196.6 GB/s: 0.30519 ms.
+        assert!((h100.units.shared - 60e6 / 24_200e9 * 1e3).abs() < 1e-12);
+        let switch = shared("switch-docked");
+        assert!((switch.units.shared - 60e6 / 196.6e9 * 1e3).abs() < 1e-12);
+        // shared_scale multiplies it, and it bounds the pass when slowest.
+        let params = ModelParams {
+            shared_scale: 2.0,
+            ..ModelParams::PEAK
+        };
+        assert!((h100.units.scaled(&params).shared - 2.0 * 60e6 / 24_200e9 * 1e3).abs() < 1e-12);
+        assert_eq!(h100.units.bound(&params), Bound::Shared);
+        // Without a compute path the dispatch is a pixel shader: no shared
+        // memory, nothing unpriced for want of its rate.
+        let xbox = shared("xbox360");
+        assert!(xbox.unpriced.is_empty(), "{:?}", xbox.unpriced);
+        assert_eq!((xbox.units.shared, xbox.units.dispatch), (0.0, false));
+        // A profile with compute but no known rate leaves it unpriced.
+        let mut p = prof("switch-docked");
+        p.alu.compute_shared_gbytes = Quantity::Unknown;
+        let u = price_units(&p, &frame(vec![staged(60.0)]));
+        assert_eq!(u[0].unpriced, vec!["alu.compute_shared_gbytes".to_string()]);
+    }
+
+    #[test]
+    fn a_dispatch_s_incoherent_taps_read_memory_as_coherent_ones() {
+        let tap = Fetch {
+            texture: "colorTex".into(),
+            format: Format::Rgba16Float,
+            filter: Filter::Bilinear,
+            count: 10.0,
+            exact: true,
+            coherent: false,
+            spread: Vec::new(),
+        };
+        let mut c = staged(0.0);
+        if let Work::Compute { shader, .. } = &mut c.work {
+            shader.fetches = vec![tap.clone()];
+        }
+        let mut d = alu_only(1_000_000, 0.0);
+        if let Work::Raster {
+            shader: Some(s), ..
+        } = &mut d.work
+        {
+            s.fetches = vec![tap];
+        }
+        let p = prof("nvidia-h100");
+        let u = price_units(&p, &frame(vec![c, d]));
+        // 1M invocations: the texture once (8 B) against 10 taps x 4 texels x 8 B,
+        // at 3350 GB/s (the raster pass also writes its RGBA16F target, 8 B).
+        let ms = |bytes: f64| bytes / 3350e9 * 1e3;
+        assert!(
+            (u[0].units.memory - ms(8e6)).abs() < 1e-12,
+            "{}",
+            u[0].units.memory
+        );
+        assert!(
+            (u[1].units.memory - ms(320e6 + 8e6)).abs() < 1e-12,
+            "{}",
+            u[1].units.memory
+        );
+        // The incoherent factor of dispatches applies to the dispatch only.
+        let params = ModelParams {
+            incoherent_factor: 3.0,
+            compute_incoherent_factor: 1.5,
+            ..ModelParams::PEAK
+        };
+        let (a, b) = (u[0].units.scaled(&params), u[1].units.scaled(&params));
+        assert!((a.texture_incoherent - 1.5 * u[0].units.texture_incoherent).abs() < 1e-12);
+        assert!((b.texture_incoherent - 3.0 * u[1].units.texture_incoherent).abs() < 1e-12);
     }
 }

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::budget::profile::RateSource;
 
 /// Number of free parameters.
-pub const N_PARAMS: usize = 10;
+pub const N_PARAMS: usize = 14;
 
 /// One set of the model's free parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,6 +41,26 @@ pub struct ModelParams {
     /// cost: rotated taps well inside it land in the texels their neighbours'
     /// taps already brought into the cache.
     pub incoherent_radius_px: f64,
+    /// Fixed cost of every dispatch and every transfer outside a render pass
+    /// (a buffer fill), in place of `fixed_kpix_per_pass`, same unit: the
+    /// H100 takes 0.012-0.014 ms for any of them, an empty indirect dispatch
+    /// included (docs/perf/issue28/floors.md), four times a draw's.
+    pub fixed_kpix_per_dispatch: f64,
+    /// Multiplies the ALU time of dispatches (`alu_scale` is the pixel
+    /// shaders'): the compute rate is the chip's published peak, which a
+    /// shader of workgroup barriers and shared-memory instructions does not
+    /// reach, while the pixel rate is a fitted guess of the graphics slice.
+    pub compute_alu_scale: f64,
+    /// `incoherent_factor` of dispatches: the compute path spreads its taps
+    /// over every SM's texture cache (the H100 took the gather's rotated taps
+    /// near its coherent compute rate), the pixel path over a few.
+    pub compute_incoherent_factor: f64,
+    /// Multiplies the shared-memory time of dispatches (their
+    /// `shared_bytes` at the profile's shared-memory rate). Fitted on the
+    /// one shader that stages a tile in shared memory (the separable compute
+    /// blur), it is not a bandwidth efficiency: it prices the staging (store,
+    /// workgroup barrier, reload) per byte staged.
+    pub shared_scale: f64,
 }
 
 impl ModelParams {
@@ -56,6 +76,10 @@ impl ModelParams {
         fixed_kpix_per_pass: 0.0,
         rect_kpix: 0.0,
         incoherent_radius_px: 1.0,
+        fixed_kpix_per_dispatch: 0.0,
+        compute_alu_scale: 1.0,
+        compute_incoherent_factor: 1.0,
+        shared_scale: 1.0,
     };
 
     /// The texture-time multiplier of incoherent taps landing `radius_px`
@@ -64,9 +88,19 @@ impl ModelParams {
     /// texels its neighbours' taps do not share grows with the area the
     /// rotated taps sweep, `r^2 / (r^2 + r_half^2)`.
     pub fn incoherence(&self, radius_px: f64) -> f64 {
+        self.incoherence_to(self.incoherent_factor, radius_px)
+    }
+
+    /// [`ModelParams::incoherence`] of a dispatch's taps: the same rise to
+    /// `compute_incoherent_factor`.
+    pub fn compute_incoherence(&self, radius_px: f64) -> f64 {
+        self.incoherence_to(self.compute_incoherent_factor, radius_px)
+    }
+
+    fn incoherence_to(&self, factor: f64, radius_px: f64) -> f64 {
         let r2 = radius_px * radius_px;
         let h2 = self.incoherent_radius_px * self.incoherent_radius_px;
-        1.0 + (self.incoherent_factor - 1.0) * r2 / (r2 + h2)
+        1.0 + (factor - 1.0) * r2 / (r2 + h2)
     }
 
     /// The parameters as a vector (for fitting) and back.
@@ -82,6 +116,10 @@ impl ModelParams {
             self.fixed_kpix_per_pass,
             self.rect_kpix,
             self.incoherent_radius_px,
+            self.fixed_kpix_per_dispatch,
+            self.compute_alu_scale,
+            self.compute_incoherent_factor,
+            self.shared_scale,
         ]
     }
 
@@ -97,6 +135,10 @@ impl ModelParams {
             fixed_kpix_per_pass: v[7],
             rect_kpix: v[8],
             incoherent_radius_px: v[9],
+            fixed_kpix_per_dispatch: v[10],
+            compute_alu_scale: v[11],
+            compute_incoherent_factor: v[12],
+            shared_scale: v[13],
         }
     }
 }
@@ -132,28 +174,36 @@ impl ParamSet {
 /// See [`ParamSet::fitted`].
 pub const FITTED: ParamSet = ParamSet {
     peak: ModelParams {
-        texture_scale: 1.16682,
-        alu_scale: 1.07458,
-        fill_scale: 1.96421,
-        memory_scale: 0.55136,
-        reject_scale: 1.66102,
-        hiz_reject_scale: 0.29755,
-        incoherent_factor: 2.67270,
-        fixed_kpix_per_pass: 20.11136,
-        rect_kpix: 29.62749,
-        incoherent_radius_px: 8.18831,
+        texture_scale: 1.15983,
+        alu_scale: 1.06743,
+        fill_scale: 2.09130,
+        memory_scale: 0.54768,
+        reject_scale: 1.64821,
+        hiz_reject_scale: 0.13733,
+        incoherent_factor: 2.67479,
+        fixed_kpix_per_pass: 20.27306,
+        rect_kpix: 34.76759,
+        incoherent_radius_px: 8.22099,
+        fixed_kpix_per_dispatch: 179.97864,
+        compute_alu_scale: 0.99952,
+        compute_incoherent_factor: 1.18741,
+        shared_scale: 25.39211,
     },
     probed: ModelParams {
-        texture_scale: 1.14105,
-        alu_scale: 0.98099,
-        fill_scale: 1.05803,
-        memory_scale: 1.00010,
-        reject_scale: 0.15480,
-        hiz_reject_scale: 0.29755,
-        incoherent_factor: 2.67270,
-        fixed_kpix_per_pass: 41.30713,
-        rect_kpix: 29.62749,
-        incoherent_radius_px: 8.18831,
+        texture_scale: 1.14078,
+        alu_scale: 0.98076,
+        fill_scale: 0.98252,
+        memory_scale: 1.63252,
+        reject_scale: 0.07979,
+        hiz_reject_scale: 0.13733,
+        incoherent_factor: 2.67479,
+        fixed_kpix_per_pass: 46.02980,
+        rect_kpix: 34.76759,
+        incoherent_radius_px: 8.22099,
+        fixed_kpix_per_dispatch: 179.97864,
+        compute_alu_scale: 0.99952,
+        compute_incoherent_factor: 1.18741,
+        shared_scale: 25.39211,
     },
 };
 
@@ -175,5 +225,21 @@ mod tests {
                 last = f;
             }
         }
+    }
+
+    #[test]
+    fn a_dispatch_s_incoherence_rises_to_its_own_factor() {
+        let p = ModelParams {
+            incoherent_factor: 3.0,
+            compute_incoherent_factor: 1.5,
+            incoherent_radius_px: 4.0,
+            ..ModelParams::PEAK
+        };
+        // At the half radius: 1 + (1.5 - 1) / 2 for a dispatch, 1 + (3 - 1) / 2 for a draw.
+        assert!((p.compute_incoherence(4.0) - 1.25).abs() < 1e-12);
+        assert!((p.incoherence(4.0) - 2.0).abs() < 1e-12);
+        // 12 px: 144 / (144 + 16) = 0.9 of the way.
+        assert!((p.compute_incoherence(12.0) - 1.45).abs() < 1e-12);
+        assert!((p.compute_incoherence(0.0) - 1.0).abs() < 1e-12);
     }
 }

@@ -11,7 +11,13 @@
 //!   `docs/perf/h100/` (priced with the stored frame of its configuration,
 //!   `frames::paired_frame`) and of every directory of new-format bench
 //!   reports in [`BENCH_DIRS`] (the H200's, once committed), each on the
-//!   profile of the GPU that ran it.
+//!   profile of the GPU that ran it; and the H100's compute-path runs of
+//!   issue 28 at the 1080p close-up ([`ISSUE28_FIT`]), with the counted
+//!   fetches of their stored frames (`profiles/frames/issue28/`). The same
+//!   runs at the 1080p mid shot and at 4K ([`ISSUE28_HELD_OUT`]) are in no
+//!   fit: [`issue28_held_out`] scores the model on them.
+
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -29,6 +35,36 @@ use crate::report;
 /// A missing directory contributes nothing; a report from another device is
 /// left out (named in the skipped list).
 pub const BENCH_DIRS: &[(&str, &str, &str)] = &[("h200", "nvidia-h200", "H200")];
+
+/// docs/perf/issue28/h100/'s reports that calibrate the compute path (the
+/// 1080p close-up, every compute method; each report's raster passes join
+/// too), paired with `profiles/frames/issue28/NAME.json`.
+pub const ISSUE28_FIT: &[&str] = &[
+    "1080-close-1-compute",
+    "1080-close-1-ssg-compute",
+    "1080-close-1-ss-jittered-compute",
+    "1080-close-1-poisson-compute",
+    "1080-close-1-gather-20",
+    "1080-close-1-gather-40",
+    "1080-close-1-gather-80",
+    "1080-close-1-gather-burley-40",
+];
+
+/// The same directory's runs kept out of every fit (other shots and sizes):
+/// the model's out-of-sample check.
+pub const ISSUE28_HELD_OUT: &[&str] = &[
+    "1080-mid-1-compute",
+    "1080-mid-1-ssg-compute",
+    "1080-mid-1-gather-20",
+    "1080-mid-1-gather-40",
+    "1080-mid-1-gather-80",
+    "1080-mid-1-gather-burley-40",
+    "2160-close-1-compute",
+    "2160-mid-1-compute",
+];
+
+/// The set the issue-28 points are summarised in.
+pub const ISSUE28_SET: &str = "H100 compute";
 
 /// Where a point comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -268,25 +304,66 @@ pub fn benchmark() -> Result<(Vec<Point>, Vec<String>)> {
         let source = format!("docs/perf/{dir}");
         for path in json_files(&perf_dir().join(dir))? {
             let name = path.file_stem().unwrap_or_default().to_string_lossy();
-            let frame = report::load(&path)
-                .and_then(|r| {
-                    if !r.run.device.device.contains(device) {
-                        anyhow::bail!("run on {}, not an {device}", r.run.device.device);
-                    }
-                    frame_from_record(&r, None, &name)
-                })
-                .with_context(|| format!("{dir}/{name}"));
-            let frame = match frame {
-                Ok(f) => f,
-                Err(e) => {
-                    skipped.push(format!("{e:#}"));
-                    continue;
-                }
-            };
             let stored = load_frame(&frames_dir().join("matrix").join(format!("{name}.json"))).ok();
-            let f = with_counted_fetches(&frame, stored.as_ref());
-            v.extend(pass_points(&f, &set, profile, &name, &source));
+            match new_format_frame(&path, device, stored.as_ref())
+                .with_context(|| format!("{dir}/{name}"))
+            {
+                Ok(f) => v.extend(pass_points(&f, &set, profile, &name, &source)),
+                Err(e) => skipped.push(format!("{e:#}")),
+            }
         }
     }
+    match issue28(ISSUE28_FIT) {
+        Ok(p) => v.extend(p),
+        Err(e) => skipped.push(format!("{e:#}")),
+    }
     Ok((v, skipped))
+}
+
+/// A new-format report of `device` as a frame, with the counted fetches of
+/// `stored` (its configuration's frame) when given.
+fn new_format_frame(path: &Path, device: &str, stored: Option<&FrameInput>) -> Result<FrameInput> {
+    let name = path.file_stem().unwrap_or_default().to_string_lossy();
+    let r = report::load(path)?;
+    if !r.run.device.device.contains(device) {
+        anyhow::bail!("run on {}, not an {device}", r.run.device.device);
+    }
+    let frame = frame_from_record(&r, None, &name)?;
+    Ok(with_counted_fetches(&frame, stored))
+}
+
+/// The points of docs/perf/issue28/h100/'s reports `names` (set
+/// [`ISSUE28_SET`]), each with its stored frame's counted fetches: a report
+/// without its stored frame is an error (the compute passes' fetch counts
+/// are bounds until counted).
+fn issue28(names: &[&str]) -> Result<Vec<Point>> {
+    let source = "docs/perf/issue28/h100 (NVIDIA H100, medians of 200 frames)";
+    let mut v = Vec::new();
+    for name in names {
+        let path = perf_dir().join("issue28/h100").join(format!("{name}.json"));
+        let stored = load_frame(&frames_dir().join("issue28").join(format!("{name}.json")))
+            .with_context(|| format!("issue28/h100/{name}: its stored frame"))?;
+        let rep = report::load(&path)?;
+        let names = |v: Vec<&str>| v.join(", ");
+        let (a, b): (Vec<&str>, Vec<&str>) = (
+            rep.passes.iter().map(|p| p.name.as_str()).collect(),
+            stored.passes.iter().map(|p| p.name.as_str()).collect(),
+        );
+        if a != b {
+            anyhow::bail!(
+                "issue28/h100/{name}: passes differ from its stored frame's: report [{}], frame [{}]",
+                names(a),
+                names(b)
+            );
+        }
+        let f = new_format_frame(&path, "H100", Some(&stored))
+            .with_context(|| format!("issue28/h100/{name}"))?;
+        v.extend(pass_points(&f, ISSUE28_SET, "nvidia-h100", name, source));
+    }
+    Ok(v)
+}
+
+/// The points of [`ISSUE28_HELD_OUT`]: in no fit, scored out of sample.
+pub fn issue28_held_out() -> Result<Vec<Point>> {
+    issue28(ISSUE28_HELD_OUT)
 }

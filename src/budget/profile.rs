@@ -157,6 +157,12 @@ pub struct Alu {
     /// Peak rate reachable by compute dispatches (`"unknown"` where the GPU
     /// has no compute path).
     pub compute_gflops: Quantity,
+    /// Workgroup shared-memory bandwidth of compute dispatches, GB/s (what
+    /// `ShaderWork::shared_bytes` moves): probed on the benchmark GPUs,
+    /// per-SM bytes a clock x SMs x clock elsewhere; `"unknown"` where the
+    /// GPU has no compute path (a dispatch is then priced as a pixel shader,
+    /// which has no shared memory).
+    pub compute_shared_gbytes: Quantity,
     /// How the ALUs issue ([`Alu::issue`]): instructions per second, 1e9, of a
     /// GPU whose ALUs issue whole vector instructions (Xenos: a vec4 and a
     /// scalar slot per ALU per clock; RSX: two vec4 units per pixel pipe).
@@ -444,6 +450,7 @@ impl Profile {
         }
         q("alu.gflops", self.alu.gflops)?;
         q("alu.compute_gflops", self.alu.compute_gflops)?;
+        q("alu.compute_shared_gbytes", self.alu.compute_shared_gbytes)?;
         if let Some(v) = self.alu.vector_ginstr {
             q("alu.vector_ginstr", v)?;
             // An instruction fills at least one lane: a vector-issue rate above

@@ -15,6 +15,7 @@ fn bound_name(b: Option<Bound>) -> &'static str {
         Some(Bound::Alu) => "ALU",
         Some(Bound::Fill) => "fill",
         Some(Bound::Memory) => "memory",
+        Some(Bound::Shared) => "shared",
         Some(Bound::Resolve) => "resolve",
         Some(Bound::Overhead) => "overhead",
         None => "UNPRICED",

@@ -5,9 +5,19 @@
 //!
 //! ```text
 //! t = fixed + k_rect rects + k_fill T_clear
-//!       + max(k_tex (T_tex + f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem)
+//!       + max(k_tex (T_tex + f_inc T_tex_incoherent), k_alu T_alu, k_fill T_fill, k_mem T_mem,
+//!             k_shared T_shared)
 //!       + k_rej T_reject + k_hiz T_reject_hiz + T_geometry + T_resolve + T_restore
 //! ```
+//!
+//! A dispatch (and a transfer outside a render pass, a buffer fill) takes
+//! `fixed` at `fixed_kpix_per_dispatch`, its ALU at `compute_alu_scale` and
+//! its incoherent taps at `compute_incoherent_factor`, and its incoherent
+//! taps' memory traffic as its coherent taps' (each texture's footprint once
+//! an invocation: the H100 took the gather's rotated taps at its coherent
+//! rate, over images its 50 MB L2 holds); `T_shared` is its workgroup
+//! shared-memory bytes over the profile's shared-memory rate, scaled by
+//! `shared_scale` (`ModelParams::shared_scale` says what it prices).
 //!
 //! Units overlap (they work concurrently on different fragments), so the
 //! slowest bounds the pass; what happens before the draws (clears), outside
@@ -62,6 +72,8 @@ pub enum Bound {
     Alu,
     Fill,
     Memory,
+    /// Workgroup shared memory (dispatches).
+    Shared,
     /// eDRAM resolves and restores outweigh the shading.
     Resolve,
     /// Clears, rejection, set-up or the fixed costs outweigh the shading.
@@ -97,6 +109,12 @@ pub struct UnitTimes {
     pub fixed_unit: f64,
     /// Copy rectangles (after `scaled`: their cost in ms).
     pub copy_rects: f64,
+    /// Workgroup shared-memory bytes over the profile's shared-memory rate
+    /// (`alu.compute_shared_gbytes`; dispatches only).
+    pub shared: f64,
+    /// A dispatch or a transfer outside a render pass: the compute
+    /// parameters apply (module docs).
+    pub dispatch: bool,
 }
 
 impl UnitTimes {
@@ -108,18 +126,33 @@ impl UnitTimes {
 
     /// Each term as it enters the sum (parameters applied).
     pub fn scaled(&self, p: &ModelParams) -> UnitTimes {
+        let (factor, alu_scale, fixed) = if self.dispatch {
+            (
+                p.compute_incoherent_factor,
+                p.compute_alu_scale,
+                p.fixed_kpix_per_dispatch,
+            )
+        } else {
+            (p.incoherent_factor, p.alu_scale, p.fixed_kpix_per_pass)
+        };
+        let incoherence = |r: f64| {
+            if self.dispatch {
+                p.compute_incoherence(r)
+            } else {
+                p.incoherence(r)
+            }
+        };
         UnitTimes {
             texture: p.texture_scale * self.texture,
             texture_incoherent: p.texture_scale
-                * (p.incoherent_factor * self.texture_incoherent
+                * (factor * self.texture_incoherent
                     + (0..SPREAD_BINS)
                         .map(|b| {
-                            self.texture_incoherent_by_radius[b]
-                                * p.incoherence(spread_bin_radius(b))
+                            self.texture_incoherent_by_radius[b] * incoherence(spread_bin_radius(b))
                         })
                         .sum::<f64>()),
             texture_incoherent_by_radius: [0.0; SPREAD_BINS],
-            alu: p.alu_scale * self.alu,
+            alu: alu_scale * self.alu,
             fill: p.fill_scale * self.fill,
             memory: p.memory_scale * self.memory,
             reject: p.reject_scale * self.reject,
@@ -128,8 +161,10 @@ impl UnitTimes {
             geometry: self.geometry,
             resolve: self.resolve,
             restore: self.restore,
-            fixed_unit: p.fixed_kpix_per_pass * self.fixed_unit,
+            fixed_unit: fixed * self.fixed_unit,
             copy_rects: p.rect_kpix * self.fixed_unit * self.copy_rects,
+            shared: p.shared_scale * self.shared,
+            dispatch: self.dispatch,
         }
     }
 
@@ -150,6 +185,7 @@ impl UnitTimes {
             (self.alu, Bound::Alu),
             (self.fill, Bound::Fill),
             (self.memory, Bound::Memory),
+            (self.shared, Bound::Shared),
         ];
         units
             .into_iter()
@@ -436,9 +472,10 @@ impl Pricing<'_> {
             }
             // Memory: each texture's footprint is read about once per
             // invocation (neighbouring taps hit the cache); incoherent taps
-            // read their 4 texels each.
+            // of a pixel shader read their 4 texels each, a dispatch's as
+            // its coherent taps (module docs).
             let bpt = f64::from(f.format.bytes_per_texel());
-            if !f.coherent {
+            if !f.coherent && !compute {
                 self.u.memory += n * f.count * 4.0 * bpt;
             } else if !seen.contains(&f.texture.as_str()) {
                 seen.push(&f.texture);
@@ -728,6 +765,21 @@ impl Pricing<'_> {
             });
         }
         self.shader_terms(shader, n, has_compute);
+        if has_compute {
+            self.u.dispatch = true;
+            self.u.shared = self.shared_ms(shader.shared_bytes * n);
+        }
+    }
+
+    /// Time of `bytes` of workgroup shared memory at the profile's rate
+    /// (0 without a byte: a profile lacking the rate prices such dispatches).
+    fn shared_ms(&mut self, bytes: f64) -> f64 {
+        if bytes <= 0.0 {
+            return 0.0;
+        }
+        let q = self.prof.alu.compute_shared_gbytes;
+        self.need("alu.compute_shared_gbytes", q)
+            .map_or(0.0, |r| bytes / (r * G) * MS)
     }
 
     fn copy(&mut self, p: &PassInput, texels: u64, bpt: u32, rects: u32) {
@@ -783,7 +835,10 @@ impl Pricing<'_> {
         });
     }
 
+    /// A clear outside a render pass (a buffer or image fill): a transfer
+    /// command, whose fixed cost is a dispatch's.
     fn clear_pass(&mut self, p: &PassInput, texels: u64, bpt: u32) {
+        self.u.dispatch = true;
         let fmt = p
             .images
             .first()

@@ -25,13 +25,28 @@ fn main() -> Result<()> {
     // Ready to paste into params.rs when the points change.
     let f = |m: &ModelParams| {
         let v = m.to_vec();
-        format!(
-            "ModelParams {{ texture_scale: {:.5}, alu_scale: {:.5}, fill_scale: {:.5}, \
-             memory_scale: {:.5}, reject_scale: {:.5}, hiz_reject_scale: {:.5}, \
-             incoherent_factor: {:.5}, fixed_kpix_per_pass: {:.5}, rect_kpix: {:.5}, \
-             incoherent_radius_px: {:.5} }}",
-            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]
-        )
+        let names = [
+            "texture_scale",
+            "alu_scale",
+            "fill_scale",
+            "memory_scale",
+            "reject_scale",
+            "hiz_reject_scale",
+            "incoherent_factor",
+            "fixed_kpix_per_pass",
+            "rect_kpix",
+            "incoherent_radius_px",
+            "fixed_kpix_per_dispatch",
+            "compute_alu_scale",
+            "compute_incoherent_factor",
+            "shared_scale",
+        ];
+        let fields: Vec<String> = names
+            .iter()
+            .zip(v)
+            .map(|(n, x)| format!("{n}: {x:.5}"))
+            .collect();
+        format!("ModelParams {{ {} }}", fields.join(", "))
     };
     println!(
         "pub const FITTED: ParamSet = ParamSet {{ peak: {}, probed: {} }};",
