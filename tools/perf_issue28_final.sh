@@ -3,12 +3,14 @@
 # it): the one-group dispatch probe and the compute floors that start from it; the gather with
 # its normal test; the budget model's calibrated compute prices checked out of sample at
 # 2560x1440, a size no fit saw; plans that choose the path per group, predicted by `dermis plan`
-# and measured by `dermis bench --plan` on the same card.
+# and measured by `dermis bench --plan` on the same card; the gather's rows of the accuracy
+# model (tools/accuracy_sweep.sh with ONLY=gather).
 #
 #   OUT=$OUT bash tools/perf_issue28_final.sh
 #
 # Carried (ignored folders): .gl (the Vulkan loader debs), .bin (dermis, stripped release
-# build), .assets (../shared/assets).
+# build; dermis-before, the build of the previous calls, before the blur's arithmetic cut),
+# .assets (../shared/assets).
 set -uo pipefail
 ROOT=$PWD
 OUT=$(realpath -m "${OUT:-out}")
@@ -18,6 +20,7 @@ mkdir -p "$R" "$OUT"
 for f in .gl/*.deb; do dpkg -x "$f" /; done
 ldconfig
 N=$ROOT/.bin/dermis
+export DERMIS_FONT=$ROOT/.bin/DejaVuSans.ttf
 if ! "$N" devices 2>&1 | grep -qi nvidia; then
   export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 fi
@@ -47,6 +50,16 @@ QHD="--width 2560 --height 1440"
   # The baseline of this call and the compute floors (the dispatch probe is in every report).
   bench close-fragment $HD --shot close --method separable --path fragment $F
   bench close-compute $HD --shot close --method separable --path compute $F
+  bench mid-compute $HD --shot mid --method separable --path compute $F
+  # The blur's arithmetic cut: the build before it, same views, same card.
+  if [ -x "$ROOT/.bin/dermis-before" ]; then
+    for shot in close mid; do
+      log dermis-before bench $HD --shot $shot --method separable --path compute $F
+      "$ROOT/.bin/dermis-before" bench $HD --shot $shot --method separable --path compute $F \
+        --report "$R/before-$shot-compute.json" > "$R/before-$shot-compute.txt" 2>&1
+      echo "before-$shot-compute exit $?" >> "$R/exits.txt"
+    done
+  fi
   # The gather with its normal test, both profiles.
   for b in 20 40 80; do
     bench close-gather-$b $HD --shot close --method gather --sample-budget $b $F
@@ -69,4 +82,10 @@ QHD="--width 2560 --height 1440"
   plan plan-crowd64-0.5 --profile nvidia-h100 --budget-ms 0.5 $HD --view study --heads 64 --scene "$LPS"
   bench plan-crowd64-0.5 $HD --view study --heads 64 --scene "$LPS" --plan "$R/plan-crowd64-0.5/plan.json" $F
 }
+# The gather's rows of the accuracy model (the planner's error for it): both heads, every
+# shadow-map size, at once (each sweep is mostly CPU work per view); merged afterwards into
+# profiles/accuracy/ by tools/accuracy_merge.py.
+JOBS=8 DEADLINE=${ACC_DEADLINE:-300} ONLY=gather HEAD=$LPS \
+  bash "$ROOT/tools/accuracy_sweep.sh" "$N" "$R/accuracy" > "$R/accuracy.log" 2>&1
+echo "accuracy exit $?" >> "$R/exits.txt"
 cd "$R" && tar czf "$OUT/final.tgz" --exclude='*.png' --exclude='*.exr' --exclude='*.svg' . && cd "$ROOT"
