@@ -62,7 +62,12 @@ pub fn select(configs: Vec<Config>, only: &[String]) -> Result<Vec<Config>> {
                 anyhow::bail!(
                     "--only {o}: {} has no eval setting '{l}' (its settings: {})",
                     method.name,
-                    method.eval.iter().map(|s| s.label).collect::<Vec<_>>().join("; ")
+                    method
+                        .eval
+                        .iter()
+                        .map(|s| s.label)
+                        .collect::<Vec<_>>()
+                        .join("; ")
                 );
             }
         }
@@ -479,7 +484,11 @@ mod tests {
         assert_eq!(select(all.clone(), &[]).unwrap().len(), all.len());
         let gather = select(all.clone(), &["gather".into()]).unwrap();
         assert!(!gather.is_empty() && gather.iter().all(|c| c.method.name == "gather"));
-        let one = select(all.clone(), &["gather/40 samples".into(), "disk/80 samples".into()]).unwrap();
+        let one = select(
+            all.clone(),
+            &["gather/40 samples".into(), "disk/80 samples".into()],
+        )
+        .unwrap();
         let labels: Vec<_> = one.iter().map(|c| c.setting.label).collect();
         assert_eq!(labels, ["40 samples", "80 samples"]);
         assert!(select(all.clone(), &["gather/41 samples".into()]).is_err());
