@@ -445,6 +445,55 @@ mod tests {
     }
 
     #[test]
+    fn the_tissue_test_stops_light_at_a_fold_and_not_at_a_ridge() {
+        // Two half-planes meeting at x = 20 at 30 degrees to the screen, the
+        // seam deepest (a fold) or nearest (a ridge): equal depths at equal
+        // distances from the seam, so only the normals tell them apart. A
+        // pixel 4 px right of the seam, all the red on the left: at the fold
+        // no tap across the seam counts (the red it gets comes from bilinear
+        // taps straddling the seam only), at the ridge all do.
+        let (w, h) = (40, 30);
+        let color: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| [if i % w < 20 { 1.0 } else { 0.0 }, 0.0, 0.0, 1.0])
+            .collect();
+        let skin = vec![true; w * h];
+        let (t, hp, z0) = (0.2f32, 30.0f32, 2.0f32);
+        let step = 2.0 * z0 * t / hp * 30f32.to_radians().tan();
+        let red_at = |fold: bool| {
+            let sign = if fold { -1.0 } else { 1.0 };
+            let depth: Vec<f32> = (0..w * h)
+                .map(|i| z0 + sign * ((i % w) as f32 + 0.5 - 20.0).abs() * step)
+                .collect();
+            // The surfaces' normals: +-30 degrees about the view axis, the
+            // fold's sides facing each other, the ridge's facing apart.
+            let (s30, c30) = (0.5f32, 0.75f32.sqrt());
+            let normal: Vec<[f32; 3]> = (0..w * h)
+                .map(|i| {
+                    let left = if i % w < 20 { 1.0 } else { -1.0 };
+                    [left * -sign * s30, 0.0, c30]
+                })
+                .collect();
+            let input = GatherInputs {
+                width: w,
+                height: h,
+                color: &color,
+                depth: &depth,
+                normal: &normal,
+                skin: &skin,
+                height_px: hp,
+                tan_half_fovy: t,
+                mm_per_unit: 2.0,
+            };
+            let g = GatherProfile::new(Profile::SixGaussian);
+            gather_pixel(&g, 80, &input, 24, 15)[0]
+        };
+        let (fold, ridge) = (red_at(true), red_at(false));
+        println!("fold {fold}, ridge {ridge}");
+        assert!(ridge > 0.05, "ridge {ridge}");
+        assert!(fold < 0.2 * ridge, "fold {fold} vs ridge {ridge}");
+    }
+
+    #[test]
     fn uniform_light_stays_uniform_and_a_lone_pixel_keeps_its_light() {
         let (w, h) = (40, 30);
         let color = vec![[0.5, 0.4, 0.3, 1.0]; w * h];
