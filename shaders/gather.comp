@@ -9,8 +9,10 @@
 // their cache (as ss-jittered's), not a shared-memory apron that would have
 // to hold the kept-mass radius around the tile. The light is filtered
 // bilinearly at the sample where its four texels are this group's skin
-// (else the nearest texel's, if it is); the depth is the nearest texel's. Reads the diffuse target,
-// writes the intermediate at skin pixels (merged back by tiles_merge.comp).
+// (else the nearest texel's, if it is); the depth and the normal are the nearest texel's, and a
+// sample counts only where light reaches the pixel from it through tissue (the ground truth's
+// test on the two texels' points and normals, below). Reads the diffuse target, writes the
+// intermediate at skin pixels (merged back by tiles_merge.comp).
 #include "shader_constants.glsl"
 #include "fetch_count.glsl"
 #include "view_scale.glsl"
@@ -25,6 +27,7 @@ layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D outImage;
 layout(set = 0, binding = 5) uniform Lut { vec4 lut[GATHER_LUT_VEC4S]; };
 layout(set = 0, binding = 6) uniform sampler linearClamp;
 layout(set = 0, binding = 7) uniform sampler nearestClamp;
+layout(set = 0, binding = 8) uniform texture2D normalTex;  // RGBA16F, view-space unit normal
 
 layout(push_constant) uniform Push {
     vec4 burleyS;         // xyz: Burley's s per channel (1/mm); w: 1 = Burley, 0 = six Gaussians
@@ -39,8 +42,12 @@ layout(push_constant) uniform Push {
     float goldenAngle;
     uint widest;          // the channel the samples follow
     uint lutSize;         // intervals of the table
-    float pad;
+    float tissueTolerance; // reference::tissue::TISSUE_TOLERANCE
 } pc;
+
+#define TISSUE_MM_PER_UNIT pc.mmPerUnit
+#define TISSUE_TOLERANCE_VALUE pc.tissueTolerance
+#include "tissue.glsl"
 
 const float PI = 3.14159265358979;
 
@@ -89,6 +96,15 @@ vec2 jitter(uvec2 p) {
     return vec2(float(h & 0xffffu) / 65536.0 * (2.0 * PI), float(h >> 16u) / 65536.0);
 }
 
+// The view-space point at the texel centre `c` (pixels) and linear depth z, as
+// the ground truth reconstructs its pixels (reference::mirror::PixelPoint:
+// ndc.x t aspect z, -ndc.y t z, -z; aspect = width / height).
+vec3 viewPoint(vec2 c, float z, vec2 size) {
+    vec2 ndc = c / size * 2.0 - 1.0;
+    float t = pc.tanHalfFovy;
+    return vec3(ndc.x * t * (size.x / size.y) * z, -ndc.y * t * z, -z);
+}
+
 void main() {
     COUNT_INVOCATION();
     uint t = tiles[gl_WorkGroupID.x];
@@ -104,6 +120,8 @@ void main() {
         imageStore(outImage, p, centre);
         return;
     }
+    vec3 xo = viewPoint(vec2(p) + 0.5, depth, vec2(size));
+    vec3 no = COUNTED(SITE(0, 8, FK_POINT), texelFetch(normalTex, p, 0)).xyz;
     vec2 j = jitter(uvec2(p));
     float theta = j.x;
     vec3 sum = vec3(0.0);
@@ -136,7 +154,19 @@ void main() {
             if (COUNTED(SITE(0, 2, FK_POINT), texelFetch(stencilTex, qi, 0)).r != pc.code) continue;
             c = COUNTED(SITE(0, 0, FK_POINT), texelFetch(colorTex, qi, 0)).rgb;
         }
-        float dz = (COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, qi, 0)).r - depth) * pc.mmPerUnit;
+        float zq = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, qi, 0)).r;
+        // The ground truth's definition of which surface light reaches the
+        // pixel from (reference/tissue.rs): only through tissue, each point
+        // on or behind the other's tangent plane (within the tolerance).
+        // Across a fold (a lip seam, an eyelid on the eye, a silhouette in
+        // front of skin whose normal faces it) the two points sit in front
+        // of each other's planes: the light crosses air, and the depth
+        // weight alone keeps it where both lie at one depth. A binary test,
+        // not a cosine weight: a cosine would also dim convex skin (a nose's
+        // sides, an ear lit through), which the truth keeps whole.
+        vec3 nq = COUNTED(SITE(0, 8, FK_POINT), texelFetch(normalTex, qi, 0)).xyz;
+        if (!throughTissue(xo, no, viewPoint(vec2(qi) + 0.5, zq, vec2(size)), nq)) continue;
+        float dz = (zq - depth) * pc.mmPerUnit;
         float r3 = sqrt(r * r + dz * dz);
         vec3 w = profile(r3) / profile(r)[pc.widest];
         sum += w * c;

@@ -204,6 +204,11 @@ pub struct EvalArgs {
     /// ASSET.toml for profiles/accuracy/, the charts and the leave-one-scale-out error).
     #[arg(long, default_value = "thesis")]
     pub scenes: String,
+    /// Sweep only these settings: METHOD (every eval setting of it) or METHOD/LABEL
+    /// (one, its label as `dermis methods` lists it); repeatable. The ground truths
+    /// and the no-SSS frame they are scored with are rendered as always.
+    #[arg(long)]
+    pub only: Vec<String>,
     #[command(flatten)]
     pub frames: Frames<2, 10>,
 }

@@ -117,7 +117,8 @@ pub fn run(a: &EvalArgs, given: &Given) -> Result<()> {
         source.clone()
     };
     let scenes = load_scenes(&specs, &head_source)?;
-    let plan = plan_sweep(&specs, &scenes, &base, &sweep::registry())?;
+    let configs = sweep::select(sweep::registry(), &a.only)?;
+    let plan = plan_sweep(&specs, &scenes, &base, &configs)?;
     OutputPaths::new()
         .folder("--out", &a.out, &FILES, &[])
         .prepare()?;

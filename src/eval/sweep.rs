@@ -41,6 +41,48 @@ pub fn registry() -> Vec<Config> {
         .collect()
 }
 
+/// The settings of `configs` that `only` names (`eval --only`): `METHOD`
+/// takes every setting of the method (by name or alias), `METHOD/LABEL` the
+/// one whose label is `LABEL`. Empty: all of them. A sweep over a few settings
+/// costs minutes on lavapipe where the whole registry costs an hour; an entry
+/// that names nothing is an error, not a silently empty sweep.
+pub fn select(configs: Vec<Config>, only: &[String]) -> Result<Vec<Config>> {
+    if only.is_empty() {
+        return Ok(configs);
+    }
+    let mut wanted = Vec::with_capacity(only.len());
+    for o in only {
+        let (name, label) = match o.split_once('/') {
+            Some((n, l)) => (n, Some(l.trim())),
+            None => (o.as_str(), None),
+        };
+        let method = crate::method::lookup(name)?;
+        if let Some(l) = label {
+            if !method.eval.iter().any(|s| s.label == l) {
+                anyhow::bail!(
+                    "--only {o}: {} has no eval setting '{l}' (its settings: {})",
+                    method.name,
+                    method
+                        .eval
+                        .iter()
+                        .map(|s| s.label)
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                );
+            }
+        }
+        wanted.push((method.name, label));
+    }
+    Ok(configs
+        .into_iter()
+        .filter(|c| {
+            wanted
+                .iter()
+                .any(|(m, l)| *m == c.method.name && l.is_none_or(|l| l == c.setting.label))
+        })
+        .collect())
+}
+
 /// The settings that approximate the six Gaussians (`method::profile::approximated`):
 /// the ones the accuracy model measures and the planner chooses among (its
 /// err/none is against the six Gaussians' truth; Burley's settings answer
@@ -435,6 +477,23 @@ pub fn summarise(rows: &[EvalRow]) -> Vec<SummaryRow> {
 mod tests {
     use super::super::bands::BandError;
     use super::*;
+
+    #[test]
+    fn only_selects_a_method_or_one_setting_and_rejects_what_names_nothing() {
+        let all = registry();
+        assert_eq!(select(all.clone(), &[]).unwrap().len(), all.len());
+        let gather = select(all.clone(), &["gather".into()]).unwrap();
+        assert!(!gather.is_empty() && gather.iter().all(|c| c.method.name == "gather"));
+        let one = select(
+            all.clone(),
+            &["gather/40 samples".into(), "disk/80 samples".into()],
+        )
+        .unwrap();
+        let labels: Vec<_> = one.iter().map(|c| c.setting.label).collect();
+        assert_eq!(labels, ["40 samples", "80 samples"]);
+        assert!(select(all.clone(), &["gather/41 samples".into()]).is_err());
+        assert!(select(all, &["no-such-method".into()]).is_err());
+    }
 
     /// The leaf keys of a JSON value, nested keys joined by `_` and array
     /// elements named r, g, b (a gain); the bands' columns go by their keys

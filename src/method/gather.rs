@@ -11,7 +11,7 @@
 
 use std::any::Any;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context as _, Result};
 use ash::vk;
 
 use super::profile::{self, Profile};
@@ -24,6 +24,7 @@ use super::{
 };
 use crate::graph::work::{Fetch, Filter, ShaderWork, Spread};
 use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
+use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::skin::gather::{
     sample_count, GatherProfile, BUDGET_RANGE, GOLDEN_ANGLE, LUT_SIZE, LUT_VEC4S, MIN_SAMPLES,
     PIXELS_PER_SAMPLE,
@@ -73,7 +74,11 @@ pub static ENTRY: MethodEntry = MethodEntry {
     ],
     ground_truth: false,
     dolly: &["40 samples"],
-    needs: |_, _| Needs::PLAIN,
+    // The geometry pass's view-space normals: the tissue test of each tap.
+    needs: |_, _| Needs {
+        normals: true,
+        ..Needs::PLAIN
+    },
     check: |o| Config::parse(o).map(|_| ()),
     build: |s| Ok(Box::new(Gather::new(s)?)),
     no_msaa: None,
@@ -121,7 +126,7 @@ struct GatherPush {
     golden_angle: f32,
     widest: u32,
     lut_size: u32,
-    pad: f32,
+    tissue_tolerance: f32,
 }
 
 pub struct Gather {
@@ -130,6 +135,7 @@ pub struct Gather {
     lut: Buffer,
     tiles: SkinTiles,
     diffuse: ImageId,
+    normals: ImageId,
     push: GatherPush,
     scale: ViewScale,
     pub config: Config,
@@ -141,6 +147,10 @@ impl Gather {
         let config = Config::parse(&s.options)?;
         let profile = GatherProfile::new(config.profile);
         let diffuse = s.targets.diffuse;
+        let normals = s
+            .targets
+            .normals
+            .context("the frame has no normal target, which gather's tissue test needs")?;
         let out = declare_intermediate(s.res, diffuse, "sss intermediate");
         // Guarded until the method holds them: an error frees what exists.
         let pipeline = Guard::new(s.ctx, Pipeline::compute(s.ctx, "gather", SHADER)?);
@@ -164,6 +174,7 @@ impl Gather {
             vec![
                 ("colorTex", Binding::Sampled(diffuse)),
                 ("depthTex", Binding::Sampled(s.targets.linear_depth)),
+                ("normalTex", Binding::Sampled(normals)),
                 (
                     "stencilTex",
                     Binding::SampledStencil(s.targets.depth_stencil),
@@ -207,7 +218,7 @@ impl Gather {
             golden_angle: GOLDEN_ANGLE,
             widest: profile.widest as u32,
             lut_size: LUT_SIZE as u32,
-            pad: 0.0,
+            tissue_tolerance: TISSUE_TOLERANCE,
         };
         Ok(Gather {
             pipeline: pipeline.keep(),
@@ -215,6 +226,7 @@ impl Gather {
             lut: lut.keep(),
             tiles: tiles.keep(),
             diffuse,
+            normals,
             push,
             scale,
             config,
@@ -237,8 +249,8 @@ impl SssMethod for Gather {
         // The most samples a skin pixel takes: the count at each skin
         // cluster's nearest depth (full strength), doubled for the pixels of
         // a cluster nearer than its box says (the count grows with the square
-        // of the scale), within the budget. Each sample reads stencil, colour
-        // and depth.
+        // of the scale), within the budget. Each sample reads stencil, colour,
+        // depth and normal (the tissue test).
         let clusters: Vec<(f64, f32)> =
             f.depths.iter().copied().filter(|&(_, d)| d > 0.0).collect();
         let total: f64 = clusters.iter().map(|c| c.0).sum();
@@ -265,7 +277,7 @@ impl SssMethod for Gather {
         // Invocations outside the image or the skin fetch nothing. Each
         // sample gathers the stencil of its 2x2 footprint and reads the light
         // bilinearly there, or at the skin's edge the nearest texel's
-        // stencil and light (point: at most once a sample).
+        // stencil and light (point: at most once a sample); the pixel's normal once.
         let fetches = vec![
             fetch_at_most(
                 f.res,
@@ -276,6 +288,7 @@ impl SssMethod for Gather {
             ),
             fetch_at_most(f.res, t.diffuse, "colorTex", Filter::Point, 1.0 + mean),
             fetch_at_most(f.res, t.linear_depth, "depthTex", Filter::Point, 1.0),
+            fetch_at_most(f.res, self.normals, "normalTex", Filter::Point, 1.0),
             Fetch {
                 filter: Filter::Bilinear,
                 ..taps(t.depth_stencil, "stencilTex")
@@ -285,6 +298,7 @@ impl SssMethod for Gather {
                 ..taps(t.diffuse, "colorTex")
             },
             taps(t.linear_depth, "depthTex"),
+            taps(self.normals, "normalTex"),
         ];
         let work = ShaderWork {
             shader: SHADER.into(),
