@@ -9,7 +9,7 @@
 #   OUT=$OUT bash tools/perf_issue28_final.sh
 #
 # Carried (ignored folders): .gl (the Vulkan loader debs), .bin (dermis, stripped release
-# build; dermis-before, the build of the previous calls, before the blur's arithmetic cut),
+# build; dermis-before.gz, the build of the previous calls, before the blur's arithmetic cut),
 # .assets (../shared/assets).
 set -uo pipefail
 ROOT=$PWD
@@ -51,11 +51,15 @@ QHD="--width 2560 --height 1440"
   bench close-fragment $HD --shot close --method separable --path fragment $F
   bench close-compute $HD --shot close --method separable --path compute $F
   bench mid-compute $HD --shot mid --method separable --path compute $F
-  # The blur's arithmetic cut: the build before it, same views, same card.
-  if [ -x "$ROOT/.bin/dermis-before" ]; then
+  # The blur's arithmetic cut: the build before it, same views, same card (carried gzipped:
+  # the carried tree has a size limit).
+  if [ -f "$ROOT/.bin/dermis-before.gz" ]; then
+    gunzip -c "$ROOT/.bin/dermis-before.gz" > /tmp/dermis-before && chmod +x /tmp/dermis-before
+  fi
+  if [ -x /tmp/dermis-before ]; then
     for shot in close mid; do
       log dermis-before bench $HD --shot $shot --method separable --path compute $F
-      "$ROOT/.bin/dermis-before" bench $HD --shot $shot --method separable --path compute $F \
+      /tmp/dermis-before bench $HD --shot $shot --method separable --path compute $F \
         --report "$R/before-$shot-compute.json" > "$R/before-$shot-compute.txt" 2>&1
       echo "before-$shot-compute exit $?" >> "$R/exits.txt"
     done
