@@ -42,7 +42,7 @@ layout(push_constant) uniform Push {
     float goldenAngle;
     uint widest;          // the channel the samples follow
     uint lutSize;         // intervals of the table
-    float tissueTolerance; // reference::tissue::TISSUE_TOLERANCE
+    float tissueTolerance; // skin::tissue::TISSUE_TOLERANCE
 } pc;
 
 #define TISSUE_MM_PER_UNIT pc.mmPerUnit
@@ -156,7 +156,7 @@ void main() {
         }
         float zq = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, qi, 0)).r;
         // The ground truth's definition of which surface light reaches the
-        // pixel from (reference/tissue.rs): only through tissue, each point
+        // pixel from (skin/tissue.rs): only through tissue, each point
         // on or behind the other's tangent plane (within the tolerance).
         // Across a fold (a lip seam, an eyelid on the eye, a silhouette in
         // front of skin whose normal faces it) the two points sit in front

@@ -7,7 +7,7 @@
 // accumulates sum_j L_d(x_j) R(|x_j - x_o|) dA_j (accum4.rgb) and
 // sum_j R(|x_j - x_o|) dA_j (accum5.rgb), per channel, over all surface
 // samples from BURLEY_NEAR_MM to the cut-off that light reaches through tissue
-// (true 3D distances, visible or not; src/reference/tissue.rs).
+// (true 3D distances, visible or not; src/skin/tissue.rs).
 // reference_burley_resolve.comp divides one by the other and adds it to the
 // near part (src/reference/burley.rs). accum6 is bound (the six Gaussians'
 // layout) and unused.

@@ -7,7 +7,7 @@
 // Gaussians 4-6, accumulates sum_j L_d(x_j) G_i(|x_j - x_o|) dA_j (rgb) and
 // sum_j G_i(|x_j - x_o|) dA_j (alpha) over all surface samples within the cut-off
 // that light reaches through tissue (true 3D distances, visible or not;
-// src/reference/tissue.rs). reference_resolve.comp divides one by the other
+// src/skin/tissue.rs). reference_resolve.comp divides one by the other
 // (each Gaussian conserves the light it gathers; src/reference/narrow.rs says
 // why) and adds them to the narrow part. The split comes from NARROW_GAUSSIANS
 // (src/shader_constants.rs).

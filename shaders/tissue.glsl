@@ -1,4 +1,4 @@
-// The tissue test of src/reference/tissue.rs (the module doc says why): whether
+// The tissue test of src/skin/tissue.rs (the module doc says why): whether
 // light diffuses from xi (normal ni) to xo (normal no) through tissue. Points
 // closer than SAME_POINT_MM are one point. The includer first defines
 // TISSUE_MM_PER_UNIT and TISSUE_TOLERANCE_VALUE as the expressions (its uniform

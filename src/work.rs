@@ -209,6 +209,26 @@ pub enum Work {
     Clear { texels: u64, bytes_per_texel: u32 },
 }
 
+impl Work {
+    /// The shader it runs per fragment or per invocation (`None`: a
+    /// depth-only draw, a copy or a clear).
+    pub fn shader(&self) -> Option<&ShaderWork> {
+        match self {
+            Work::Raster { shader, .. } => shader.as_ref(),
+            Work::Compute { shader, .. } => Some(shader),
+            Work::Copy { .. } | Work::Clear { .. } => None,
+        }
+    }
+
+    pub fn shader_mut(&mut self) -> Option<&mut ShaderWork> {
+        match self {
+            Work::Raster { shader, .. } => shader.as_mut(),
+            Work::Compute { shader, .. } => Some(shader),
+            Work::Copy { .. } | Work::Clear { .. } => None,
+        }
+    }
+}
+
 /// How a pass uses one image (derived from its declared access and the image's
 /// description; what the budget model needs for render-target footprints and
 /// the resolves a later read forces).

@@ -34,6 +34,7 @@ pub mod record;
 pub mod table;
 pub mod table91;
 pub mod transfers;
+pub mod unit_times;
 pub mod units;
 
 pub use input::{FrameInput, PassInput};

@@ -24,11 +24,11 @@ use super::{
 };
 use crate::graph::work::{Fetch, Filter, ShaderWork, Spread};
 use crate::graph::{Binding, GraphSet, ImageId, Pass, Storage};
-use crate::reference::tissue::TISSUE_TOLERANCE;
 use crate::skin::gather::{
     sample_count, GatherProfile, BUDGET_RANGE, GOLDEN_ANGLE, LUT_SIZE, LUT_VEC4S, MIN_SAMPLES,
     PIXELS_PER_SAMPLE,
 };
+use crate::skin::tissue::TISSUE_TOLERANCE;
 use crate::view::ViewScale;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};

@@ -50,8 +50,9 @@ use crate::budget::input::{FrameInput, PassInput};
 use crate::budget::model::{price_frame, Rescale};
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
-use crate::method::path::Path;
-use crate::work::{PassRole, ShaderWork, Spread, Work};
+use crate::work::{PassRole, Spread, Work};
+
+use super::log_interp::{bracket, lerp};
 
 /// One stored frame of a setting: one character at a known scale.
 #[derive(Clone, Debug, PartialEq)]
@@ -134,23 +135,6 @@ enum PassKind {
     PerCharacter,
 }
 
-/// The shader a pass runs per fragment or per invocation.
-fn shader_of(w: &Work) -> Option<&ShaderWork> {
-    match w {
-        Work::Raster { shader, .. } => shader.as_ref(),
-        Work::Compute { shader, .. } => Some(shader),
-        _ => None,
-    }
-}
-
-fn shader_of_mut(w: &mut Work) -> Option<&mut ShaderWork> {
-    match w {
-        Work::Raster { shader, .. } => shader.as_mut(),
-        Work::Compute { shader, .. } => Some(shader),
-        _ => None,
-    }
-}
-
 fn area(w: &Work) -> Option<u64> {
     match w {
         Work::Raster { width, height, .. } => Some(u64::from(*width) * u64::from(*height)),
@@ -203,26 +187,6 @@ fn pass_kind(samples: &[Sample], k: usize) -> PassKind {
     }
 }
 
-/// Where `x` falls among ascending `xs`: indices of the bracketing samples and
-/// the weight of the second, linear in ln(x), clamped to the ends.
-fn bracket(xs: &[f64], x: f64) -> (usize, usize, f64) {
-    let n = xs.len();
-    if n == 1 || x <= xs[0] {
-        return (0, 0, 0.0);
-    }
-    if x >= xs[n - 1] {
-        return (n - 1, n - 1, 0.0);
-    }
-    let j = xs.iter().position(|&v| v >= x).unwrap_or(n - 1);
-    let i = j - 1;
-    let t = (x.ln() - xs[i].ln()) / (xs[j].ln() - xs[i].ln());
-    (i, j, t)
-}
-
-fn lerp(a: f64, b: f64, t: f64) -> f64 {
-    a + (b - a) * t
-}
-
 /// One method setting's stored frames, read for pricing.
 #[derive(Clone, Debug)]
 pub struct SettingModel {
@@ -232,9 +196,10 @@ pub struct SettingModel {
     /// The eval setting the accuracy model measured for it (its own label but
     /// for a compute twin: `pipeline::Registered::eval`).
     pub eval: String,
-    /// The path its blurs take: a compute twin is unpriced on a profile
-    /// without compute ([`CostModel::fixed_ms`]).
-    pub path: Path,
+    /// Whether its blurs are dispatches (a compute twin,
+    /// `pipeline::Registered::path`): unpriced on a profile without compute
+    /// ([`CostModel::fixed_ms`]).
+    pub needs_compute: bool,
     /// Ascending in px/mm; every frame has the same passes.
     samples: Vec<Sample>,
     /// The reference counts at each sample's scale.
@@ -291,18 +256,19 @@ impl SettingModel {
             method: method.to_string(),
             setting: setting.to_string(),
             eval: setting.to_string(),
-            path: Path::Fragment,
+            needs_compute: false,
             samples,
             refs,
             kinds,
         })
     }
 
-    /// This setting as the twin of eval setting `eval` on `path`.
-    pub fn measured_as(self, eval: &str, path: Path) -> SettingModel {
+    /// This setting as the twin of eval setting `eval`, its blurs
+    /// dispatches or not.
+    pub fn measured_as(self, eval: &str, needs_compute: bool) -> SettingModel {
         SettingModel {
             eval: eval.to_string(),
-            path,
+            needs_compute,
             ..self
         }
     }
@@ -532,10 +498,11 @@ impl SettingModel {
         forced: Option<usize>,
     ) {
         let fetches = |p: &PassInput| -> Vec<f64> {
-            shader_of(&p.work)
+            p.work
+                .shader()
                 .map_or_else(Vec::new, |s| s.fetches.iter().map(|f| f.count).collect())
         };
-        let Some(sh) = shader_of_mut(&mut q.work) else {
+        let Some(sh) = q.work.shader_mut() else {
             return;
         };
         let xs = self.xs();
@@ -561,7 +528,7 @@ impl SettingModel {
             // Where the taps land: the nearer sample's, its radii scaled to
             // this character's px/mm (a kernel's size on screen is linear in it).
             let near = forced.map_or(if t < 0.5 { i } else { j }, |n| n.min(xs.len() - 1));
-            if let Some(s) = shader_of(&self.samples[near].frame.passes[k].work) {
+            if let Some(s) = self.samples[near].frame.passes[k].work.shader() {
                 let scale = l.px_per_mm / xs[near];
                 for (out, f) in spreads.iter_mut().zip(&s.fetches) {
                     out.extend(f.spread.iter().map(|x| Spread {
@@ -724,7 +691,7 @@ impl CostModel<'_> {
         // A compute twin is no choice where there is no compute: the budget
         // model would price its dispatches as pixel shaders, a frame no
         // renderer of that GPU draws (its fragment twin is the choice).
-        if s.path == Path::Compute && self.profile.alu.compute_gflops.value().is_none() {
+        if s.needs_compute && self.profile.alu.compute_gflops.value().is_none() {
             return None;
         }
         s.group_ms(self.profile, &self.params, &[], self.width, self.height)

@@ -31,6 +31,7 @@ pub mod cost;
 pub mod dolly;
 pub mod fades;
 pub mod frame_inputs;
+pub mod log_interp;
 pub mod measured;
 pub mod motion;
 pub mod motion_chart;

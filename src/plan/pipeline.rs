@@ -272,7 +272,7 @@ pub fn load_models() -> Result<(Vec<SettingModel>, Vec<String>)> {
         }
         models.push(
             SettingModel::new(r.method, &r.setting, samples, reference)
-                .map(|m| m.measured_as(r.eval, r.path))
+                .map(|m| m.measured_as(r.eval, r.path == SssPath::Compute))
                 .map_err(|e| anyhow::anyhow!("{dir}: {e}"))?,
         );
     }

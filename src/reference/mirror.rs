@@ -10,8 +10,8 @@ use glam::{DMat4, DVec3, Mat4};
 use super::burley;
 use super::narrow::radius;
 use super::sampling::{cutoff_mm, SurfaceSample, NARROW_GAUSSIANS};
-use super::tissue::through_tissue;
 use crate::skin::profile::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
+use crate::skin::tissue::through_tissue;
 use crate::view::ViewScale;
 
 /// What the gather needs of the view.

@@ -6,4 +6,3 @@ pub mod chunks;
 pub mod mirror;
 pub mod narrow;
 pub mod sampling;
-pub mod tissue;

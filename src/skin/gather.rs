@@ -36,7 +36,7 @@
 //! visible surface has over what it lacks, as the ground truth does.
 //!
 //! A sample counts only where light reaches the pixel from it through
-//! tissue: the ground truth's own test (`reference::tissue::through_tissue`,
+//! tissue: the ground truth's own test (`skin::tissue::through_tissue`,
 //! its module doc says why) on the view-space points of the two texels
 //! (reconstructed from the linear depth at their centres, as the truth's
 //! `PixelPoint` is) and the geometry pass's view-space normals. Across a
@@ -61,10 +61,10 @@
 //! budget (HDRP's low / medium / high: 20, 40, 80); a pixel whose radius is
 //! under one pixel keeps its light (its whole profile lies in the pixel).
 
-use crate::reference::tissue::through_tissue;
 use crate::shader_constants::{SIX_GAUSSIAN_VARIANCES_MM2, SIX_GAUSSIAN_WEIGHTS_RGB};
 use crate::skin::burley;
 use crate::skin::diffusion::Profile;
+use crate::skin::tissue::through_tissue;
 
 /// The mass of the widest channel's profile the samples cover (HDRP's 99.7%).
 pub const KEPT_MASS: f64 = 0.997;

@@ -24,6 +24,7 @@ pub mod separable_mirror;
 pub mod ssg;
 pub mod ssg_mirror;
 pub mod texel;
+pub mod tissue;
 pub mod transmittance;
 pub mod tsd;
 pub mod tsd_mirror;

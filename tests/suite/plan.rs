@@ -589,13 +589,9 @@ fn plan_check_scores_plans_against_the_ground_truth() {
 /// compute; on the H100 the two twins of a setting cost differently.
 #[test]
 fn a_plan_chooses_the_path_per_group_where_the_profile_has_compute() {
-    use dermis::method::path::Path as SssPath;
     let Some(scene) = lps_scene() else { return };
     let models = models();
-    let twins: Vec<&SettingModel> = models
-        .iter()
-        .filter(|m| m.path == SssPath::Compute)
-        .collect();
+    let twins: Vec<&SettingModel> = models.iter().filter(|m| m.needs_compute).collect();
     // separable 5, ssg 3 (its branch mask has none), ss-jittered 1, poisson 1.
     assert_eq!(
         twins.len(),
@@ -608,7 +604,7 @@ fn a_plan_chooses_the_path_per_group_where_the_profile_has_compute() {
             .iter()
             .find(|m| m.method == t.method && m.setting == t.eval)
             .unwrap_or_else(|| panic!("{} '{}' has no fragment twin", t.method, t.setting));
-        assert_eq!(frag.path, SssPath::Fragment);
+        assert!(!frag.needs_compute);
         assert_ne!(t.setting, frag.setting);
     }
     let refm = reference(&models);

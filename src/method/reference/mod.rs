@@ -1,6 +1,6 @@
 //! The ground truth as a method of the frame (`--method reference`): the diffuse
 //! radiant exitance M(x_o) = integral E(x_i) R(|x_i - x_o|) dA over the actual skin
-//! surface, through tissue only (`crate::reference::tissue`), by brute force on
+//! surface, through tissue only (`crate::skin::tissue`), by brute force on
 //! the GPU. The narrow Gaussians (sigma <= 0.43 mm) are summed over the visible
 //! surface rendered at s x the frame's resolution (`crate::reference::narrow`);
 //! the wide ones over area-weighted samples of the whole skin surface: their
@@ -43,7 +43,7 @@ use super::{
 };
 use crate::graph::{BufferId, GraphSet, ImageId, Pass};
 use crate::reference::sampling::SurfaceSample;
-use crate::reference::tissue::TISSUE_TOLERANCE;
+use crate::skin::tissue::TISSUE_TOLERANCE;
 use crate::vk::context::{Context, DeviceFacts};
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::Buffer;

@@ -15,7 +15,7 @@ use crate::method::MethodSetup;
 use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
 use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface_within};
-use crate::reference::tissue::TISSUE_TOLERANCE;
+use crate::skin::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
