@@ -70,6 +70,13 @@ QHD="--width 2560 --height 1440"
   done
   bench close-gather-burley-40 $HD --shot close --method gather --sample-budget 40 --diffusion-profile burley $F
   bench mid-gather-40 $HD --shot mid --method gather --sample-budget 40 $F
+  # Plans choosing the path per group on the H100 profile, then the planned frame measured.
+  for b in 0.1 0.3; do
+    plan plan-study16-$b --profile nvidia-h100 --budget-ms $b --view study --heads 16 --scene "$LPS"
+    bench plan-study16-$b --view study --heads 16 --scene "$LPS" --plan "$R/plan-study16-$b/plan.json" $F
+  done
+  plan plan-crowd64-0.5 --profile nvidia-h100 --budget-ms 0.5 $HD --view study --heads 64 --scene "$LPS"
+  bench plan-crowd64-0.5 $HD --view study --heads 64 --scene "$LPS" --plan "$R/plan-crowd64-0.5/plan.json" $F
   # Out of sample for the budget model: 2560x1440, close-up and mid, every compute method.
   for shot in close mid; do
     bench qhd-$shot-separable $QHD --shot $shot --method separable --path compute $F
@@ -78,13 +85,6 @@ QHD="--width 2560 --height 1440"
     bench qhd-$shot-poisson $QHD --shot $shot --method poisson --path compute $F
     bench qhd-$shot-gather-40 $QHD --shot $shot --method gather --sample-budget 40 $F
   done
-  # Plans choosing the path per group on the H100 profile, then the planned frame measured.
-  for b in 0.1 0.3; do
-    plan plan-study16-$b --profile nvidia-h100 --budget-ms $b --view study --heads 16 --scene "$LPS"
-    bench plan-study16-$b --view study --heads 16 --scene "$LPS" --plan "$R/plan-study16-$b/plan.json" $F
-  done
-  plan plan-crowd64-0.5 --profile nvidia-h100 --budget-ms 0.5 $HD --view study --heads 64 --scene "$LPS"
-  bench plan-crowd64-0.5 $HD --view study --heads 64 --scene "$LPS" --plan "$R/plan-crowd64-0.5/plan.json" $F
 }
 # The gather's rows of the accuracy model (the planner's error for it): both heads, every
 # shadow-map size, at once (each sweep is mostly CPU work per view); merged afterwards into
