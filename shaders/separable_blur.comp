@@ -46,12 +46,7 @@ layout(push_constant) uniform Push {
 // banks) put all of them on one shared-memory bank (measured on an H200:
 // the vertical blur took 2.4x the horizontal's time).
 #define ROW (ALONG + 1)
-// Colours in float, not packed halves: the source is RGBA16F, so a float
-// holds each value exactly (the images are the same), and the taps, which
-// read every texel up to 34 times, do no conversions (the blurs are bound
-// by their arithmetic, docs/perf/issue28). 26 KB a group: eight groups fit
-// an SM's shared memory on the H100, as many as its 2048 threads allow.
-shared vec4 sColor[SSS_TILE_SIDE * ROW];
+shared uvec2 sColor[SSS_TILE_SIDE * ROW];
 shared float sDepth[SSS_TILE_SIDE * ROW];
 
 // Image coordinates of (along the blur, across it).
@@ -83,8 +78,9 @@ void main() {
          i += uint(SSS_TILE_SIDE * SSS_TILE_SIDE)) {
         int across = int(i) / ALONG, along = int(i) % ALONG;
         ivec2 q = at(clamp(along0 + along, 0, alongMax), min(across0 + across, acrossMax));
+        vec4 v = source(q);
         int slot = across * ROW + along;
-        sColor[slot] = source(q);
+        sColor[slot] = uvec2(packHalf2x16(v.rg), packHalf2x16(v.ba));
         sDepth[slot] = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, q, 0)).r;
     }
     barrier();
@@ -95,7 +91,7 @@ void main() {
     if (COUNTED(SITE(0, 2, FK_POINT), texelFetch(stencilTex, p, 0)).r != pc.code) return;
     int row = (pc.vertical != 0 ? lid.x : lid.y) * ROW;
     int centre = row + SSS_APRON_PX + (pc.vertical != 0 ? lid.y : lid.x);
-    vec4 colorM = sColor[centre];
+    vec4 colorM = vec4(unpackHalf2x16(sColor[centre].x), unpackHalf2x16(sColor[centre].y));
     float depthM = sDepth[centre];
     vec2 uv = (vec2(p) + 0.5) / vec2(size);
 
@@ -118,26 +114,18 @@ void main() {
         float f = x - x0;
         vec4 c2[2];
         float d2[2];
-        int s0 = int(x0) - along0;
-        if (s0 >= 0 && s0 + 1 < ALONG) {
-            // Both texels in the apron: the common case, one test a tap.
-            c2[0] = sColor[row + s0];
-            c2[1] = sColor[row + s0 + 1];
-            d2[0] = sDepth[row + s0];
-            d2[1] = sDepth[row + s0 + 1];
-        } else {
-            for (int j = 0; j < 2; j++) {
-                int s = s0 + j;
-                if (s >= 0 && s < ALONG) {
-                    c2[j] = sColor[row + s];
-                    d2[j] = sDepth[row + s];
-                } else {
-                    // Beyond the apron (a kernel wider than SSS_APRON_PX on
-                    // screen): the same texel from the images.
-                    ivec2 q = at(clamp(int(x0) + j, 0, alongMax), across);
-                    c2[j] = source(q);
-                    d2[j] = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, q, 0)).r;
-                }
+        for (int j = 0; j < 2; j++) {
+            int s = int(x0) + j - along0;
+            if (s >= 0 && s < ALONG) {
+                uvec2 h = sColor[row + s];
+                c2[j] = vec4(unpackHalf2x16(h.x), unpackHalf2x16(h.y));
+                d2[j] = sDepth[row + s];
+            } else {
+                // Beyond the apron (a kernel wider than SSS_APRON_PX on
+                // screen): the same texel from the images.
+                ivec2 q = at(clamp(int(x0) + j, 0, alongMax), across);
+                c2[j] = source(q);
+                d2[j] = COUNTED(SITE(0, 1, FK_POINT), texelFetch(depthTex, q, 0)).r;
             }
         }
         vec3 c = c2[0].rgb * (1.0 - f) + c2[1].rgb * f;

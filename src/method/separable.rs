@@ -377,10 +377,9 @@ impl Separable {
                 storage_read_bytes: 4.0 / (side * side) + if vertical { 8.0 * loads } else { 0.0 },
                 storage_write_bytes: 8.0,
                 // Every invocation stores its `loads` texels of the tile and
-                // apron (an RGBA16F texel as four floats and a depth, 20
-                // bytes); its reads (the centre, the taps) are behind the
-                // skin test.
-                shared_bytes: 20.0 * loads,
+                // apron (a packed RGBA16F and a depth, 12 bytes); its reads
+                // (the centre, the taps) are behind the skin test.
+                shared_bytes: 12.0 * loads,
             };
             let push = ComputePush {
                 base: self.push[pass],
