@@ -17,25 +17,8 @@ OUT=$(realpath -m "${OUT:-out}")
 R=/tmp/final
 rm -rf "$R"
 mkdir -p "$R" "$OUT"
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-N=$ROOT/.bin/dermis
-export DERMIS_FONT=$ROOT/.bin/DejaVuSans.ttf
-if ! "$N" devices 2>&1 | grep -qi nvidia; then
-  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-fi
-log() { echo "+ $*" >> "$R/commands.txt"; }
-{
-  "$N" --version
-  "$N" devices
-} > "$R/gpu.txt" 2>&1
-LPS=$ROOT/.assets/lee-perry-smith/LeePerrySmith.glb
-bench() { # name, args...
-  local n=$1; shift
-  log dermis bench "$@" --report "$R/$n.json"
-  "$N" bench "$@" --report "$R/$n.json" > "$R/$n.txt" 2>&1
-  echo "$n exit $?" >> "$R/exits.txt"
-}
+# shellcheck source=tools/device_env.sh
+. "$ROOT/tools/device_env.sh"
 plan() { # name, args... (no device: the plan's prediction)
   local n=$1; shift
   log dermis plan "$@" --out "$R/$n"

@@ -186,6 +186,12 @@ pub enum AluIssue {
 }
 
 impl Alu {
+    /// Whether the GPU runs compute dispatches at all (`compute_gflops`
+    /// known): the Xbox 360 and the PS3 do not.
+    pub fn has_compute(&self) -> bool {
+        self.compute_gflops.value().is_some()
+    }
+
     pub fn issue(&self) -> AluIssue {
         self.vector_ginstr.map_or(AluIssue::Lanes, AluIssue::Vector)
     }

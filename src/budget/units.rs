@@ -594,7 +594,7 @@ impl Pricing<'_> {
     /// it is priced as the pixel shader a port would write: one fragment per
     /// invocation at the pixel-shader rates, storage writes through memory.
     fn compute(&mut self, shader: &ShaderWork, n: f64) {
-        let has_compute = self.prof.alu.compute_gflops.value().is_some();
+        let has_compute = self.prof.alu.has_compute();
         if !has_compute {
             self.subs.push(Substitution {
                 wanted: "compute".into(),

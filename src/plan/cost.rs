@@ -691,7 +691,7 @@ impl CostModel<'_> {
         // A compute twin is no choice where there is no compute: the budget
         // model would price its dispatches as pixel shaders, a frame no
         // renderer of that GPU draws (its fragment twin is the choice).
-        if s.needs_compute && self.profile.alu.compute_gflops.value().is_none() {
+        if s.needs_compute && !self.profile.alu.has_compute() {
             return None;
         }
         s.group_ms(self.profile, &self.params, &[], self.width, self.height)
