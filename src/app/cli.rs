@@ -388,6 +388,13 @@ pub struct FrameArgs {
     /// are taken as bottom-up (OpenGL convention), as the Lee Perry-Smith head's are.
     #[arg(long)]
     pub sidecar_top_down: bool,
+    /// Materials of a glTF scene that scatter, whatever their names or extras say:
+    /// names or indices, comma-separated (the rule: docs/usage.md, materials).
+    #[arg(long, value_name = "MATERIALS", value_delimiter = ',')]
+    pub skin: Vec<String>,
+    /// Materials of a glTF scene drawn without scattering (eyes, teeth, cloth...).
+    #[arg(long, value_name = "MATERIALS", value_delimiter = ',')]
+    pub not_skin: Vec<String>,
     #[arg(long, help = with_range("Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head)", &ranges::MM_PER_UNIT))]
     pub mm_per_unit: Option<f32>,
     #[arg(long, default_value_t = defaults().width, help = with_range("Frame width", &ranges::WIDTH))]

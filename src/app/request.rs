@@ -123,6 +123,8 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         spec_map: a.spec_map.clone(),
         sidecar_top_down: a.sidecar_top_down,
         mm_per_unit: a.mm_per_unit,
+        skin: a.skin.clone(),
+        not_skin: a.not_skin.clone(),
     }
 }
 

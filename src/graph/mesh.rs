@@ -29,13 +29,25 @@ impl GpuMesh {
         vertices: &[V],
         indices: &[u32],
     ) -> Result<Self> {
+        Self::upload_with(ctx, name, vertices, indices, vk::BufferUsageFlags::empty())
+    }
+
+    /// [`GpuMesh::upload`] with a vertex buffer also usable as `extra` (a
+    /// storage buffer the deform pass writes).
+    pub fn upload_with<V: bytemuck::Pod>(
+        ctx: &Context,
+        name: &str,
+        vertices: &[V],
+        indices: &[u32],
+        extra: vk::BufferUsageFlags,
+    ) -> Result<Self> {
         let vertex_buffer = Guard::new(
             ctx,
             device_buffer(
                 ctx,
                 &format!("{name} vertices"),
                 bytemuck::cast_slice(vertices),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
+                vk::BufferUsageFlags::VERTEX_BUFFER | extra,
                 AccessKind::VertexInputRead,
             )?,
         );

@@ -153,6 +153,13 @@ impl<'a> Pass<'a> {
         BufferRef::new(id, AccessKind::TransferWrite)
     }
 
+    /// A tracked buffer the pass's draws read as vertices (one a compute
+    /// pass wrote: the deform pass's).
+    pub fn vertex_input(mut self, id: BufferId) -> Self {
+        self.buffer(id, AccessKind::VertexInputRead);
+        self
+    }
+
     /// A tracked buffer the host reads after the fence (no command of the
     /// pass uses it: the pass is the host-visibility step).
     pub fn host_read(mut self, id: BufferId) -> Self {

@@ -368,6 +368,12 @@ impl Resources {
         self.buffers[id.0].raw
     }
 
+    /// The buffer behind `id`, for a copy recorded outside the graph's
+    /// passes (a read-back, whose barriers `transition` derives).
+    pub fn raw_buffer(&self, id: BufferId) -> vk::Buffer {
+        self.buffers[id.0].raw
+    }
+
     pub fn buffer_name(&self, id: BufferId) -> &str {
         &self.buffers[id.0].name
     }

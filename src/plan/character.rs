@@ -79,14 +79,9 @@ pub fn estimate(
     let cam = framing.camera;
     let vp = cam.view_proj(width as f32 / height as f32);
     let visible = if scene.head.material.skin {
-        rasterise(
-            &scene.head.mesh,
-            &framing.instances,
-            &vp,
-            cam.eye,
-            width,
-            height,
-        )
+        let mut meshes = vec![(&scene.head.mesh, true)];
+        meshes.extend(scene.parts.iter().map(|p| (&p.mesh, false)));
+        rasterise(&meshes, &framing.instances, &vp, cam.eye, width, height)
     } else {
         vec![(0.0, [0; 4]); framing.instances.len()]
     };
@@ -163,11 +158,13 @@ pub fn from_visible(
         .collect()
 }
 
-/// Pixels of each instance of `mesh` left visible in one depth buffer of
-/// `width` x `height` (front-facing triangles, pixel centres inside, the
-/// nearest depth kept), with each instance's bounding rectangle.
+/// Skin pixels of each instance left visible in one depth buffer of `width` x
+/// `height` (front-facing triangles, pixel centres inside, the nearest depth
+/// kept), with each instance's bounding rectangle: `meshes` are a
+/// character's, `true` for its skin; the others (its parts) hide skin and
+/// count for no one, as the geometry pass's stencil does.
 fn rasterise(
-    mesh: &crate::scene::mesh::Mesh,
+    meshes: &[(&crate::scene::mesh::Mesh, bool)],
     instances: &[Mat4],
     vp: &Mat4,
     eye: Vec3,
@@ -177,7 +174,12 @@ fn rasterise(
     let (w, h) = (width as usize, height as usize);
     let mut depth = vec![f32::INFINITY; w * h];
     let mut owner = vec![u32::MAX; w * h];
-    for (k, model) in instances.iter().enumerate() {
+    // A part (not skin) hides the skin behind it and owns nothing.
+    for (k, model, mesh, skin) in instances
+        .iter()
+        .enumerate()
+        .flat_map(|(k, m)| meshes.iter().map(move |&(mesh, skin)| (k, m, mesh, skin)))
+    {
         let world: Vec<Vec3> = mesh
             .vertices
             .iter()
@@ -230,7 +232,7 @@ fn rasterise(
                     let i = y * w + x;
                     if z < depth[i] && (0.0..=1.0).contains(&z) {
                         depth[i] = z;
-                        owner[i] = k as u32;
+                        owner[i] = if skin { k as u32 } else { u32::MAX };
                     }
                 }
             }
@@ -289,11 +291,30 @@ mod tests {
         let vp = cam.view_proj(1.0);
         let near = Mat4::IDENTITY;
         let behind = Mat4::from_translation(Vec3::new(6.0, 0.0, -5.0));
-        let r = rasterise(&mesh, &[near, behind], &vp, cam.eye, 100, 100);
+        let r = rasterise(&[(&mesh, true)], &[near, behind], &vp, cam.eye, 100, 100);
         assert_eq!(r[0].0, 2500.0, "{r:?}");
         assert_eq!(r[0].1, [25, 25, 75, 75]);
         // The one behind is half as large (twice as far) and half hidden.
         assert!(r[1].0 > 0.0 && r[1].0 < 625.0, "{r:?}");
+        // A part (not skin) a unit nearer and half the size, inside the
+        // square's outline, hides exactly its own pixels of the skin and
+        // owns none.
+        let mut part = mesh.clone();
+        part.transform(
+            &(Mat4::from_translation(Vec3::new(0.0, 0.0, 1.0))
+                * Mat4::from_scale(Vec3::splat(0.5))),
+        );
+        let with = rasterise(
+            &[(&mesh, true), (&part, false)],
+            &[near],
+            &vp,
+            cam.eye,
+            100,
+            100,
+        );
+        let alone = rasterise(&[(&part, true)], &[near], &vp, cam.eye, 100, 100);
+        assert!(alone[0].0 > 0.0);
+        assert_eq!(with[0].0, 2500.0 - alone[0].0, "{with:?} {alone:?}");
     }
 
     #[test]

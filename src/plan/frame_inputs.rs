@@ -21,6 +21,7 @@ use super::skin_patches::{SkinPatches, View};
 use crate::budget::profile::Profile;
 use crate::render::RenderSettings;
 use crate::scene::framing::frame_sized;
+use crate::scene::mesh::Mesh;
 use crate::scene::{HeadSize, Scene};
 
 /// Builds one [`FrameInput`] per frame for frames of one size on one profile.
@@ -50,11 +51,12 @@ impl<'a> FrameInputs<'a> {
         height: u32,
     ) -> FrameInputs<'a> {
         let t = Instant::now();
-        let patches = scene
-            .head
-            .material
-            .skin
-            .then(|| SkinPatches::of(&scene.head.mesh, scene.mm_per_unit));
+        let patches = scene.head.material.skin.then(|| {
+            // Skin inside a closed part (behind an eyeball) is never seen.
+            let parts: Vec<&Mesh> = scene.parts.iter().map(|p| &p.mesh).collect();
+            let skin = crate::scene::enclosed::visible_skin(&scene.head.mesh, &parts);
+            SkinPatches::of(&skin, scene.mm_per_unit)
+        });
         let mut inputs = FrameInputs {
             scene,
             size: scene.head_size(),

@@ -17,11 +17,14 @@ use anyhow::Result;
 use ash::vk;
 use glam::Mat4;
 
+mod character_ids;
+
+use super::deform::Deform;
 use super::groups::merge::Merge;
 use super::groups::region::scissors;
 use super::groups::{passes as groups, GroupMethod};
 use super::instances::{Instances, SkinGroup};
-use super::scene_gpu::GpuObject;
+use super::scene_gpu::{GpuObject, ObjectKind};
 use super::settings::RenderSettings;
 use super::targets::SHADOW_FORMAT;
 use super::uniforms::FrameUniforms;
@@ -64,14 +67,6 @@ struct ShadowPush {
     light_view_proj: [[f32; 4]; 4],
 }
 
-/// Push constants of the character-id pass: the id.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct IdPush {
-    id: f32,
-}
-
-const IDS_SHADER: &str = "geometry_ids.frag";
 /// The geometry pass's vertex shader: geometry.vert (what tsd's final pass and
 /// the ground truth's surface pass draw one head with) with the model matrix
 /// read per instance.
@@ -107,6 +102,8 @@ pub struct Frame {
     frame_ubo: Buffer,
     beckmann: Image,
     pub objects: Vec<GpuObject>,
+    /// The morphing objects' deform passes (`enable_deform`).
+    pub deform: Deform,
     /// The characters of each group with its stencil code, in group order:
     /// the geometry pass draws each group's heads with its code as the
     /// stencil reference (one group of every character, code 1, until
@@ -166,6 +163,7 @@ impl Frame {
             frame_ubo: Buffer::default(),
             beckmann: Image::default(),
             objects: Vec::new(),
+            deform: Deform::default(),
             skin_groups: vec![SkinGroup {
                 stencil: STENCIL_SKIN,
                 characters: every,
@@ -193,7 +191,8 @@ impl Frame {
         transmittance: bool,
     ) -> Result<()> {
         self.samplers = Samplers::new(ctx)?;
-        self.pool = DescriptorPool::new(ctx, DESCRIPTOR_SETS)?;
+        // One material set per object beyond the few the constant counts.
+        self.pool = DescriptorPool::new(ctx, DESCRIPTOR_SETS + scene.parts.len() as u32)?;
         self.create_pipelines(ctx, res)?;
         let lut: Vec<u16> = beckmann_lut(BECKMANN_SIZE as usize)
             .iter()
@@ -223,15 +222,34 @@ impl Frame {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
         self.frame_set = GraphSet::new(res, &self.geometry_pipeline, 0, self.frame_binds());
+        let kind = |skin: bool| {
+            if skin {
+                ObjectKind::Skin
+            } else {
+                ObjectKind::Part
+            }
+        };
         let objects = scene
             .backdrop
             .iter()
-            .map(|b| ("backdrop", b))
-            .chain(std::iter::once(("head", &scene.head)));
-        for (name, o) in objects {
+            .map(|b| ("backdrop".to_string(), ObjectKind::Backdrop, b))
+            .chain(std::iter::once((
+                "head".to_string(),
+                kind(scene.head.material.skin),
+                &scene.head,
+            )))
+            .chain(
+                scene
+                    .parts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| (format!("part {i}"), ObjectKind::Part, p)),
+            );
+        for (name, kind, o) in objects {
             let g = GpuObject::new(
                 ctx,
-                name,
+                &name,
+                kind,
                 o,
                 &self.pool,
                 &self.geometry_pipeline,
@@ -328,39 +346,38 @@ impl Frame {
         Ok(())
     }
 
-    /// Adds the character-id pass (`--character-ids`) writing into `ids`
-    /// (before the usages are derived: the pass declares its target).
-    pub fn enable_character_ids(
+    /// The deform pass of every object whose morph weights are not all 0
+    /// (`scene`'s, in the order `build` made the objects).
+    pub fn enable_deform(
         &mut self,
         ctx: &Context,
-        res: &Resources,
-        ids: ImageId,
+        scene: &Scene,
+        res: &mut Resources,
     ) -> Result<()> {
-        let ds_format = res.format(self.targets.depth_stencil);
-        // The geometry pass's vertex shader, so positions match its depth exactly.
-        self.ids_pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                name: "character ids".into(),
-                vert: GEOMETRY_VERT,
-                frag: Some(IDS_SHADER),
-                color_formats: vec![res.format(ids)],
-                depth_format: Some(ds_format),
-                stencil_format: Some(ds_format),
-                vertex_input: VertexInput::Mesh,
-                cull: vk::CullModeFlags::BACK,
-                depth_test: true,
-                depth_write: false,
-                depth_compare: vk::CompareOp::EQUAL,
-                stencil: None,
-                depth_bias: None,
-                blend: Blend::None,
-            },
-        )?;
-        // The frame's uniforms alone (the id shader reads nothing else).
-        self.ids_set = GraphSet::new(res, &self.ids_pipeline, 0, self.frame_binds()[..1].to_vec());
-        self.character_ids = Some(ids);
-        self.write_instances(ctx)
+        let morphs = scene
+            .backdrop
+            .iter()
+            .chain([&scene.head])
+            .chain(&scene.parts)
+            .map(|o| &o.morph);
+        self.deform = Deform::new(ctx)?;
+        for (obj, morph) in self.objects.iter_mut().zip(morphs) {
+            if !morph.at_rest() {
+                let id = self
+                    .deform
+                    .add(ctx, res, &obj.name, obj.mesh.vertices.raw, morph)?;
+                obj.deformed = Some(id);
+            }
+        }
+        Ok(())
+    }
+
+    /// Declares every deformed vertex buffer the frame's draws read.
+    fn reads_vertices<'a>(&self, pass: Pass<'a>) -> Pass<'a> {
+        self.objects
+            .iter()
+            .filter_map(|o| o.deformed)
+            .fold(pass, |p, id| p.vertex_input(id))
     }
 
     /// Builds the post chain: the bloom with `--bloom`, the tone map, and
@@ -479,6 +496,7 @@ impl Frame {
         if self.character_ids.is_some() {
             self.ids_set.write(ctx, pool, res, &self.ids_pipeline)?;
         }
+        self.deform.bind(ctx, pool, res)?;
         self.post.bind(&PostBind { ctx, res, pool })
     }
 
@@ -491,6 +509,7 @@ impl Frame {
         res: &Resources,
     ) -> Vec<Pass<'a>> {
         let mut passes = Vec::new();
+        self.deform.passes(&mut passes);
         let shadow = self.shadow_map(&mut passes);
         let gbuffer = self.geometry(&mut passes, res, shadow);
         let diffuse = groups::sss(&mut passes, &gbuffer, groups, merge);
@@ -509,9 +528,9 @@ impl Frame {
     fn shadow_map<'a>(&'a self, passes: &mut Vec<Pass<'a>>) -> ImageId {
         let shadow = self.targets.shadow;
         passes.push(
-            Pass::new("shadow map", PassRole::Shadow)
+            self.reads_vertices(Pass::new("shadow map", PassRole::Shadow))
                 .depth_stencil(DepthStencil::cleared(shadow, 1.0))
-                .draws(None, self.triangles(true))
+                .draws(None, self.triangles(ObjectKind::per_character))
                 .record(move |pc: &PassContext| {
                     let (ctx, cmd) = (pc.ctx, pc.cmd);
                     self.shadow_pipeline.bind(ctx, cmd, &[self.shadow_set]);
@@ -519,9 +538,10 @@ impl Frame {
                         light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
                     };
                     self.shadow_pipeline.push(ctx, cmd, &push);
-                    // Every character in one instanced draw.
+                    // Every character (its skin and its parts) in one
+                    // instanced draw each.
                     let heads = self.instance_buffer.backdrop_slot;
-                    for obj in self.objects.iter().filter(|o| o.skin) {
+                    for obj in self.objects.iter().filter(|o| o.kind.per_character()) {
                         obj.draw_instances(ctx, cmd, 0, heads);
                     }
                 }),
@@ -609,7 +629,7 @@ impl Frame {
             Some(m) => DepthStencil::cleared(m.depth_stencil, 1.0).resolved_into(t.depth_stencil),
             None => DepthStencil::cleared(t.depth_stencil, 1.0),
         };
-        let mut pass = Pass::new("geometry", PassRole::Geometry);
+        let mut pass = self.reads_vertices(Pass::new("geometry", PassRole::Geometry));
         // The frame's set samples the shadow map.
         let frame = pass.set(&self.frame_set);
         pass = pass
@@ -625,7 +645,7 @@ impl Frame {
         if let Some(n) = t.normals {
             pass = pass.color(clear(n, ms.and_then(|m| m.normals), [0.0; 4]));
         }
-        passes.push(pass.draws(Some(work), self.triangles(false)).record(
+        passes.push(pass.draws(Some(work), self.triangles(|_| true)).record(
             move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.geometry_pipeline;
@@ -641,9 +661,15 @@ impl Frame {
                 };
                 for obj in &self.objects {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
-                    if !obj.skin {
+                    // The backdrop once, a character's other parts with
+                    // every character: no skin bit, so no SSS pass reads them.
+                    if obj.kind != ObjectKind::Skin {
                         set_reference(0);
-                        obj.draw_instances(ctx, cmd, slots.backdrop_slot, 1);
+                        let (first, count) = match obj.kind {
+                            ObjectKind::Backdrop => (slots.backdrop_slot, 1),
+                            _ => (0, slots.backdrop_slot),
+                        };
+                        obj.draw_instances(ctx, cmd, first, count);
                         continue;
                     }
                     // Each group's heads in one instanced draw with its code
@@ -696,46 +722,20 @@ impl Frame {
         hdr
     }
 
-    /// After the frame (`--character-ids`): every head again, depth-tested
-    /// EQUAL against the frame's depth, writing its frame index + 1 into
-    /// `ids`. Set-up work, not frame cost; only the flag adds it.
-    fn character_ids<'a>(
-        &'a self,
-        passes: &mut Vec<Pass<'a>>,
-        ids: ImageId,
-        depth_stencil: ImageId,
-    ) {
-        let mut pass = Pass::new("character ids", PassRole::Setup);
-        let set = pass.set(&self.ids_set);
-        passes.push(
-            pass.color(ColorTarget::new(ids, Load::Clear([0.0; 4])))
-                .depth_stencil(DepthStencil::test_only(depth_stencil).depth_test(true))
-                .draws(None, self.triangles(true))
-                .record(move |pc: &PassContext| {
-                    let (ctx, cmd) = (pc.ctx, pc.cmd);
-                    let p = &self.ids_pipeline;
-                    pc.bind(p, &[set]);
-                    p.bind_sets(ctx, cmd, 2, &[self.ids_instance_set]);
-                    let slots = &self.instance_buffer.character_slots;
-                    for obj in self.objects.iter().filter(|o| o.skin) {
-                        for (c, &slot) in slots.iter().enumerate() {
-                            p.push(ctx, cmd, &IdPush { id: (c + 1) as f32 });
-                            obj.draw_instances(ctx, cmd, slot, 1);
-                        }
-                    }
-                }),
-        );
-    }
-
-    /// Triangles the skin objects submit per frame (every character), and all objects.
-    fn triangles(&self, skin_only: bool) -> u64 {
+    /// Triangles the objects `of` selects submit per frame (a character's
+    /// objects once per character).
+    fn triangles(&self, of: impl Fn(ObjectKind) -> bool) -> u64 {
+        let copies = |k: ObjectKind| {
+            if k.per_character() {
+                self.instances.len() as u64
+            } else {
+                1
+            }
+        };
         self.objects
             .iter()
-            .filter(|o| o.skin || !skin_only)
-            .map(|o| {
-                let copies = if o.skin { self.instances.len() } else { 1 };
-                o.mesh.triangles() * copies as u64
-            })
+            .filter(|o| of(o.kind))
+            .map(|o| o.mesh.triangles() * copies(o.kind))
             .sum()
     }
 
@@ -743,6 +743,7 @@ impl Frame {
         for o in &mut self.objects {
             o.destroy(ctx);
         }
+        self.deform.destroy(ctx);
         self.post.destroy(ctx);
         self.beckmann.destroy(ctx);
         self.frame_ubo.destroy(ctx);
@@ -775,7 +776,7 @@ pub fn skin_material_binds(frame: &Frame) -> Vec<(&'static str, Bind)> {
     frame
         .objects
         .iter()
-        .find(|o| o.skin)
+        .find(|o| o.kind == ObjectKind::Skin)
         .map(|o| o.material_binds(&frame.samplers))
         .unwrap_or_default()
 }

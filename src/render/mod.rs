@@ -6,6 +6,7 @@
 //! submitted and measured frame by frame.
 
 pub mod counting;
+pub mod deform;
 pub mod frame;
 pub mod groups;
 pub mod inputs;
@@ -174,6 +175,7 @@ impl<'c> Renderer<'c> {
         if let Some(ids) = ids {
             frame.enable_character_ids(ctx, &resources, ids)?;
         }
+        frame.enable_deform(ctx, scene, &mut resources)?;
         frame.enable_post(ctx, &mut resources)?;
         frame.set_skin_groups(
             ctx,
@@ -237,6 +239,12 @@ impl<'c> Renderer<'c> {
         }
         ctx.check_validation("while setting up the renderer")?;
         Ok(r)
+    }
+
+    /// Every morphing object's vertices and previous positions as the last
+    /// frame's deform pass wrote them (empty when nothing morphs).
+    pub fn deformed(&mut self) -> Result<Vec<deform::Deformed>> {
+        self.frame.deform.read_back(self.ctx, &mut self.resources)
     }
 
     /// The SSS region of every group, one after another (one group's in a

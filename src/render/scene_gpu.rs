@@ -19,10 +19,33 @@ pub struct MaterialUniforms {
     pub params: [f32; 4],
 }
 
+/// What an object is to the frame: how often it is drawn and whether it
+/// writes the skin stencil.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjectKind {
+    /// A character's scattered skin: every character, its group's stencil code.
+    Skin,
+    /// A character's other part (eyes, teeth, cloth; or a head without skin):
+    /// every character, stencil 0.
+    Part,
+    /// Drawn once, stencil 0.
+    Backdrop,
+}
+
+impl ObjectKind {
+    /// Drawn once per character (skin and parts), not once per frame.
+    pub fn per_character(self) -> bool {
+        self != ObjectKind::Backdrop
+    }
+}
+
 pub struct GpuObject {
     pub name: String,
     pub mesh: GpuMesh,
-    pub skin: bool,
+    pub kind: ObjectKind,
+    /// Its vertex buffer as the graph tracks it, when the deform pass writes
+    /// it (`Frame::enable_deform`): every draw of it declares the read.
+    pub deformed: Option<crate::graph::BufferId>,
     textures: Vec<Image>,
     uniforms: Buffer,
     pub material_set: vk::DescriptorSet,
@@ -77,6 +100,7 @@ impl GpuObject {
     pub fn new(
         ctx: &Context,
         name: &str,
+        kind: ObjectKind,
         object: &Object,
         pool: &DescriptorPool,
         geometry: &Pipeline,
@@ -87,7 +111,8 @@ impl GpuObject {
             GpuObject {
                 name: name.to_string(),
                 mesh: GpuMesh::default(),
-                skin: object.material.skin,
+                kind,
+                deformed: None,
                 textures: Vec::new(),
                 uniforms: Buffer::default(),
                 material_set: vk::DescriptorSet::null(),
@@ -107,7 +132,14 @@ impl GpuObject {
     ) -> Result<()> {
         let name = self.name.clone();
         let mesh = &object.mesh;
-        self.mesh = GpuMesh::upload(ctx, &name, &mesh.vertices, &mesh.indices)?;
+        // A morphing object's vertices are written by the deform pass too.
+        let extra = if object.morph.at_rest() {
+            vk::BufferUsageFlags::empty()
+        } else {
+            // Written by the deform pass, read back by tests.
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC
+        };
+        self.mesh = GpuMesh::upload_with(ctx, &name, &mesh.vertices, &mesh.indices, extra)?;
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [

@@ -1,5 +1,5 @@
 //! A procedural head that reads as a face, for the first picture a newcomer sees: brow,
-//! closed eyes, nose, cheekbones, lips, chin, jaw, ears thin enough to glow when lit from
+//! open eyes (eyeballs, a part of their own: `eyes`), nose, cheekbones, lips, chin, jaw, ears thin enough to glow when lit from
 //! behind, and a neck that leaves the frame, in front of a backdrop placed for the default
 //! key light.
 //!
@@ -24,6 +24,7 @@
 //! built from one set of measurements (740 lines of code) and their tests (360)
 //! check those measurements against each other.
 
+use super::eyes::{self, EYEBALL_RADIUS_MM};
 use super::mesh::{Material, Mesh, Object, Vertex};
 use super::procedural::MM_PER_UNIT;
 use super::Scene;
@@ -70,9 +71,11 @@ const PARALLELS_MM: [f32; 6] = [30.0, 0.0, -40.0, -70.0, -100.0, -180.0];
 /// Squared half-width (mm^2) of the band around the midline over which mirrored
 /// features are blended rather than folded.
 const MIRROR_ROUNDING_MM2: f32 = 4.0;
-/// Eyeball centre (right eye; the left mirrors it) and the radius of the closed lid.
+/// Eyeball centre (right eye; the left mirrors it), the radius of the lid over it
+/// and half the width of the opening between the lids.
 const EYE_MM: Vec3 = Vec3::new(32.0, 1.0, 66.0);
 const LID_RADIUS_MM: f32 = 13.0;
+const EYE_HALF_WIDTH_MM: f32 = 12.0;
 /// Height of the mouth line, where the lips overlap by 1 mm, half the mouth's width,
 /// and the depth (along the dental arch) down to which the mouth line is grooved.
 const MOUTH_Y_MM: f32 = -69.0;
@@ -226,19 +229,19 @@ fn skull_field(p: Vec3) -> f32 {
     d = smin(d, jaw_line, 14.0);
     d = smin(d, blob(p, [0.0, -101.0, 71.0], [20.0, 14.0, 17.0]), 8.0);
 
-    // Shallow eye sockets, then the closed lids over the eyeballs.
+    // Shallow eye sockets, then the lids over the eyeballs (`eyes`), open: an
+    // almond between the upper lid's arc (4.5 mm above the centre) and the
+    // lower's (3.5 below), 24 mm wide, carved from the lids' front down to
+    // 1.5 mm inside the eyeball, which fills the opening.
     d = smax(d, -blob(q, [32.0, 4.0, 92.0], [18.0, 11.0, 14.0]), 8.0);
     let e = q - EYE_MM;
     d = smin(d, e.length() - LID_RADIUS_MM, 4.0);
-    // Where the lids meet: a groove along a gentle downward arc, tilted up toward the
-    // outer corner, wide and deep enough (~1.5 mm) to survive the subsurface blur as a
-    // dark line at the mid shot. Bounded to the front of the eye.
-    let lash_line = e.y + 3.5 - 0.012 * e.x * e.x - 0.06 * e.x;
-    let fissure = (lash_line.abs() - 0.7)
-        .max(LID_RADIUS_MM - 1.3 - e.length())
-        .max(e.x.abs() - 13.0)
-        .max(-e.z);
-    d = smax(d, -fissure, 0.8);
+    let w = (1.0 - (e.x / EYE_HALF_WIDTH_MM).powi(2)).max(0.0);
+    let almond = (e.y - (4.0 * w + 0.5))
+        .max(-(3.0 * w + 0.5) - e.y)
+        .max(e.x.abs() - EYE_HALF_WIDTH_MM);
+    let opening = almond.max(EYEBALL_RADIUS_MM - 1.5 - e.length()).max(-e.z);
+    d = smax(d, -opening, 0.8);
 
     // Nose: a narrow bridge from the root to the tip, the tip, the wings.
     let narrow = Vec3::new(p.x * 1.4, p.y, p.z);
@@ -729,10 +732,13 @@ pub fn face_scene() -> Scene {
         name: "procedural face".to_owned(),
         mm_per_unit: MM_PER_UNIT,
         head: Object {
+            morph: Default::default(),
             mesh: head,
             material: Material::skin(SKIN_ALBEDO),
         },
+        parts: vec![eyes::eyes(EYE_MM, MM_PER_UNIT)],
         backdrop: Some(Object {
+            morph: Default::default(),
             mesh: backdrop_mesh(),
             material: backdrop_material(),
         }),
@@ -1006,24 +1012,41 @@ mod tests {
         let subnasale = (0..=30)
             .map(|k| profile_mm(&m, -44.0 - 0.5 * k as f32))
             .fold(f32::INFINITY, f32::min);
-        // The closed eyes: the lid's front at the pupil.
-        let lid = 300.0
-            - ray_hits(
-                &m,
-                Vec3::new(EYE_MM.x, EYE_MM.y + 4.0, 300.0) / MM_PER_UNIT,
-                Vec3::NEG_Z,
-            )[0] * MM_PER_UNIT;
+        // The open eyes: the eyeball's front at the pupil, seen through the lids.
+        let eyes = eyes::eyes(EYE_MM, MM_PER_UNIT).mesh;
+        let front = |mesh: &Mesh, y_mm: f32| {
+            300.0
+                - ray_hits(
+                    mesh,
+                    Vec3::new(EYE_MM.x, y_mm, 300.0) / MM_PER_UNIT,
+                    Vec3::NEG_Z,
+                )[0] * MM_PER_UNIT
+        };
+        let pupil = front(&eyes, EYE_MM.y);
         eprintln!(
-            "nose tip z {tip} mm: {} mm ahead of the subnasale, {} mm ahead of the closed lids",
+            "nose tip z {tip} mm: {} mm ahead of the subnasale, {} mm ahead of the pupils",
             tip - subnasale,
-            tip - lid
+            tip - pupil
         );
         assert!(
             (14.0..=25.0).contains(&(tip - subnasale)),
             "{}",
             tip - subnasale
         );
-        assert!((25.0..=45.0).contains(&(tip - lid)), "{}", tip - lid);
+        assert!((25.0..=45.0).contains(&(tip - pupil)), "{}", tip - pupil);
+        // Through the opening the eyeball is in front of the skin; above and
+        // below it the lids cover the eyeball.
+        for (y, open) in [
+            (0.0, true),
+            (3.0, true),
+            (-2.5, true),
+            (8.0, false),
+            (-7.0, false),
+        ] {
+            let y = EYE_MM.y + y;
+            let (skin, ball) = (front(&m, y), front(&eyes, y));
+            assert_eq!(ball > skin, open, "at {y} mm: skin {skin}, eyeball {ball}");
+        }
     }
 
     #[test]

@@ -26,12 +26,14 @@ pub enum Use {
     Tangent,
     TexCoord,
     Indices,
+    /// A morph target's offsets (position, normal or tangent: VEC3).
+    Offset,
 }
 
 impl Use {
     fn dims(self) -> Dimensions {
         match self {
-            Use::Position | Use::Normal => Dimensions::Vec3,
+            Use::Position | Use::Normal | Use::Offset => Dimensions::Vec3,
             Use::Tangent => Dimensions::Vec4,
             Use::TexCoord => Dimensions::Vec2,
             Use::Indices => Dimensions::Scalar,
@@ -45,6 +47,7 @@ impl Use {
             Use::Tangent => "tangents",
             Use::TexCoord => "texture coordinates",
             Use::Indices => "indices",
+            Use::Offset => "morph offsets",
         }
     }
 
@@ -67,6 +70,8 @@ impl Use {
             Use::Position => quantization && small,
             Use::Normal | Use::Tangent => quantization && signed_small && normalized,
             Use::TexCoord => small && (normalized || quantization),
+            // KHR_mesh_quantization: BYTE or SHORT offsets, normalized or not.
+            Use::Offset => quantization && signed_small,
         }
     }
 }

@@ -1,5 +1,7 @@
-//! Loads a head scan from glTF/GLB: every triangle primitive of the default scene, in world
-//! space, merged into one mesh, plus its skin textures.
+//! Loads a character from glTF/GLB: every triangle primitive of the default scene, in world
+//! space, merged per material: the head (its one scattered skin material, chosen by
+//! `crate::scene::skin_rule`, each decision a note) and its other parts, each with its own
+//! material and textures.
 //!
 //! Scans are often shipped as a bare mesh with textures lying next to it (the Lee
 //! Perry-Smith head is), so textures the glTF does not reference are found beside it
@@ -41,6 +43,7 @@ mod primitives;
 mod textures;
 
 use super::mesh::Object;
+use super::skin_rule;
 use anyhow::{anyhow, bail, Result};
 use std::path::Path;
 
@@ -82,13 +85,14 @@ impl Warnings {
         self.notes.push(n);
     }
 
-    fn finish(mut self, object: Object) -> Loaded {
+    fn finish(mut self, object: Object, parts: Vec<Object>) -> Loaded {
         if self.dropped > 0 {
             self.list
                 .push(format!("... and {} more warnings", self.dropped));
         }
         Loaded {
             object,
+            parts,
             warnings: self.list,
             notes: self.notes,
         }
@@ -122,7 +126,11 @@ pub fn load_head_with_warnings(
 /// it took from where without being asked (notes: the textures found beside the
 /// file).
 pub struct Loaded {
+    /// The character's head: its scattered skin material's primitives (or,
+    /// when nothing is skin, its largest material's).
     pub object: Object,
+    /// Its other materials' primitives, each with its own material.
+    pub parts: Vec<Object>,
     pub warnings: Vec<String>,
     pub notes: Vec<String>,
 }
@@ -151,26 +159,111 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     c.mesh
         .validate()
         .map_err(|e| anyhow!("merged mesh: {e:#}"))?;
-    if c.with_uvs > 0 && !c.without_uvs.is_empty() {
-        // Skin needs texture coordinates where it is textured; an eye or a tooth
-        // without them still draws, in the colour of the texture's first texel.
-        let n = c.without_uvs.len();
-        let first = &c.without_uvs[0];
-        let more = if n > 1 {
-            format!(" and {} more", n - 1)
-        } else {
-            String::new()
-        };
+    let groups = c.split();
+    let facts = groups
+        .iter()
+        .map(|g| material_facts(&src, g.material, g.mesh.triangle_count()))
+        .collect::<Result<Vec<_>>>()?;
+    let decisions = skin_rule::decide(&facts, &overrides.skin)?;
+    let scattered = skin_rule::scattered(&facts, &decisions);
+    // With no skin, the head is the largest part (what the framing measures).
+    let head = scattered.unwrap_or_else(|| {
+        (0..facts.len())
+            .max_by_key(|&i| (facts[i].triangles, std::cmp::Reverse(i)))
+            .unwrap_or(0)
+    });
+    // One note per material when the model has several or the rule had to
+    // choose; a lone unnamed material is a scan's skin, as it always was.
+    let lone_default =
+        facts.len() == 1 && decisions[0].reason == (skin_rule::Reason::Unnamed { alone: true });
+    if !lone_default {
+        for (f, d) in facts.iter().zip(&decisions) {
+            warn.note(d.note(f));
+        }
+    }
+    let also_skin: Vec<String> = (0..facts.len())
+        .filter(|&i| decisions[i].skin && Some(i) != scattered)
+        .map(|i| facts[i].label())
+        .collect();
+    if !also_skin.is_empty() {
         warn.push(format!(
-            "{first}{more} have no TEXCOORD_0: loaded with zero texture coordinates"
+            "{} also skin, but dermis scatters one material per character ({}, the largest): drawn in their own materials without scattering (--skin chooses)",
+            also_skin.join(", ") + if also_skin.len() == 1 { " is" } else { " are" },
+            facts[head].label()
         ));
     }
-    let material = textures::material(&src, &c, overrides, &mut warn)?;
-    let object = Object {
-        mesh: c.mesh,
-        material,
+    let mut head_object = None;
+    let mut parts = Vec::new();
+    for (i, g) in groups.into_iter().enumerate() {
+        if g.with_uvs > 0 && !g.without_uvs.is_empty() {
+            // Skin needs texture coordinates where it is textured; an eye or a tooth
+            // without them still draws, in the colour of the texture's first texel.
+            let n = g.without_uvs.len();
+            let first = &g.without_uvs[0];
+            let more = if n > 1 {
+                format!(" and {} more", n - 1)
+            } else {
+                String::new()
+            };
+            warn.push(format!(
+                "{first}{more} have no TEXCOORD_0: loaded with zero texture coordinates"
+            ));
+        }
+        let role = textures::Role {
+            head: i == head,
+            skin: i == head && scattered.is_some(),
+        };
+        let material = textures::material(&src, &g, role, overrides, &mut warn).map_err(|e| {
+            if facts.len() > 1 {
+                anyhow!("{}: {e:#}", facts[i].label())
+            } else {
+                e
+            }
+        })?;
+        let mut object = Object {
+            morph: Default::default(),
+            mesh: g.mesh,
+            material,
+        };
+        object
+            .set_morph(g.morph)
+            .map_err(|e| anyhow!("{}: {e:#}", facts[i].label()))?;
+        if role.head {
+            head_object = Some(object);
+        } else {
+            parts.push(object);
+        }
+    }
+    let object = head_object.ok_or_else(|| anyhow!("no triangle mesh in the default scene"))?;
+    Ok(warn.finish(object, parts))
+}
+
+/// What the skin rule reads of one material: its name and its extras' `skin`.
+fn material_facts(
+    src: &super::gltf_source::Source,
+    index: Option<usize>,
+    triangles: usize,
+) -> Result<skin_rule::MaterialFacts> {
+    let json = index.and_then(|i| src.json.get("materials")?.get(i));
+    let name = json
+        .and_then(|j| j.get("name"))
+        .and_then(|n| n.as_str())
+        .map(|n| super::gltf_source::short(n).to_string());
+    let extras_skin = match json.and_then(|j| j.pointer("/extras/skin")) {
+        None => None,
+        Some(v) => Some(v.as_bool().ok_or_else(|| {
+            anyhow!(
+                "material {}: extras \"skin\" is {v}, not true or false",
+                index.unwrap_or(0)
+            )
+        })?),
     };
-    Ok(warn.finish(object))
+    Ok(skin_rule::MaterialFacts {
+        index,
+        name,
+        extras_skin,
+        triangles,
+    })
 }
 
 #[cfg(test)]

@@ -115,10 +115,13 @@ pub fn lines_scene() -> Scene {
         name: "thin lines and a grid".to_owned(),
         mm_per_unit: MM_PER_UNIT,
         head: Object {
+            morph: Default::default(),
             mesh: head,
             material: Material::skin(BAR_ALBEDO),
         },
+        parts: Vec::new(),
         backdrop: Some(Object {
+            morph: Default::default(),
             mesh: card_mesh(),
             material: Material {
                 skin: false,

@@ -1,20 +1,11 @@
 //! CPU-side geometry and material data, laid out so the renderer can upload it as-is.
 
 use anyhow::{bail, Result};
+
+use super::morph::{posed, Morph};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
-/// One vertex exactly as the vertex buffer holds it (48 bytes, no padding), so a
-/// `&[Vertex]` can be uploaded with `bytemuck::cast_slice` without repacking.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Vertex {
-    pub position: [f32; 3],
-    pub normal: [f32; 3],
-    pub uv: [f32; 2],
-    /// xyz: tangent along +u; w: handedness (+1 or -1) so the shader can rebuild the
-    /// bitangent as `cross(normal, tangent.xyz) * tangent.w` (mirrored UVs flip it).
-    pub tangent: [f32; 4],
-}
+pub use super::vertex::Vertex;
 
 /// An indexed triangle list. Front faces are counter-clockwise seen from outside, which is
 /// what back-face culling and the "inside/outside" tests of the skin passes rely on.
@@ -187,8 +178,37 @@ impl Material {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
+    /// Its vertices as drawn: the rest mesh posed by `morph`'s weights
+    /// (`morph::posed`), what every CPU consumer reads.
     pub mesh: Mesh,
     pub material: Material,
+    /// Its morph targets and weights (none: a still mesh). The renderer
+    /// deforms `rest` on the GPU (`morph::apply`).
+    pub morph: Morph,
+}
+
+impl Object {
+    /// Gives the object its targets (its mesh now is their rest shape),
+    /// checks them and poses it by their weights.
+    pub fn set_morph(&mut self, mut morph: Morph) -> Result<()> {
+        if morph.targets.is_empty() {
+            self.morph = Morph::default();
+            return Ok(());
+        }
+        morph.check(self.mesh.vertices.len())?;
+        morph.rest = self.mesh.vertices.clone();
+        self.morph = morph;
+        self.pose();
+        Ok(())
+    }
+
+    /// Its mesh posed by its morph's weights (`morph::posed`); a still
+    /// object stays as it is.
+    pub fn pose(&mut self) {
+        if !self.morph.targets.is_empty() {
+            self.mesh.vertices = posed(&self.morph.rest, &self.morph);
+        }
+    }
 }
 
 impl Mesh {

@@ -3,6 +3,8 @@
 //! independent of Vulkan so it can be tested without a GPU.
 
 pub mod camera;
+pub mod enclosed;
+pub mod eyes;
 pub mod face;
 pub mod framing;
 pub mod gltf_accessor;
@@ -13,9 +15,12 @@ pub mod layout;
 pub mod light;
 pub mod lines;
 pub mod mesh;
+pub mod morph;
 pub mod procedural;
 pub mod robust_bounds;
+pub mod skin_rule;
 pub mod source;
+pub mod vertex;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
@@ -27,11 +32,19 @@ use std::path::Path;
 pub struct Scene {
     pub name: String,
     pub mm_per_unit: f32,
+    /// The character's skin: the one material scattered per character
+    /// (`skin_rule`); every SSS method, the ground truth and the planner's
+    /// skin estimate read it alone.
     pub head: mesh::Object,
+    /// The character's other parts (eyes, teeth, hair, cloth), each with its
+    /// own material: drawn and shadowed with every character, never
+    /// scattered, kept out of the skin stencil.
+    pub parts: Vec<mesh::Object>,
     pub backdrop: Option<mesh::Object>,
-    /// Bounds of the whole head object, neck and shoulders included when a scan has them
-    /// (what shadows must cover), far outlier vertices left out (a loaded scene says
-    /// how many); frame the camera with `head_center`/`head_height_units`.
+    /// Bounds of the whole character (head and parts), neck and shoulders included
+    /// when a scan has them (what shadows must cover), far outlier vertices left out
+    /// (a loaded scene says how many); frame the camera with
+    /// `head_center`/`head_height_units`.
     pub head_bounds: mesh::Aabb,
     /// Unit vector from the head centre toward the face: where the camera goes.
     pub forward: Vec3,
@@ -108,8 +121,9 @@ pub fn builtin_scene(
         || o.normal_map.is_some()
         || o.specular_map.is_some()
         || o.sidecar_top_down
+        || !o.skin.is_empty()
     {
-        bail!("--albedo, --normal-map, --spec-map and --sidecar-top-down apply to a glTF --scene, not to builtin:{name}");
+        bail!("--albedo, --normal-map, --spec-map, --sidecar-top-down, --skin and --not-skin apply to a glTF --scene, not to builtin:{name}");
     }
     let mut s = builtin(name)?;
     if let Some(mm) = mm_per_unit {
@@ -131,9 +145,11 @@ pub fn egg_scene() -> Scene {
         name: "procedural head".to_owned(),
         mm_per_unit: procedural::MM_PER_UNIT,
         head: mesh::Object {
+            morph: Default::default(),
             mesh: head,
             material: mesh::Material::skin([0.62, 0.40, 0.32]),
         },
+        parts: Vec::new(),
         backdrop: Some(backdrop(procedural::backdrop_mesh())),
         head_bounds,
         forward: Vec3::Z,
@@ -144,6 +160,7 @@ pub fn egg_scene() -> Scene {
 /// Matte grey, no subsurface: it only catches shadows and frames the silhouette.
 fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
     mesh::Object {
+        morph: Default::default(),
         mesh,
         material: mesh::Material {
             skin: false,
@@ -183,13 +200,19 @@ pub fn load_gltf_scene(
     if let Some(mm) = mm_per_unit {
         check_mm_per_unit(mm)?;
     }
-    let head = gltf_load::load_head(path, overrides)
+    let loaded = gltf_load::load_head_with_notes(path, overrides)
         .with_context(|| format!("loading scene {}", path.display()))?;
+    for n in &loaded.notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
+    for w in &loaded.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
-    let mut scene = scene_from_head(&name, head, mm_per_unit)
+    let mut scene = scene_from_character(&name, loaded.object, loaded.parts, mm_per_unit)
         .with_context(|| format!("framing the head in {}", path.display()))?;
     scene.source = Some(source::SceneSource {
         scene: Some(path.to_path_buf()),
@@ -198,6 +221,8 @@ pub fn load_gltf_scene(
         spec_map: overrides.specular_map.clone(),
         sidecar_top_down: overrides.sidecar_top_down,
         mm_per_unit,
+        skin: overrides.skin.skin.clone(),
+        not_skin: overrides.skin.not_skin.clone(),
     });
     Ok(scene)
 }
@@ -207,6 +232,17 @@ pub fn load_gltf_scene(
 /// vertices are left out of every measurement; a flat object faces the camera
 /// with its largest extent (`head_measure`).
 pub fn scene_from_head(name: &str, head: mesh::Object, mm_per_unit: Option<f32>) -> Result<Scene> {
+    scene_from_character(name, head, Vec::new(), mm_per_unit)
+}
+
+/// [`scene_from_head`] for a character with other parts: the head (its skin)
+/// frames and scales it, the parts widen its bounds.
+pub fn scene_from_character(
+    name: &str,
+    head: mesh::Object,
+    parts: Vec<mesh::Object>,
+    mm_per_unit: Option<f32>,
+) -> Result<Scene> {
     let forward = gltf_load::face_direction(&head.mesh);
     let (center, height) = head_measure::framed_part(&head.mesh, forward);
     let mm_per_unit = match mm_per_unit {
@@ -229,10 +265,17 @@ pub fn scene_from_head(name: &str, head: mesh::Object, mm_per_unit: Option<f32>)
             center.y
         ),
     };
+    let head_bounds = parts
+        .iter()
+        .map(|p| head_measure::inlier_bounds(&p.mesh).0)
+        .fold(head_measure::inlier_bounds(&head.mesh).0, |a, b| {
+            a.union(&b)
+        });
     Ok(Scene {
         name: name.to_string(),
         mm_per_unit,
-        head_bounds: head_measure::inlier_bounds(&head.mesh).0,
+        head_bounds,
+        parts,
         backdrop: Some(backdrop(procedural::backdrop_behind(
             center, forward, height,
         ))),

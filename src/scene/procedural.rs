@@ -194,6 +194,7 @@ pub fn flat_card(w: f32, h: f32, m: Mat4, albedo: [f32; 3]) -> Object {
         }
     }
     Object {
+        morph: Default::default(),
         mesh,
         material: Material::skin(albedo),
     }

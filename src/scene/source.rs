@@ -29,6 +29,12 @@ pub struct SceneSource {
     pub sidecar_top_down: bool,
     /// Millimetres per scene unit (`None`: from a 230 mm chin-to-crown head).
     pub mm_per_unit: Option<f32>,
+    /// Materials the command line makes skin or not skin (names or indices;
+    /// `crate::scene::skin_rule`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub skin: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_skin: Vec<String>,
 }
 
 impl SceneSource {
@@ -62,6 +68,10 @@ impl SceneSource {
             normal_map: self.normal_map.clone(),
             specular_map: self.spec_map.clone(),
             sidecar_top_down: self.sidecar_top_down,
+            skin: crate::scene::skin_rule::SkinChoice {
+                skin: self.skin.clone(),
+                not_skin: self.not_skin.clone(),
+            },
         }
     }
 

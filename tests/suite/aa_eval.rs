@@ -177,9 +177,11 @@ fn a_frame_with_no_edges_has_the_1x_frame_as_its_reference() {
         name: "uniform card".into(),
         mm_per_unit: 10.0,
         head: Object {
+            morph: Default::default(),
             mesh,
             material: Material::skin([0.6, 0.45, 0.4]),
         },
+        parts: Vec::new(),
         backdrop: None,
         head_bounds,
         forward: glam::Vec3::Z,

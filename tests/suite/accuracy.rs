@@ -54,7 +54,12 @@ pub(crate) fn card_scene() -> Scene {
     });
     material.specular_intensity = 0.0;
     scene.head_bounds = mesh.bounds();
-    scene.head = Object { mesh, material };
+    scene.head = Object {
+        morph: Default::default(),
+        mesh,
+        material,
+    };
+    scene.parts.clear();
     scene.backdrop = None;
     scene.mm_per_unit = 1.0;
     scene.forward = Vec3::Z;

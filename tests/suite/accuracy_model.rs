@@ -128,8 +128,11 @@ fn the_datas_shadow_texels_are_the_sweeps_frames() {
     let m = AccuracyModel::load_default().unwrap();
     for (asset, k, size, sh) in frames {
         let curve = m.curve(asset, "none", "-").unwrap();
+        // Within 1e-6: the face's eyes (issue 29) carved its lids open, and
+        // that moved its bounds by 5e-7 of their radius; the data is of the
+        // face before its eyes (docs/accuracy.md).
         assert!(
-            (curve.shadows[k] / sh - 1.0).abs() < 1e-9,
+            (curve.shadows[k] / sh - 1.0).abs() < 1e-6,
             "{} at {size}: data {} against the frame's {sh}",
             asset.name(),
             curve.shadows[k]

@@ -483,6 +483,7 @@ fn shaders_are_named_after_their_owner() {
         "composite",
         "tonemap",
         "probe",
+        "deform",
     ];
     // The post chain's stages (`src/post/`, one file each) and their shared include.
     let post: Vec<String> = std::fs::read_dir(src().join("post"))

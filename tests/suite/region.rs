@@ -270,6 +270,7 @@ fn card_scene() -> Scene {
     };
     scene.head_bounds = mesh.bounds();
     scene.head = Object {
+        morph: Default::default(),
         mesh,
         material: Material::skin([0.6, 0.45, 0.4]),
     };

@@ -161,9 +161,11 @@ fn halo_scene() -> Scene {
         name: "halo".into(),
         mm_per_unit: 10.0,
         head: Object {
+            morph: Default::default(),
             mesh,
             material: Material::skin([0.6, 0.45, 0.4]),
         },
+        parts: Vec::new(),
         backdrop: None,
         head_bounds: bounds,
         forward: Vec3::Z,

@@ -122,12 +122,14 @@ fn scene_of(mesh: Mesh, mm_per_unit: f32, albedo: Option<Texture>) -> Scene {
         name: "tsd test".into(),
         mm_per_unit,
         head: Object {
+            morph: Default::default(),
             mesh,
             material: Material {
                 base_color: albedo,
                 ..Material::skin([0.8, 0.6, 0.5])
             },
         },
+        parts: Vec::new(),
         backdrop: None,
         head_bounds,
         forward: Vec3::Z,

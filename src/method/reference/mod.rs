@@ -158,6 +158,8 @@ struct Surface {
     vertices: Buffer,
     indices: Buffer,
     index_count: u32,
+    /// The skin's indices, first in `indices` (the parts' follow).
+    skin_index_count: u32,
     /// The largest narrow window radius (subsamples) any skin pixel uses.
     max_radius: u32,
     mm_per_subsample_per_depth: f32,

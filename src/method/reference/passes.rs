@@ -156,19 +156,27 @@ impl Reference {
                         vk::IndexType::UINT32,
                     );
                 }
+                let (skin, all) = (self.surf.skin_index_count, self.surf.index_count);
                 for m in &self.instances {
-                    p.push(
-                        ctx,
-                        cmd,
-                        &SurfacePush {
-                            model: m.to_cols_array_2d(),
-                            mm_per_subsample_per_depth: self.surf.mm_per_subsample_per_depth,
-                        },
-                    );
-                    unsafe {
-                        ctx.device
-                            .cmd_draw_indexed(cmd, self.surf.index_count, 1, 0, 0, 0)
-                    };
+                    // The skin with its subsamples' area; the parts with
+                    // none: occluders only.
+                    for (first, count, scale) in [
+                        (0, skin, self.surf.mm_per_subsample_per_depth),
+                        (skin, all - skin, 0.0),
+                    ] {
+                        if count == 0 {
+                            continue;
+                        }
+                        p.push(
+                            ctx,
+                            cmd,
+                            &SurfacePush {
+                                model: m.to_cols_array_2d(),
+                                mm_per_subsample_per_depth: scale,
+                            },
+                        );
+                        unsafe { ctx.device.cmd_draw_indexed(cmd, count, 1, first, 0, 0) };
+                    }
                 }
             })
     }

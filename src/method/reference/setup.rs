@@ -274,7 +274,14 @@ impl Reference {
             .mm_per_px_per_depth(),
             ..Default::default()
         };
-        let mesh = &skin.mesh;
+        // The skin, then the character's other parts: drawn with no area,
+        // they hide the skin behind them (an eyeball in its socket) and are
+        // no surface to the narrow part (area 0 is "none").
+        let mut mesh = skin.mesh.clone();
+        for part in &s.scene.parts {
+            mesh.append(&part.mesh);
+        }
+        self.surf.skin_index_count = skin.mesh.indices.len() as u32;
         self.surf.vertices = device_buffer(
             s.ctx,
             "reference surface vertices",

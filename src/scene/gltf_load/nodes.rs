@@ -12,6 +12,7 @@ use super::primitives::{read_primitive, Part};
 use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
+use crate::scene::morph::{Morph, MorphTarget};
 use crate::scene::robust_bounds::robust_bounds_f64;
 
 /// A model whose centre lies farther from the origin than this many times its size is
@@ -145,13 +146,154 @@ pub(super) fn append_part(
     Ok(())
 }
 
-/// What the walk over the scene collected.
+/// A primitive's morph targets placed by `world` (offsets are directions:
+/// the linear part moves positions' and tangents', its inverse transpose
+/// normals', none normalised), named by the mesh's `extras.targetNames`, with
+/// their default weights: the node's, else the mesh's, else 0.
+fn placed_targets(
+    src: &Source,
+    part: &Part,
+    world: &DMat4,
+    node: &gltf::Node,
+    mesh: &gltf::Mesh,
+    label: &str,
+) -> Result<(Vec<MorphTarget>, Vec<f32>)> {
+    let n = part.targets.len();
+    if n == 0 {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let defaults = node.weights().or_else(|| mesh.weights());
+    let weights = match defaults {
+        None => vec![0.0; n],
+        Some(w) if w.len() == n => w.to_vec(),
+        Some(w) => bail!(
+            "{label} has {n} morph targets but {} gives {} default weights",
+            if node.weights().is_some() {
+                node_label(node)
+            } else {
+                mesh_label(mesh)
+            },
+            w.len()
+        ),
+    };
+    if let Some(w) = weights.iter().find(|w| !w.is_finite()) {
+        bail!("{label}: default morph weight {w} is not finite");
+    }
+    let names = src
+        .json
+        .pointer(&format!("/meshes/{}/extras/targetNames", mesh.index()))
+        .and_then(|v| v.as_array());
+    let lin = DMat3::from_mat4(*world).as_mat3();
+    let normal_m = lin.inverse().transpose();
+    let map = |m: &glam::Mat3, v: &[[f32; 3]]| -> Vec<[f32; 3]> {
+        v.iter()
+            .map(|d| (*m * glam::Vec3::from(*d)).into())
+            .collect()
+    };
+    let targets = part
+        .targets
+        .iter()
+        .enumerate()
+        .map(|(i, t)| MorphTarget {
+            name: names
+                .and_then(|a| a.get(i))
+                .and_then(|v| v.as_str())
+                .map(crate::scene::gltf_source::short),
+            first: 0,
+            position: map(&lin, &t.position),
+            normal: map(&normal_m, &t.normal),
+            tangent: map(&lin, &t.tangent),
+        })
+        .collect::<Vec<_>>();
+    for t in &targets {
+        let all = t.position.iter().chain(&t.normal).chain(&t.tangent);
+        if all.flatten().any(|c| !c.is_finite()) {
+            bail!(
+                "{}: its transform takes {label}'s morph offsets beyond the f32 range",
+                node_label(node)
+            );
+        }
+    }
+    Ok((targets, weights))
+}
+
+/// What the walk over the scene collected: one merged mesh, and which of its
+/// vertices and indices each placed primitive wrote (`split` cuts it by material).
 pub(super) struct Collected {
     pub(super) mesh: Mesh,
     pub(super) world_pos: Vec<DVec3>,
+    pub(super) spans: Vec<Span>,
+}
+
+/// One placed primitive in the merged mesh.
+#[derive(Clone, Debug)]
+pub(super) struct Span {
+    /// The glTF material (`None`: the default material).
     pub(super) material: Option<usize>,
+    pub(super) vertices: std::ops::Range<usize>,
+    pub(super) indices: std::ops::Range<usize>,
+    pub(super) has_uvs: bool,
+    pub(super) label: String,
+    /// Its morph targets placed in world space (`first` 0: the span's first
+    /// vertex) and their default weights (the node's, else the mesh's, else 0).
+    pub(super) targets: Vec<MorphTarget>,
+    pub(super) weights: Vec<f32>,
+}
+
+/// The primitives of one material, merged: a mesh of its own (indices from 0).
+pub(super) struct MaterialMesh {
+    pub(super) material: Option<usize>,
+    pub(super) mesh: Mesh,
     pub(super) with_uvs: usize,
     pub(super) without_uvs: Vec<String>,
+    /// Its primitives' targets, each over its own vertices (rest: none yet).
+    pub(super) morph: Morph,
+}
+
+impl Collected {
+    /// The merged mesh cut by material, in the order materials are first met.
+    pub(super) fn split(&self) -> Vec<MaterialMesh> {
+        let mut out: Vec<MaterialMesh> = Vec::new();
+        for span in &self.spans {
+            let k = match out.iter().position(|m| m.material == span.material) {
+                Some(k) => k,
+                None => {
+                    out.push(MaterialMesh {
+                        material: span.material,
+                        mesh: Mesh::default(),
+                        with_uvs: 0,
+                        without_uvs: Vec::new(),
+                        morph: Morph::default(),
+                    });
+                    out.len() - 1
+                }
+            };
+            let m = &mut out[k];
+            let base = m.mesh.vertices.len() as u32;
+            let first = span.vertices.start as u32;
+            m.mesh
+                .vertices
+                .extend_from_slice(&self.mesh.vertices[span.vertices.clone()]);
+            m.mesh.indices.extend(
+                self.mesh.indices[span.indices.clone()]
+                    .iter()
+                    .map(|&i| i - first + base),
+            );
+            for (t, &w) in span.targets.iter().zip(&span.weights) {
+                m.morph.targets.push(MorphTarget {
+                    first: t.first + base as usize,
+                    ..t.clone()
+                });
+                m.morph.weights.push(w);
+            }
+            if span.has_uvs {
+                m.with_uvs += 1;
+            } else if !m.without_uvs.contains(&span.label) {
+                m.without_uvs.push(span.label.clone());
+            }
+        }
+        out
+    }
 }
 
 /// Walks the default scene (or the first, or every root node when there is none)
@@ -176,9 +318,7 @@ pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
     let mut out = Collected {
         mesh: Mesh::default(),
         world_pos: Vec::new(),
-        material: None,
-        with_uvs: 0,
-        without_uvs: Vec::new(),
+        spans: Vec::new(),
     };
     let mut parts: HashMap<(usize, usize), Option<Rc<Part>>> = HashMap::new();
     let mut visited = vec![false; nodes.len()];
@@ -206,15 +346,18 @@ pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
                     }
                 };
                 let Some(part) = part else { continue };
+                let (v0, i0) = (out.mesh.vertices.len(), out.mesh.indices.len());
                 append_part(&mut out.mesh, &mut out.world_pos, &part, &world, node)?;
-                if part.has_uvs {
-                    out.with_uvs += 1;
-                } else if !out.without_uvs.contains(&label) {
-                    out.without_uvs.push(label);
-                }
-                if out.material.is_none() {
-                    out.material = prim.material().index();
-                }
+                let (targets, weights) = placed_targets(src, &part, &world, node, &mesh, &label)?;
+                out.spans.push(Span {
+                    material: prim.material().index(),
+                    vertices: v0..out.mesh.vertices.len(),
+                    indices: i0..out.mesh.indices.len(),
+                    has_uvs: part.has_uvs,
+                    label,
+                    targets,
+                    weights,
+                });
             }
         }
         let children: Vec<usize> = node.children().map(|c| c.index()).collect();

@@ -13,6 +13,7 @@ use super::Warnings;
 use crate::scene::gltf_accessor::{read_attribute, read_indices, Use};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::{Mesh, Vertex};
+use crate::scene::morph::MorphTarget;
 
 /// Converts an index list of any triangle mode into a triangle list with the winding
 /// glTF defines (3.7.2.1): strip triangle i is (i, i+1, i+2) for even i and
@@ -66,6 +67,54 @@ pub(super) fn triangulate(mode: Mode, idx: &[u32], label: &str) -> Result<Vec<u3
 pub(super) struct Part {
     pub(super) mesh: Mesh,
     pub(super) has_uvs: bool,
+    /// Its morph targets, in its own space (`first` 0).
+    pub(super) targets: Vec<MorphTarget>,
+}
+
+/// A primitive's morph targets (POSITION, NORMAL, TANGENT offsets), each the
+/// primitive's vertex count long and finite. Tangent offsets are dropped
+/// where the primitive's tangents are generated (they offset tangents the
+/// file did not give).
+fn read_targets(
+    src: &Source,
+    label: &str,
+    prim: &gltf::Primitive,
+    n: usize,
+    tangents_generated: bool,
+) -> Result<Vec<MorphTarget>> {
+    let mut out = Vec::new();
+    for (i, t) in prim.morph_targets().enumerate() {
+        let read = |acc: Option<gltf::Accessor>, what: &str| -> Result<Vec<[f32; 3]>> {
+            let Some(acc) = acc else {
+                return Ok(Vec::new());
+            };
+            let what = format!("{label}: morph target {i} {what}");
+            let v: Vec<[f32; 3]> = read_attribute(src, &acc, Use::Offset, &what)?;
+            if v.len() != n {
+                bail!("{what} has {} offsets but POSITION has {n}", v.len());
+            }
+            check_finite(&v, &what)?;
+            Ok(v)
+        };
+        let position = match t.positions() {
+            Some(a) => read(Some(a), "POSITION")?,
+            None => vec![[0.0; 3]; n],
+        };
+        let normal = read(t.normals(), "NORMAL")?;
+        let tangent = read(t.tangents(), "TANGENT")?;
+        out.push(MorphTarget {
+            name: None,
+            first: 0,
+            position,
+            normal,
+            tangent: if tangents_generated {
+                Vec::new()
+            } else {
+                tangent
+            },
+        });
+    }
+    Ok(out)
 }
 
 /// Reads one primitive into a triangle mesh in the primitive's own space; `None` when
@@ -164,11 +213,32 @@ pub(super) fn read_primitive(
         vertices,
         indices: triangles,
     };
+    let mut targets = read_targets(src, label, prim, n, tangents.is_none())?;
     if normals.is_none() {
         warn.push(format!(
             "{label} has no NORMAL: flat normals computed, as glTF specifies (it will look faceted)"
         ));
+        // Flat normals give each triangle corner a vertex of its own: the
+        // targets follow (corner k is vertex triangles[k]).
+        let corners = mesh.indices.clone();
         mesh.make_flat_normals();
+        if !targets.is_empty() {
+            warn.push(format!(
+                "{label} has morph targets and no NORMAL: its flat normals are the rest shape's"
+            ));
+        }
+        for t in &mut targets {
+            let pick = |v: &Vec<[f32; 3]>| -> Vec<[f32; 3]> {
+                if v.is_empty() {
+                    Vec::new()
+                } else {
+                    corners.iter().map(|&i| v[i as usize]).collect()
+                }
+            };
+            t.position = pick(&t.position);
+            t.normal = pick(&t.normal);
+            t.tangent = pick(&t.tangent);
+        }
     }
     if tangents.is_none() {
         mesh.generate_tangents();
@@ -176,6 +246,7 @@ pub(super) fn read_primitive(
     Ok(Some(Part {
         mesh,
         has_uvs: uvs.is_some(),
+        targets,
     }))
 }
 

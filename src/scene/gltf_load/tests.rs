@@ -639,3 +639,156 @@ fn panics_the_fuzzer_found_in_the_gltf_crate() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Three primitives of one quad, each its own material: a skin named by its
+/// name, an eye (not skin by its name) and one named nothing useful.
+fn three_material_quad(dir: &Path, extras_skin: Option<bool>) -> PathBuf {
+    let mut m = Model::quad(
+        serde_json::json!({"attributes": attrs()}),
+        serde_json::json!([]),
+        &[],
+        None,
+    );
+    let prim = |material: usize| serde_json::json!({"attributes": attrs(), "mode": 6, "material": material});
+    m.json["meshes"][0]["primitives"] = serde_json::json!([prim(0), prim(1), prim(2)]);
+    let mut third = serde_json::json!({"name": "mat_03", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1.0], "roughnessFactor": 0.5}});
+    if let Some(s) = extras_skin {
+        third["extras"] = serde_json::json!({"skin": s});
+    }
+    m.json["materials"] = serde_json::json!([
+        {"name": "Head_Skin", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.5, 1.0]}},
+        {"name": "EyeBall_L", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "roughnessFactor": 0.2}},
+        third
+    ]);
+    write_gltf(dir, "three", m.json, &m.buffer)
+}
+
+#[test]
+fn each_primitive_keeps_its_material_and_the_rule_says_which_is_skin() {
+    let dir = temp_dir("materials");
+    let l = load_head_with_notes(&three_material_quad(&dir, None), &Default::default()).unwrap();
+    assert!(l.object.material.skin);
+    assert_eq!(l.object.material.base_color_factor, [0.9, 0.6, 0.5]);
+    assert_eq!(l.object.mesh.triangle_count(), 2);
+    assert_eq!(l.parts.len(), 2);
+    let eye = &l.parts[0].material;
+    assert!(!eye.skin && eye.sss_strength == 0.0);
+    assert_eq!(eye.base_color_factor, [1.0; 3]);
+    assert!(
+        (eye.roughness - 0.08).abs() < 1e-6,
+        "0.2^2 kept off the mirror: {}",
+        eye.roughness
+    );
+    assert_eq!(l.parts[1].material.base_color_factor, [0.1, 0.2, 0.3]);
+    assert!((l.parts[1].material.roughness - 0.25).abs() < 1e-6);
+    for (n, want) in [
+        ("material 0 'Head_Skin' is skin (scattered) by its name (the word 'head')", true),
+        ("material 1 'EyeBall_L' is not skin (drawn without scattering) by its name (the word 'eye')", true),
+        ("material 2 'mat_03' is not skin (drawn without scattering) as another material is skin", true),
+    ] {
+        assert_eq!(l.notes.iter().any(|x| x.contains(n)), want, "{n}: {:?}", l.notes);
+    }
+    // The command line moves the skin to the third material: the largest
+    // skin (ties: the first) is scattered, the other skin named in a warning.
+    let o = TextureOverrides {
+        skin: crate::scene::skin_rule::SkinChoice::parse(Some("mat_03"), Some("Head_Skin"))
+            .unwrap(),
+        ..Default::default()
+    };
+    let l = load_head_with_notes(&three_material_quad(&dir, None), &o).unwrap();
+    assert_eq!(l.object.material.base_color_factor, [0.1, 0.2, 0.3]);
+    assert!(l.object.material.skin && l.object.material.roughness == 0.3);
+    assert!(l.parts.iter().all(|p| !p.material.skin));
+    // Extras beat the name; two skins: one scattered, the other warned about.
+    let l =
+        load_head_with_notes(&three_material_quad(&dir, Some(true)), &Default::default()).unwrap();
+    assert_eq!(l.object.material.base_color_factor, [0.9, 0.6, 0.5]);
+    assert!(
+        l.warnings.iter().any(|w| w.contains(
+            "material 2 'mat_03' is also skin, but dermis scatters one material per character"
+        )),
+        "{:?}",
+        l.warnings
+    );
+    // A name that matches nothing, and extras of the wrong type, are one line.
+    let o = TextureOverrides {
+        skin: crate::scene::skin_rule::SkinChoice::parse(Some("Hed"), None).unwrap(),
+        ..Default::default()
+    };
+    let e = format!(
+        "{:#}",
+        load_head_with_notes(&three_material_quad(&dir, None), &o)
+            .err()
+            .unwrap()
+    );
+    assert!(
+        e.contains("'Hed' names no material") && !e.contains('\n'),
+        "{e}"
+    );
+    let path = three_material_quad(&dir, None);
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "\"name\":\"mat_03\"",
+        "\"name\":\"mat_03\",\"extras\":{\"skin\":\"yes\"}",
+    );
+    std::fs::write(&path, text).unwrap();
+    let e = load_err(&path);
+    assert!(
+        e.contains("extras \"skin\" is \"yes\", not true or false"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_scene_draws_every_part_and_scales_by_the_skin() {
+    let dir = temp_dir("parts");
+    let s =
+        crate::scene::load_gltf_scene(&three_material_quad(&dir, None), &Default::default(), None)
+            .unwrap();
+    assert_eq!(s.parts.len(), 2);
+    assert!(s.head.material.skin);
+    assert_eq!(s.source.as_ref().unwrap().skin, Vec::<String>::new());
+}
+
+/// The quad with one morph target lifting its vertices along +Z by 1, 2, 3
+/// and 4 (accessor 3), `weights` its mesh's default weights.
+fn morph_quad(dir: &Path, weights: serde_json::Value, offsets: usize) -> PathBuf {
+    let d: Vec<f32> = (0..offsets)
+        .flat_map(|i| [0.0, 0.0, (i + 1) as f32])
+        .collect();
+    let acc = serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": offsets, "type": "VEC3"}]);
+    let prim = serde_json::json!({"attributes": attrs(), "targets": [{"POSITION": 3}]});
+    let mut m = Model::quad(prim, acc, &f32_bytes(&d), None);
+    m.json["meshes"][0]["weights"] = weights;
+    m.json["meshes"][0]["extras"] = serde_json::json!({"targetNames": ["lift"]});
+    write_gltf(dir, "morph", m.json, &m.buffer)
+}
+
+#[test]
+fn morph_targets_load_posed_by_the_files_default_weights() {
+    let dir = temp_dir("morph");
+    let o = load_head(
+        &morph_quad(&dir, serde_json::json!([0.5]), 4),
+        &Default::default(),
+    )
+    .unwrap();
+    let m = &o.morph;
+    assert_eq!(m.targets.len(), 1);
+    assert_eq!(m.targets[0].name.as_deref(), Some("lift"));
+    assert_eq!(m.weights, [0.5]);
+    // Drawn posed: half of each offset (the fan's vertices in file order).
+    let z: Vec<f32> = o.mesh.vertices.iter().map(|v| v.position[2]).collect();
+    assert_eq!(z, [0.5, 1.0, 1.5, 2.0]);
+    assert!(m.rest.iter().all(|v| v.position[2] == 0.0));
+    // Malformed: a weight count that is not the target count, and offsets
+    // that are not one per vertex, are one line each.
+    let e = load_err(&morph_quad(&dir, serde_json::json!([0.5, 1.0]), 4));
+    assert!(
+        e.contains("has 1 morph targets but mesh 'quad' gives 2 default weights"),
+        "{e}"
+    );
+    let e = load_err(&morph_quad(&dir, serde_json::json!([0.5]), 3));
+    assert!(
+        e.contains("morph target 0 POSITION has 3 offsets but POSITION has 4"),
+        "{e}"
+    );
+}

@@ -34,7 +34,7 @@ use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 
 use super::checks::check_tex_coord;
-use super::nodes::Collected;
+use super::nodes::MaterialMesh;
 use super::Warnings;
 use crate::files::{self, ImageBound};
 use crate::scene::gltf_accessor::view_bytes;
@@ -53,6 +53,10 @@ pub struct TextureOverrides {
     /// example that distributes the Lee Perry-Smith head loads them with
     /// flipY = true); set this when such files are top-down.
     pub sidecar_top_down: bool,
+    /// The command line's choice of skin materials (`--skin`, `--not-skin`;
+    /// `crate::scene::skin_rule`): beside the textures because it, too,
+    /// replaces what the file says.
+    pub skin: crate::scene::skin_rule::SkinChoice,
 }
 
 /// A texture role of the skin material.
@@ -226,13 +230,26 @@ pub(super) fn specular_texture_index(src: &Source, material: usize) -> Option<us
         .map(|i| i as usize)
 }
 
-/// The skin material of the collected mesh: the glTF material's textures, then
-/// for each role it leaves empty the file beside the scene the naming rule
-/// finds, then the command line's overrides over both. Notes name every file
-/// taken from beside the scene.
+/// What a material group is to the character: its head (the scattered skin,
+/// or the largest part when nothing is skin), which the files beside the scene
+/// and the command line's textures are for, or one of its other parts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Role {
+    pub(super) head: bool,
+    pub(super) skin: bool,
+}
+
+/// The material of one material group: the glTF material's textures, then,
+/// for the head only, for each role it leaves empty the file beside the scene
+/// the naming rule finds, then the command line's overrides over both. Notes
+/// name every file taken from beside the scene. Skin keeps the project's skin
+/// lobe (Beckmann 0.3, rho_s 0.18); another part takes the file's roughness
+/// (glTF's perceptual roughness squared, as a Beckmann m) and
+/// KHR_materials_specular's factor over the skin's rho_s.
 pub(super) fn material(
     src: &Source,
-    c: &Collected,
+    c: &MaterialMesh,
+    role: Role,
     overrides: &TextureOverrides,
     warn: &mut Warnings,
 ) -> Result<Material> {
@@ -285,6 +302,16 @@ pub(super) fn material(
             c.material.unwrap_or(0)
         );
     };
+    if !role.head {
+        let [base_color, normal_map, specular_map] = slots;
+        return Ok(part_material(
+            src,
+            c.material,
+            role.skin,
+            [factor[0], factor[1], factor[2]],
+            [base_color, normal_map, specular_map],
+        ));
+    }
     let given = [
         &overrides.albedo,
         &overrides.normal_map,
@@ -384,12 +411,53 @@ pub(super) fn material(
         );
     }
     let [base_color, normal_map, specular_map] = slots;
-    Ok(Material {
+    Ok(part_material(
+        src,
+        c.material,
+        role.skin,
+        [factor[0], factor[1], factor[2]],
+        [base_color, normal_map, specular_map],
+    ))
+}
+
+/// The lobe and textures of a material group (`material`'s docs).
+fn part_material(
+    src: &Source,
+    index: Option<usize>,
+    skin: bool,
+    factor: [f32; 3],
+    [base_color, normal_map, specular_map]: [Option<Texture>; 3],
+) -> Material {
+    let mut m = Material {
         base_color,
         normal_map,
         specular_map,
-        ..Material::skin([factor[0], factor[1], factor[2]])
-    })
+        ..Material::skin(factor)
+    };
+    if skin {
+        return m;
+    }
+    let json = index.and_then(|i| src.json.get("materials")?.get(i));
+    let num = |ptr: &str| {
+        json.and_then(|j| j.pointer(ptr))
+            .and_then(|v| v.as_f64())
+            .filter(|f| f.is_finite())
+            .map(|f| f as f32)
+    };
+    // glTF's default roughness is 1; its alpha is roughness squared, close
+    // to a Beckmann m at the roughnesses materials use. Kept off 0: the
+    // Beckmann lookup has no mirror.
+    let r = num("/pbrMetallicRoughness/roughnessFactor")
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    m.skin = false;
+    m.sss_strength = 0.0;
+    m.roughness = (r * r).clamp(0.08, 1.0);
+    m.specular_intensity = 0.18
+        * num("/extensions/KHR_materials_specular/specularFactor")
+            .unwrap_or(1.0)
+            .clamp(0.0, 1.0);
+    m
 }
 
 #[cfg(test)]

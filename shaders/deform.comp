@@ -1,0 +1,77 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The deform pass (issue 29): an object's morph targets blended into the
+// vertex buffer every draw of the frame reads (the thesis' stream-out pass,
+// ch. 8, as a compute pass: written once a frame, drawn by the shadow map,
+// the geometry pass and every method's mesh passes), and its positions at
+// the previous frame's weights beside them (the velocity the temporal
+// anti-aliasing reads). src/scene/morph.rs's `apply` is this, operation for
+// operation: `precise` keeps each product and sum rounded alone, so the
+// CPU's vertices are these to the bit.
+#include "fetch_count.glsl"
+layout(local_size_x = 64) in;
+
+// The object's rest vertices: position 3, normal 3, uv 2, tangent 4 floats.
+layout(set = 0, binding = 0, std430) readonly buffer Rest { float rest[]; };
+struct Target {
+    uint first;      // first vertex it covers
+    uint count;      // vertices it covers
+    uint offset;     // its offsets in `deltas` (floats): positions, then normals, tangents
+    uint flags;      // 1: normals, 2: tangents
+    float weight;    // this frame's
+    float previous;  // the previous frame's
+    float pad0;
+    float pad1;
+};
+layout(set = 0, binding = 1, std430) readonly buffer Targets { Target targets[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Deltas { float deltas[]; };
+layout(set = 0, binding = 3, std430) buffer Deformed { float deformed[]; };
+layout(set = 0, binding = 4, std430) buffer Previous { float previous[]; };
+layout(push_constant) uniform Push { uint vertexCount; uint targetCount; } pc;
+
+const uint STRIDE = 12u;
+
+vec3 delta(uint at) {
+    return vec3(deltas[at], deltas[at + 1u], deltas[at + 2u]);
+}
+
+void main() {
+    COUNT_INVOCATION();
+    uint v = gl_GlobalInvocationID.x;
+    if (v >= pc.vertexCount) return;
+    uint b = v * STRIDE;
+    precise vec3 p = vec3(rest[b], rest[b + 1u], rest[b + 2u]);
+    precise vec3 n = vec3(rest[b + 3u], rest[b + 4u], rest[b + 5u]);
+    precise vec3 t = vec3(rest[b + 8u], rest[b + 9u], rest[b + 10u]);
+    precise vec3 q = p;
+    for (uint i = 0u; i < pc.targetCount; i++) {
+        Target g = targets[i];
+        if (v < g.first || v >= g.first + g.count) continue;
+        uint k = v - g.first;
+        uint at = g.offset + 3u * k;
+        if (g.weight != 0.0) {
+            precise vec3 wp = g.weight * delta(at);
+            p = p + wp;
+            if ((g.flags & 1u) != 0u) {
+                precise vec3 wn = g.weight * delta(at + 3u * g.count);
+                n = n + wn;
+            }
+            if ((g.flags & 2u) != 0u) {
+                uint tangents = at + 3u * g.count * (((g.flags & 1u) != 0u) ? 2u : 1u);
+                precise vec3 wt = g.weight * delta(tangents);
+                t = t + wt;
+            }
+        }
+        if (g.previous != 0.0) {
+            precise vec3 wq = g.previous * delta(at);
+            q = q + wq;
+        }
+    }
+    deformed[b] = p.x; deformed[b + 1u] = p.y; deformed[b + 2u] = p.z;
+    deformed[b + 3u] = n.x; deformed[b + 4u] = n.y; deformed[b + 5u] = n.z;
+    deformed[b + 6u] = rest[b + 6u]; deformed[b + 7u] = rest[b + 7u];
+    deformed[b + 8u] = t.x; deformed[b + 9u] = t.y; deformed[b + 10u] = t.z;
+    deformed[b + 11u] = rest[b + 11u];
+    uint o = v * 3u;
+    previous[o] = q.x; previous[o + 1u] = q.y; previous[o + 2u] = q.z;
+}

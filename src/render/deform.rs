@@ -1,0 +1,331 @@
+//! The deform pass: each morphing object's targets blended into the vertex
+//! buffer every draw of the frame reads (`deform.comp`; the CPU's twin is
+//! `scene::morph::apply`), with its positions at the previous frame's
+//! weights beside them (velocity, for the temporal anti-aliasing).
+//!
+//! A compute pass, not the vertex shader: the frame draws a character's
+//! mesh in the shadow map, the geometry pass and the id pass (and a method
+//! may draw it again), so blending in the vertex shader would redo the
+//! targets once per draw; written once, every draw reads plain vertices (the
+//! thesis' stream-out pass, ch. 8, in today's form). An object whose weights
+//! are all 0 is its rest mesh: no pass.
+
+use anyhow::Result;
+use ash::vk;
+
+use crate::graph::{Binding, BufferId, GraphSet, Pass, PassContext, Resources, Storage};
+use crate::scene::morph::Morph;
+use crate::vk::barrier::AccessKind;
+use crate::vk::context::Context;
+use crate::vk::guard::Guard;
+use crate::vk::memory::Buffer;
+use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline};
+use crate::vk::shader_stats::alu_estimate;
+use crate::vk::upload::device_buffer;
+use crate::work::{PassRole, ShaderWork};
+use gpu_allocator::MemoryLocation;
+
+pub const SHADER: &str = "deform.comp";
+/// Invocations per workgroup (`local_size_x` of the shader).
+const GROUP: u32 = 64;
+/// Floats per vertex (`Vertex`: position, normal, uv, tangent).
+const VERTEX_FLOATS: u64 = 12;
+
+/// std430 `Target` of the shader.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TargetRow {
+    first: u32,
+    count: u32,
+    offset: u32,
+    flags: u32,
+    weight: f32,
+    previous: f32,
+    pad: [f32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DeformPush {
+    vertex_count: u32,
+    target_count: u32,
+}
+
+/// One morphing object's buffers on the GPU.
+#[derive(Default)]
+pub struct DeformObject {
+    name: String,
+    rest: Buffer,
+    targets: Buffer,
+    deltas: Buffer,
+    previous: Buffer,
+    /// The object's vertex buffer (written here, drawn by the frame).
+    pub vertices: BufferId,
+    previous_id: BufferId,
+    set: GraphSet,
+    vertex_count: u32,
+    target_count: u32,
+    /// Offsets read per vertex, on average (what the work declares).
+    offsets_per_vertex: f64,
+}
+
+/// A morphing object's vertices as the deform pass wrote them
+/// (`Deform::read_back`): 12 floats a vertex (`Vertex`), and 3 a previous
+/// position.
+pub struct Deformed {
+    pub name: String,
+    pub vertices: Vec<f32>,
+    pub previous: Vec<f32>,
+}
+
+/// Every morphing object's pass.
+#[derive(Default)]
+pub struct Deform {
+    pipeline: Pipeline,
+    pub objects: Vec<DeformObject>,
+}
+
+/// The offsets of `morph`, flattened as the shader reads them (per target:
+/// positions, then normals, then tangents, 3 floats each), and its table.
+fn flatten(morph: &Morph) -> (Vec<f32>, Vec<TargetRow>) {
+    let mut deltas = Vec::new();
+    let mut rows = Vec::new();
+    for (t, &w) in morph.targets.iter().zip(&morph.weights) {
+        let offset = deltas.len() as u32;
+        for part in [&t.position, &t.normal, &t.tangent] {
+            deltas.extend(part.iter().flatten());
+        }
+        rows.push(TargetRow {
+            first: t.first as u32,
+            count: t.len() as u32,
+            offset,
+            flags: u32::from(!t.normal.is_empty()) | (u32::from(!t.tangent.is_empty()) << 1),
+            weight: w,
+            // No frame before the first: still.
+            previous: w,
+            pad: [0.0; 2],
+        });
+    }
+    // A storage buffer may not be empty.
+    if deltas.is_empty() {
+        deltas.push(0.0);
+    }
+    (deltas, rows)
+}
+
+impl Deform {
+    /// The pass's pipeline (made once, whether or not anything morphs).
+    pub fn new(ctx: &Context) -> Result<Self> {
+        Ok(Deform {
+            pipeline: Pipeline::compute(ctx, "deform", SHADER)?,
+            objects: Vec::new(),
+        })
+    }
+
+    /// Adds an object drawn from `vertices` (a vertex and storage buffer of
+    /// the rest mesh's size) morphing by `morph`: its static buffers, and
+    /// the vertex buffer tracked, so the draws that read it wait for the
+    /// pass. Returns its tracked id.
+    pub fn add(
+        &mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        name: &str,
+        vertices: vk::Buffer,
+        morph: &Morph,
+    ) -> Result<BufferId> {
+        let n = morph.rest.len() as u64;
+        let (deltas, rows) = flatten(morph);
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        // Read back by tests (`read_back`).
+        let readable = usage | vk::BufferUsageFlags::TRANSFER_SRC;
+        let read = AccessKind::ComputeStorageRead;
+        let mut o = DeformObject {
+            name: name.to_string(),
+            vertex_count: n as u32,
+            target_count: rows.len() as u32,
+            offsets_per_vertex: rows.iter().map(|r| r.count as f64).sum::<f64>() / n.max(1) as f64,
+            ..Default::default()
+        };
+        o.rest = device_buffer(
+            ctx,
+            &format!("{name} rest vertices"),
+            bytemuck::cast_slice(&morph.rest),
+            usage,
+            read,
+        )?;
+        o.targets = device_buffer(
+            ctx,
+            &format!("{name} morph targets"),
+            bytemuck::cast_slice(&rows),
+            usage,
+            read,
+        )?;
+        o.deltas = device_buffer(
+            ctx,
+            &format!("{name} morph offsets"),
+            bytemuck::cast_slice(&deltas),
+            usage,
+            read,
+        )?;
+        let zeros = vec![0f32; 3 * n as usize];
+        o.previous = device_buffer(
+            ctx,
+            &format!("{name} previous positions"),
+            bytemuck::cast_slice(&zeros),
+            readable,
+            read,
+        )?;
+        o.vertices = res.add_buffer(&format!("{name} vertices"), vertices);
+        res.set_buffer_uploaded(o.vertices, AccessKind::VertexInputRead);
+        o.previous_id = res.add_buffer(&format!("{name} previous positions"), o.previous.raw);
+        res.set_buffer_uploaded(o.previous_id, read);
+        let whole = |b: &Buffer, bytes: u64| {
+            Binding::Fixed(Bind::Uniform {
+                buffer: b.raw,
+                size: bytes,
+            })
+        };
+        o.set = GraphSet::new(
+            res,
+            &self.pipeline,
+            0,
+            vec![
+                ("Rest", whole(&o.rest, 4 * VERTEX_FLOATS * n)),
+                (
+                    "Targets",
+                    whole(
+                        &o.targets,
+                        (rows.len() * std::mem::size_of::<TargetRow>()) as u64,
+                    ),
+                ),
+                ("Deltas", whole(&o.deltas, 4 * deltas.len() as u64)),
+                (
+                    "Deformed",
+                    Binding::StorageBuffer {
+                        id: o.vertices,
+                        offset: 0,
+                        size: 4 * VERTEX_FLOATS * n,
+                        storage: Storage::Write,
+                    },
+                ),
+                (
+                    "Previous",
+                    Binding::StorageBuffer {
+                        id: o.previous_id,
+                        offset: 0,
+                        size: 12 * n,
+                        storage: Storage::Write,
+                    },
+                ),
+            ],
+        );
+        let id = o.vertices;
+        self.objects.push(o);
+        Ok(id)
+    }
+
+    /// Writes the objects' sets (once the frame's pool exists).
+    pub fn bind(&mut self, ctx: &Context, pool: &DescriptorPool, res: &Resources) -> Result<()> {
+        for o in &mut self.objects {
+            o.set.write(ctx, pool, res, &self.pipeline)?;
+        }
+        Ok(())
+    }
+
+    /// Each morphing object's pass, first in the frame.
+    pub fn passes<'a>(&'a self, passes: &mut Vec<Pass<'a>>) {
+        for o in &self.objects {
+            let work = ShaderWork {
+                shader: SHADER.into(),
+                fetches: Vec::new(),
+                alu: alu_estimate(SHADER, &[o.target_count]),
+                // The rest vertex and the table, each covering target's
+                // offsets (position, normal, tangent at most); the vertex
+                // and its previous position written.
+                storage_read_bytes: 4.0 * VERTEX_FLOATS as f64
+                    + 32.0 * o.target_count as f64
+                    + 36.0 * o.offsets_per_vertex,
+                storage_write_bytes: 4.0 * VERTEX_FLOATS as f64 + 12.0,
+                shared_bytes: 0.0,
+            };
+            let push = DeformPush {
+                vertex_count: o.vertex_count,
+                target_count: o.target_count,
+            };
+            // Vertex work of the frame, with the geometry it feeds.
+            let mut pass = Pass::new(format!("deform {}", o.name), PassRole::Geometry);
+            let set = pass.set(&o.set);
+            passes.push(
+                pass.dispatch(work, [o.vertex_count.div_ceil(GROUP), 1, 1], GROUP)
+                    .record(move |pc: &PassContext| {
+                        pc.bind(&self.pipeline, &[set]);
+                        self.pipeline.push(pc.ctx, pc.cmd, &push);
+                    }),
+            );
+        }
+    }
+
+    /// Every morphing object's vertices and previous positions as the last
+    /// frame wrote them (for tests and dumps: after the frame's fence), with
+    /// the object's name. The graph's barriers take each buffer from its
+    /// last access to the copy.
+    pub fn read_back(&self, ctx: &Context, res: &mut Resources) -> Result<Vec<Deformed>> {
+        let mut out = Vec::new();
+        for o in &self.objects {
+            let n = o.vertex_count as u64;
+            let mut read = |id: BufferId, bytes: u64, what: &str| -> Result<Vec<f32>> {
+                let name = format!("{} {what} read-back", o.name);
+                let host = Guard::new(
+                    ctx,
+                    Buffer::new(
+                        ctx,
+                        &name,
+                        bytes,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                        MemoryLocation::GpuToCpu,
+                    )?,
+                );
+                let host_id = res.add_buffer(&name, host.raw);
+                let src = res.raw_buffer(id);
+                ctx.one_shot(&name, |cmd| {
+                    res.transition(
+                        ctx,
+                        cmd,
+                        &[],
+                        &[
+                            (id, AccessKind::TransferRead),
+                            (host_id, AccessKind::TransferWrite),
+                        ],
+                    );
+                    let region = [vk::BufferCopy {
+                        src_offset: 0,
+                        dst_offset: 0,
+                        size: bytes,
+                    }];
+                    unsafe { ctx.device.cmd_copy_buffer(cmd, src, host.raw, &region) };
+                    res.transition(ctx, cmd, &[], &[(host_id, AccessKind::HostRead)]);
+                })?;
+                res.truncate_buffers(host_id.0);
+                Ok(bytemuck::cast_slice::<u8, f32>(&host.read()?[..bytes as usize]).to_vec())
+            };
+            let vertices = read(o.vertices, 4 * VERTEX_FLOATS * n, "vertices")?;
+            let previous = read(o.previous_id, 12 * n, "previous positions")?;
+            out.push(Deformed {
+                name: o.name.clone(),
+                vertices,
+                previous,
+            });
+        }
+        Ok(out)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for o in &mut self.objects {
+            for b in [&mut o.rest, &mut o.targets, &mut o.deltas, &mut o.previous] {
+                b.destroy(ctx);
+            }
+        }
+        self.pipeline.destroy(ctx);
+    }
+}
