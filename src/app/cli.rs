@@ -395,6 +395,10 @@ pub struct FrameArgs {
     /// Materials of a glTF scene drawn without scattering (eyes, teeth, cloth...).
     #[arg(long, value_name = "MATERIALS", value_delimiter = ',')]
     pub not_skin: Vec<String>,
+    /// Morph target weights, NAME=W comma-separated (the built-in face's expressions:
+    /// joy, surprise, fear, anger, disgust, sad; a glTF's targets by name or index).
+    #[arg(long, value_name = "NAME=W", value_delimiter = ',')]
+    pub morph_weights: Vec<String>,
     #[arg(long, help = with_range("Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head)", &ranges::MM_PER_UNIT))]
     pub mm_per_unit: Option<f32>,
     #[arg(long, default_value_t = defaults().width, help = with_range("Frame width", &ranges::WIDTH))]

@@ -125,6 +125,7 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         mm_per_unit: a.mm_per_unit,
         skin: a.skin.clone(),
         not_skin: a.not_skin.clone(),
+        morph_weights: a.morph_weights.clone(),
     }
 }
 

@@ -24,6 +24,7 @@
 //! built from one set of measurements (740 lines of code) and their tests (360)
 //! check those measurements against each other.
 
+use super::expressions::expression_morph;
 use super::eyes::{self, EYEBALL_RADIUS_MM};
 use super::mesh::{Material, Mesh, Object, Vertex};
 use super::procedural::MM_PER_UNIT;
@@ -654,13 +655,20 @@ pub fn ears() -> [Ear; 2] {
 /// The procedural face: skull, neck and both ears in one mesh (scene units), smooth
 /// normals, tangents from the UVs.
 pub fn head_mesh() -> Mesh {
+    head_mesh_and_skull().0
+}
+
+/// [`head_mesh`] and how many of its first vertices are the skull's (the
+/// ears follow): what the expressions move.
+fn head_mesh_and_skull() -> (Mesh, usize) {
     let mut mesh = skull_shell();
+    let skull = mesh.vertices.len();
     for ear in ears() {
         mesh.append(&ear_shell(&ear));
     }
     mesh.compute_normals();
     mesh.generate_tangents();
-    mesh
+    (mesh, skull)
 }
 
 /// Depth of the backdrop below its middle at `(x, y)` (units): quadratic near the head,
@@ -726,9 +734,17 @@ fn backdrop_material() -> Material {
 /// 60 round and 30 up) throws the shadow to the lower left into the backdrop's
 /// falloff. Light from behind (azimuth ~150) makes the ears' rims glow.
 pub fn face_scene() -> Scene {
-    let head = head_mesh();
+    // Built once a process (a second or two in a test build, the six
+    // expressions' normals and tangents included); every caller gets a copy.
+    static FACE: std::sync::OnceLock<Scene> = std::sync::OnceLock::new();
+    FACE.get_or_init(build_face_scene).clone()
+}
+
+fn build_face_scene() -> Scene {
+    let (head, skull) = head_mesh_and_skull();
     let head_bounds = head.bounds();
-    Scene {
+    let expressions = expression_morph(&head, skull, MM_PER_UNIT);
+    let mut scene = Scene {
         name: "procedural face".to_owned(),
         mm_per_unit: MM_PER_UNIT,
         head: Object {
@@ -745,7 +761,13 @@ pub fn face_scene() -> Scene {
         head_bounds,
         forward: Vec3::Z,
         source: Some(super::source::SceneSource::default()),
-    }
+    };
+    // Every weight 0: the neutral face, drawn without a deform pass.
+    scene
+        .head
+        .set_morph(expressions)
+        .expect("the expressions cover the skull's vertices");
+    scene
 }
 
 #[cfg(test)]

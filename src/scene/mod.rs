@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod enclosed;
+pub mod expressions;
 pub mod eyes;
 pub mod face;
 pub mod framing;
@@ -73,6 +74,65 @@ impl Scene {
         let (centre, height) = head_measure::framed_part(&self.head.mesh, self.forward);
         HeadSize { centre, height }
     }
+}
+
+impl Scene {
+    /// Sets morph weights by the command line's `NAME=W` entries (`INDEX=W`:
+    /// the head's targets by index), on every object with a target of that
+    /// name, and poses the objects again. A name no object has is an error
+    /// naming the targets there are.
+    pub fn set_morph_weights(&mut self, entries: &[(String, f32)]) -> Result<()> {
+        for (key, w) in entries {
+            let by_index = key.parse::<usize>().is_ok();
+            let mut found = false;
+            for o in std::iter::once(&mut self.head).chain(&mut self.parts) {
+                let has = o
+                    .morph
+                    .targets
+                    .iter()
+                    .any(|t| t.name.as_deref() == Some(key.as_str()));
+                if has || (by_index && !found) {
+                    o.morph.set_weights(&[(key.clone(), *w)])?;
+                    found = true;
+                }
+            }
+            if !found {
+                let names: Vec<&str> = std::iter::once(&self.head)
+                    .chain(&self.parts)
+                    .flat_map(|o| o.morph.targets.iter().filter_map(|t| t.name.as_deref()))
+                    .collect();
+                bail!(
+                    "--morph-weights {key}={w}: no morph target of '{}' is named '{key}' (named: {})",
+                    self.name,
+                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                );
+            }
+        }
+        self.head.pose();
+        for p in &mut self.parts {
+            p.pose();
+        }
+        Ok(())
+    }
+}
+
+/// Parses `NAME=W[,NAME=W...]` (what `--morph-weights` takes).
+pub fn parse_morph_weights(entries: &[String]) -> Result<Vec<(String, f32)>> {
+    entries
+        .iter()
+        .map(|e| {
+            let (k, v) = e
+                .split_once('=')
+                .with_context(|| format!("--morph-weights '{e}': not NAME=WEIGHT"))?;
+            let w: f32 = v
+                .trim()
+                .parse()
+                .ok()
+                .filter(|w: &f32| w.is_finite())
+                .with_context(|| format!("--morph-weights '{e}': '{v}' is not a finite number"))?;
+            Ok((k.trim().to_string(), w))
+        })
+        .collect()
 }
 
 /// Where a scene's head is and how tall (`Scene::head_size`).
@@ -223,6 +283,7 @@ pub fn load_gltf_scene(
         mm_per_unit,
         skin: overrides.skin.skin.clone(),
         not_skin: overrides.skin.not_skin.clone(),
+        morph_weights: Vec::new(),
     });
     Ok(scene)
 }

@@ -35,6 +35,10 @@ pub struct SceneSource {
     pub skin: Vec<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub not_skin: Vec<String>,
+    /// Morph weights the command line sets (`NAME=W`; the face's
+    /// expressions, a file's targets).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub morph_weights: Vec<String>,
 }
 
 impl SceneSource {
@@ -78,14 +82,20 @@ impl SceneSource {
     /// Loads the scene (every file through the bounded reader; texture
     /// files given for a built-in scene are an error, not silently unused).
     pub fn load(&self) -> Result<Scene> {
-        match (self.gltf(), self.builtin()) {
-            (Some(path), _) => load_gltf_scene(path, &self.overrides(), self.mm_per_unit),
+        let weights = super::parse_morph_weights(&self.morph_weights)?;
+        let mut scene = match (self.gltf(), self.builtin()) {
+            (Some(path), _) => load_gltf_scene(path, &self.overrides(), self.mm_per_unit)?,
             (None, name) => builtin_scene(
                 name.unwrap_or(DEFAULT_BUILTIN),
                 &self.overrides(),
                 self.mm_per_unit,
-            ),
+            )?,
+        };
+        scene.set_morph_weights(&weights)?;
+        if let Some(src) = &mut scene.source {
+            src.morph_weights = self.morph_weights.clone();
         }
+        Ok(scene)
     }
 }
 
