@@ -8,8 +8,10 @@
 // anti-aliasing reads). src/scene/morph.rs's `apply` is this, operation for
 // operation: `precise` keeps each product and sum rounded alone, so the
 // CPU's vertices are these to the bit.
-#include "fetch_count.glsl"
-layout(local_size_x = 64) in;
+// No fetch counter: it reads buffers only (the counting build counts
+// texture fetches), so its counting build is this shader unchanged.
+#include "shader_constants.glsl"
+layout(local_size_x = DEFORM_GROUP_SIZE) in;
 
 // The object's rest vertices: position 3, normal 3, uv 2, tangent 4 floats.
 layout(set = 0, binding = 0, std430) readonly buffer Rest { float rest[]; };
@@ -36,7 +38,6 @@ vec3 delta(uint at) {
 }
 
 void main() {
-    COUNT_INVOCATION();
     uint v = gl_GlobalInvocationID.x;
     if (v >= pc.vertexCount) return;
     uint b = v * STRIDE;

@@ -293,8 +293,18 @@ pub const WARMUP: Range = range(
     "",
 );
 
+/// The time an animation is posed at: a day of clip is more than any file
+/// holds, and keeps f32 time steps under 8 ms.
+pub const TIME: Range = range(
+    "--time",
+    "time",
+    End::Incl(0.0),
+    End::Incl(86_400.0),
+    "seconds",
+);
+
 /// Every range above, in the order docs/usage.md lists them.
-pub const ALL: [&Range; 16] = [
+pub const ALL: [&Range; 17] = [
     &WIDTH,
     &HEIGHT,
     &SHADOW_SIZE,
@@ -311,6 +321,7 @@ pub const ALL: [&Range; 16] = [
     &MM_PER_UNIT,
     &FRAMES,
     &WARMUP,
+    &TIME,
 ];
 
 #[cfg(test)]

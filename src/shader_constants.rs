@@ -122,6 +122,10 @@ pub const COMPUTE_GROUP_SIDE: u32 = 8;
 /// one workgroup of SSS_TILE_SIDE^2 invocations per tile, HDRP's 16x16.
 pub const SSS_TILE_SIDE: u32 = 16;
 
+/// Invocations of the deform pass's one-dimensional workgroup (deform.comp:
+/// one a vertex), the size its dispatches of ceil(vertices / size) divide by.
+pub const DEFORM_GROUP_SIZE: u32 = 64;
+
 /// Texels the compute blurs load on each side of a tile along their
 /// direction (shared memory: the tile and its apron, 16 rows of 80 texels
 /// (81 with the bank padding) of 12 bytes, 15.2 KiB, under the 16 KiB every
@@ -216,6 +220,7 @@ pub fn glsl() -> String {
     def("COMPUTE_GROUP_SIDE", COMPUTE_GROUP_SIDE.to_string());
     def("SSS_TILE_SIDE", SSS_TILE_SIDE.to_string());
     def("SSS_APRON_PX", SSS_APRON_PX.to_string());
+    def("DEFORM_GROUP_SIZE", DEFORM_GROUP_SIZE.to_string());
     def("SSS_MAX_TILE_LISTS", SSS_MAX_TILE_LISTS.to_string());
     def("GATHER_LUT_VEC4S", GATHER_LUT_VEC4S.to_string());
     s.push_str("#endif\n");
@@ -244,6 +249,7 @@ mod tests {
             "COMPUTE_GROUP_SIDE",
             "SSS_TILE_SIDE",
             "SSS_APRON_PX",
+            "DEFORM_GROUP_SIZE",
             "BURLEY_S_PER_MM",
             "BURLEY_ALBEDO",
             "BURLEY_NEAR_MM",

@@ -399,6 +399,15 @@ pub struct FrameArgs {
     /// joy, surprise, fear, anger, disgust, sad; a glTF's targets by name or index).
     #[arg(long, value_name = "NAME=W", value_delimiter = ',')]
     pub morph_weights: Vec<String>,
+    /// Pose the scene's animation at this time: a glTF's clip, the built-in face's
+    /// expressions (neutral to each of Table 8.1's and back, 2.5 s each), or, for a
+    /// scene without animation, dermis's rigid turn and nod (4 s, looped).
+    #[arg(long, value_name = "SECONDS", help = with_range("Pose the scene's animation at this time (a glTF's clip, the face's expressions, else a rigid turn and nod)", &ranges::TIME))]
+    pub time: Option<f32>,
+    /// The glTF animation --time plays (default: the file's first). Not `--clip`:
+    /// tsd's option of that name clips its unwrapped meshes.
+    #[arg(long, value_name = "NAME", requires = "time")]
+    pub animation: Option<String>,
     #[arg(long, help = with_range("Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head)", &ranges::MM_PER_UNIT))]
     pub mm_per_unit: Option<f32>,
     #[arg(long, default_value_t = defaults().width, help = with_range("Frame width", &ranges::WIDTH))]

@@ -126,6 +126,8 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         skin: a.skin.clone(),
         not_skin: a.not_skin.clone(),
         morph_weights: a.morph_weights.clone(),
+        time: a.time,
+        clip: a.animation.clone(),
     }
 }
 

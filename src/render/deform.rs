@@ -27,7 +27,7 @@ use gpu_allocator::MemoryLocation;
 
 pub const SHADER: &str = "deform.comp";
 /// Invocations per workgroup (`local_size_x` of the shader).
-const GROUP: u32 = 64;
+const GROUP: u32 = crate::shader_constants::DEFORM_GROUP_SIZE;
 /// Floats per vertex (`Vertex`: position, normal, uv, tangent).
 const VERTEX_FLOATS: u64 = 12;
 

@@ -16,6 +16,7 @@
 
 use glam::Vec3;
 
+use super::animation::{Channel, Clip, Interpolation, Path};
 use super::mesh::Mesh;
 use super::morph::{Morph, MorphTarget};
 
@@ -148,9 +149,58 @@ pub fn expression_morph(head: &Mesh, count: usize, mm_per_unit: f32) -> Morph {
     }
 }
 
+/// Seconds each expression takes: rising from neutral, held, falling back.
+pub const RISE_S: f32 = 1.0;
+pub const HOLD_S: f32 = 0.5;
+pub const FALL_S: f32 = 1.0;
+
+/// The face's clip: neutral to each expression of Table 8.1 and back, in
+/// turn (15 s), as one LINEAR channel of the six weights on node 0.
+pub fn expression_clip() -> Clip {
+    let n = EXPRESSIONS.len();
+    let step = RISE_S + HOLD_S + FALL_S;
+    let mut times = Vec::new();
+    let mut values = Vec::new();
+    let mut key = |t: f32, on: Option<usize>| {
+        times.push(t);
+        values.extend((0..n).map(|i| if Some(i) == on { 1.0 } else { 0.0 }));
+    };
+    for e in 0..n {
+        let t0 = step * e as f32;
+        key(t0, None);
+        key(t0 + RISE_S, Some(e));
+        key(t0 + RISE_S + HOLD_S, Some(e));
+    }
+    key(step * n as f32, None);
+    Clip {
+        name: "dermis expressions".into(),
+        channels: vec![Channel {
+            node: 0,
+            path: Path::Weights,
+            interpolation: Interpolation::Linear,
+            times,
+            values,
+            width: n,
+        }],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_clip_rises_to_each_expression_and_falls_back() {
+        let c = &expression_clip().channels[0];
+        c.check("face").unwrap();
+        assert_eq!(c.sample(0.0), [0.0; 6]);
+        assert_eq!(c.sample(1.0), [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(c.sample(0.5)[0], 0.5);
+        // Surprise held from 3.5 to 4 s, sadness last, neutral at the end.
+        assert_eq!(c.sample(3.75), [0.0, 1.0, 0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(c.sample(13.75)[5], 1.0);
+        assert_eq!(c.sample(15.0), [0.0; 6]);
+    }
 
     #[test]
     fn each_expression_moves_what_its_action_units_move() {

@@ -28,13 +28,21 @@ pub enum Use {
     Indices,
     /// A morph target's offsets (position, normal or tangent: VEC3).
     Offset,
+    /// An animation sampler's keyframe times (SCALAR, FLOAT).
+    KeyTimes,
+    /// An animation sampler's values: translations and scales (VEC3),
+    /// rotations (VEC4), morph weights (SCALAR).
+    KeyVec3,
+    KeyVec4,
+    KeyScalar,
 }
 
 impl Use {
     fn dims(self) -> Dimensions {
         match self {
-            Use::Position | Use::Normal | Use::Offset => Dimensions::Vec3,
-            Use::Tangent => Dimensions::Vec4,
+            Use::Position | Use::Normal | Use::Offset | Use::KeyVec3 => Dimensions::Vec3,
+            Use::Tangent | Use::KeyVec4 => Dimensions::Vec4,
+            Use::KeyTimes | Use::KeyScalar => Dimensions::Scalar,
             Use::TexCoord => Dimensions::Vec2,
             Use::Indices => Dimensions::Scalar,
         }
@@ -48,6 +56,10 @@ impl Use {
             Use::TexCoord => "texture coordinates",
             Use::Indices => "indices",
             Use::Offset => "morph offsets",
+            Use::KeyTimes => "keyframe times",
+            Use::KeyVec3 => "translations or scales",
+            Use::KeyVec4 => "rotations",
+            Use::KeyScalar => "morph weights",
         }
     }
 
@@ -72,6 +84,10 @@ impl Use {
             Use::TexCoord => small && (normalized || quantization),
             // KHR_mesh_quantization: BYTE or SHORT offsets, normalized or not.
             Use::Offset => quantization && signed_small,
+            // Core (3.11): times and translations and scales are FLOAT;
+            // rotations and weights may be normalized integers.
+            Use::KeyTimes | Use::KeyVec3 => false,
+            Use::KeyVec4 | Use::KeyScalar => small && normalized,
         }
     }
 }
@@ -344,6 +360,13 @@ pub fn read_attribute<const N: usize>(
             v
         })
         .collect())
+}
+
+/// Reads a float accessor of any of `usage`'s components as one flat list
+/// (normalised integers converted as glTF defines): animation samplers.
+pub fn read_floats(src: &Source, acc: &gltf::Accessor, usage: Use, what: &str) -> Result<Vec<f32>> {
+    let (ty, normalized) = (acc.data_type(), acc.normalized());
+    read(src, acc, usage, what, |b| component_f32(b, ty, normalized))
 }
 
 /// Reads an index accessor as u32.

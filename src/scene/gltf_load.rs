@@ -36,6 +36,7 @@
 //! - Far outlier vertices (one flipped exponent bit) load with a warning; the framing
 //!   (`head_measure`, the scene's bounds) leaves them out.
 
+mod animations;
 mod checks;
 pub mod fixture;
 mod nodes;
@@ -93,6 +94,7 @@ impl Warnings {
         Loaded {
             object,
             parts,
+            animated: false,
             warnings: self.list,
             notes: self.notes,
         }
@@ -131,6 +133,8 @@ pub struct Loaded {
     pub object: Object,
     /// Its other materials' primitives, each with its own material.
     pub parts: Vec<Object>,
+    /// Whether one of the file's animations posed it (`--time`, `--animation`).
+    pub animated: bool,
     pub warnings: Vec<String>,
     pub notes: Vec<String>,
 }
@@ -151,7 +155,37 @@ pub fn load_head_with_notes(path: &Path, overrides: &TextureOverrides) -> Result
 fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     let src = super::gltf_source::open(path)?;
     let mut warn = Warnings::default();
-    let mut c = nodes::collect(&src, &mut warn)?;
+    let clips = animations::clips(&src)?;
+    let clip = match (&overrides.clip, overrides.time) {
+        (Some(name), _) => Some(clips.iter().find(|c| &c.name == name).ok_or_else(|| {
+            let names: Vec<&str> = clips.iter().map(|c| c.name.as_str()).collect();
+            anyhow!(
+                "--animation '{name}': the file has no animation of that name (it has: {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        })?),
+        (None, Some(_)) => clips.first(),
+        (None, None) => None,
+    };
+    let time = overrides.time.unwrap_or(0.0);
+    if let Some(c) = clip {
+        warn.note(format!(
+            "animation '{}' ({:.3} s, {} channels) posed at {time} s",
+            c.name,
+            c.duration(),
+            c.channels.len()
+        ));
+    } else if !clips.is_empty() {
+        warn.note(format!(
+            "{} animation(s) not played (the rest pose is drawn; --time plays the first, --animation chooses)",
+            clips.len()
+        ));
+    }
+    let mut c = nodes::collect(&src, &mut warn, clip.map(|c| (c, time)))?;
     if c.mesh.indices.is_empty() {
         bail!("no triangle mesh in the default scene");
     }
@@ -235,7 +269,9 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
         }
     }
     let object = head_object.ok_or_else(|| anyhow!("no triangle mesh in the default scene"))?;
-    Ok(warn.finish(object, parts))
+    let mut loaded = warn.finish(object, parts);
+    loaded.animated = clip.is_some();
+    Ok(loaded)
 }
 
 /// What the skin rule reads of one material: its name and its extras' `skin`.

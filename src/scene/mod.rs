@@ -2,6 +2,7 @@
 //! camera and light placement, and multi-head layouts. Everything here is CPU-side and
 //! independent of Vulkan so it can be tested without a GPU.
 
+pub mod animation;
 pub mod camera;
 pub mod enclosed;
 pub mod expressions;
@@ -113,6 +114,44 @@ impl Scene {
             p.pose();
         }
         Ok(())
+    }
+}
+
+impl Scene {
+    /// A built-in scene at time `t`: the face's expressions
+    /// (`expressions::expression_clip`), any other dermis's rigid turn and
+    /// nod.
+    pub fn play_builtin(&mut self, t: f32) {
+        let clip = expressions::expression_clip();
+        let face = self.head.morph.targets.len() == expressions::EXPRESSIONS.len();
+        match animation::animated_weights(&clip, 0, t).filter(|_| face) {
+            Some(w) => {
+                self.head.morph.weights = w;
+                self.head.pose();
+            }
+            None => self.rotate_character(animation::rigid_rotation(t)),
+        }
+    }
+
+    /// Turns the character (its head and parts, their morphs' rest shapes and
+    /// offsets too) by `q` about the head's centre, the camera and light
+    /// left where they are (they were placed from the rest pose).
+    pub fn rotate_character(&mut self, q: glam::Quat) {
+        let c = self.head_center();
+        let m = glam::Mat4::from_translation(c)
+            * glam::Mat4::from_quat(q)
+            * glam::Mat4::from_translation(-c);
+        for o in std::iter::once(&mut self.head).chain(&mut self.parts) {
+            o.mesh.transform(&m);
+            o.morph.rotate(&m, q);
+        }
+        self.head_bounds = self
+            .parts
+            .iter()
+            .map(|p| head_measure::inlier_bounds(&p.mesh).0)
+            .fold(head_measure::inlier_bounds(&self.head.mesh).0, |a, b| {
+                a.union(&b)
+            });
     }
 }
 
@@ -274,6 +313,14 @@ pub fn load_gltf_scene(
         .unwrap_or_else(|| path.display().to_string());
     let mut scene = scene_from_character(&name, loaded.object, loaded.parts, mm_per_unit)
         .with_context(|| format!("framing the head in {}", path.display()))?;
+    if let (Some(t), false) = (overrides.time, loaded.animated) {
+        eprintln!(
+            "note: {}: the file has no animation: --time {t} turns and nods it (dermis's rigid clip, {} s, looped)",
+            path.display(),
+            animation::RIGID_PERIOD_S
+        );
+        scene.rotate_character(animation::rigid_rotation(t));
+    }
     scene.source = Some(source::SceneSource {
         scene: Some(path.to_path_buf()),
         albedo: overrides.albedo.clone(),
@@ -284,6 +331,8 @@ pub fn load_gltf_scene(
         skin: overrides.skin.skin.clone(),
         not_skin: overrides.skin.not_skin.clone(),
         morph_weights: Vec::new(),
+        time: overrides.time,
+        clip: overrides.clip.clone(),
     });
     Ok(scene)
 }

@@ -128,6 +128,32 @@ impl Morph {
     }
 }
 
+impl Morph {
+    /// Moves the rest shape by `m` (a rigid motion whose rotation is `q`)
+    /// and turns the offsets with it.
+    pub fn rotate(&mut self, m: &glam::Mat4, q: glam::Quat) {
+        if self.targets.is_empty() {
+            return;
+        }
+        for v in &mut self.rest {
+            v.position = m.transform_point3(Vec3::from(v.position)).into();
+            v.normal = (q * Vec3::from(v.normal)).into();
+            let t = q * Vec3::from([v.tangent[0], v.tangent[1], v.tangent[2]]);
+            v.tangent = [t.x, t.y, t.z, v.tangent[3]];
+        }
+        let turn = |v: &mut Vec<[f32; 3]>| {
+            for d in v.iter_mut() {
+                *d = (q * Vec3::from(*d)).into();
+            }
+        };
+        for t in &mut self.targets {
+            turn(&mut t.position);
+            turn(&mut t.normal);
+            turn(&mut t.tangent);
+        }
+    }
+}
+
 /// `a + w * d`, each operation rounded alone (what `precise` keeps the
 /// shader to).
 fn mad(a: [f32; 3], w: f32, d: [f32; 3]) -> [f32; 3] {

@@ -39,6 +39,13 @@ pub struct SceneSource {
     /// expressions, a file's targets).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub morph_weights: Vec<String>,
+    /// The time (seconds) the scene's animation is posed at (`--time`): a
+    /// file's clip (`clip`, or its first), the face's expressions, or for a
+    /// scene without animation dermis's rigid turn and nod.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<f32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clip: Option<String>,
 }
 
 impl SceneSource {
@@ -76,6 +83,8 @@ impl SceneSource {
                 skin: self.skin.clone(),
                 not_skin: self.not_skin.clone(),
             },
+            time: self.time,
+            clip: self.clip.clone(),
         }
     }
 
@@ -83,6 +92,12 @@ impl SceneSource {
     /// files given for a built-in scene are an error, not silently unused).
     pub fn load(&self) -> Result<Scene> {
         let weights = super::parse_morph_weights(&self.morph_weights)?;
+        if let Some(t) = self.time {
+            crate::ranges::TIME.check(t)?;
+        }
+        if self.clip.is_some() && self.gltf().is_none() {
+            anyhow::bail!("--animation names an animation of a glTF --scene; the built-in scenes have one clip each");
+        }
         let mut scene = match (self.gltf(), self.builtin()) {
             (Some(path), _) => load_gltf_scene(path, &self.overrides(), self.mm_per_unit)?,
             (None, name) => builtin_scene(
@@ -91,9 +106,15 @@ impl SceneSource {
                 self.mm_per_unit,
             )?,
         };
+        // A file's clip is posed as it loads (`TextureOverrides::time`).
+        if let (Some(t), None) = (self.time, self.gltf()) {
+            scene.play_builtin(t);
+        }
         scene.set_morph_weights(&weights)?;
         if let Some(src) = &mut scene.source {
             src.morph_weights = self.morph_weights.clone();
+            src.time = self.time;
+            src.clip = self.clip.clone();
         }
         Ok(scene)
     }

@@ -270,29 +270,31 @@ mod tests {
     /// own local size, or a dispatch sized by another, fails here.
     #[test]
     fn compute_workgroups_are_the_shared_side() {
-        use crate::shader_constants::{COMPUTE_GROUP_SIDE, SSS_TILE_SIDE};
+        use crate::shader_constants::{COMPUTE_GROUP_SIDE, DEFORM_GROUP_SIZE, SSS_TILE_SIDE};
         let mut seen = 0;
         for (name, bytes) in SHADERS {
             let module =
                 naga::front::spv::parse_u8_slice(bytes, &naga::front::spv::Options::default())
                     .unwrap();
-            let side = if name.starts_with("reference_") {
-                COMPUTE_GROUP_SIDE
+            let size = if name.starts_with("reference_") {
+                [COMPUTE_GROUP_SIDE, COMPUTE_GROUP_SIDE, 1]
+            } else if name.starts_with("deform.") {
+                [DEFORM_GROUP_SIZE, 1, 1]
             } else {
-                SSS_TILE_SIDE
+                [SSS_TILE_SIDE, SSS_TILE_SIDE, 1]
             };
             for e in &module.entry_points {
                 if e.stage == naga::ShaderStage::Compute {
-                    assert_eq!(e.workgroup_size, [side, side, 1], "{name}");
+                    assert_eq!(e.workgroup_size, size, "{name}");
                     seen += 1;
                 }
             }
         }
-        // Sixteen shaders (three of the ground truth per profile, seven of
+        // Seventeen shaders (three of the ground truth per profile, seven of
         // the compute path, the 2D gather, the compute ceiling probes of
-        // fetches and of shared memory), each also in its fetch-counting
-        // build.
-        assert_eq!(seen, 32);
+        // fetches and of shared memory, the deform pass), each also in its
+        // fetch-counting build.
+        assert_eq!(seen, 34);
     }
 
     #[test]

@@ -134,7 +134,13 @@ fn the_face_has_table_8_1s_six_expressions_and_the_command_line_poses_them() {
     use dermis::scene::expressions::EXPRESSIONS;
     use dermis::scene::source::SceneSource;
     let face = dermis::scene::default_scene();
-    let names: Vec<&str> = face.head.morph.targets.iter().filter_map(|t| t.name.as_deref()).collect();
+    let names: Vec<&str> = face
+        .head
+        .morph
+        .targets
+        .iter()
+        .filter_map(|t| t.name.as_deref())
+        .collect();
     assert_eq!(names, EXPRESSIONS);
     assert!(face.head.morph.at_rest());
     let src = |w: &[&str]| SceneSource {
@@ -144,9 +150,15 @@ fn the_face_has_table_8_1s_six_expressions_and_the_command_line_poses_them() {
     let joy = src(&["joy=1", "sad=0.25"]).load().unwrap();
     assert_eq!(joy.head.morph.weights, [1.0, 0.0, 0.0, 0.0, 0.0, 0.25]);
     assert_ne!(joy.head.mesh.vertices, face.head.mesh.vertices);
-    assert_eq!(joy.source.as_ref().unwrap().morph_weights, ["joy=1", "sad=0.25"]);
+    assert_eq!(
+        joy.source.as_ref().unwrap().morph_weights,
+        ["joy=1", "sad=0.25"]
+    );
     for (bad, says) in [
-        ("smile=1", "no morph target of 'procedural face' is named 'smile' (named: joy, surprise"),
+        (
+            "smile=1",
+            "no morph target of 'procedural face' is named 'smile' (named: joy, surprise",
+        ),
         ("joy", "not NAME=WEIGHT"),
         ("joy=inf", "is not a finite number"),
     ] {
@@ -159,13 +171,20 @@ fn the_face_has_table_8_1s_six_expressions_and_the_command_line_poses_them() {
 fn the_truth_of_a_posed_face_is_the_truth_of_the_same_mesh_as_a_still() {
     let ctx = common::ctx();
     let mut face = dermis::scene::default_scene();
-    face.set_morph_weights(&[("surprise".into(), 1.0), ("joy".into(), 0.5)]).unwrap();
+    face.set_morph_weights(&[("surprise".into(), 1.0), ("joy".into(), 0.5)])
+        .unwrap();
     let mut still = face.clone();
     still.head.morph = Morph::default();
     let s = settings().with(common::m("reference"), &[]);
-    let posed = Renderer::new(&ctx, &face, &s).unwrap().capture(false).unwrap();
+    let posed = Renderer::new(&ctx, &face, &s)
+        .unwrap()
+        .capture(false)
+        .unwrap();
     assert!(posed.samples.iter().any(|p| p.name == "deform head"));
-    let drawn = Renderer::new(&ctx, &still, &s).unwrap().capture(false).unwrap();
+    let drawn = Renderer::new(&ctx, &still, &s)
+        .unwrap()
+        .capture(false)
+        .unwrap();
     assert_eq!(posed.depth, drawn.depth);
     let worst = posed
         .diffuse
@@ -175,4 +194,141 @@ fn the_truth_of_a_posed_face_is_the_truth_of_the_same_mesh_as_a_still() {
         .fold(0.0f32, f32::max);
     println!("truth of the posed face against the still: worst relative difference {worst:e}");
     assert!(worst < 1e-3, "{worst}");
+}
+
+/// `--time` poses the face by its expression clip (rise 1 s, hold 0.5 s,
+/// fall 1 s, each expression in turn), and the pose at a time is the same
+/// whatever was loaded before it (the face is built once a process).
+#[test]
+fn time_poses_the_face_by_its_expression_clip_whatever_came_before() {
+    use dermis::scene::expressions::{EXPRESSIONS, FALL_S, HOLD_S, RISE_S};
+    use dermis::scene::source::SceneSource;
+    let at = |t: f32| {
+        SceneSource {
+            time: Some(t),
+            ..SceneSource::default()
+        }
+        .load()
+        .unwrap()
+    };
+    let step = RISE_S + HOLD_S + FALL_S;
+    for (e, name) in EXPRESSIONS.iter().enumerate() {
+        // Held: the expression alone at weight 1, the same mesh as
+        // --morph-weights NAME=1.
+        let held = at(step * e as f32 + RISE_S + 0.5 * HOLD_S);
+        let mut want = vec![0.0; EXPRESSIONS.len()];
+        want[e] = 1.0;
+        assert_eq!(held.head.morph.weights, want, "{name}");
+        let mut by_weight = dermis::scene::default_scene();
+        by_weight
+            .set_morph_weights(&[(name.to_string(), 1.0)])
+            .unwrap();
+        assert_eq!(
+            held.head.mesh.vertices, by_weight.head.mesh.vertices,
+            "{name}"
+        );
+    }
+    // Halfway up joy: half of it.
+    assert_eq!(at(0.5 * RISE_S).head.morph.weights[0], 0.5);
+    // The end of the clip is neutral, and neutral is the still face.
+    let end = at(step * EXPRESSIONS.len() as f32);
+    assert!(end.head.morph.at_rest());
+    assert_eq!(
+        end.head.mesh.vertices,
+        dermis::scene::default_scene().head.mesh.vertices
+    );
+    // The same time after other times: the same bits.
+    let first = at(3.9);
+    let _ = at(7.2);
+    let _ = at(0.3);
+    assert_eq!(at(3.9).head.mesh.vertices, first.head.mesh.vertices);
+    // Out of range, and a clip name for a built-in scene: one line each.
+    let e = SceneSource {
+        time: Some(-1.0),
+        ..SceneSource::default()
+    }
+    .load()
+    .unwrap_err();
+    assert!(format!("{e:#}").contains("time"), "{e:#}");
+    let e = SceneSource {
+        clip: Some("walk".into()),
+        ..SceneSource::default()
+    }
+    .load()
+    .unwrap_err();
+    assert!(format!("{e:#}").contains("--animation"), "{e:#}");
+}
+
+/// A character without animation turns and nods (dermis's rigid clip):
+/// every vertex keeps its distance to the head's centre (a rotation), the
+/// loop comes back to the rest pose, and the turn at a quarter period is
+/// 25 degrees about the vertical.
+fn assert_rigid_turn(rest: &Scene, at: impl Fn(f32) -> Scene) {
+    use dermis::scene::animation::RIGID_PERIOD_S;
+    let c = rest.head_center();
+    let quarter = at(0.25 * RIGID_PERIOD_S);
+    let mut worst_len = 0.0f32;
+    let (mut yaw_sum, mut n) = (0.0f64, 0);
+    for (a, b) in rest
+        .head
+        .mesh
+        .vertices
+        .iter()
+        .zip(&quarter.head.mesh.vertices)
+    {
+        let (a, b) = (Vec3::from(a.position) - c, Vec3::from(b.position) - c);
+        worst_len = worst_len.max((a.length() - b.length()).abs() / a.length().max(1.0));
+        // Yaw seen from above, on vertices far from the vertical axis.
+        if a.x.hypot(a.z) > 0.5 * a.length() {
+            let d = (b.x.atan2(b.z) - a.x.atan2(a.z)).to_degrees();
+            yaw_sum += f64::from((d + 540.0).rem_euclid(360.0) - 180.0);
+            n += 1;
+        }
+    }
+    assert!(worst_len < 1e-4, "lengths change by {worst_len}");
+    // The nod of 8 degrees tilts the azimuths a little; on average the turn
+    // is the clip's 25 degrees.
+    let yaw = yaw_sum / n as f64;
+    assert!((yaw - 25.0).abs() < 2.0, "mean yaw {yaw}");
+    let looped = at(RIGID_PERIOD_S);
+    for (a, b) in rest
+        .head
+        .mesh
+        .vertices
+        .iter()
+        .zip(&looped.head.mesh.vertices)
+    {
+        assert!((Vec3::from(a.position) - Vec3::from(b.position)).length() < 1e-3);
+    }
+}
+
+#[test]
+fn time_turns_and_nods_a_character_without_animation() {
+    use dermis::scene::source::SceneSource;
+    let egg = SceneSource::builtin_named("egg");
+    let at = |t: f32| {
+        SceneSource {
+            time: Some(t),
+            ..egg.clone()
+        }
+        .load()
+        .unwrap()
+    };
+    assert_rigid_turn(&egg_scene(), at);
+    let Some(lps) = common::lps_path() else {
+        return;
+    };
+    let src = SceneSource {
+        scene: Some(lps),
+        ..SceneSource::default()
+    };
+    let rest = src.load().unwrap();
+    assert_rigid_turn(&rest, |t| {
+        SceneSource {
+            time: Some(t),
+            ..src.clone()
+        }
+        .load()
+        .unwrap()
+    });
 }

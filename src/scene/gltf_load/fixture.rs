@@ -287,7 +287,11 @@ impl Model {
             v["byteStride"] = json!(s);
         }
         self.buffer.extend(bytes);
-        self.json["buffers"][0]["byteLength"] = json!(self.buffer.len());
+        // A model without buffers gets its one buffer when written
+        // (`write_gltf` embeds it whole).
+        if let Some(b) = self.json.pointer_mut("/buffers/0") {
+            b["byteLength"] = json!(self.buffer.len());
+        }
         let views = self.json["bufferViews"]
             .as_array_mut()
             .expect("bufferViews is an array");

@@ -10,6 +10,7 @@ use std::rc::Rc;
 use super::checks::{mesh_label, node_label};
 use super::primitives::{read_primitive, Part};
 use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
+use crate::scene::animation::{animated_trs, animated_weights, Clip, Path};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
 use crate::scene::morph::{Morph, MorphTarget};
@@ -144,6 +145,41 @@ pub(super) fn append_part(
     placed.transform(&linear);
     mesh.append(&placed);
     Ok(())
+}
+
+/// A node's local transform with `clip`'s channels at `t` (its own local
+/// transform where none animates it). glTF animates only nodes written as
+/// translation, rotation and scale.
+fn animated_matrix(node: &gltf::Node, clip: &Clip, t: f32) -> Result<DMat4> {
+    let animates = clip
+        .channels
+        .iter()
+        .any(|c| c.node == node.index() && c.path != Path::Weights);
+    if !animates {
+        return local_matrix(node);
+    }
+    let gltf::scene::Transform::Decomposed {
+        translation,
+        rotation,
+        scale,
+    } = node.transform()
+    else {
+        bail!(
+            "{} is animated but written as a matrix, which glTF forbids",
+            node_label(node)
+        );
+    };
+    let rest = (
+        glam::Vec3::from(translation),
+        glam::Quat::from_array(rotation).normalize(),
+        glam::Vec3::from(scale),
+    );
+    let (tr, rot, sc) = animated_trs(clip, node.index(), t, rest);
+    Ok(DMat4::from_scale_rotation_translation(
+        sc.as_dvec3(),
+        rot.as_dquat(),
+        tr.as_dvec3(),
+    ))
 }
 
 /// A primitive's morph targets placed by `world` (offsets are directions:
@@ -298,7 +334,11 @@ impl Collected {
 
 /// Walks the default scene (or the first, or every root node when there is none)
 /// without recursion, appending every triangle primitive in world space.
-pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
+pub(super) fn collect(
+    src: &Source,
+    warn: &mut Warnings,
+    pose: Option<(&Clip, f32)>,
+) -> Result<Collected> {
     let nodes: Vec<gltf::Node> = src.doc.nodes().collect();
     let parent = parents(&nodes)?;
     let roots: Vec<usize> = match src.doc.default_scene().or_else(|| src.doc.scenes().next()) {
@@ -332,7 +372,11 @@ pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
                 node_label(node)
             );
         }
-        let world = parent_world * local_matrix(node)?;
+        let local = match pose {
+            Some((clip, t)) => animated_matrix(node, clip, t)?,
+            None => local_matrix(node)?,
+        };
+        let world = parent_world * local;
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
                 let key = (mesh.index(), prim.index());
@@ -348,7 +392,16 @@ pub(super) fn collect(src: &Source, warn: &mut Warnings) -> Result<Collected> {
                 let Some(part) = part else { continue };
                 let (v0, i0) = (out.mesh.vertices.len(), out.mesh.indices.len());
                 append_part(&mut out.mesh, &mut out.world_pos, &part, &world, node)?;
-                let (targets, weights) = placed_targets(src, &part, &world, node, &mesh, &label)?;
+                let (targets, mut weights) =
+                    placed_targets(src, &part, &world, node, &mesh, &label)?;
+                if let Some(w) = pose.and_then(|(clip, t)| animated_weights(clip, node.index(), t))
+                {
+                    // A mesh's primitives share its weights; one with fewer
+                    // targets takes the first of them.
+                    for (d, v) in weights.iter_mut().zip(w) {
+                        *d = v;
+                    }
+                }
                 out.spans.push(Span {
                     material: prim.material().index(),
                     vertices: v0..out.mesh.vertices.len(),

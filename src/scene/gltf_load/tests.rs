@@ -792,3 +792,93 @@ fn morph_targets_load_posed_by_the_files_default_weights() {
         "{e}"
     );
 }
+
+/// `morph_quad` with an animation: node 0 turns 90 degrees about +Z from 0
+/// to 2 s (LINEAR), and the lift's weight steps 0 -> 1 at 1 s (STEP).
+fn animated_quad(dir: &Path, times: &[f32]) -> PathBuf {
+    let d: Vec<f32> = (0..4).flat_map(|i| [0.0, 0.0, (i + 1) as f32]).collect();
+    let acc =
+        serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3"}]);
+    let prim = serde_json::json!({"attributes": attrs(), "targets": [{"POSITION": 3}]});
+    let mut m = Model::quad(prim, acc, &f32_bytes(&d), None);
+    let q = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
+    let tv = m.add_view(&f32_bytes(times), None);
+    let ta = m.add_accessor(serde_json::json!({"bufferView": tv, "componentType": 5126, "count": times.len(), "type": "SCALAR", "min": [times[0]], "max": [times[times.len() - 1]]}));
+    let rv = m.add_view(
+        &f32_bytes(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]]),
+        None,
+    );
+    let ra = m.add_accessor(
+        serde_json::json!({"bufferView": rv, "componentType": 5126, "count": 2, "type": "VEC4"}),
+    );
+    let wv = m.add_view(&f32_bytes(&[0.0, 1.0]), None);
+    let wa = m.add_accessor(
+        serde_json::json!({"bufferView": wv, "componentType": 5126, "count": 2, "type": "SCALAR"}),
+    );
+    let step_times = m.add_view(&f32_bytes(&[0.0, 1.0]), None);
+    let sa = m.add_accessor(serde_json::json!({"bufferView": step_times, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1.0]}));
+    m.json["animations"] = serde_json::json!([{
+        "name": "turn",
+        "samplers": [
+            {"input": ta, "output": ra, "interpolation": "LINEAR"},
+            {"input": sa, "output": wa, "interpolation": "STEP"}
+        ],
+        "channels": [
+            {"sampler": 0, "target": {"node": 0, "path": "rotation"}},
+            {"sampler": 1, "target": {"node": 0, "path": "weights"}}
+        ]
+    }]);
+    write_gltf(dir, "animated", m.json, &m.buffer)
+}
+
+#[test]
+fn animations_pose_nodes_and_weights_at_the_time_asked() {
+    let dir = temp_dir("anim");
+    let path = animated_quad(&dir, &[0.0, 2.0]);
+    let at = |t: Option<f32>| {
+        let o = TextureOverrides {
+            time: t,
+            ..Default::default()
+        };
+        load_head_with_notes(&path, &o).unwrap()
+    };
+    // No time: the rest pose, the animation named in a note.
+    let rest = at(None);
+    assert!(
+        rest.notes
+            .iter()
+            .any(|n| n.contains("1 animation(s) not played")),
+        "{:?}",
+        rest.notes
+    );
+    assert_eq!(rest.object.mesh.vertices[1].position, [1.0, 0.0, 0.0]);
+    // At 1 s: turned 45 degrees (the file states 0 and 90 at 0 and 2 s), the
+    // weight stepped to 1 (its key at 1 s), so vertex 1 (1, 0, 0) lifted by 2.
+    let l = at(Some(1.0));
+    assert!(l.animated);
+    let p = glam::Vec3::from(l.object.mesh.vertices[1].position);
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    assert!((p - glam::Vec3::new(h, h, 2.0)).length() < 1e-5, "{p}");
+    assert_eq!(l.object.morph.weights, [1.0]);
+    // Just before: the weight is still 0 (STEP).
+    assert_eq!(at(Some(0.999)).object.morph.weights, [0.0]);
+    // After the end: the last key (90 degrees), clamped.
+    let p = glam::Vec3::from(at(Some(5.0)).object.mesh.vertices[1].position);
+    assert!((p - glam::Vec3::new(0.0, 1.0, 2.0)).length() < 1e-5, "{p}");
+    // A clip that does not exist, and times that do not increase, are one line.
+    let o = TextureOverrides {
+        time: Some(1.0),
+        clip: Some("walk".into()),
+        ..Default::default()
+    };
+    let e = format!("{:#}", load_head_with_notes(&path, &o).err().unwrap());
+    assert!(
+        e.contains("--animation 'walk': the file has no animation of that name (it has: turn)"),
+        "{e}"
+    );
+    let e = load_err(&animated_quad(&dir, &[2.0, 2.0]));
+    assert!(
+        e.contains("animation 'turn' channel 0: keyframe times are not increasing"),
+        "{e}"
+    );
+}

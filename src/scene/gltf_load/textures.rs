@@ -57,6 +57,11 @@ pub struct TextureOverrides {
     /// `crate::scene::skin_rule`): beside the textures because it, too,
     /// replaces what the file says.
     pub skin: crate::scene::skin_rule::SkinChoice,
+    /// The time (seconds) the file's animation is posed at (`--time`), and
+    /// which clip (`--animation`; the first when none is named). No time: the
+    /// file's rest pose.
+    pub time: Option<f32>,
+    pub clip: Option<String>,
 }
 
 /// A texture role of the skin material.
