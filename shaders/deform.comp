@@ -1,13 +1,13 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The deform pass (issue 29): an object's morph targets blended into the
-// vertex buffer every draw of the frame reads (the thesis' stream-out pass,
+// The deform pass (issue 29): an object's morph targets blended, then its
+// skin's joints applied (glTF's order), into the vertex buffer every draw of the frame reads (the thesis' stream-out pass,
 // ch. 8, as a compute pass: written once a frame, drawn by the shadow map,
 // the geometry pass and every method's mesh passes), and its positions at
 // the previous frame's weights beside them (the velocity the temporal
-// anti-aliasing reads). src/scene/morph.rs's `apply` is this, operation for
-// operation: `precise` keeps each product and sum rounded alone, so the
-// CPU's vertices are these to the bit.
+// anti-aliasing reads). src/scene/morph.rs's `apply` and src/scene/skin.rs's
+// `apply` are this, operation for operation: `precise` keeps each product and
+// sum rounded alone, so the CPU's vertices are these to the bit.
 // No fetch counter: it reads buffers only (the counting build counts
 // texture fetches), so its counting build is this shader unchanged.
 #include "shader_constants.glsl"
@@ -29,12 +29,37 @@ layout(set = 0, binding = 1, std430) readonly buffer Targets { Target targets[];
 layout(set = 0, binding = 2, std430) readonly buffer Deltas { float deltas[]; };
 layout(set = 0, binding = 3, std430) buffer Deformed { float deformed[]; };
 layout(set = 0, binding = 4, std430) buffer Previous { float previous[]; };
-layout(push_constant) uniform Push { uint vertexCount; uint targetCount; } pc;
+// Per vertex: its joints and their weights (two sets of four; unused 0).
+struct Influence { uvec4 j0; uvec4 j1; vec4 w0; vec4 w1; };
+layout(set = 0, binding = 5, std430) readonly buffer Influences { Influence influences[]; };
+// The joint matrices at this frame's pose, then at the previous frame's.
+layout(set = 0, binding = 6, std430) readonly buffer Joints { mat4 joints[]; };
+// skinSlots: 0 (no skin), 4 or 8; jointCount: where the previous matrices start.
+layout(push_constant) uniform Push {
+    uint vertexCount; uint targetCount; uint skinSlots; uint jointCount;
+} pc;
 
 const uint STRIDE = 12u;
 
 vec3 delta(uint at) {
     return vec3(deltas[at], deltas[at + 1u], deltas[at + 2u]);
+}
+
+// m times (v, 1): the columns' products summed in order (skin.rs's `transform`).
+vec3 point(mat4 m, vec3 v) {
+    precise vec3 r = m[0].xyz * v.x;
+    r = r + m[1].xyz * v.y;
+    r = r + m[2].xyz * v.z;
+    r = r + m[3].xyz;
+    return r;
+}
+
+// m times (v, 0).
+vec3 direction(mat4 m, vec3 v) {
+    precise vec3 r = m[0].xyz * v.x;
+    r = r + m[1].xyz * v.y;
+    r = r + m[2].xyz * v.z;
+    return r;
 }
 
 void main() {
@@ -67,6 +92,28 @@ void main() {
             precise vec3 wq = g.previous * delta(at);
             q = q + wq;
         }
+    }
+    if (pc.skinSlots != 0u) {
+        Influence inf = influences[v];
+        precise vec3 sp = vec3(0.0);
+        precise vec3 sn = vec3(0.0);
+        precise vec3 st = vec3(0.0);
+        precise vec3 sq = vec3(0.0);
+        for (uint s = 0u; s < pc.skinSlots; s++) {
+            float w = s < 4u ? inf.w0[s] : inf.w1[s - 4u];
+            if (w == 0.0) continue;
+            uint j = s < 4u ? inf.j0[s] : inf.j1[s - 4u];
+            mat4 m = joints[j];
+            precise vec3 a = point(m, p) * w;
+            sp = sp + a;
+            precise vec3 c = direction(m, n) * w;
+            sn = sn + c;
+            precise vec3 d = direction(m, t) * w;
+            st = st + d;
+            precise vec3 e = point(joints[pc.jointCount + j], q) * w;
+            sq = sq + e;
+        }
+        p = sp; n = sn; t = st; q = sq;
     }
     deformed[b] = p.x; deformed[b + 1u] = p.y; deformed[b + 2u] = p.z;
     deformed[b + 3u] = n.x; deformed[b + 4u] = n.y; deformed[b + 5u] = n.z;

@@ -1,20 +1,22 @@
-//! The deform pass: each morphing object's targets blended into the vertex
-//! buffer every draw of the frame reads (`deform.comp`; the CPU's twin is
-//! `scene::morph::apply`), with its positions at the previous frame's
-//! weights beside them (velocity, for the temporal anti-aliasing).
+//! The deform pass: each deforming object's morph targets blended, then its
+//! skin's joints applied, into the vertex buffer every draw of the frame
+//! reads (`deform.comp`; the CPU's twin is `scene::morph::deformed`), with
+//! its positions at the previous frame's weights and joints beside them
+//! (velocity, for the temporal anti-aliasing).
 //!
 //! A compute pass, not the vertex shader: the frame draws a character's
 //! mesh in the shadow map, the geometry pass and the id pass (and a method
 //! may draw it again), so blending in the vertex shader would redo the
-//! targets once per draw; written once, every draw reads plain vertices (the
-//! thesis' stream-out pass, ch. 8, in today's form). An object whose weights
-//! are all 0 is its rest mesh: no pass.
+//! targets and joints once per draw; written once, every draw reads plain
+//! vertices (the thesis' stream-out pass, ch. 8, in today's form). An object
+//! without a skin whose weights are all 0 is its rest mesh: no pass.
 
 use anyhow::Result;
 use ash::vk;
 
 use crate::graph::{Binding, BufferId, GraphSet, Pass, PassContext, Resources, Storage};
 use crate::scene::morph::Morph;
+use crate::scene::skin::{Skin, SLOTS};
 use crate::vk::barrier::AccessKind;
 use crate::vk::context::Context;
 use crate::vk::guard::Guard;
@@ -23,6 +25,7 @@ use crate::vk::pipeline::{Bind, DescriptorPool, Pipeline};
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload::device_buffer;
 use crate::work::{PassRole, ShaderWork};
+use bytemuck::Zeroable;
 use gpu_allocator::MemoryLocation;
 
 pub const SHADER: &str = "deform.comp";
@@ -44,11 +47,23 @@ struct TargetRow {
     pad: [f32; 2],
 }
 
+/// std430 `Influence` of the shader: joints of both sets, then weights.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct InfluenceRow {
+    joints: [u32; SLOTS],
+    weights: [f32; SLOTS],
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct DeformPush {
     vertex_count: u32,
     target_count: u32,
+    /// 0 (no skin), 4 or 8.
+    skin_slots: u32,
+    /// Where the previous pose's matrices start in `Joints`.
+    joint_count: u32,
 }
 
 /// One morphing object's buffers on the GPU.
@@ -58,6 +73,8 @@ pub struct DeformObject {
     rest: Buffer,
     targets: Buffer,
     deltas: Buffer,
+    influences: Buffer,
+    joints: Buffer,
     previous: Buffer,
     /// The object's vertex buffer (written here, drawn by the frame).
     pub vertices: BufferId,
@@ -65,6 +82,8 @@ pub struct DeformObject {
     set: GraphSet,
     vertex_count: u32,
     target_count: u32,
+    skin_slots: u32,
+    joint_count: u32,
     /// Offsets read per vertex, on average (what the work declares).
     offsets_per_vertex: f64,
 }
@@ -106,11 +125,36 @@ fn flatten(morph: &Morph) -> (Vec<f32>, Vec<TargetRow>) {
             pad: [0.0; 2],
         });
     }
-    // A storage buffer may not be empty.
+    // A storage buffer may not be empty: a skin without targets binds one
+    // row that covers no vertex, and one float.
     if deltas.is_empty() {
         deltas.push(0.0);
     }
+    if rows.is_empty() {
+        rows.push(TargetRow::zeroed());
+    }
     (deltas, rows)
+}
+
+/// A skin's influences as the shader reads them, and its matrices (the
+/// pose's, then the previous pose's); one zero row each without a skin.
+fn flatten_skin(skin: Option<&Skin>) -> (Vec<InfluenceRow>, Vec<[f32; 16]>) {
+    let Some(skin) = skin else {
+        return (vec![InfluenceRow::zeroed()], vec![[0.0; 16]]);
+    };
+    let rows = skin
+        .joints
+        .iter()
+        .zip(&skin.weights)
+        .map(|(&joints, &weights)| InfluenceRow { joints, weights })
+        .collect();
+    let matrices = skin
+        .matrices
+        .iter()
+        .chain(&skin.previous)
+        .map(|m| m.to_cols_array())
+        .collect();
+    (rows, matrices)
 }
 
 impl Deform {
@@ -136,6 +180,7 @@ impl Deform {
     ) -> Result<BufferId> {
         let n = morph.rest.len() as u64;
         let (deltas, rows) = flatten(morph);
+        let (influences, joints) = flatten_skin(morph.skin.as_ref());
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // Read back by tests (`read_back`).
         let readable = usage | vk::BufferUsageFlags::TRANSFER_SRC;
@@ -143,7 +188,9 @@ impl Deform {
         let mut o = DeformObject {
             name: name.to_string(),
             vertex_count: n as u32,
-            target_count: rows.len() as u32,
+            target_count: morph.targets.len() as u32,
+            skin_slots: morph.skin.as_ref().map_or(0, |s| s.slots as u32),
+            joint_count: morph.skin.as_ref().map_or(0, |s| s.matrices.len() as u32),
             offsets_per_vertex: rows.iter().map(|r| r.count as f64).sum::<f64>() / n.max(1) as f64,
             ..Default::default()
         };
@@ -165,6 +212,20 @@ impl Deform {
             ctx,
             &format!("{name} morph offsets"),
             bytemuck::cast_slice(&deltas),
+            usage,
+            read,
+        )?;
+        o.influences = device_buffer(
+            ctx,
+            &format!("{name} joint influences"),
+            bytemuck::cast_slice(&influences),
+            usage,
+            read,
+        )?;
+        o.joints = device_buffer(
+            ctx,
+            &format!("{name} joint matrices"),
+            bytemuck::cast_slice(&joints),
             usage,
             read,
         )?;
@@ -200,6 +261,14 @@ impl Deform {
                     ),
                 ),
                 ("Deltas", whole(&o.deltas, 4 * deltas.len() as u64)),
+                (
+                    "Influences",
+                    whole(
+                        &o.influences,
+                        (influences.len() * std::mem::size_of::<InfluenceRow>()) as u64,
+                    ),
+                ),
+                ("Joints", whole(&o.joints, 64 * joints.len() as u64)),
                 (
                     "Deformed",
                     Binding::StorageBuffer {
@@ -239,19 +308,28 @@ impl Deform {
             let work = ShaderWork {
                 shader: SHADER.into(),
                 fetches: Vec::new(),
-                alu: alu_estimate(SHADER, &[o.target_count]),
+                alu: alu_estimate(SHADER, &[o.target_count, o.skin_slots]),
                 // The rest vertex and the table, each covering target's
-                // offsets (position, normal, tangent at most); the vertex
-                // and its previous position written.
+                // offsets (position, normal, tangent at most), the
+                // influences and two matrices a slot (as many as are used:
+                // the slots' count is the upper bound); the vertex and its
+                // previous position written.
                 storage_read_bytes: 4.0 * VERTEX_FLOATS as f64
                     + 32.0 * o.target_count as f64
-                    + 36.0 * o.offsets_per_vertex,
+                    + 36.0 * o.offsets_per_vertex
+                    + if o.skin_slots > 0 {
+                        std::mem::size_of::<InfluenceRow>() as f64 + 128.0 * o.skin_slots as f64
+                    } else {
+                        0.0
+                    },
                 storage_write_bytes: 4.0 * VERTEX_FLOATS as f64 + 12.0,
                 shared_bytes: 0.0,
             };
             let push = DeformPush {
                 vertex_count: o.vertex_count,
                 target_count: o.target_count,
+                skin_slots: o.skin_slots,
+                joint_count: o.joint_count,
             };
             // Vertex work of the frame, with the geometry it feeds.
             let mut pass = Pass::new(format!("deform {}", o.name), PassRole::Geometry);
@@ -322,7 +400,14 @@ impl Deform {
 
     pub fn destroy(&mut self, ctx: &Context) {
         for o in &mut self.objects {
-            for b in [&mut o.rest, &mut o.targets, &mut o.deltas, &mut o.previous] {
+            for b in [
+                &mut o.rest,
+                &mut o.targets,
+                &mut o.deltas,
+                &mut o.influences,
+                &mut o.joints,
+                &mut o.previous,
+            ] {
                 b.destroy(ctx);
             }
         }

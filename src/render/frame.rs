@@ -346,8 +346,8 @@ impl Frame {
         Ok(())
     }
 
-    /// The deform pass of every object whose morph weights are not all 0
-    /// (`scene`'s, in the order `build` made the objects).
+    /// The deform pass of every object with a skin or morph weights not all
+    /// 0 (`scene`'s, in the order `build` made the objects).
     pub fn enable_deform(
         &mut self,
         ctx: &Context,

@@ -146,6 +146,7 @@ pub fn expression_morph(head: &Mesh, count: usize, mm_per_unit: f32) -> Morph {
         rest: Vec::new(),
         weights: vec![0.0; targets.len()],
         targets,
+        skin: None,
     }
 }
 

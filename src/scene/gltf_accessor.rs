@@ -35,13 +35,20 @@ pub enum Use {
     KeyVec3,
     KeyVec4,
     KeyScalar,
+    /// A skin's joints per vertex (`JOINTS_n`: VEC4 of unsigned integers).
+    Joints,
+    /// Their weights (`WEIGHTS_n`: VEC4).
+    Weights,
+    /// A skin's inverse bind matrices (MAT4, FLOAT).
+    InverseBind,
 }
 
 impl Use {
     fn dims(self) -> Dimensions {
         match self {
             Use::Position | Use::Normal | Use::Offset | Use::KeyVec3 => Dimensions::Vec3,
-            Use::Tangent | Use::KeyVec4 => Dimensions::Vec4,
+            Use::Tangent | Use::KeyVec4 | Use::Joints | Use::Weights => Dimensions::Vec4,
+            Use::InverseBind => Dimensions::Mat4,
             Use::KeyTimes | Use::KeyScalar => Dimensions::Scalar,
             Use::TexCoord => Dimensions::Vec2,
             Use::Indices => Dimensions::Scalar,
@@ -60,6 +67,9 @@ impl Use {
             Use::KeyVec3 => "translations or scales",
             Use::KeyVec4 => "rotations",
             Use::KeyScalar => "morph weights",
+            Use::Joints => "joints",
+            Use::Weights => "joint weights",
+            Use::InverseBind => "inverse bind matrices",
         }
     }
 
@@ -78,6 +88,10 @@ impl Use {
         let signed_small = matches!(ty, I8 | I16);
         match self {
             Use::Indices => matches!(ty, U8 | U16 | U32) && !normalized,
+            // Core (3.7.3.3): joints are unsigned bytes or shorts; weights
+            // floats or normalized unsigned bytes or shorts.
+            Use::Joints => matches!(ty, U8 | U16) && !normalized,
+            Use::Weights => (ty == F32 && !normalized) || (matches!(ty, U8 | U16) && normalized),
             _ if ty == F32 => !normalized,
             Use::Position => quantization && small,
             Use::Normal | Use::Tangent => quantization && signed_small && normalized,
@@ -86,7 +100,7 @@ impl Use {
             Use::Offset => quantization && signed_small,
             // Core (3.11): times and translations and scales are FLOAT;
             // rotations and weights may be normalized integers.
-            Use::KeyTimes | Use::KeyVec3 => false,
+            Use::KeyTimes | Use::KeyVec3 | Use::InverseBind => false,
             Use::KeyVec4 | Use::KeyScalar => small && normalized,
         }
     }
@@ -367,6 +381,16 @@ pub fn read_attribute<const N: usize>(
 pub fn read_floats(src: &Source, acc: &gltf::Accessor, usage: Use, what: &str) -> Result<Vec<f32>> {
     let (ty, normalized) = (acc.data_type(), acc.normalized());
     read(src, acc, usage, what, |b| component_f32(b, ty, normalized))
+}
+
+/// Reads a skin's joints (`JOINTS_n`) as u32, four a vertex.
+pub fn read_joints(src: &Source, acc: &gltf::Accessor, what: &str) -> Result<Vec<[u32; 4]>> {
+    let ty = acc.data_type();
+    let flat = read(src, acc, Use::Joints, what, |b| component_u32(b, ty))?;
+    Ok(flat
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect())
 }
 
 /// Reads an index accessor as u32.

@@ -41,6 +41,7 @@ mod checks;
 pub mod fixture;
 mod nodes;
 mod primitives;
+mod skins;
 mod textures;
 
 use super::mesh::Object;
@@ -302,5 +303,7 @@ fn material_facts(
     })
 }
 
+#[cfg(test)]
+mod motion_tests;
 #[cfg(test)]
 pub(super) mod tests;

@@ -191,7 +191,7 @@ impl Object {
     /// Gives the object its targets (its mesh now is their rest shape),
     /// checks them and poses it by their weights.
     pub fn set_morph(&mut self, mut morph: Morph) -> Result<()> {
-        if morph.targets.is_empty() {
+        if !morph.deforms() {
             self.morph = Morph::default();
             return Ok(());
         }
@@ -205,7 +205,7 @@ impl Object {
     /// Its mesh posed by its morph's weights (`morph::posed`); a still
     /// object stays as it is.
     pub fn pose(&mut self) {
-        if !self.morph.targets.is_empty() {
+        if self.morph.deforms() {
             self.mesh.vertices = posed(&self.morph.rest, &self.morph);
         }
     }

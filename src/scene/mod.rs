@@ -20,6 +20,7 @@ pub mod mesh;
 pub mod morph;
 pub mod procedural;
 pub mod robust_bounds;
+pub mod skin;
 pub mod skin_rule;
 pub mod source;
 pub mod vertex;
@@ -144,6 +145,9 @@ impl Scene {
         for o in std::iter::once(&mut self.head).chain(&mut self.parts) {
             o.mesh.transform(&m);
             o.morph.rotate(&m, q);
+            // The drawn mesh from the moved rest (or joints), so it is the
+            // deform pass's to the bit.
+            o.pose();
         }
         self.head_bounds = self
             .parts

@@ -13,6 +13,7 @@
 use anyhow::{bail, Result};
 use glam::Vec3;
 
+use super::skin::Skin;
 use super::vertex::Vertex;
 
 /// One target's offsets over `first..first + position.len()`.
@@ -38,26 +39,38 @@ impl MorphTarget {
     }
 }
 
-/// An object's targets and the weights they are posed with.
+/// An object's deformation: its targets and the weights they are posed
+/// with, then its skin (glTF's order: targets in bind space, then joints).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Morph {
-    /// The object's vertices with every weight 0 (empty without targets).
+    /// The object's vertices with every weight 0 and no joint moved: its
+    /// bind pose (empty for a still object).
     pub rest: Vec<Vertex>,
     pub targets: Vec<MorphTarget>,
     /// One per target: the file's defaults, then the command line's, then
     /// an animation's at the frame's time.
     pub weights: Vec<f32>,
+    /// Its joints (`None`: placed by its targets alone).
+    pub skin: Option<Skin>,
 }
 
 impl Morph {
-    /// Every weight zero: the rest mesh, no work.
+    /// Every weight zero and no skin: the rest mesh, no work.
     pub fn at_rest(&self) -> bool {
-        self.weights.iter().all(|&w| w == 0.0)
+        self.skin.is_none() && self.weights.iter().all(|&w| w == 0.0)
+    }
+
+    /// Whether it deforms its object at all (targets or a skin).
+    pub fn deforms(&self) -> bool {
+        !self.targets.is_empty() || self.skin.is_some()
     }
 
     /// Checks the shapes against an object of `vertices` vertices: every
     /// target within the object, its attributes of one length, finite.
     pub fn check(&self, vertices: usize) -> Result<()> {
+        if let Some(skin) = &self.skin {
+            skin.check(vertices)?;
+        }
         if self.weights.len() != self.targets.len() {
             bail!(
                 "{} morph weights for {} targets",
@@ -130,8 +143,13 @@ impl Morph {
 
 impl Morph {
     /// Moves the rest shape by `m` (a rigid motion whose rotation is `q`)
-    /// and turns the offsets with it.
+    /// and turns the offsets with it; a skinned rest stays in its bind
+    /// space and its joints move instead.
     pub fn rotate(&mut self, m: &glam::Mat4, q: glam::Quat) {
+        if let Some(skin) = &mut self.skin {
+            skin.transform(m);
+            return;
+        }
         if self.targets.is_empty() {
             return;
         }
@@ -185,9 +203,19 @@ pub fn apply(rest: &[Vertex], morph: &Morph) -> Vec<Vertex> {
     out
 }
 
-/// [`apply`] with unit normals and tangents: what CPU consumers read.
+/// The vertices exactly as the deform pass writes them: [`apply`], then the
+/// skin's joints (`skin::apply`) where it has one.
+pub fn deformed(rest: &[Vertex], morph: &Morph) -> Vec<Vertex> {
+    let morphed = apply(rest, morph);
+    match &morph.skin {
+        Some(skin) => super::skin::apply(&morphed, skin),
+        None => morphed,
+    }
+}
+
+/// [`deformed`] with unit normals and tangents: what CPU consumers read.
 pub fn posed(rest: &[Vertex], morph: &Morph) -> Vec<Vertex> {
-    let mut out = apply(rest, morph);
+    let mut out = deformed(rest, morph);
     for v in &mut out {
         let n = Vec3::from(v.normal).normalize_or(Vec3::Y);
         v.normal = n.into();
@@ -235,6 +263,7 @@ mod tests {
                 },
             ],
             weights: vec![0.5, 0.25],
+            skin: None,
             rest: Vec::new(),
         };
         m.check(3).unwrap();
@@ -262,6 +291,7 @@ mod tests {
                 ..Default::default()
             }],
             weights: vec![0.0],
+            skin: None,
             rest: Vec::new(),
         };
         assert!(m

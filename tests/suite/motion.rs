@@ -42,6 +42,7 @@ fn morphing_egg() -> Scene {
             rest: Vec::new(),
             targets: vec![swell, lift],
             weights: vec![0.7, -0.3],
+            skin: None,
         })
         .unwrap();
     scene
@@ -331,4 +332,101 @@ fn time_turns_and_nods_a_character_without_animation() {
         .load()
         .unwrap()
     });
+}
+
+/// The egg with a skin of three joints: the lower half held by a still
+/// joint, the upper half by one turned 0.4 rad about Z and lifted, a band
+/// between weighted by height (two slots; a few vertices with the second
+/// set), and its targets too: morph in bind space, then joints. The
+/// previous pose is the joints before a step.
+fn skinned_egg() -> Scene {
+    use dermis::scene::skin::{Skin, SLOTS};
+    let mut scene = morphing_egg();
+    let rest = scene.head.morph.rest.clone();
+    let (lo, hi) = rest.iter().fold((f32::MAX, f32::MIN), |(a, b), v| {
+        (a.min(v.position[1]), b.max(v.position[1]))
+    });
+    let mut joints = Vec::new();
+    let mut weights = Vec::new();
+    for (k, v) in rest.iter().enumerate() {
+        let h = ((v.position[1] - lo) / (hi - lo)).clamp(0.0, 1.0);
+        let mut j = [0u32; SLOTS];
+        let mut w = [0.0f32; SLOTS];
+        j[0] = 0;
+        j[1] = 1;
+        w[0] = 1.0 - h;
+        w[1] = h;
+        if k % 7 == 0 {
+            // Some weight on the third joint, in the second set.
+            j[5] = 2;
+            w[5] = 0.25 * w[1];
+            w[1] -= w[5];
+        }
+        joints.push(j);
+        weights.push(w);
+    }
+    let c = glam::Vec3::new(0.0, 0.5 * (lo + hi), 0.0);
+    let turn = |a: f32, lift: f32| {
+        glam::Mat4::from_translation(c + glam::Vec3::Y * lift)
+            * glam::Mat4::from_rotation_z(a)
+            * glam::Mat4::from_translation(-c)
+    };
+    let mut morph = scene.head.morph.clone();
+    morph.skin = Some(Skin {
+        joints,
+        weights,
+        slots: SLOTS,
+        matrices: vec![glam::Mat4::IDENTITY, turn(0.4, 0.2), turn(-0.3, 0.0)],
+        previous: vec![glam::Mat4::IDENTITY, turn(0.3, 0.1), turn(-0.2, 0.0)],
+    });
+    scene.head.mesh.vertices = rest;
+    scene.head.set_morph(morph).unwrap();
+    scene
+}
+
+#[test]
+fn the_deform_pass_skins_exactly_as_the_cpu_does() {
+    use dermis::scene::morph::deformed;
+    use dermis::scene::skin::apply_previous;
+    let ctx = common::ctx();
+    let scene = skinned_egg();
+    let m = &scene.head.morph;
+    let mut r = Renderer::new(&ctx, &scene, &settings()).unwrap();
+    r.capture(false).unwrap();
+    let got = r.deformed().unwrap();
+    let want = deformed(&m.rest, m);
+    let want: Vec<f32> = bytemuck::cast_slice(&want).to_vec();
+    let differ = got[0]
+        .vertices
+        .iter()
+        .zip(&want)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(differ, 0, "{differ} of {} floats differ", want.len());
+    // Previous positions: the previous joints over the targets at the
+    // previous weights (the first frame's: these).
+    let prev = apply_previous(&apply(&m.rest, m), m.skin.as_ref().unwrap());
+    let prev: Vec<f32> = prev.iter().flatten().copied().collect();
+    assert_eq!(got[0].previous, prev);
+    // Skinning moved the head: the velocity is not zero where the turning
+    // joint holds a vertex.
+    assert!(got[0]
+        .previous
+        .chunks_exact(3)
+        .zip(want.chunks_exact(12))
+        .any(|(p, v)| (p[1] - v[1]).abs() > 1e-3));
+    // And the frame draws the skinned mesh: the same depth as the CPU's
+    // posed mesh drawn as a still.
+    let mut still = scene.clone();
+    still.head.morph = Morph::default();
+    let s = settings();
+    let a = Renderer::new(&ctx, &scene, &s)
+        .unwrap()
+        .capture(false)
+        .unwrap();
+    let b = Renderer::new(&ctx, &still, &s)
+        .unwrap()
+        .capture(false)
+        .unwrap();
+    assert_eq!(a.depth, b.depth);
 }

@@ -9,12 +9,14 @@ use std::rc::Rc;
 
 use super::checks::{mesh_label, node_label};
 use super::primitives::{read_primitive, Part};
+use super::skins::{append_skinned, skin_matrices, SpanSkin};
 use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::animation::{animated_trs, animated_weights, Clip, Path};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
 use crate::scene::morph::{Morph, MorphTarget};
 use crate::scene::robust_bounds::robust_bounds_f64;
+use crate::scene::skin::{Skin, SLOTS};
 
 /// A model whose centre lies farther from the origin than this many times its size is
 /// moved to the origin: f32 keeps 24 bits, and at 128 sizes away fewer than 16 of
@@ -271,9 +273,12 @@ pub(super) struct Span {
     pub(super) has_uvs: bool,
     pub(super) label: String,
     /// Its morph targets placed in world space (`first` 0: the span's first
-    /// vertex) and their default weights (the node's, else the mesh's, else 0).
+    /// vertex; in bind space when skinned) and their default weights (the
+    /// node's, else the mesh's, else 0).
     pub(super) targets: Vec<MorphTarget>,
     pub(super) weights: Vec<f32>,
+    /// Its skin: its vertices stay in bind space, its joints place them.
+    pub(super) skin: Option<SpanSkin>,
 }
 
 /// The primitives of one material, merged: a mesh of its own (indices from 0).
@@ -290,6 +295,9 @@ impl Collected {
     /// The merged mesh cut by material, in the order materials are first met.
     pub(super) fn split(&self) -> Vec<MaterialMesh> {
         let mut out: Vec<MaterialMesh> = Vec::new();
+        // Where each material's rigid primitives' one identity joint is
+        // (a material with a skinned primitive is skinned as a whole).
+        let mut rigid_joint: Vec<Option<u32>> = Vec::new();
         for span in &self.spans {
             let k = match out.iter().position(|m| m.material == span.material) {
                 Some(k) => k,
@@ -301,10 +309,50 @@ impl Collected {
                         without_uvs: Vec::new(),
                         morph: Morph::default(),
                     });
+                    rigid_joint.push(None);
+                    let skinned = self
+                        .spans
+                        .iter()
+                        .filter(|s| s.material == span.material)
+                        .filter_map(|s| s.skin.as_ref())
+                        .map(|s| s.slots)
+                        .max();
+                    if let Some(slots) = skinned {
+                        out.last_mut().expect("just pushed").morph.skin = Some(Skin {
+                            slots,
+                            ..Skin::default()
+                        });
+                    }
                     out.len() - 1
                 }
             };
             let m = &mut out[k];
+            if let Some(skin) = &mut m.morph.skin {
+                let n = span.vertices.len();
+                match &span.skin {
+                    Some(s) => {
+                        let base = skin.matrices.len() as u32;
+                        skin.matrices.extend(s.matrices.iter().map(|j| j.as_mat4()));
+                        skin.joints
+                            .extend(s.joints.iter().map(|j| j.map(|i| i + base)));
+                        skin.weights.extend_from_slice(&s.weights);
+                    }
+                    None => {
+                        // Placed in world space already: one identity joint.
+                        let j = *rigid_joint[k].get_or_insert_with(|| {
+                            skin.matrices.push(glam::Mat4::IDENTITY);
+                            skin.matrices.len() as u32 - 1
+                        });
+                        let mut joints = [0; SLOTS];
+                        joints[0] = j;
+                        let mut weights = [0.0; SLOTS];
+                        weights[0] = 1.0;
+                        skin.joints.extend(std::iter::repeat_n(joints, n));
+                        skin.weights.extend(std::iter::repeat_n(weights, n));
+                    }
+                }
+                skin.previous = skin.matrices.clone();
+            }
             let base = m.mesh.vertices.len() as u32;
             let first = span.vertices.start as u32;
             m.mesh
@@ -362,9 +410,12 @@ pub(super) fn collect(
     };
     let mut parts: HashMap<(usize, usize), Option<Rc<Part>>> = HashMap::new();
     let mut visited = vec![false; nodes.len()];
-    let mut stack: Vec<(usize, DMat4)> =
-        roots.iter().rev().map(|&r| (r, DMat4::IDENTITY)).collect();
-    while let Some((ni, parent_world)) = stack.pop() {
+    // Every node's world matrix first: a skin's joints may lie anywhere in
+    // the hierarchy, before or after the meshes they move.
+    let worlds = node_worlds(&nodes, &parent, pose)?;
+    let mut stack: Vec<usize> = roots.iter().rev().copied().collect();
+    let mut said_unskinned = false;
+    while let Some(ni) = stack.pop() {
         let node = &nodes[ni];
         if std::mem::replace(&mut visited[ni], true) {
             bail!(
@@ -372,11 +423,12 @@ pub(super) fn collect(
                 node_label(node)
             );
         }
-        let local = match pose {
-            Some((clip, t)) => animated_matrix(node, clip, t)?,
-            None => local_matrix(node)?,
-        };
-        let world = parent_world * local;
+        let world = worlds[ni];
+        let skin = node
+            .skin()
+            .filter(|_| node.mesh().is_some())
+            .map(|sk| skin_matrices(src, &sk, &worlds))
+            .transpose()?;
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
                 let key = (mesh.index(), prim.index());
@@ -391,9 +443,15 @@ pub(super) fn collect(
                 };
                 let Some(part) = part else { continue };
                 let (v0, i0) = (out.mesh.vertices.len(), out.mesh.indices.len());
-                append_part(&mut out.mesh, &mut out.world_pos, &part, &world, node)?;
+                // A skinned mesh ignores its node's transform (glTF
+                // 3.7.3.1): its joints place it.
+                let placing = if skin.is_some() {
+                    DMat4::IDENTITY
+                } else {
+                    world
+                };
                 let (targets, mut weights) =
-                    placed_targets(src, &part, &world, node, &mesh, &label)?;
+                    placed_targets(src, &part, &placing, node, &mesh, &label)?;
                 if let Some(w) = pose.and_then(|(clip, t)| animated_weights(clip, node.index(), t))
                 {
                     // A mesh's primitives share its weights; one with fewer
@@ -402,6 +460,40 @@ pub(super) fn collect(
                         *d = v;
                     }
                 }
+                let span_skin = match (&skin, &part.influences) {
+                    (None, inf) => {
+                        if inf.is_some() && !std::mem::replace(&mut said_unskinned, true) {
+                            warn.note(format!(
+                                "{label} has joints and weights but {} has no skin: placed by its node",
+                                node_label(node)
+                            ));
+                        }
+                        append_part(&mut out.mesh, &mut out.world_pos, &part, &world, node)?;
+                        None
+                    }
+                    (Some(_), None) => bail!(
+                        "{} has a skin but {label} has no JOINTS_0 and WEIGHTS_0",
+                        node_label(node)
+                    ),
+                    (Some(matrices), Some(inf)) => {
+                        let span_skin = SpanSkin {
+                            joints: inf.joints.clone(),
+                            weights: inf.weights.clone(),
+                            slots: inf.slots,
+                            matrices: matrices.clone(),
+                        };
+                        append_skinned(
+                            &mut out.mesh,
+                            &mut out.world_pos,
+                            &part,
+                            &span_skin,
+                            &targets,
+                            &weights,
+                            &label,
+                        )?;
+                        Some(span_skin)
+                    }
+                };
                 out.spans.push(Span {
                     material: prim.material().index(),
                     vertices: v0..out.mesh.vertices.len(),
@@ -410,13 +502,51 @@ pub(super) fn collect(
                     label,
                     targets,
                     weights,
+                    skin: span_skin,
                 });
             }
         }
-        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
-        stack.extend(children.into_iter().rev().map(|c| (c, world)));
+        stack.extend(
+            node.children()
+                .map(|c| c.index())
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev(),
+        );
     }
     Ok(out)
+}
+
+/// Every node's world matrix, posed by `pose`: each node's local matrix
+/// computed once, each parent chain walked once (no recursion).
+fn node_worlds(
+    nodes: &[gltf::Node],
+    parent: &[Option<usize>],
+    pose: Option<(&Clip, f32)>,
+) -> Result<Vec<DMat4>> {
+    let mut world: Vec<Option<DMat4>> = vec![None; nodes.len()];
+    let mut chain = Vec::new();
+    for i in 0..nodes.len() {
+        chain.clear();
+        let mut c = Some(i);
+        while let Some(k) = c.filter(|&k| world[k].is_none()) {
+            chain.push(k);
+            c = parent[k];
+        }
+        let mut acc = c.and_then(|k| world[k]).unwrap_or(DMat4::IDENTITY);
+        for &k in chain.iter().rev() {
+            let local = match pose {
+                Some((clip, t)) => animated_matrix(&nodes[k], clip, t)?,
+                None => local_matrix(&nodes[k])?,
+            };
+            acc *= local;
+            world[k] = Some(acc);
+        }
+    }
+    Ok(world
+        .into_iter()
+        .map(|w| w.unwrap_or(DMat4::IDENTITY))
+        .collect())
 }
 
 /// Converts the f64 world positions into the mesh, moving the model to the origin when
@@ -448,7 +578,20 @@ pub(super) fn place(c: &mut Collected, warn: &mut Warnings) -> Result<()> {
     } else {
         DVec3::ZERO
     };
-    for (v, p) in c.mesh.vertices.iter_mut().zip(&c.world_pos) {
+    let mut bind = vec![false; c.mesh.vertices.len()];
+    for span in c.spans.iter_mut() {
+        if let Some(skin) = &mut span.skin {
+            bind[span.vertices.clone()].fill(true);
+            let m = DMat4::from_translation(-shift);
+            for j in &mut skin.matrices {
+                *j = m * *j;
+            }
+        }
+    }
+    for ((v, p), bind) in c.mesh.vertices.iter_mut().zip(&c.world_pos).zip(bind) {
+        if bind {
+            continue;
+        }
         let q = (*p - shift).as_vec3();
         if !q.is_finite() {
             bail!("vertex positions exceed the f32 range");

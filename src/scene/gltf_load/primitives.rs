@@ -10,10 +10,11 @@ use super::checks::{
     check_finite, check_precision, check_tex_coord, check_texcoord_range, mode_name,
 };
 use super::Warnings;
-use crate::scene::gltf_accessor::{read_attribute, read_indices, Use};
+use crate::scene::gltf_accessor::{read_attribute, read_indices, read_joints, Use};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::{Mesh, Vertex};
 use crate::scene::morph::MorphTarget;
+use crate::scene::skin::SLOTS;
 
 /// Converts an index list of any triangle mode into a triangle list with the winding
 /// glTF defines (3.7.2.1): strip triangle i is (i, i+1, i+2) for even i and
@@ -69,6 +70,72 @@ pub(super) struct Part {
     pub(super) has_uvs: bool,
     /// Its morph targets, in its own space (`first` 0).
     pub(super) targets: Vec<MorphTarget>,
+    /// Its vertices' joints and weights (`JOINTS_0/1`, `WEIGHTS_0/1`).
+    pub(super) influences: Option<Influences>,
+}
+
+/// A primitive's skin attributes, both sets in one list of eight slots.
+pub(super) struct Influences {
+    pub(super) joints: Vec<[u32; SLOTS]>,
+    pub(super) weights: Vec<[f32; SLOTS]>,
+    /// 4 (one set) or 8 (two).
+    pub(super) slots: usize,
+}
+
+/// Reads `JOINTS_0`/`WEIGHTS_0` and `JOINTS_1`/`WEIGHTS_1` (glTF 3.7.3.3):
+/// each set's two attributes together, as long as POSITION. More sets than
+/// two are refused (dermis's skins carry eight joints a vertex).
+fn read_influences(
+    src: &Source,
+    label: &str,
+    prim: &gltf::Primitive,
+    n: usize,
+) -> Result<Option<Influences>> {
+    let mut out: Option<Influences> = None;
+    for set in 0..3u32 {
+        let j = prim.get(&Semantic::Joints(set));
+        let w = prim.get(&Semantic::Weights(set));
+        let (j, w) = match (j, w) {
+            (None, None) => break,
+            (Some(j), Some(w)) => (j, w),
+            (j, _) => bail!(
+                "{label} has {} without {}",
+                if j.is_some() {
+                    format!("JOINTS_{set}")
+                } else {
+                    format!("WEIGHTS_{set}")
+                },
+                if j.is_some() {
+                    format!("WEIGHTS_{set}")
+                } else {
+                    format!("JOINTS_{set}")
+                }
+            ),
+        };
+        if set == 2 {
+            bail!("{label} has a third set of joints (JOINTS_2): dermis skins with eight joints a vertex at most");
+        }
+        let joints = read_joints(src, &j, &format!("{label}: JOINTS_{set}"))?;
+        let weights: Vec<[f32; 4]> =
+            read_attribute(src, &w, Use::Weights, &format!("{label}: WEIGHTS_{set}"))?;
+        for (name, len) in [("JOINTS", joints.len()), ("WEIGHTS", weights.len())] {
+            if len != n {
+                bail!("{label}: {name}_{set} has {len} elements but POSITION has {n}");
+            }
+        }
+        let o = out.get_or_insert_with(|| Influences {
+            joints: vec![[0; SLOTS]; n],
+            weights: vec![[0.0; SLOTS]; n],
+            slots: 0,
+        });
+        let base = 4 * set as usize;
+        for k in 0..n {
+            o.joints[k][base..base + 4].copy_from_slice(&joints[k]);
+            o.weights[k][base..base + 4].copy_from_slice(&weights[k]);
+        }
+        o.slots = base + 4;
+    }
+    Ok(out)
 }
 
 /// A primitive's morph targets (POSITION, NORMAL, TANGENT offsets), each the
@@ -214,6 +281,7 @@ pub(super) fn read_primitive(
         indices: triangles,
     };
     let mut targets = read_targets(src, label, prim, n, tangents.is_none())?;
+    let mut influences = read_influences(src, label, prim, n)?;
     if normals.is_none() {
         warn.push(format!(
             "{label} has no NORMAL: flat normals computed, as glTF specifies (it will look faceted)"
@@ -239,6 +307,10 @@ pub(super) fn read_primitive(
             t.normal = pick(&t.normal);
             t.tangent = pick(&t.tangent);
         }
+        if let Some(inf) = &mut influences {
+            inf.joints = corners.iter().map(|&i| inf.joints[i as usize]).collect();
+            inf.weights = corners.iter().map(|&i| inf.weights[i as usize]).collect();
+        }
     }
     if tangents.is_none() {
         mesh.generate_tangents();
@@ -247,6 +319,7 @@ pub(super) fn read_primitive(
         mesh,
         has_uvs: uvs.is_some(),
         targets,
+        influences,
     }))
 }
 
