@@ -20,13 +20,13 @@ struct Target {
     uint count;      // vertices it covers
     uint offset;     // its offsets in `deltas` (floats): positions, then normals, tangents
     uint flags;      // 1: normals, 2: tangents
-    float weight;    // this frame's
-    float previous;  // the previous frame's
-    float pad0;
-    float pad1;
 };
 layout(set = 0, binding = 1, std430) readonly buffer Targets { Target targets[]; };
+// Per copy (a crowd's characters, in instance-slot order), per target: this
+// frame's weight and the previous frame's.
+layout(set = 0, binding = 7, std430) readonly buffer Weights { vec2 weights[]; };
 layout(set = 0, binding = 2, std430) readonly buffer Deltas { float deltas[]; };
+// Copy after copy: each the object's vertex count long.
 layout(set = 0, binding = 3, std430) buffer Deformed { float deformed[]; };
 layout(set = 0, binding = 4, std430) buffer Previous { float previous[]; };
 // Per vertex: its joints and their weights (two sets of four; unused 0).
@@ -36,7 +36,7 @@ layout(set = 0, binding = 5, std430) readonly buffer Influences { Influence infl
 layout(set = 0, binding = 6, std430) readonly buffer Joints { mat4 joints[]; };
 // skinSlots: 0 (no skin), 4 or 8; jointCount: where the previous matrices start.
 layout(push_constant) uniform Push {
-    uint vertexCount; uint targetCount; uint skinSlots; uint jointCount;
+    uint vertexCount; uint targetCount; uint skinSlots; uint jointCount; uint copies;
 } pc;
 
 const uint STRIDE = 12u;
@@ -64,6 +64,7 @@ vec3 direction(mat4 m, vec3 v) {
 
 void main() {
     uint v = gl_GlobalInvocationID.x;
+    uint copy = gl_GlobalInvocationID.y;
     if (v >= pc.vertexCount) return;
     uint b = v * STRIDE;
     precise vec3 p = vec3(rest[b], rest[b + 1u], rest[b + 2u]);
@@ -72,24 +73,25 @@ void main() {
     precise vec3 q = p;
     for (uint i = 0u; i < pc.targetCount; i++) {
         Target g = targets[i];
+        vec2 w = weights[copy * pc.targetCount + i];
         if (v < g.first || v >= g.first + g.count) continue;
         uint k = v - g.first;
         uint at = g.offset + 3u * k;
-        if (g.weight != 0.0) {
-            precise vec3 wp = g.weight * delta(at);
+        if (w.x != 0.0) {
+            precise vec3 wp = w.x * delta(at);
             p = p + wp;
             if ((g.flags & 1u) != 0u) {
-                precise vec3 wn = g.weight * delta(at + 3u * g.count);
+                precise vec3 wn = w.x * delta(at + 3u * g.count);
                 n = n + wn;
             }
             if ((g.flags & 2u) != 0u) {
                 uint tangents = at + 3u * g.count * (((g.flags & 1u) != 0u) ? 2u : 1u);
-                precise vec3 wt = g.weight * delta(tangents);
+                precise vec3 wt = w.x * delta(tangents);
                 t = t + wt;
             }
         }
-        if (g.previous != 0.0) {
-            precise vec3 wq = g.previous * delta(at);
+        if (w.y != 0.0) {
+            precise vec3 wq = w.y * delta(at);
             q = q + wq;
         }
     }
@@ -115,11 +117,14 @@ void main() {
         }
         p = sp; n = sn; t = st; q = sq;
     }
+    // Written into this copy's vertices.
+    uint r = b;
+    b = (copy * pc.vertexCount + v) * STRIDE;
     deformed[b] = p.x; deformed[b + 1u] = p.y; deformed[b + 2u] = p.z;
     deformed[b + 3u] = n.x; deformed[b + 4u] = n.y; deformed[b + 5u] = n.z;
-    deformed[b + 6u] = rest[b + 6u]; deformed[b + 7u] = rest[b + 7u];
+    deformed[b + 6u] = rest[r + 6u]; deformed[b + 7u] = rest[r + 7u];
     deformed[b + 8u] = t.x; deformed[b + 9u] = t.y; deformed[b + 10u] = t.z;
-    deformed[b + 11u] = rest[b + 11u];
-    uint o = v * 3u;
+    deformed[b + 11u] = rest[r + 11u];
+    uint o = (copy * pc.vertexCount + v) * 3u;
     previous[o] = q.x; previous[o + 1u] = q.y; previous[o + 2u] = q.z;
 }

@@ -408,6 +408,11 @@ pub struct FrameArgs {
     /// tsd's option of that name clips its unwrapped meshes.
     #[arg(long, value_name = "NAME", requires = "time")]
     pub animation: Option<String>,
+    /// With --time and --heads: the seed each character's phase is drawn from
+    /// (every character but the first plays the motion at its own phase; the same
+    /// seed, the same crowd).
+    #[arg(long, value_name = "SEED", requires = "time")]
+    pub crowd_seed: Option<u64>,
     #[arg(long, help = with_range("Scene scale in millimetres per unit (default: from a 230 mm chin-to-crown head)", &ranges::MM_PER_UNIT))]
     pub mm_per_unit: Option<f32>,
     #[arg(long, default_value_t = defaults().width, help = with_range("Frame width", &ranges::WIDTH))]

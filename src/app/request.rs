@@ -128,6 +128,7 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         morph_weights: a.morph_weights.clone(),
         time: a.time,
         clip: a.animation.clone(),
+        crowd_seed: a.crowd_seed,
     }
 }
 

@@ -18,6 +18,12 @@ pub struct GpuMesh {
     pub vertices: Buffer,
     pub indices: Buffer,
     pub index_count: u32,
+    /// Vertices of one copy of the mesh.
+    pub vertex_count: u32,
+    /// Copies of the vertices the buffer holds, one per instance slot when
+    /// more than one (a crowd whose characters each deform their own: the
+    /// deform pass writes them); 0 or 1: one shared by every instance.
+    pub copies: u32,
 }
 
 impl GpuMesh {
@@ -41,12 +47,31 @@ impl GpuMesh {
         indices: &[u32],
         extra: vk::BufferUsageFlags,
     ) -> Result<Self> {
+        Self::upload_copies(ctx, name, vertices, indices, extra, 1)
+    }
+
+    /// [`GpuMesh::upload_with`] with `copies` copies of the vertices, one
+    /// per instance slot (`draw_instances` draws slot i from copy i).
+    pub fn upload_copies<V: bytemuck::Pod>(
+        ctx: &Context,
+        name: &str,
+        vertices: &[V],
+        indices: &[u32],
+        extra: vk::BufferUsageFlags,
+        copies: u32,
+    ) -> Result<Self> {
+        let copies = copies.max(1);
+        let all: Vec<V> = if copies > 1 {
+            vertices.repeat(copies as usize)
+        } else {
+            vertices.to_vec()
+        };
         let vertex_buffer = Guard::new(
             ctx,
             device_buffer(
                 ctx,
                 &format!("{name} vertices"),
-                bytemuck::cast_slice(vertices),
+                bytemuck::cast_slice(&all),
                 vk::BufferUsageFlags::VERTEX_BUFFER | extra,
                 AccessKind::VertexInputRead,
             )?,
@@ -62,6 +87,8 @@ impl GpuMesh {
             vertices: vertex_buffer.keep(),
             indices: index_buffer,
             index_count: indices.len() as u32,
+            vertex_count: vertices.len() as u32,
+            copies,
         })
     }
 
@@ -86,9 +113,24 @@ impl GpuMesh {
     /// `first..first + count` in one draw (the vertex shader reads each
     /// instance's model matrix by `gl_InstanceIndex`). Primitives are
     /// rasterised instance by instance, so this draws the same triangles in
-    /// the same order as `count` draws of one instance each.
+    /// the same order as `count` draws of one instance each. A mesh of
+    /// several copies draws each instance from its own copy (one draw each).
     pub fn draw_instances(&self, ctx: &Context, cmd: vk::CommandBuffer, first: u32, count: u32) {
         if count == 0 {
+            return;
+        }
+        if self.copies > 1 {
+            unsafe {
+                ctx.device
+                    .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
+                ctx.device
+                    .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
+                for i in first..first + count {
+                    let offset = (i * self.vertex_count) as i32;
+                    ctx.device
+                        .cmd_draw_indexed(cmd, self.index_count, 1, 0, offset, i);
+                }
+            }
             return;
         }
         unsafe {

@@ -42,9 +42,6 @@ struct TargetRow {
     count: u32,
     offset: u32,
     flags: u32,
-    weight: f32,
-    previous: f32,
-    pad: [f32; 2],
 }
 
 /// std430 `Influence` of the shader: joints of both sets, then weights.
@@ -64,6 +61,8 @@ struct DeformPush {
     skin_slots: u32,
     /// Where the previous pose's matrices start in `Joints`.
     joint_count: u32,
+    /// Copies deformed (one per crowd character, else 1).
+    copies: u32,
 }
 
 /// One morphing object's buffers on the GPU.
@@ -72,6 +71,7 @@ pub struct DeformObject {
     name: String,
     rest: Buffer,
     targets: Buffer,
+    weights: Buffer,
     deltas: Buffer,
     influences: Buffer,
     joints: Buffer,
@@ -84,6 +84,7 @@ pub struct DeformObject {
     target_count: u32,
     skin_slots: u32,
     joint_count: u32,
+    copies: u32,
     /// Offsets read per vertex, on average (what the work declares).
     offsets_per_vertex: f64,
 }
@@ -109,7 +110,7 @@ pub struct Deform {
 fn flatten(morph: &Morph) -> (Vec<f32>, Vec<TargetRow>) {
     let mut deltas = Vec::new();
     let mut rows = Vec::new();
-    for (t, &w) in morph.targets.iter().zip(&morph.weights) {
+    for t in &morph.targets {
         let offset = deltas.len() as u32;
         for part in [&t.position, &t.normal, &t.tangent] {
             deltas.extend(part.iter().flatten());
@@ -119,10 +120,6 @@ fn flatten(morph: &Morph) -> (Vec<f32>, Vec<TargetRow>) {
             count: t.len() as u32,
             offset,
             flags: u32::from(!t.normal.is_empty()) | (u32::from(!t.tangent.is_empty()) << 1),
-            weight: w,
-            // No frame before the first: still.
-            previous: w,
-            pad: [0.0; 2],
         });
     }
     // A storage buffer may not be empty: a skin without targets binds one
@@ -134,6 +131,22 @@ fn flatten(morph: &Morph) -> (Vec<f32>, Vec<TargetRow>) {
         rows.push(TargetRow::zeroed());
     }
     (deltas, rows)
+}
+
+/// Each copy's weights as the shader reads them: (this frame's, the
+/// previous frame's) per target, copy after copy; with no frame before the
+/// first, the previous are these. One zero pair without targets.
+fn flatten_weights(morph: &Morph, copies: &[Vec<f32>]) -> Vec<[f32; 2]> {
+    let one = [morph.weights.clone()];
+    let copies = if copies.is_empty() { &one[..] } else { copies };
+    let mut out: Vec<[f32; 2]> = copies
+        .iter()
+        .flat_map(|w| w.iter().map(|&w| [w, w]))
+        .collect();
+    if out.is_empty() {
+        out.push([0.0; 2]);
+    }
+    out
 }
 
 /// A skin's influences as the shader reads them, and its matrices (the
@@ -169,7 +182,9 @@ impl Deform {
     /// Adds an object drawn from `vertices` (a vertex and storage buffer of
     /// the rest mesh's size) morphing by `morph`: its static buffers, and
     /// the vertex buffer tracked, so the draws that read it wait for the
-    /// pass. Returns its tracked id.
+    /// pass; `copies`: each copy's weights (a crowd's characters, in
+    /// instance-slot order; empty: one copy at `morph`'s). Returns its
+    /// tracked id.
     pub fn add(
         &mut self,
         ctx: &Context,
@@ -177,9 +192,12 @@ impl Deform {
         name: &str,
         vertices: vk::Buffer,
         morph: &Morph,
+        copies: &[Vec<f32>],
     ) -> Result<BufferId> {
         let n = morph.rest.len() as u64;
         let (deltas, rows) = flatten(morph);
+        let weights = flatten_weights(morph, copies);
+        let c = copies.len().max(1) as u64;
         let (influences, joints) = flatten_skin(morph.skin.as_ref());
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // Read back by tests (`read_back`).
@@ -191,6 +209,7 @@ impl Deform {
             target_count: morph.targets.len() as u32,
             skin_slots: morph.skin.as_ref().map_or(0, |s| s.slots as u32),
             joint_count: morph.skin.as_ref().map_or(0, |s| s.matrices.len() as u32),
+            copies: c as u32,
             offsets_per_vertex: rows.iter().map(|r| r.count as f64).sum::<f64>() / n.max(1) as f64,
             ..Default::default()
         };
@@ -205,6 +224,13 @@ impl Deform {
             ctx,
             &format!("{name} morph targets"),
             bytemuck::cast_slice(&rows),
+            usage,
+            read,
+        )?;
+        o.weights = device_buffer(
+            ctx,
+            &format!("{name} morph weights"),
+            bytemuck::cast_slice(&weights),
             usage,
             read,
         )?;
@@ -229,7 +255,7 @@ impl Deform {
             usage,
             read,
         )?;
-        let zeros = vec![0f32; 3 * n as usize];
+        let zeros = vec![0f32; (3 * n * c) as usize];
         o.previous = device_buffer(
             ctx,
             &format!("{name} previous positions"),
@@ -260,6 +286,7 @@ impl Deform {
                         (rows.len() * std::mem::size_of::<TargetRow>()) as u64,
                     ),
                 ),
+                ("Weights", whole(&o.weights, 8 * weights.len() as u64)),
                 ("Deltas", whole(&o.deltas, 4 * deltas.len() as u64)),
                 (
                     "Influences",
@@ -274,7 +301,7 @@ impl Deform {
                     Binding::StorageBuffer {
                         id: o.vertices,
                         offset: 0,
-                        size: 4 * VERTEX_FLOATS * n,
+                        size: 4 * VERTEX_FLOATS * n * c,
                         storage: Storage::Write,
                     },
                 ),
@@ -283,7 +310,7 @@ impl Deform {
                     Binding::StorageBuffer {
                         id: o.previous_id,
                         offset: 0,
-                        size: 12 * n,
+                        size: 12 * n * c,
                         storage: Storage::Write,
                     },
                 ),
@@ -315,7 +342,7 @@ impl Deform {
                 // the slots' count is the upper bound); the vertex and its
                 // previous position written.
                 storage_read_bytes: 4.0 * VERTEX_FLOATS as f64
-                    + 32.0 * o.target_count as f64
+                    + 24.0 * o.target_count as f64
                     + 36.0 * o.offsets_per_vertex
                     + if o.skin_slots > 0 {
                         std::mem::size_of::<InfluenceRow>() as f64 + 128.0 * o.skin_slots as f64
@@ -330,12 +357,13 @@ impl Deform {
                 target_count: o.target_count,
                 skin_slots: o.skin_slots,
                 joint_count: o.joint_count,
+                copies: o.copies,
             };
             // Vertex work of the frame, with the geometry it feeds.
             let mut pass = Pass::new(format!("deform {}", o.name), PassRole::Geometry);
             let set = pass.set(&o.set);
             passes.push(
-                pass.dispatch(work, [o.vertex_count.div_ceil(GROUP), 1, 1], GROUP)
+                pass.dispatch(work, [o.vertex_count.div_ceil(GROUP), o.copies, 1], GROUP)
                     .record(move |pc: &PassContext| {
                         pc.bind(&self.pipeline, &[set]);
                         self.pipeline.push(pc.ctx, pc.cmd, &push);
@@ -351,7 +379,7 @@ impl Deform {
     pub fn read_back(&self, ctx: &Context, res: &mut Resources) -> Result<Vec<Deformed>> {
         let mut out = Vec::new();
         for o in &self.objects {
-            let n = o.vertex_count as u64;
+            let n = o.vertex_count as u64 * o.copies as u64;
             let mut read = |id: BufferId, bytes: u64, what: &str| -> Result<Vec<f32>> {
                 let name = format!("{} {what} read-back", o.name);
                 let host = Guard::new(
@@ -403,6 +431,7 @@ impl Deform {
             for b in [
                 &mut o.rest,
                 &mut o.targets,
+                &mut o.weights,
                 &mut o.deltas,
                 &mut o.influences,
                 &mut o.joints,

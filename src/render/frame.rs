@@ -18,6 +18,8 @@ use ash::vk;
 use glam::Mat4;
 
 mod character_ids;
+mod motion;
+pub use motion::head_copies;
 
 use super::deform::Deform;
 use super::groups::merge::Merge;
@@ -50,6 +52,7 @@ use crate::vk::pipeline::{
 };
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
+use motion::turned;
 
 /// Descriptor sets the frame's pool holds: the frame's and the objects' few,
 /// and every method's (the reference's sets grow with its sample chunks).
@@ -141,6 +144,7 @@ impl Frame {
         };
         let full = PixelRect::full(extent.width, extent.height);
         let every = (0..framing.instances.len()).collect();
+        let instances = turned(scene, framing.instances);
         let f = Frame {
             settings: settings.clone(),
             extent,
@@ -148,7 +152,7 @@ impl Frame {
             targets,
             camera: framing.camera,
             light_frame: framing.light,
-            instances: framing.instances,
+            instances,
             backdrop: framing.backdrop,
             samplers: Samplers::default(),
             pool: DescriptorPool::default(),
@@ -245,12 +249,13 @@ impl Frame {
                     .enumerate()
                     .map(|(i, p)| (format!("part {i}"), ObjectKind::Part, p)),
             );
+        let copies = head_copies(scene, self.instances.len());
         for (name, kind, o) in objects {
             let g = GpuObject::new(
                 ctx,
                 &name,
                 kind,
-                o,
+                (o, if name == "head" { copies } else { 1 }),
                 &self.pool,
                 &self.geometry_pipeline,
                 &self.samplers,
@@ -343,32 +348,6 @@ impl Frame {
             ctx,
             &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
         )?;
-        Ok(())
-    }
-
-    /// The deform pass of every object with a skin or morph weights not all
-    /// 0 (`scene`'s, in the order `build` made the objects).
-    pub fn enable_deform(
-        &mut self,
-        ctx: &Context,
-        scene: &Scene,
-        res: &mut Resources,
-    ) -> Result<()> {
-        let morphs = scene
-            .backdrop
-            .iter()
-            .chain([&scene.head])
-            .chain(&scene.parts)
-            .map(|o| &o.morph);
-        self.deform = Deform::new(ctx)?;
-        for (obj, morph) in self.objects.iter_mut().zip(morphs) {
-            if !morph.at_rest() {
-                let id = self
-                    .deform
-                    .add(ctx, res, &obj.name, obj.mesh.vertices.raw, morph)?;
-                obj.deformed = Some(id);
-            }
-        }
         Ok(())
     }
 

@@ -175,7 +175,6 @@ impl<'c> Renderer<'c> {
         if let Some(ids) = ids {
             frame.enable_character_ids(ctx, &resources, ids)?;
         }
-        frame.enable_deform(ctx, scene, &mut resources)?;
         frame.enable_post(ctx, &mut resources)?;
         frame.set_skin_groups(
             ctx,
@@ -187,6 +186,8 @@ impl<'c> Renderer<'c> {
                 })
                 .collect(),
         )?;
+        // After the groups: a crowd's copies are in their instance slots.
+        frame.enable_deform(ctx, scene, &mut resources)?;
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
         let sss_output = groups::passes::output(&groups, &frame.targets);

@@ -101,7 +101,8 @@ impl GpuObject {
         ctx: &Context,
         name: &str,
         kind: ObjectKind,
-        object: &Object,
+        // The object, and the copies of its vertices (`GpuMesh::copies`).
+        (object, copies): (&Object, u32),
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -118,7 +119,7 @@ impl GpuObject {
                 material_set: vk::DescriptorSet::null(),
             },
         );
-        g.upload(ctx, object, pool, geometry, samplers)?;
+        g.upload(ctx, object, copies, pool, geometry, samplers)?;
         Ok(g.keep())
     }
 
@@ -126,6 +127,7 @@ impl GpuObject {
         &mut self,
         ctx: &Context,
         object: &Object,
+        copies: u32,
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -133,13 +135,14 @@ impl GpuObject {
         let name = self.name.clone();
         let mesh = &object.mesh;
         // A morphing object's vertices are written by the deform pass too.
-        let extra = if object.morph.at_rest() {
+        let extra = if object.morph.at_rest() && copies <= 1 {
             vk::BufferUsageFlags::empty()
         } else {
             // Written by the deform pass, read back by tests.
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC
         };
-        self.mesh = GpuMesh::upload_with(ctx, &name, &mesh.vertices, &mesh.indices, extra)?;
+        self.mesh =
+            GpuMesh::upload_copies(ctx, &name, &mesh.vertices, &mesh.indices, extra, copies)?;
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [

@@ -745,6 +745,7 @@ fn build_face_scene() -> Scene {
     let head_bounds = head.bounds();
     let expressions = expression_morph(&head, skull, MM_PER_UNIT);
     let mut scene = Scene {
+        tracks: None,
         name: "procedural face".to_owned(),
         mm_per_unit: MM_PER_UNIT,
         head: Object {

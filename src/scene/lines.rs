@@ -112,6 +112,7 @@ pub fn lines_scene() -> Scene {
     let head = lines_mesh();
     let head_bounds = head.bounds();
     Scene {
+        tracks: None,
         name: "thin lines and a grid".to_owned(),
         mm_per_unit: MM_PER_UNIT,
         head: Object {

@@ -4,6 +4,7 @@
 
 pub mod animation;
 pub mod camera;
+pub mod crowd_motion;
 pub mod enclosed;
 pub mod expressions;
 pub mod eyes;
@@ -55,6 +56,10 @@ pub struct Scene {
     /// scale): what a report records to render the frame again. `None`: a
     /// scene built in code (tests).
     pub source: Option<source::SceneSource>,
+    /// How a crowd of it moves at the scene's time (`--time`): each
+    /// character its own phase (`crowd_motion`). `None`: every character
+    /// as posed.
+    pub tracks: Option<crowd_motion::Tracks>,
 }
 
 impl Scene {
@@ -125,13 +130,22 @@ impl Scene {
     pub fn play_builtin(&mut self, t: f32) {
         let clip = expressions::expression_clip();
         let face = self.head.morph.targets.len() == expressions::EXPRESSIONS.len();
-        match animation::animated_weights(&clip, 0, t).filter(|_| face) {
+        let motion = match animation::animated_weights(&clip, 0, t).filter(|_| face) {
             Some(w) => {
                 self.head.morph.weights = w;
                 self.head.pose();
+                crowd_motion::Motion::Weights(clip)
             }
-            None => self.rotate_character(animation::rigid_rotation(t)),
-        }
+            None => {
+                self.rotate_character(animation::rigid_rotation(t));
+                crowd_motion::Motion::Rigid
+            }
+        };
+        self.tracks = Some(crowd_motion::Tracks {
+            time: t,
+            seed: crowd_motion::DEFAULT_SEED,
+            motion,
+        });
     }
 
     /// Turns the character (its head and parts, their morphs' rest shapes and
@@ -245,6 +259,7 @@ pub fn egg_scene() -> Scene {
     let head = procedural::head_mesh();
     let head_bounds = head.bounds();
     Scene {
+        tracks: None,
         name: "procedural head".to_owned(),
         mm_per_unit: procedural::MM_PER_UNIT,
         head: mesh::Object {
@@ -324,6 +339,11 @@ pub fn load_gltf_scene(
             animation::RIGID_PERIOD_S
         );
         scene.rotate_character(animation::rigid_rotation(t));
+        scene.tracks = Some(crowd_motion::Tracks {
+            time: t,
+            seed: crowd_motion::DEFAULT_SEED,
+            motion: crowd_motion::Motion::Rigid,
+        });
     }
     scene.source = Some(source::SceneSource {
         scene: Some(path.to_path_buf()),
@@ -337,6 +357,7 @@ pub fn load_gltf_scene(
         morph_weights: Vec::new(),
         time: overrides.time,
         clip: overrides.clip.clone(),
+        crowd_seed: None,
     });
     Ok(scene)
 }
@@ -386,6 +407,7 @@ pub fn scene_from_character(
             a.union(&b)
         });
     Ok(Scene {
+        tracks: None,
         name: name.to_string(),
         mm_per_unit,
         head_bounds,

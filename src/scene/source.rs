@@ -46,6 +46,10 @@ pub struct SceneSource {
     pub time: Option<f32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clip: Option<String>,
+    /// The seed of a crowd's phases (`crowd_motion`; default its
+    /// `DEFAULT_SEED`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crowd_seed: Option<u64>,
 }
 
 impl SceneSource {
@@ -110,11 +114,15 @@ impl SceneSource {
         if let (Some(t), None) = (self.time, self.gltf()) {
             scene.play_builtin(t);
         }
+        if let Some(tracks) = &mut scene.tracks {
+            tracks.seed = self.crowd_seed.unwrap_or(super::crowd_motion::DEFAULT_SEED);
+        }
         scene.set_morph_weights(&weights)?;
         if let Some(src) = &mut scene.source {
             src.morph_weights = self.morph_weights.clone();
             src.time = self.time;
             src.clip = self.clip.clone();
+            src.crowd_seed = self.crowd_seed;
         }
         Ok(scene)
     }

@@ -174,6 +174,7 @@ fn a_frame_with_no_edges_has_the_1x_frame_as_its_reference() {
     };
     let head_bounds = mesh.bounds();
     let scene = Scene {
+        tracks: None,
         name: "uniform card".into(),
         mm_per_unit: 10.0,
         head: Object {

@@ -158,6 +158,7 @@ fn halo_scene() -> Scene {
     mesh.generate_tangents();
     let bounds = Aabb::from_points(mesh.vertices.iter().map(|v| Vec3::from(v.position))).unwrap();
     Scene {
+        tracks: None,
         name: "halo".into(),
         mm_per_unit: 10.0,
         head: Object {

@@ -119,6 +119,7 @@ fn checker() -> Texture {
 fn scene_of(mesh: Mesh, mm_per_unit: f32, albedo: Option<Texture>) -> Scene {
     let head_bounds = mesh.bounds();
     Scene {
+        tracks: None,
         name: "tsd test".into(),
         mm_per_unit,
         head: Object {
