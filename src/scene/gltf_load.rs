@@ -173,9 +173,15 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
         (None, None) => None,
     };
     let time = overrides.time.unwrap_or(0.0);
+    unsupported_features(&src, &mut warn);
     if let Some(c) = clip {
+        let past = if time > c.duration() {
+            " (past its end: its last pose)".to_string()
+        } else {
+            String::new()
+        };
         warn.note(format!(
-            "animation '{}' ({:.3} s, {} channels) posed at {time} s",
+            "animation '{}' ({:.3} s, {} channels) posed at {time} s{past}",
             c.name,
             c.duration(),
             c.channels.len()
@@ -273,6 +279,48 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     let mut loaded = warn.finish(object, parts);
     loaded.animated = clip.is_some();
     Ok(loaded)
+}
+
+/// What the file has that dermis does not draw, each said once: extensions
+/// it uses without requiring them (a file that requires one is refused by
+/// `gltf_source`), its cameras and its lights.
+fn unsupported_features(src: &super::gltf_source::Source, warn: &mut Warnings) {
+    let used = src
+        .json
+        .get("extensionsUsed")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+        .filter_map(|v| v.as_str());
+    for e in used.filter(|e| !super::gltf_source::SUPPORTED_REQUIRED_EXTENSIONS.contains(e)) {
+        let e = super::gltf_source::short(e);
+        match e.as_ref() {
+            "EXT_mesh_gpu_instancing" => warn.push(format!(
+                "{e} is not supported: each instanced mesh is drawn once, at its node, without its instances"
+            )),
+            "KHR_lights_punctual" => warn.note(format!(
+                "{e}: the file's lights are not used (dermis lights every scene with its own key light)"
+            )),
+            _ => warn.push(format!("{e} is not supported: drawn without it")),
+        }
+    }
+    let cameras = src.doc.cameras().count();
+    if cameras > 0 {
+        warn.note(format!(
+            "the file's {cameras} camera(s) are not used (dermis frames the character: --shot, --distance)"
+        ));
+    }
+    let colours = src
+        .doc
+        .meshes()
+        .flat_map(|m| m.primitives())
+        .filter(|p| p.get(&gltf::Semantic::Colors(0)).is_some())
+        .count();
+    if colours > 0 {
+        warn.push(format!(
+            "{colours} primitive(s) have vertex colours (COLOR_0), which dermis does not draw: their materials' colours are used"
+        ));
+    }
 }
 
 /// What the skin rule reads of one material: its name and its extras' `skin`.

@@ -330,8 +330,30 @@ pub fn load_gltf_scene(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
+    // A posed clip is measured at its rest pose: one scale (the SSS's
+    // millimetres) and one face direction for every time of the clip.
+    let rest = match (loaded.animated, mm_per_unit) {
+        (true, None) => {
+            let still = gltf_load::TextureOverrides {
+                time: None,
+                clip: None,
+                ..overrides.clone()
+            };
+            let r = gltf_load::load_head_with_notes(path, &still)
+                .with_context(|| format!("loading the rest pose of {}", path.display()))?;
+            let forward = gltf_load::face_direction(&r.object.mesh);
+            let (_, height) = head_measure::framed_part(&r.object.mesh, forward);
+            (height.is_finite() && height > 0.0)
+                .then(|| (head_measure::HEAD_HEIGHT_MM / height, forward))
+        }
+        _ => None,
+    };
+    let mm_per_unit = rest.map(|r| r.0).or(mm_per_unit);
     let mut scene = scene_from_character(&name, loaded.object, loaded.parts, mm_per_unit)
         .with_context(|| format!("framing the head in {}", path.display()))?;
+    if let Some((_, forward)) = rest {
+        scene.forward = forward;
+    }
     if let (Some(t), false) = (overrides.time, loaded.animated) {
         eprintln!(
             "note: {}: the file has no animation: --time {t} turns and nods it (dermis's rigid clip, {} s, looped)",

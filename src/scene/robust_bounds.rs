@@ -9,6 +9,8 @@
 //! scale, so a flat mesh with a zero span on one axis does not reject its own relief).
 //! The box is then the exact box of the points inside the fence, so a mesh without
 //! outliers gets exactly its plain bounds. Non-finite points are always left out.
+//! A mesh of fewer than `SMALL` points has no percentiles worth the name: its band is
+//! the box of all but the point farthest from the median (fewer than four: all).
 
 use super::mesh::Aabb;
 use glam::{DVec3, Vec3};
@@ -22,6 +24,10 @@ pub const FENCE: f64 = 2.0;
 /// Lower and upper percentile of the band the fence is built around.
 const LOW_QUANTILE: f64 = 0.05;
 const HIGH_QUANTILE: f64 = 0.95;
+
+/// Below this many points the percentiles hold less than one point each
+/// side: the band is built without them.
+const SMALL: usize = 20;
 
 /// Bounds of the points inside the fence, and how many were left out.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,21 +77,53 @@ pub fn robust_bounds_f64(points: &[DVec3]) -> Option<RobustBounds64> {
         return None;
     }
     let n = finite.len();
-    let (lo_at, hi_at) = (
-        ((n - 1) as f64 * LOW_QUANTILE) as usize,
-        ((n - 1) as f64 * HIGH_QUANTILE) as usize,
-    );
     let mut lo = DVec3::ZERO;
     let mut hi = DVec3::ZERO;
-    let mut axis: Vec<f64> = Vec::with_capacity(n);
-    for a in 0..3 {
-        axis.clear();
-        axis.extend(finite.iter().map(|p| p[a]));
-        // Selection, not a sort: linear time on multi-million-vertex scans.
-        let (_, &mut l, _) = axis.select_nth_unstable_by(lo_at, f64::total_cmp);
-        let (_, &mut h, _) = axis.select_nth_unstable_by(hi_at, f64::total_cmp);
-        lo[a] = l;
-        hi[a] = h;
+    if n < SMALL {
+        // Too few points for percentiles (5% of them is not one point, and
+        // the middle values of a small shape can coincide on every axis):
+        // the band is the box of all but the one point farthest from the
+        // per-axis median, which alone may be judged an outlier. Fewer than
+        // four points are all kept (a triangle's third vertex is not an
+        // outlier of the other two).
+        if n < 4 {
+            lo = finite.iter().copied().fold(DVec3::INFINITY, DVec3::min);
+            hi = finite.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
+        } else {
+            let mut median = DVec3::ZERO;
+            let mut axis: Vec<f64> = Vec::with_capacity(n);
+            for a in 0..3 {
+                axis.clear();
+                axis.extend(finite.iter().map(|p| p[a]));
+                let (_, &mut m, _) = axis.select_nth_unstable_by(n / 2, f64::total_cmp);
+                median[a] = m;
+            }
+            let far = (0..n)
+                .max_by(|&i, &j| {
+                    finite[i]
+                        .distance_squared(median)
+                        .total_cmp(&finite[j].distance_squared(median))
+                })
+                .unwrap_or(0);
+            let rest = finite.iter().enumerate().filter(|(i, _)| *i != far);
+            lo = rest.clone().fold(DVec3::INFINITY, |a, (_, p)| a.min(*p));
+            hi = rest.fold(DVec3::NEG_INFINITY, |a, (_, p)| a.max(*p));
+        }
+    } else {
+        let (lo_at, hi_at) = (
+            ((n - 1) as f64 * LOW_QUANTILE) as usize,
+            ((n - 1) as f64 * HIGH_QUANTILE) as usize,
+        );
+        let mut axis: Vec<f64> = Vec::with_capacity(n);
+        for a in 0..3 {
+            axis.clear();
+            axis.extend(finite.iter().map(|p| p[a]));
+            // Selection, not a sort: linear time on multi-million-vertex scans.
+            let (_, &mut l, _) = axis.select_nth_unstable_by(lo_at, f64::total_cmp);
+            let (_, &mut h, _) = axis.select_nth_unstable_by(hi_at, f64::total_cmp);
+            lo[a] = l;
+            hi[a] = h;
+        }
     }
     let scale = (hi - lo).max_element();
     // When the band is a single point on every axis (most vertices coincide) there is
@@ -167,6 +205,17 @@ mod tests {
         let b =
             robust_bounds([Vec3::ZERO, Vec3::ONE, Vec3::splat(0.5), Vec3::splat(1e30)]).unwrap();
         assert_eq!((b.ignored, b.aabb.max), (1, Vec3::ONE));
+    }
+
+    #[test]
+    fn a_triangle_keeps_its_three_vertices() {
+        // The Khronos SimpleMorph sample at its default weights: a tip three
+        // base widths above its base is the triangle, not corrupt data.
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::new(0.5, 1.5, 0.0)];
+        let b = robust_bounds(tri).unwrap();
+        assert_eq!((b.ignored, b.aabb.max), (0, Vec3::new(1.0, 1.5, 0.0)));
+        let b = robust_bounds([Vec3::ZERO, Vec3::splat(1e30)]).unwrap();
+        assert_eq!(b.ignored, 0);
     }
 
     #[test]

@@ -286,3 +286,57 @@ fn skins_place_vertices_by_their_joints_at_the_time_asked() {
         "{e}"
     );
 }
+
+/// A clip is measured at its rest pose: the scale (the SSS's millimetres)
+/// and the face direction are the same at every time, though the bend
+/// changes the mesh's height.
+#[test]
+fn a_clip_keeps_the_scale_of_its_rest_pose() {
+    let dir = temp_dir("skin-scale");
+    let path = skinned_quad(&dir, "scale.gltf", QUAD_JOINTS, QUAD_WEIGHTS, 2, true);
+    let at = |t: Option<f32>| {
+        let o = TextureOverrides {
+            time: t,
+            ..Default::default()
+        };
+        crate::scene::load_gltf_scene(&path, &o, None).unwrap()
+    };
+    let rest = at(None);
+    for t in [0.25, 0.5, 1.0] {
+        let s = at(Some(t));
+        assert_eq!(s.mm_per_unit, rest.mm_per_unit, "at {t} s");
+        assert_eq!(s.forward, rest.forward, "at {t} s");
+        assert_ne!(s.head.mesh.vertices, rest.head.mesh.vertices);
+    }
+}
+
+/// What a file has that dermis does not draw is said: instancing, vertex
+/// colours, cameras, lights, other extensions.
+#[test]
+fn what_is_not_drawn_is_said() {
+    let dir = temp_dir("unsaid");
+    let colours = f32_bytes(&[1.0; 16]);
+    let prim = serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "COLOR_0": 3}});
+    let acc =
+        serde_json::json!([{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"}]);
+    let mut m = Model::quad(prim, acc, &colours, None);
+    m.json["extensionsUsed"] = serde_json::json!([
+        "EXT_mesh_gpu_instancing",
+        "KHR_lights_punctual",
+        "KHR_materials_sheen"
+    ]);
+    m.json["cameras"] =
+        serde_json::json!([{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}]);
+    let path = write_gltf(&dir, "unsaid.gltf", m.json, &m.buffer);
+    let l = load_head_with_notes(&path, &TextureOverrides::default()).unwrap();
+    let all: Vec<&String> = l.warnings.iter().chain(&l.notes).collect();
+    for says in [
+        "EXT_mesh_gpu_instancing is not supported: each instanced mesh is drawn once",
+        "KHR_lights_punctual: the file's lights are not used",
+        "KHR_materials_sheen is not supported: drawn without it",
+        "the file's 1 camera(s) are not used",
+        "1 primitive(s) have vertex colours (COLOR_0)",
+    ] {
+        assert!(all.iter().any(|w| w.contains(says)), "{says}: {all:?}");
+    }
+}
