@@ -488,3 +488,57 @@ fn a_moving_crowd_deforms_each_character_at_its_own_phase() {
         .unwrap();
     assert_ne!(first.diffuse, other.diffuse);
 }
+
+/// A public sample no code of ours wrote: the glTF tutorial's SimpleSkin
+/// (tests/fixtures/khronos). At the 1 s key the upper joint (at y = 1) has
+/// turned 90 degrees about +Z (the file's quaternion (0, 0, 0.707, 0.707)),
+/// the lower joint is still; the strip's top corner (0.5, 2), held by the
+/// upper joint alone, goes to (-1, 1.5), and the middle corner (0.5, 1),
+/// held half and half, to the mean of (0.5, 1) and (0, 1.5). The GPU's
+/// deform pass writes those vertices as the CPU does, to the bit.
+#[test]
+fn the_khronos_simple_skin_bends_as_its_file_states() {
+    use dermis::scene::morph::deformed;
+    use dermis::scene::source::SceneSource;
+    let path = std::path::PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/khronos/SimpleSkin.gltf"
+    ));
+    let src = SceneSource {
+        scene: Some(path),
+        time: Some(1.0),
+        ..SceneSource::default()
+    };
+    let scene = src.load().unwrap();
+    let m = &scene.head.morph;
+    assert!(m.skin.is_some(), "the strip is skinned");
+    let at = |bind: [f32; 3]| -> Vec<Vec3> {
+        m.rest
+            .iter()
+            .zip(&scene.head.mesh.vertices)
+            .filter(|(r, _)| r.position == bind)
+            .map(|(_, v)| Vec3::from(v.position))
+            .collect()
+    };
+    for (bind, want) in [
+        ([0.5, 2.0, 0.0], Vec3::new(-1.0, 1.5, 0.0)),
+        ([0.5, 1.0, 0.0], Vec3::new(0.25, 1.25, 0.0)),
+        ([-0.5, 0.0, 0.0], Vec3::new(-0.5, 0.0, 0.0)),
+    ] {
+        let got = at(bind);
+        assert!(!got.is_empty(), "no vertex at {bind:?}");
+        for p in got {
+            assert!(
+                (p - want).length() < 1e-5,
+                "{bind:?} went to {p}, not {want}"
+            );
+        }
+    }
+    // The GPU: the same vertices to the bit.
+    let ctx = common::ctx();
+    let mut r = Renderer::new(&ctx, &scene, &settings()).unwrap();
+    r.capture(false).unwrap();
+    let got = r.deformed().unwrap();
+    let want = deformed(&m.rest, m);
+    assert_eq!(got[0].vertices, bytemuck::cast_slice::<_, f32>(&want));
+}
