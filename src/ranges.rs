@@ -303,8 +303,18 @@ pub const TIME: Range = range(
     "seconds",
 );
 
+/// The levels of detail's error budget: 0 (off) to 64 pixels (a level that
+/// strays more is no longer the character).
+pub const LOD_PIXELS: Range = range(
+    "--lod-pixels",
+    "lod_pixels",
+    End::Incl(0.0),
+    End::Incl(64.0),
+    "pixels",
+);
+
 /// Every range above, in the order docs/usage.md lists them.
-pub const ALL: [&Range; 17] = [
+pub const ALL: [&Range; 18] = [
     &WIDTH,
     &HEIGHT,
     &SHADOW_SIZE,
@@ -322,6 +332,7 @@ pub const ALL: [&Range; 17] = [
     &FRAMES,
     &WARMUP,
     &TIME,
+    &LOD_PIXELS,
 ];
 
 #[cfg(test)]

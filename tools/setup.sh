@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs what dermis needs on Debian 12 that a fresh machine lacks: the GLSL
 # compiler, the Vulkan loader, lavapipe (the CPU Vulkan driver the tests run
-# on) and the Khronos validation layer. Idempotent: installed packages are skipped.
+# on), the Khronos validation layer and g++ (meshoptimizer, the levels of
+# detail's simplifier, is C++ built by its crate). Idempotent: installed packages are skipped.
 set -euo pipefail
-packages=(glslang-tools mesa-vulkan-drivers libvulkan1 vulkan-validationlayers fonts-dejavu-core)
+packages=(glslang-tools mesa-vulkan-drivers libvulkan1 vulkan-validationlayers fonts-dejavu-core g++)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -508,6 +508,11 @@ pub struct FrameArgs {
     /// before the SSS passes (1: none; the device must support the count).
     #[arg(long, default_value_t = defaults().msaa)]
     pub msaa: u32,
+    /// Levels of detail: each character drawn with the coarsest simplified level of
+    /// its meshes whose measured error covers at most this many pixels at its
+    /// distance (0: the full meshes).
+    #[arg(long, default_value_t = defaults().lod_pixels, help = with_range("Levels of detail: the error a character's simplified meshes may cover on screen (0: full meshes)", &ranges::LOD_PIXELS))]
+    pub lod_pixels: f32,
 }
 
 /// The options every registered method declares, one flag each, added from the

@@ -175,6 +175,7 @@ pub fn settings(a: &FrameArgs) -> Result<RenderSettings> {
     s.post.aa_edges = a.aa_edges;
     s.post.smaa_preset = a.smaa_preset;
     s.msaa = a.msaa;
+    s.lod_pixels = a.lod_pixels;
     Ok(s)
 }
 

@@ -24,6 +24,13 @@ pub struct GpuMesh {
     /// more than one (a crowd whose characters each deform their own: the
     /// deform pass writes them); 0 or 1: one shared by every instance.
     pub copies: u32,
+    /// Its levels of detail (`scene::lod`): each level's first index and
+    /// index count in the index buffer, the full mesh first; empty: the full
+    /// mesh only.
+    pub levels: Vec<(u32, u32)>,
+    /// The level each instance slot draws (set by the frame once it knows
+    /// where each character stands); empty: every slot the full mesh.
+    pub slot_levels: Vec<u8>,
 }
 
 impl GpuMesh {
@@ -89,12 +96,30 @@ impl GpuMesh {
             index_count: indices.len() as u32,
             vertex_count: vertices.len() as u32,
             copies,
+            levels: Vec::new(),
+            slot_levels: Vec::new(),
         })
     }
 
-    /// Triangles of one draw.
+    /// Triangles of one draw of the full mesh.
     pub fn triangles(&self) -> u64 {
         self.index_count as u64 / 3
+    }
+
+    /// Triangles instance slot `slot` draws (its level's).
+    pub fn slot_triangles(&self, slot: usize) -> u64 {
+        match self.slot_levels.get(slot) {
+            Some(&l) => self.levels[l as usize].1 as u64 / 3,
+            None => self.triangles(),
+        }
+    }
+
+    /// The (first index, index count) slot `slot` draws.
+    fn slot_range(&self, slot: u32) -> (u32, u32) {
+        match self.slot_levels.get(slot as usize) {
+            Some(&l) => self.levels[l as usize],
+            None => (0, self.index_count),
+        }
     }
 
     /// Binds the buffers and draws every triangle once.
@@ -119,17 +144,32 @@ impl GpuMesh {
         if count == 0 {
             return;
         }
-        if self.copies > 1 {
+        if self.copies > 1 || !self.slot_levels.is_empty() {
             unsafe {
                 ctx.device
                     .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
                 ctx.device
                     .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
-                for i in first..first + count {
-                    let offset = (i * self.vertex_count) as i32;
-                    ctx.device
-                        .cmd_draw_indexed(cmd, self.index_count, 1, 0, offset, i);
+            }
+            // Runs of slots that draw the same range from the same vertices
+            // in one instanced draw each.
+            let mut i = first;
+            while i < first + count {
+                let range = self.slot_range(i);
+                let mut n = 1;
+                while self.copies <= 1 && i + n < first + count && self.slot_range(i + n) == range {
+                    n += 1;
                 }
+                let offset = if self.copies > 1 {
+                    (i * self.vertex_count) as i32
+                } else {
+                    0
+                };
+                unsafe {
+                    ctx.device
+                        .cmd_draw_indexed(cmd, range.1, n, range.0, offset, i);
+                }
+                i += n;
             }
             return;
         }

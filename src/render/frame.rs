@@ -255,7 +255,11 @@ impl Frame {
                 ctx,
                 &name,
                 kind,
-                (o, if name == "head" { copies } else { 1 }),
+                (
+                    o,
+                    if name == "head" { copies } else { 1 },
+                    kind.per_character() && self.settings.lod_pixels > 0.0,
+                ),
                 &self.pool,
                 &self.geometry_pipeline,
                 &self.samplers,
@@ -714,7 +718,15 @@ impl Frame {
         self.objects
             .iter()
             .filter(|o| of(o.kind))
-            .map(|o| o.mesh.triangles() * copies(o.kind))
+            .map(|o| {
+                if o.kind.per_character() && !o.mesh.slot_levels.is_empty() {
+                    (0..o.mesh.slot_levels.len())
+                        .map(|s| o.mesh.slot_triangles(s))
+                        .sum()
+                } else {
+                    o.mesh.triangles() * copies(o.kind)
+                }
+            })
             .sum()
     }
 

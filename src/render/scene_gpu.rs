@@ -46,6 +46,9 @@ pub struct GpuObject {
     /// Its vertex buffer as the graph tracks it, when the deform pass writes
     /// it (`Frame::enable_deform`): every draw of it declares the read.
     pub deformed: Option<crate::graph::BufferId>,
+    /// Each level of detail's error (object units), the full mesh's 0 first;
+    /// empty without levels.
+    pub level_errors: Vec<f32>,
     textures: Vec<Image>,
     uniforms: Buffer,
     pub material_set: vk::DescriptorSet,
@@ -101,8 +104,9 @@ impl GpuObject {
         ctx: &Context,
         name: &str,
         kind: ObjectKind,
-        // The object, and the copies of its vertices (`GpuMesh::copies`).
-        (object, copies): (&Object, u32),
+        // The object, the copies of its vertices (`GpuMesh::copies`), and
+        // whether it gets levels of detail (`scene::lod`).
+        (object, copies, lod): (&Object, u32, bool),
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -114,20 +118,20 @@ impl GpuObject {
                 mesh: GpuMesh::default(),
                 kind,
                 deformed: None,
+                level_errors: Vec::new(),
                 textures: Vec::new(),
                 uniforms: Buffer::default(),
                 material_set: vk::DescriptorSet::null(),
             },
         );
-        g.upload(ctx, object, copies, pool, geometry, samplers)?;
+        g.upload(ctx, (object, copies, lod), pool, geometry, samplers)?;
         Ok(g.keep())
     }
 
     fn upload(
         &mut self,
         ctx: &Context,
-        object: &Object,
-        copies: u32,
+        (object, copies, lod): (&Object, u32, bool),
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -141,8 +145,32 @@ impl GpuObject {
             // Written by the deform pass, read back by tests.
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC
         };
-        self.mesh =
-            GpuMesh::upload_copies(ctx, &name, &mesh.vertices, &mesh.indices, extra, copies)?;
+        // With levels: every level's indices in one buffer, the full mesh's
+        // first.
+        let levels = if lod {
+            crate::scene::lod::levels(mesh)
+        } else {
+            Vec::new()
+        };
+        let all: Vec<u32> = levels
+            .iter()
+            .flat_map(|l| l.indices.iter().copied())
+            .collect();
+        let indices = if levels.is_empty() {
+            &mesh.indices
+        } else {
+            &all
+        };
+        self.mesh = GpuMesh::upload_copies(ctx, &name, &mesh.vertices, indices, extra, copies)?;
+        if !levels.is_empty() {
+            let mut first = 0u32;
+            for l in &levels {
+                self.mesh.levels.push((first, l.indices.len() as u32));
+                first += l.indices.len() as u32;
+            }
+            self.mesh.index_count = mesh.indices.len() as u32;
+            self.level_errors = levels.iter().map(|l| l.error).collect();
+        }
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [

@@ -120,6 +120,11 @@ pub struct RenderSettings {
     /// resolved before the SSS passes (docs/aa.md, "MSAA with the SSS
     /// pipeline"). 1 is the frame as it was before, bit for bit.
     pub msaa: u32,
+    /// Levels of detail (`--lod-pixels`): each character drawn with the
+    /// coarsest level of its meshes whose error covers at most this many
+    /// pixels at its distance (`scene::lod`); 0: the full meshes.
+    #[serde(default)]
+    pub lod_pixels: f32,
 }
 
 /// The sample counts `--msaa` takes.
@@ -238,6 +243,7 @@ impl RenderSettings {
             aa: AaMode::None,
             post: PostOptions::default(),
             msaa: 1,
+            lod_pixels: 0.0,
         }
     }
 
@@ -285,6 +291,7 @@ impl RenderSettings {
         }
         ranges::SSS_REGION_TILE.check(self.sss_region_tile)?;
         ranges::HEADS.check(self.heads)?;
+        ranges::LOD_PIXELS.check(self.lod_pixels)?;
         ranges::DISTANCE.check(self.distance_heads)?;
         // Walking past the camera is allowed (a character behind it shows no
         // pixel), but not without bound.

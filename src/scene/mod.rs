@@ -17,6 +17,7 @@ pub mod head_measure;
 pub mod layout;
 pub mod light;
 pub mod lines;
+pub mod lod;
 pub mod mesh;
 pub mod morph;
 pub mod procedural;

@@ -32,6 +32,7 @@ mod compute;
 mod fade;
 mod gather;
 mod harness;
+mod lod;
 mod materials;
 mod mix;
 mod motion;

@@ -4,8 +4,40 @@
 
 use super::*;
 use crate::scene::crowd_motion::Motion;
+use crate::scene::lod;
 
 impl Frame {
+    /// Each character's level of detail (`--lod-pixels`): the coarsest level
+    /// of each of its meshes whose error, projected at the distance of its
+    /// head's centre from the camera, covers at most that many pixels; set
+    /// per instance slot (after `set_skin_groups`).
+    pub fn choose_levels(&mut self, scene: &Scene) {
+        let max_px = self.settings.lod_pixels;
+        if max_px <= 0.0 {
+            return;
+        }
+        let centre = scene.head_center();
+        let slots = &self.instance_buffer.character_slots;
+        let mut px_per_unit = vec![0.0f32; slots.len()];
+        for (c, &s) in slots.iter().enumerate() {
+            let m = self.instances[c];
+            let scale = m.x_axis.truncate().length();
+            let d = self.camera.eye.distance(m.transform_point3(centre));
+            px_per_unit[s as usize] =
+                lod::pixels_per_unit(d, self.camera.fovy_rad, self.extent.height) * scale;
+        }
+        for o in self
+            .objects
+            .iter_mut()
+            .filter(|o| !o.level_errors.is_empty())
+        {
+            o.mesh.slot_levels = px_per_unit
+                .iter()
+                .map(|&ppu| lod::choose(&o.level_errors, ppu, max_px) as u8)
+                .collect();
+        }
+    }
+
     /// The deform pass of every object with a skin or morph weights not all
     /// 0 (`scene`'s, in the order `build` made the objects); a crowd playing
     /// a clip of weights deforms one copy of the head per character, each at
