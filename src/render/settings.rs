@@ -123,8 +123,14 @@ pub struct RenderSettings {
     /// Levels of detail (`--lod-pixels`): each character drawn with the
     /// coarsest level of its meshes whose error covers at most this many
     /// pixels at its distance (`scene::lod`); 0: the full meshes.
-    #[serde(default)]
+    /// Left out of a report when 0, so the reports written before the
+    /// levels existed read back as the files they are.
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub lod_pixels: f32,
+}
+
+fn is_zero(x: &f32) -> bool {
+    *x == 0.0
 }
 
 /// The sample counts `--msaa` takes.
