@@ -202,10 +202,7 @@ fn frames_and_renders_stay_flat() {
             n as f64 / t.elapsed().as_secs_f64()
         );
         // One step is the arena's (above); the rest is bounded.
-        let largest_step = highs
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(0.0f64, f64::max);
+        let largest_step = highs.windows(2).map(|w| w[1] - w[0]).fold(0.0f64, f64::max);
         if steady < STEADY_QUARTERS || growth - largest_step > TOTAL_BOUND_MIB {
             failures.push(format!(
                 "{method}: resident memory grew {growth:.1} MiB over {n} frames ({quarters:.2?} MiB by quarter)"

@@ -125,6 +125,9 @@ pub fn measured_error(mesh: &Mesh, level: &[u32]) -> f32 {
     let mut margin = 0.1 * cell;
     let key = |q: Vec3| ((q - b.min) / cell).floor().as_ivec3();
     loop {
+        if margin > 0.25 * size {
+            break;
+        }
         let mut grid: std::collections::HashMap<glam::IVec3, Vec<u32>> =
             std::collections::HashMap::new();
         for (i, t) in tris.iter().enumerate() {
@@ -158,19 +161,18 @@ pub fn measured_error(mesh: &Mesh, level: &[u32]) -> f32 {
         if !missed {
             return worst;
         }
-        if margin > size {
-            // Far from everything (a level that lost a part): brute force.
-            return drawn
-                .iter()
-                .map(|&q| {
-                    tris.iter()
-                        .map(|t| point_triangle_distance(q, t))
-                        .fold(f32::MAX, f32::min)
-                })
-                .fold(0.0, f32::max);
-        }
         margin *= 2.0;
     }
+    // Far from everything (a level that lost a part): brute force, before
+    // a grid of wide margins grows past its use.
+    drawn
+        .iter()
+        .map(|&q| {
+            tris.iter()
+                .map(|t| point_triangle_distance(q, t))
+                .fold(f32::MAX, f32::min)
+        })
+        .fold(0.0, f32::max)
 }
 
 /// Distance from `p` to triangle `t` (Ericson's closest point, 5.1.5).

@@ -29,6 +29,11 @@ const HIGH_QUANTILE: f64 = 0.95;
 /// side: the band is built without them.
 const SMALL: usize = 20;
 
+/// A small mesh's fence, in band widths: its one suspect point must lie
+/// this far out (a pyramid's apex three base widths up is its shape; a
+/// flipped exponent is 1e30 away).
+const SMALL_FENCE: f64 = 100.0;
+
 /// Bounds of the points inside the fence, and how many were left out.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RobustBounds {
@@ -128,11 +133,12 @@ pub fn robust_bounds_f64(points: &[DVec3]) -> Option<RobustBounds64> {
     let scale = (hi - lo).max_element();
     // When the band is a single point on every axis (most vertices coincide) there is
     // no scale to judge distance by: keep every finite point rather than guess.
+    let fence = if n < SMALL { SMALL_FENCE } else { FENCE };
     let keep = |p: &DVec3| -> bool {
         if scale <= 0.0 {
             return true;
         }
-        let margin = DVec3::splat(FENCE * scale);
+        let margin = DVec3::splat(fence * scale);
         p.cmpge(lo - margin).all() && p.cmple(hi + margin).all()
     };
     let mut kept = finite.iter().filter(|p| keep(p));
@@ -216,6 +222,15 @@ mod tests {
         assert_eq!((b.ignored, b.aabb.max), (0, Vec3::new(1.0, 1.5, 0.0)));
         let b = robust_bounds([Vec3::ZERO, Vec3::splat(1e30)]).unwrap();
         assert_eq!(b.ignored, 0);
+        // A square pyramid's apex three base widths up is its shape too.
+        let pyramid = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::Y,
+            Vec3::new(0.5, 0.5, 3.0),
+        ];
+        assert_eq!(robust_bounds(pyramid).unwrap().ignored, 0);
     }
 
     #[test]

@@ -8,8 +8,9 @@ use crate::scene::lod;
 
 impl Frame {
     /// Each character's level of detail (`--lod-pixels`): the coarsest level
-    /// of each of its meshes whose error, projected at the distance of its
-    /// head's centre from the camera, covers at most that many pixels; set
+    /// of each of its meshes whose error, projected at the view depth of its
+    /// nearest point (its centre's less half its bounds' diagonal), covers at
+    /// most that many pixels; set
     /// per instance slot (after `set_skin_groups`).
     pub fn choose_levels(&mut self, scene: &Scene) {
         let max_px = self.settings.lod_pixels;
@@ -17,14 +18,28 @@ impl Frame {
             return;
         }
         let centre = scene.head_center();
+        // The character's nearest point is about half its bounds' diagonal
+        // nearer than its centre; an error is judged at the view depth there
+        // (a lateral extent projects by depth, not by distance).
+        let radius = 0.5 * scene.head_bounds.size().length();
+        let forward = (self.camera.target - self.camera.eye).normalize_or_zero();
         let slots = &self.instance_buffer.character_slots;
         let mut px_per_unit = vec![0.0f32; slots.len()];
         for (c, &s) in slots.iter().enumerate() {
             let m = self.instances[c];
-            let scale = m.x_axis.truncate().length();
-            let d = self.camera.eye.distance(m.transform_point3(centre));
-            px_per_unit[s as usize] =
-                lod::pixels_per_unit(d, self.camera.fovy_rad, self.extent.height) * scale;
+            let scale = m
+                .x_axis
+                .truncate()
+                .length()
+                .max(m.y_axis.truncate().length())
+                .max(m.z_axis.truncate().length());
+            let depth =
+                (m.transform_point3(centre) - self.camera.eye).dot(forward) - radius * scale;
+            px_per_unit[s as usize] = lod::pixels_per_unit(
+                depth.max(self.camera.near),
+                self.camera.fovy_rad,
+                self.extent.height,
+            ) * scale;
         }
         for o in self
             .objects

@@ -157,8 +157,11 @@ fn animated_matrix(node: &gltf::Node, clip: &Clip, t: f32) -> Result<DMat4> {
         .channels
         .iter()
         .any(|c| c.node == node.index() && c.path != Path::Weights);
+    // The rest transform checked as any node's is (finite, a non-zero
+    // rotation), whether or not a channel replaces part of it.
+    let rest_matrix = local_matrix(node)?;
     if !animates {
-        return local_matrix(node);
+        return Ok(rest_matrix);
     }
     let gltf::scene::Transform::Decomposed {
         translation,
