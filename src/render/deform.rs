@@ -213,48 +213,15 @@ impl Deform {
             offsets_per_vertex: rows.iter().map(|r| r.count as f64).sum::<f64>() / n.max(1) as f64,
             ..Default::default()
         };
-        o.rest = device_buffer(
-            ctx,
-            &format!("{name} rest vertices"),
-            bytemuck::cast_slice(&morph.rest),
-            usage,
-            read,
-        )?;
-        o.targets = device_buffer(
-            ctx,
-            &format!("{name} morph targets"),
-            bytemuck::cast_slice(&rows),
-            usage,
-            read,
-        )?;
-        o.weights = device_buffer(
-            ctx,
-            &format!("{name} morph weights"),
-            bytemuck::cast_slice(&weights),
-            usage,
-            read,
-        )?;
-        o.deltas = device_buffer(
-            ctx,
-            &format!("{name} morph offsets"),
-            bytemuck::cast_slice(&deltas),
-            usage,
-            read,
-        )?;
-        o.influences = device_buffer(
-            ctx,
-            &format!("{name} joint influences"),
-            bytemuck::cast_slice(&influences),
-            usage,
-            read,
-        )?;
-        o.joints = device_buffer(
-            ctx,
-            &format!("{name} joint matrices"),
-            bytemuck::cast_slice(&joints),
-            usage,
-            read,
-        )?;
+        let upload = |what: &str, bytes: &[u8]| {
+            device_buffer(ctx, &format!("{name} {what}"), bytes, usage, read)
+        };
+        o.rest = upload("rest vertices", bytemuck::cast_slice(&morph.rest))?;
+        o.targets = upload("morph targets", bytemuck::cast_slice(&rows))?;
+        o.weights = upload("morph weights", bytemuck::cast_slice(&weights))?;
+        o.deltas = upload("morph offsets", bytemuck::cast_slice(&deltas))?;
+        o.influences = upload("joint influences", bytemuck::cast_slice(&influences))?;
+        o.joints = upload("joint matrices", bytemuck::cast_slice(&joints))?;
         let zeros = vec![0f32; (3 * n * c) as usize];
         o.previous = device_buffer(
             ctx,

@@ -154,18 +154,6 @@ impl Clip {
     }
 }
 
-/// The times of `frames` frames over `0..=duration` at a fixed step (one
-/// frame: time 0), what `--frames` renders.
-pub fn frame_times(duration: f32, frames: u32) -> Vec<f32> {
-    match frames {
-        0 => Vec::new(),
-        1 => vec![0.0],
-        n => (0..n)
-            .map(|i| duration * i as f32 / (n - 1) as f32)
-            .collect(),
-    }
-}
-
 /// A node's local transform with a clip's channels applied at `t` (the
 /// node's own translation, rotation and scale where no channel animates
 /// them).
@@ -385,11 +373,5 @@ mod tests {
         assert!((yaw(3.0) + 25.0).abs() < 0.5);
         assert!((yaw(5.0) - yaw(1.0)).abs() < 1e-3);
         rigid_turn_nod().channels[0].check("rigid").unwrap();
-    }
-
-    #[test]
-    fn frames_cover_the_clip_at_a_fixed_step() {
-        assert_eq!(frame_times(2.0, 5), [0.0, 0.5, 1.0, 1.5, 2.0]);
-        assert_eq!(frame_times(2.0, 1), [0.0]);
     }
 }

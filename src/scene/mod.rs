@@ -164,14 +164,19 @@ impl Scene {
             // deform pass's to the bit.
             o.pose();
         }
-        self.head_bounds = self
-            .parts
-            .iter()
-            .map(|p| head_measure::inlier_bounds(&p.mesh).0)
-            .fold(head_measure::inlier_bounds(&self.head.mesh).0, |a, b| {
-                a.union(&b)
-            });
+        self.head_bounds = character_bounds(&self.head, &self.parts);
     }
+}
+
+/// Bounds of a character's head and parts, far outlier vertices left out
+/// (`Scene::head_bounds`).
+fn character_bounds(head: &mesh::Object, parts: &[mesh::Object]) -> mesh::Aabb {
+    parts
+        .iter()
+        .map(|p| head_measure::inlier_bounds(&p.mesh).0)
+        .fold(head_measure::inlier_bounds(&head.mesh).0, |a, b| {
+            a.union(&b)
+        })
 }
 
 /// Parses `NAME=W[,NAME=W...]` (what `--morph-weights` takes).
@@ -423,12 +428,7 @@ pub fn scene_from_character(
             center.y
         ),
     };
-    let head_bounds = parts
-        .iter()
-        .map(|p| head_measure::inlier_bounds(&p.mesh).0)
-        .fold(head_measure::inlier_bounds(&head.mesh).0, |a, b| {
-            a.union(&b)
-        });
+    let head_bounds = character_bounds(&head, &parts);
     Ok(Scene {
         tracks: None,
         name: name.to_string(),

@@ -150,44 +150,31 @@ fn skin_vertex(v: &Vertex, joints: &[u32], weights: &[f32], matrices: &[Mat4]) -
     }
 }
 
-/// The skinned vertices exactly as the deform pass writes them (normals and
-/// tangents unnormalised), from `morphed` (the rest after its targets).
-pub fn apply(morphed: &[Vertex], skin: &Skin) -> Vec<Vertex> {
+/// `morphed` moved by `skin`'s influences with `matrices` (its pose's or
+/// the previous pose's).
+fn skinned<'a>(
+    morphed: &'a [Vertex],
+    skin: &'a Skin,
+    matrices: &'a [Mat4],
+) -> impl Iterator<Item = Vertex> + 'a {
     let s = skin.slots;
     morphed
         .iter()
         .zip(skin.joints.iter().zip(&skin.weights))
-        .map(|(v, (j, w))| skin_vertex(v, &j[..s], &w[..s], &skin.matrices))
-        .collect()
+        .map(move |(v, (j, w))| skin_vertex(v, &j[..s], &w[..s], matrices))
+}
+
+/// The skinned vertices exactly as the deform pass writes them (normals and
+/// tangents unnormalised), from `morphed` (the rest after its targets).
+pub fn apply(morphed: &[Vertex], skin: &Skin) -> Vec<Vertex> {
+    skinned(morphed, skin, &skin.matrices).collect()
 }
 
 /// The skinned positions at the previous pose (the deform pass's previous
 /// positions), from the vertices morphed at the previous weights.
 pub fn apply_previous(morphed: &[Vertex], skin: &Skin) -> Vec<[f32; 3]> {
-    let s = skin.slots;
-    morphed
-        .iter()
-        .zip(skin.joints.iter().zip(&skin.weights))
-        .map(|(v, (j, w))| skin_vertex(v, &j[..s], &w[..s], &skin.previous).position)
-        .collect()
-}
-
-/// A glTF skin's joint matrices: each joint's world matrix times its inverse
-/// bind matrix (identity where the file gives none), then `place` (the
-/// loader's move of the scene) on the left. In f64 until the end, as the
-/// loader places everything.
-pub fn joint_matrices(
-    joint_worlds: &[glam::DMat4],
-    inverse_binds: Option<&[glam::DMat4]>,
-    place: &glam::DMat4,
-) -> Vec<Mat4> {
-    joint_worlds
-        .iter()
-        .enumerate()
-        .map(|(i, w)| {
-            let ibm = inverse_binds.map_or(glam::DMat4::IDENTITY, |b| b[i]);
-            (*place * *w * ibm).as_mat4()
-        })
+    skinned(morphed, skin, &skin.previous)
+        .map(|v| v.position)
         .collect()
 }
 

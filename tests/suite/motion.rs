@@ -48,6 +48,22 @@ fn morphing_egg() -> Scene {
     scene
 }
 
+/// The GPU's floats are the CPU's, bit for bit (as many, none differing).
+fn assert_same_bits(got: &[f32], want: &[f32]) {
+    assert_eq!(got.len(), want.len());
+    let differ = got
+        .iter()
+        .zip(want)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(
+        differ,
+        0,
+        "{differ} of {} floats differ from the CPU's",
+        want.len()
+    );
+}
+
 fn settings() -> RenderSettings {
     RenderSettings {
         width: 160,
@@ -68,19 +84,7 @@ fn the_deform_pass_blends_morph_targets_exactly_as_the_cpu_does() {
     assert_eq!(got.len(), 1, "one morphing object");
     let want = apply(&m.rest, m);
     let want: Vec<f32> = bytemuck::cast_slice(&want).to_vec();
-    let differ = got[0]
-        .vertices
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
-    assert_eq!(got[0].vertices.len(), want.len());
-    assert_eq!(
-        differ,
-        0,
-        "{differ} of {} floats differ from the CPU's",
-        want.len()
-    );
+    assert_same_bits(&got[0].vertices, &want);
     // No frame before the first: the previous positions are this frame's,
     // so every velocity is 0.
     for (k, p) in got[0].previous.chunks_exact(3).enumerate() {
@@ -396,13 +400,7 @@ fn the_deform_pass_skins_exactly_as_the_cpu_does() {
     let got = r.deformed().unwrap();
     let want = deformed(&m.rest, m);
     let want: Vec<f32> = bytemuck::cast_slice(&want).to_vec();
-    let differ = got[0]
-        .vertices
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
-    assert_eq!(differ, 0, "{differ} of {} floats differ", want.len());
+    assert_same_bits(&got[0].vertices, &want);
     // Previous positions: the previous joints over the targets at the
     // previous weights (the first frame's: these).
     let prev = apply_previous(&apply(&m.rest, m), m.skin.as_ref().unwrap());

@@ -10,7 +10,7 @@ use std::rc::Rc;
 use super::checks::{mesh_label, node_label};
 use super::primitives::{read_primitive, Part};
 use super::skins::{append_skinned, skin_matrices, SpanSkin};
-use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
+use super::Warnings;
 use crate::scene::animation::{animated_trs, animated_weights, Clip, Path};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
@@ -123,13 +123,7 @@ pub(super) fn append_part(
     world: &DMat4,
     node: &gltf::Node,
 ) -> Result<()> {
-    let (v, t) = (part.mesh.vertices.len(), part.mesh.triangle_count());
-    if mesh.vertices.len() + v > MAX_VERTICES || mesh.triangle_count() + t > MAX_TRIANGLES {
-        bail!(
-            "the scene has more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (after instancing, at {})",
-            node_label(node)
-        );
-    }
+    part.check_room(mesh, &node_label(node))?;
     let start = world_pos.len();
     for vert in &part.mesh.vertices {
         let p = world.transform_point3(DVec3::from_array(vert.position.map(f64::from)));

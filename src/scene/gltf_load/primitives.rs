@@ -9,7 +9,7 @@ use gltf::Semantic;
 use super::checks::{
     check_finite, check_precision, check_tex_coord, check_texcoord_range, mode_name,
 };
-use super::Warnings;
+use super::{Warnings, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::gltf_accessor::{read_attribute, read_indices, read_joints, Use};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::{Mesh, Vertex};
@@ -72,6 +72,18 @@ pub(super) struct Part {
     pub(super) targets: Vec<MorphTarget>,
     /// Its vertices' joints and weights (`JOINTS_0/1`, `WEIGHTS_0/1`).
     pub(super) influences: Option<Influences>,
+}
+
+impl Part {
+    /// Refuses to append this primitive to `mesh` past the loader's vertex
+    /// and triangle limits (`at`: where it is placed, for the message).
+    pub(super) fn check_room(&self, mesh: &Mesh, at: &str) -> Result<()> {
+        let (v, t) = (self.mesh.vertices.len(), self.mesh.triangle_count());
+        if mesh.vertices.len() + v > MAX_VERTICES || mesh.triangle_count() + t > MAX_TRIANGLES {
+            bail!("the scene has more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (after instancing, at {at})");
+        }
+        Ok(())
+    }
 }
 
 /// A primitive's skin attributes, both sets in one list of eight slots.

@@ -6,7 +6,6 @@ use anyhow::{bail, Result};
 use glam::{DMat4, DVec3};
 
 use super::primitives::Part;
-use super::{MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::gltf_accessor::{read_floats, Use};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
@@ -95,10 +94,8 @@ pub(super) fn append_skinned(
     weights: &[f32],
     label: &str,
 ) -> Result<()> {
-    let (v, t) = (part.mesh.vertices.len(), part.mesh.triangle_count());
-    if mesh.vertices.len() + v > MAX_VERTICES || mesh.triangle_count() + t > MAX_TRIANGLES {
-        bail!("the scene has more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (at {label})");
-    }
+    part.check_room(mesh, label)?;
+    let v = part.mesh.vertices.len();
     let matrices: Vec<glam::Mat4> = skin.matrices.iter().map(|m| m.as_mat4()).collect();
     let check = Skin {
         joints: skin.joints.clone(),
