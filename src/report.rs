@@ -346,6 +346,11 @@ pub struct PassReport {
     pub gpu_ms: Stats,
     /// Time of the barriers before the pass, kept out of `gpu_ms`.
     pub barrier_ms: Stats,
+    /// Primitives a drawing pass's input assembler read (pipeline
+    /// statistics), last measured frame (`None` in reports from before they
+    /// were counted, and for passes that draw nothing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input_primitives: Option<u64>,
     /// Fragment shader invocations (pipeline statistics) of the last measured frame.
     pub fragment_invocations: Option<u64>,
     /// Compute shader invocations, last measured frame (`None` in reports
@@ -407,6 +412,7 @@ pub fn aggregate(
             // A dispatch's own count (0 included: an indirect dispatch over
             // an empty list); none for the other passes.
             let dispatch = matches!(decl.work, Some(Work::Compute { .. }));
+            let decl_raster = matches!(decl.work, Some(Work::Raster { .. }));
             PassReport {
                 name: s.name.clone(),
                 role: Some(s.role),
@@ -416,6 +422,10 @@ pub fn aggregate(
                 characters: decl.characters,
                 gpu_ms: Stats::of(&gpu).expect("non-empty"),
                 barrier_ms: Stats::of(&bar).expect("non-empty"),
+                input_primitives: frames
+                    .last()
+                    .and_then(|f| f[i].input_primitives)
+                    .filter(|_| decl_raster),
                 fragment_invocations: frames.last().and_then(|f| f[i].fragment_invocations),
                 compute_invocations: frames
                     .last()
@@ -582,6 +592,7 @@ mod tests {
         let f = |a: f64, b: f64| {
             vec![
                 PassSample {
+                    input_primitives: None,
                     name: "a".into(),
                     role: PassRole::Sss,
                     merge: false,
@@ -592,6 +603,7 @@ mod tests {
                     samples_passed: 5,
                 },
                 PassSample {
+                    input_primitives: None,
                     name: "b".into(),
                     role: PassRole::Post,
                     merge: false,

@@ -194,6 +194,7 @@ mod tests {
 
     fn sample(name: &str, barrier_ms: f64, gpu_ms: f64) -> PassSample {
         PassSample {
+            input_primitives: None,
             name: name.into(),
             role: PassRole::Sss,
             merge: false,

@@ -49,6 +49,7 @@ pub fn run(a: &PlanArgs, given: &Given) -> Result<()> {
         "{}",
         table(&p.characters, &p.costs, &p.plan, &profile.profile.name)
     );
+    print!("{}", p.geometry.table());
     for n in &p.file.notes {
         println!("note: {n}");
     }

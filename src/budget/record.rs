@@ -326,6 +326,7 @@ mod tests {
             p95: 0.5,
         };
         let pass = |name: &str, role, work| PassReport {
+            input_primitives: None,
             name: name.into(),
             role: Some(role),
             gpu_ms: stats,

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Choice, Fade, Mix};
 use crate::files::{read_text, MAX_TEXT_FILE};
+use crate::scene::crowd_geometry::CharacterGeometry;
 
 /// The plan file format's version (bumped on an incompatible change).
 pub const PLAN_VERSION: u32 = 1;
@@ -43,10 +44,28 @@ pub struct PlannedCharacter {
     pub predicted_ms: Option<f64>,
     #[serde(default)]
     pub predicted_error: Option<PredictedError>,
+    /// Its level of detail and whether it casts into the shadow map (absent
+    /// in a hand-written plan or one from before: the frame chooses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<PlannedGeometry>,
     /// A cross-fade from the setting the character had (a re-planned
     /// sequence's switch, `dermis plan-motion --fade-frames`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fade: Option<PlannedFade>,
+}
+
+/// What a character draws (`scene::crowd_geometry`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannedGeometry {
+    /// 0: the full meshes; `i`: each mesh's `i`-th simplified level (its
+    /// coarsest where it has fewer).
+    pub level: u8,
+    pub casts_shadow: bool,
+    /// Triangles the character submits to the geometry pass at its level
+    /// (what the planner counted; absent in a hand-written plan).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles: Option<u64>,
 }
 
 /// The setting a character fades from and its share of the result.
@@ -162,6 +181,27 @@ impl PlanFile {
         if let Some(missing) = seen.iter().position(|s| !s) {
             bail!("character {missing} has no assignment");
         }
+        // Geometry for every character or for none (the frame cannot mix its
+        // own choice with a plan's).
+        let with = self.assignments.iter().filter(|a| a.geometry.is_some()).count();
+        if with != 0 && with != self.assignments.len() {
+            let a = self.assignments.iter().find(|a| a.geometry.is_none());
+            bail!(
+                "character {} has no geometry while {with} others have (give every character one, or none)",
+                a.map_or(0, |a| a.character)
+            );
+        }
+        if let Some(a) = self.assignments.iter().find(|a| {
+            a.geometry
+                .is_some_and(|g| g.level as usize > crate::scene::lod::LEVEL_RATIOS.len())
+        }) {
+            bail!(
+                "character {}: level {} does not exist (levels are 0, the full meshes, to {})",
+                a.character,
+                a.geometry.map_or(0, |g| g.level),
+                crate::scene::lod::LEVEL_RATIOS.len()
+            );
+        }
         // What only the groups tell: a fade to the setting it had, too many settings.
         self.mix(self.characters)?.groups()?;
         if let Some(b) = self.budget_ms {
@@ -179,6 +219,18 @@ impl PlanFile {
             bail!("a predicted figure {v} is not a finite number >= 0");
         }
         Ok(())
+    }
+
+    /// Every character's geometry in frame order, when the plan gives it.
+    pub fn geometry(&self) -> Option<Vec<CharacterGeometry>> {
+        let mut out = vec![None; self.characters];
+        for a in &self.assignments {
+            out[a.character] = a.geometry.map(|g| CharacterGeometry {
+                level: g.level,
+                casts_shadow: g.casts_shadow,
+            });
+        }
+        out.into_iter().collect()
     }
 
     /// The mix for a frame of `characters` characters: an error unless the
@@ -229,6 +281,26 @@ mod tests {
             e.contains("the plan is for 2 characters, the scene has 3"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn geometry_is_for_every_character_or_none() {
+        let g0 = r#""geometry":{"level":2,"casts_shadow":false},"#;
+        let g1 = r#""geometry":{"level":0,"casts_shadow":true,"triangles":9},"#;
+        let both = GOOD
+            .replace(r#"{"character":1,"#, &format!(r#"{{"character":1,{g1}"#))
+            .replace(r#"{"character":0,"#, &format!(r#"{{"character":0,{g0}"#));
+        let p = plan(&both).unwrap();
+        let g = p.geometry().unwrap();
+        assert_eq!((g[0].level, g[0].casts_shadow), (2, false));
+        assert_eq!((g[1].level, g[1].casts_shadow), (0, true));
+        assert!(plan(GOOD).unwrap().geometry().is_none());
+        let one = GOOD.replace(r#"{"character":0,"#, &format!(r#"{{"character":0,{g0}"#));
+        let e = format!("{:#}", plan(&one).unwrap_err());
+        assert!(e.contains("character 1 has no geometry"), "{e}");
+        let deep = both.replace(r#""level":2"#, r#""level":9"#);
+        let e = format!("{:#}", plan(&deep).unwrap_err());
+        assert!(e.contains("level 9 does not exist"), "{e}");
     }
 
     /// Character 1 fading from ssg to none, a quarter of ssg left.

@@ -13,7 +13,8 @@
 //! of the plan). The checks' records, pure: [`check`] (`dermis plan-check`:
 //! plans against the ground truth, its cases, record and summary) and its
 //! charts [`check_chart`], scoring frames with [`score`]. docs/plan.md says
-//! how it works. No device opens here: the commands that render (`plan-check`,
+//! how it works. [`geometry`] (pure): each character's level of detail and
+//! shadow casting in the plan, their triangles and triangle time. No device opens here: the commands that render (`plan-check`,
 //! `plan-motion`) run in `app`.
 //! Over time (issue 16 item 6, docs/plan-over-time.md): [`over_time`]
 //! (pure: the walking crowd re-planned with hysteresis, switches and their
@@ -31,6 +32,7 @@ pub mod cost;
 pub mod dolly;
 pub mod fades;
 pub mod frame_inputs;
+pub mod geometry;
 pub mod log_interp;
 pub mod measured;
 pub mod motion;

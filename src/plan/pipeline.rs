@@ -15,15 +15,19 @@ use serde::Deserialize;
 use super::character::{estimate, CharacterInput};
 use super::choose::{narrow_reach_mm, plan, scatter_reach_mm, Accuracy, Ask, Plan, SettingCosts};
 use super::cost::{reference_counts, CostModel, Reference, Sample, SettingModel};
+use super::geometry::{plan_geometry, PlannedGeometry};
 use crate::budget::frames::check_frame;
 use crate::budget::input::FrameInput;
 use crate::budget::params::ParamSet;
 use crate::budget::profile::Profile;
 use crate::method::path::{self, Path as SssPath};
 use crate::method::METHODS;
-use crate::mix::plan_file::{PlanFile, PlannedCharacter, PredictedError, PLAN_VERSION};
+use crate::mix::plan_file::{
+    PlanFile, PlannedCharacter, PlannedGeometry as PlannedGeometryFile, PredictedError, PLAN_VERSION,
+};
 use crate::mix::Choice;
 use crate::render::RenderSettings;
+use crate::scene::crowd_geometry::turned;
 use crate::scene::framing::frame as frame_scene;
 use crate::scene::Scene;
 use crate::view::ViewScale;
@@ -312,7 +316,9 @@ pub fn characters(
 ) -> Vec<CharacterInput> {
     // render's own shot, so what is planned is what is rendered.
     let shot = crate::render::groups::shot(scene, s);
-    let framing = frame_scene(scene, &shot);
+    let mut framing = frame_scene(scene, &shot);
+    // The models the frame draws with (a crowd's rigid turns).
+    framing.instances = turned(scene, framing.instances);
     let mut cs = estimate(
         scene,
         &framing,
@@ -523,6 +529,8 @@ pub struct Planned {
     pub costs: Vec<SettingCosts>,
     pub plan: Plan,
     pub file: PlanFile,
+    /// Each character's level and shadow casting, their triangles.
+    pub geometry: PlannedGeometry,
 }
 
 /// Plans the frame `settings` describe in `scene` under `budget_ms` on
@@ -571,12 +579,27 @@ pub fn plan_frame(
         (t2 - t1).as_secs_f64() * 1e3,
         p.solution.nodes
     ));
-    let file = plan_file(&profile.profile.name, budget_ms, &chars, &costs, &p, notes)?;
+    let shot = crate::render::groups::shot(scene, settings);
+    let framing = frame_scene(scene, &shot);
+    let models = turned(scene, framing.instances.clone());
+    let geometry = plan_geometry(scene, settings, &framing, &models, profile);
+    notes.extend(geometry.notes(&profile.profile.name, settings.lod_pixels));
+    let mut file = plan_file(&profile.profile.name, budget_ms, &chars, &costs, &p, notes)?;
+    for a in &mut file.assignments {
+        let g = geometry.characters[a.character];
+        a.geometry = Some(PlannedGeometryFile {
+            level: g.level,
+            casts_shadow: g.casts_shadow,
+            triangles: Some(geometry.triangles[a.character]),
+        });
+    }
+    file.check()?;
     Ok(Planned {
         characters: chars,
         costs,
         plan: p,
         file,
+        geometry,
     })
 }
 
@@ -715,6 +738,7 @@ pub fn plan_file(
                 silhouette: r.predicted.1,
             }),
             fade: None,
+            geometry: None,
         });
     }
     let w = w.max(1e-12);

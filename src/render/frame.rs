@@ -9,9 +9,11 @@
 //! (`--character-ids`). Each stage records its passes and hands the next
 //! the images it wrote.
 //!
-//! The frame's own stages (shadow, geometry, composite, character ids) are
-//! here, beside the pipelines, sets and instance slots they draw with; the
-//! instance buffer is `instances.rs`, the uniform block `uniforms.rs`.
+//! The frame's own stages are here (geometry, composite) and in its
+//! children (the shadow map `shadow.rs`, the character ids
+//! `character_ids.rs`), beside the pipelines, sets and instance slots they
+//! draw with; the instance buffer is `instances.rs`, the uniform block
+//! `uniforms.rs`.
 
 use anyhow::Result;
 use ash::vk;
@@ -19,6 +21,7 @@ use glam::Mat4;
 
 mod character_ids;
 mod motion;
+mod shadow;
 pub use motion::head_copies;
 
 use super::deform::Deform;
@@ -52,7 +55,7 @@ use crate::vk::pipeline::{
 };
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
-use motion::turned;
+use crate::scene::crowd_geometry::{turned, CharacterGeometry};
 
 /// Descriptor sets the frame's pool holds: the frame's and the objects' few,
 /// and every method's (the reference's sets grow with its sample chunks).
@@ -63,12 +66,6 @@ const BECKMANN_SIZE: u32 = 256;
 /// the usual 1.5 against acne on curved skin at grazing light.
 const SHADOW_SLOPE_BIAS: f32 = 1.5;
 const COMPOSITE_SHADER: &str = "composite.frag";
-
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ShadowPush {
-    light_view_proj: [[f32; 4]; 4],
-}
 
 /// The geometry pass's vertex shader: geometry.vert (what tsd's final pass and
 /// the ground truth's surface pass draw one head with) with the model matrix
@@ -107,6 +104,11 @@ pub struct Frame {
     pub objects: Vec<GpuObject>,
     /// The morphing objects' deform passes (`enable_deform`).
     pub deform: Deform,
+    /// Every character's level and caster flag, in frame order
+    /// (`choose_geometry`); `casters` the flags per instance slot, what the
+    /// shadow map draws by.
+    pub geometry: Vec<CharacterGeometry>,
+    casters: Vec<bool>,
     /// The characters of each group with its stencil code, in group order:
     /// the geometry pass draws each group's heads with its code as the
     /// stencil reference (one group of every character, code 1, until
@@ -168,6 +170,8 @@ impl Frame {
             beckmann: Image::default(),
             objects: Vec::new(),
             deform: Deform::default(),
+            geometry: Vec::new(),
+            casters: Vec::new(),
             skin_groups: vec![SkinGroup {
                 stencil: STENCIL_SKIN,
                 characters: every,
@@ -258,7 +262,7 @@ impl Frame {
                 (
                     o,
                     if name == "head" { copies } else { 1 },
-                    kind.per_character() && self.settings.lod_pixels > 0.0,
+                    kind.per_character() && self.settings.wants_levels(),
                 ),
                 &self.pool,
                 &self.geometry_pipeline,
@@ -504,32 +508,6 @@ impl Frame {
             self.character_ids(&mut passes, ids, gbuffer.targets.depth_stencil);
         }
         passes
-    }
-
-    /// The key light's depth from every head (the backdrop receives shadows
-    /// but casts none worth a texel): the shadow map.
-    fn shadow_map<'a>(&'a self, passes: &mut Vec<Pass<'a>>) -> ImageId {
-        let shadow = self.targets.shadow;
-        passes.push(
-            self.reads_vertices(Pass::new("shadow map", PassRole::Shadow))
-                .depth_stencil(DepthStencil::cleared(shadow, 1.0))
-                .draws(None, self.triangles(ObjectKind::per_character))
-                .record(move |pc: &PassContext| {
-                    let (ctx, cmd) = (pc.ctx, pc.cmd);
-                    self.shadow_pipeline.bind(ctx, cmd, &[self.shadow_set]);
-                    let push = ShadowPush {
-                        light_view_proj: self.light_frame.view_proj.to_cols_array_2d(),
-                    };
-                    self.shadow_pipeline.push(ctx, cmd, &push);
-                    // Every character (its skin and its parts) in one
-                    // instanced draw each.
-                    let heads = self.instance_buffer.backdrop_slot;
-                    for obj in self.objects.iter().filter(|o| o.kind.per_character()) {
-                        obj.draw_instances(ctx, cmd, 0, heads);
-                    }
-                }),
-        );
-        shadow
     }
 
     /// Every object lit by the key light through `shadow` into the targets:

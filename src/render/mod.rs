@@ -188,7 +188,7 @@ impl<'c> Renderer<'c> {
         )?;
         // After the groups: a crowd's copies are in their instance slots.
         frame.enable_deform(ctx, scene, &mut resources)?;
-        frame.choose_levels(scene);
+        frame.choose_geometry(scene);
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
         let sss_output = groups::passes::output(&groups, &frame.targets);

@@ -9,6 +9,7 @@ use crate::method::{default_method, MethodEntry, MethodOptions};
 use crate::mix::assign::Rules;
 use crate::mix::plan_file::PlanFile;
 use crate::post::{AaMode, PostOptions};
+use crate::scene::crowd_geometry::CharacterGeometry;
 use crate::scene::layout::Layout;
 use crate::scene::light::KeyLight;
 use crate::skin::transmittance::TransmittanceProfile;
@@ -312,6 +313,24 @@ impl RenderSettings {
 }
 
 impl RenderSettings {
+    /// Every character's level and caster flag when `--plan` gives them.
+    pub fn planned_geometry(&self) -> Option<Vec<CharacterGeometry>> {
+        match &self.assignment {
+            Some(Assignment::Plan(p)) => p.geometry(),
+            _ => None,
+        }
+    }
+
+    /// Whether the frame needs its characters' levels of detail: at
+    /// `--lod-pixels` above 0, or a plan that draws some character at a
+    /// level.
+    pub fn wants_levels(&self) -> bool {
+        self.lod_pixels > 0.0
+            || self
+                .planned_geometry()
+                .is_some_and(|g| g.iter().any(|c| c.level > 0))
+    }
+
     /// The frame's and the shadow map's sides against the largest image the
     /// device takes (`maxImageDimension2D`): the one check of the settings
     /// that needs a device, made once it is open.

@@ -4,6 +4,8 @@
 
 pub mod animation;
 pub mod camera;
+pub mod casters;
+pub mod crowd_geometry;
 pub mod crowd_motion;
 pub mod enclosed;
 pub mod expressions;

@@ -30,6 +30,9 @@ pub struct Profiler {
 pub struct PassTiming {
     pub barrier_ms: f64,
     pub gpu_ms: f64,
+    /// Primitives the input assembler read (a draw's triangles: what
+    /// shadow-caster culling and levels of detail save, counted).
+    pub input_primitives: Option<u64>,
     pub fragment_invocations: Option<u64>,
     /// Compute-shader invocations (the compute path's proof that only the
     /// listed tiles ran, as the fragment count is the stencil's).
@@ -72,9 +75,11 @@ impl Profiler {
                         "pass shader invocations",
                         vk::QueryPoolCreateInfo::default()
                             .query_type(vk::QueryType::PIPELINE_STATISTICS)
-                            // Results come in the flags' bit order: fragment, then compute.
+                            // Results come in the flags' bit order: input
+                            // primitives, fragment, then compute.
                             .pipeline_statistics(
-                                vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS
+                                vk::QueryPipelineStatisticFlags::INPUT_ASSEMBLY_PRIMITIVES
+                                    | vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS
                                     | vk::QueryPipelineStatisticFlags::COMPUTE_SHADER_INVOCATIONS,
                             )
                             .query_count(max_passes),
@@ -168,8 +173,8 @@ impl Profiler {
         }
         .map_err(Error::from)
         .context("reading timestamps")?;
-        // One query's two statistics per element (ash strides by the element).
-        let mut inv = vec![[0u64; 2]; n as usize];
+        // One query's three statistics per element (ash strides by the element).
+        let mut inv = vec![[0u64; 3]; n as usize];
         if let Some(s) = self.stats {
             unsafe {
                 ctx.device.get_query_pool_results(
@@ -201,8 +206,9 @@ impl Profiler {
             .map(|i| PassTiming {
                 barrier_ms: ms(ts[i * 3], ts[i * 3 + 1]),
                 gpu_ms: ms(ts[i * 3 + 1], ts[i * 3 + 2]),
-                fragment_invocations: self.stats.map(|_| inv[i][0]),
-                compute_invocations: self.stats.map(|_| inv[i][1]),
+                input_primitives: self.stats.map(|_| inv[i][0]),
+                fragment_invocations: self.stats.map(|_| inv[i][1]),
+                compute_invocations: self.stats.map(|_| inv[i][2]),
                 samples_passed: occ[i],
             })
             .collect())

@@ -45,6 +45,7 @@ fn fading(to: &str, from: &str, weight: f64) -> RenderSettings {
             skin_pixels: None,
             predicted_ms: None,
             predicted_error: None,
+            geometry: None,
             fade: Some(PlannedFade {
                 method: from.method.clone(),
                 options: from.options.clone(),

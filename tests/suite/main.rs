@@ -28,6 +28,7 @@ mod accuracy;
 mod accuracy_model;
 mod bloom;
 mod budget_cli;
+mod casters;
 mod compute;
 mod fade;
 mod gather;

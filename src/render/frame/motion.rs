@@ -4,51 +4,58 @@
 
 use super::*;
 use crate::scene::crowd_motion::Motion;
-use crate::scene::lod;
+use crate::scene::crowd_geometry::{self, CharacterGeometry, GeometryView};
 
 impl Frame {
-    /// Each character's level of detail (`--lod-pixels`): the coarsest level
-    /// of each of its meshes whose error, projected at the view depth of its
-    /// nearest point (its centre's less half its bounds' diagonal), covers at
-    /// most that many pixels; set
-    /// per instance slot (after `set_skin_groups`).
-    pub fn choose_levels(&mut self, scene: &Scene) {
-        let max_px = self.settings.lod_pixels;
-        if max_px <= 0.0 {
-            return;
-        }
-        let centre = scene.head_center();
-        // The character's nearest point is about half its bounds' diagonal
-        // nearer than its centre; an error is judged at the view depth there
-        // (a lateral extent projects by depth, not by distance).
-        let radius = 0.5 * scene.head_bounds.size().length();
-        let forward = (self.camera.target - self.camera.eye).normalize_or_zero();
+    /// Each character's level of detail and whether it casts into the
+    /// shadow map (`crowd_geometry`): the plan's choice under `--plan` when
+    /// it made one, else the frame's own (levels at `--lod-pixels`, casters
+    /// whose shadow can reach a receiver in view); set per instance slot
+    /// (after `set_skin_groups`).
+    pub fn choose_geometry(&mut self, scene: &Scene) {
+        let errors: Vec<Vec<f32>> = self
+            .objects
+            .iter()
+            .filter(|o| o.kind.per_character() && !o.level_errors.is_empty())
+            .map(|o| o.level_errors.clone())
+            .collect();
+        let planned = self
+            .settings
+            .planned_geometry()
+            .filter(|g| g.len() == self.instances.len());
+        self.geometry = planned.unwrap_or_else(|| {
+            crowd_geometry::choose(
+                scene,
+                &self.instances,
+                &GeometryView {
+                    camera: &self.camera,
+                    width: self.extent.width,
+                    height: self.extent.height,
+                    light_view_proj: self.light_frame.view_proj,
+                    backdrop: self.backdrop,
+                },
+                &errors,
+                self.settings.lod_pixels,
+            )
+        });
         let slots = &self.instance_buffer.character_slots;
-        let mut px_per_unit = vec![0.0f32; slots.len()];
+        let mut by_slot = vec![CharacterGeometry {
+            level: 0,
+            casts_shadow: true,
+        }; slots.len()];
         for (c, &s) in slots.iter().enumerate() {
-            let m = self.instances[c];
-            let scale = m
-                .x_axis
-                .truncate()
-                .length()
-                .max(m.y_axis.truncate().length())
-                .max(m.z_axis.truncate().length());
-            let depth =
-                (m.transform_point3(centre) - self.camera.eye).dot(forward) - radius * scale;
-            px_per_unit[s as usize] = lod::pixels_per_unit(
-                depth.max(self.camera.near),
-                self.camera.fovy_rad,
-                self.extent.height,
-            ) * scale;
+            by_slot[s as usize] = self.geometry[c];
         }
+        self.casters = by_slot.iter().map(|g| g.casts_shadow).collect();
         for o in self
             .objects
             .iter_mut()
             .filter(|o| !o.level_errors.is_empty())
         {
-            o.mesh.slot_levels = px_per_unit
+            let last = o.level_errors.len() - 1;
+            o.mesh.slot_levels = by_slot
                 .iter()
-                .map(|&ppu| lod::choose(&o.level_errors, ppu, max_px) as u8)
+                .map(|g| (g.level as usize).min(last) as u8)
                 .collect();
         }
     }
@@ -118,22 +125,4 @@ pub fn head_copies(scene: &Scene, characters: usize) -> u32 {
         }
         _ => 1,
     }
-}
-
-/// The characters' models with each one's rigid turn beyond the scene's
-/// pose (a crowd of characters without animation, `Scene::tracks`), about
-/// the head's centre.
-pub(super) fn turned(scene: &Scene, mut models: Vec<Mat4>) -> Vec<Mat4> {
-    if let Some(t) = scene.tracks.as_ref().filter(|t| t.motion == Motion::Rigid) {
-        if models.len() > 1 {
-            let c = scene.head_center();
-            for (i, m) in models.iter_mut().enumerate() {
-                *m = *m
-                    * Mat4::from_translation(c)
-                    * Mat4::from_quat(t.turn(i))
-                    * Mat4::from_translation(-c);
-            }
-        }
-    }
-    models
 }

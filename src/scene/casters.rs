@@ -1,0 +1,232 @@
+//! Shadow-caster culling: which characters the shadow map must draw. A
+//! character casts into the frame only when its shadow can land on a lit
+//! receiver the camera sees: a character in view (itself included), or the
+//! part of the backdrop in view. Everything else's shadow falls where no
+//! pixel of the frame reads the map, so leaving it out changes no pixel
+//! (`tests/suite/casters.rs` renders both and compares the bits).
+//!
+//! The test is conservative, on boxes in the key light's space (the shadow
+//! map's orthographic projection: x, y across the map, z the depth from the
+//! light). A caster's shadow is the set of points behind it along the light,
+//! so it can reach a receiver only where their boxes overlap across the map
+//! and the caster's nearest depth is in front of the receiver's farthest.
+//! A receiver's box is its world box's light-space box, cut to the light
+//! box of the view frustum (which no visible point leaves); the backdrop,
+//! a wall larger than the view, is only ever that cut. Pure: no device.
+
+use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
+
+use super::mesh::Aabb;
+
+/// The 8 corners of `b`.
+fn corners(b: &Aabb) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        )
+    })
+}
+
+/// Whether any of `b` can be inside the frustum of `view_proj` (Vulkan clip
+/// space: -w <= x, y <= w, 0 <= z <= w): false only when all eight corners
+/// lie outside one plane. Conservative (a box across a frustum's corner
+/// reads as in view).
+pub fn in_view(view_proj: &Mat4, b: &Aabb) -> bool {
+    let clip: Vec<Vec4> = corners(b)
+        .iter()
+        .map(|c| *view_proj * c.extend(1.0))
+        .collect();
+    let planes: [fn(&Vec4) -> bool; 6] = [
+        |c| c.x < -c.w,
+        |c| c.x > c.w,
+        |c| c.y < -c.w,
+        |c| c.y > c.w,
+        |c| c.z < 0.0,
+        |c| c.z > c.w,
+    ];
+    !planes.iter().any(|outside| clip.iter().all(outside))
+}
+
+/// The world points of the frustum of `view_proj` (its eight corners).
+fn frustum_corners(view_proj: &Mat4) -> Option<[Vec3; 8]> {
+    let inv = view_proj.inverse();
+    let corners: [Vec3; 8] = std::array::from_fn(|i| {
+        let ndc = Vec4::new(
+            if i & 1 == 0 { -1.0 } else { 1.0 },
+            if i & 2 == 0 { -1.0 } else { 1.0 },
+            if i & 4 == 0 { 0.0 } else { 1.0 },
+            1.0,
+        );
+        let p = inv * ndc;
+        p.xyz() / p.w
+    });
+    corners
+        .iter()
+        .all(|c| c.is_finite())
+        .then_some(corners)
+}
+
+/// A box in the light's space (map x, y and depth).
+fn light_box(light: &Mat4, points: &[Vec3]) -> Option<Aabb> {
+    Aabb::from_points(points.iter().map(|p| {
+        let c = *light * p.extend(1.0);
+        c.xyz() / c.w
+    }))
+}
+
+fn intersect(a: &Aabb, b: &Aabb) -> Option<Aabb> {
+    let (min, max) = (a.min.max(b.min), a.max.min(b.max));
+    (min.cmple(max).all()).then_some(Aabb { min, max })
+}
+
+/// Which of `characters` (world boxes, in frame order) cast a shadow the
+/// frame can show, for a camera of `view_proj` and the key light's map
+/// projection `light` (depth grows away from the light); `backdrop` is the
+/// backdrop's world box, a receiver where the camera sees it. A character
+/// in view always casts (onto itself); every caster is kept when the
+/// frustum cannot be measured (a degenerate projection).
+pub fn casting(
+    view_proj: &Mat4,
+    light: &Mat4,
+    characters: &[Aabb],
+    backdrop: Option<&Aabb>,
+) -> Vec<bool> {
+    let everyone = vec![true; characters.len()];
+    let Some(frustum) = frustum_corners(view_proj).and_then(|c| light_box(light, &c)) else {
+        return everyone;
+    };
+    let lit = |b: &Aabb| light_box(light, &corners(b)).and_then(|l| intersect(&l, &frustum));
+    let receivers: Vec<Aabb> = characters
+        .iter()
+        .chain(backdrop)
+        .filter(|b| in_view(view_proj, b))
+        .filter_map(lit)
+        .collect();
+    characters
+        .iter()
+        .map(|c| {
+            in_view(view_proj, c)
+                || light_box(light, &corners(c)).is_some_and(|caster| {
+                    receivers.iter().any(|r| {
+                        caster.min.x <= r.max.x
+                            && r.min.x <= caster.max.x
+                            && caster.min.y <= r.max.y
+                            && r.min.y <= caster.max.y
+                            && caster.min.z <= r.max.z
+                    })
+                })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::camera::Camera;
+    use crate::scene::light::shadow_frame;
+
+    fn unit_at(x: f32, y: f32, z: f32) -> Aabb {
+        Aabb {
+            min: Vec3::new(x - 0.5, y - 0.5, z - 0.5),
+            max: Vec3::new(x + 0.5, y + 0.5, z + 0.5),
+        }
+    }
+
+    /// A camera at +z looking down -z with a 40-degree field, square frame.
+    fn camera() -> Mat4 {
+        Camera {
+            eye: Vec3::new(0.0, 0.0, 10.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_rad: 40f32.to_radians(),
+            near: 0.1,
+            far: 100.0,
+        }
+        .view_proj(1.0)
+    }
+
+    #[test]
+    fn boxes_in_view_and_out() {
+        let vp = camera();
+        assert!(in_view(&vp, &unit_at(0.0, 0.0, 0.0)));
+        // Behind the camera, far to the side, past the far plane.
+        assert!(!in_view(&vp, &unit_at(0.0, 0.0, 20.0)));
+        assert!(!in_view(&vp, &unit_at(30.0, 0.0, 0.0)));
+        assert!(!in_view(&vp, &unit_at(0.0, 0.0, -200.0)));
+        // Across the left edge: part of it shows.
+        let edge = 10.0 * 20f32.to_radians().tan();
+        assert!(in_view(&vp, &unit_at(-edge - 0.4, 0.0, 0.0)));
+    }
+
+    /// The closed form of a light straight overhead: a box out of view casts
+    /// exactly when it stands above a visible receiver.
+    #[test]
+    fn a_caster_out_of_view_casts_only_onto_what_is_below_it() {
+        let vp = camera();
+        let light = shadow_frame(Vec3::Y, Vec3::ZERO, 60.0).view_proj;
+        let visible = unit_at(0.0, 0.0, 0.0);
+        // Out of view above the frame's top edge (edge at y = 3.64 at z = 0),
+        // straight over the visible box: its shadow falls on it.
+        let above = unit_at(0.0, 8.0, 0.0);
+        // Out of view above, but beside the visible box: shadow on nothing seen.
+        let beside = unit_at(25.0, 8.0, 0.0);
+        // Out of view below the visible box: the light is above, so its
+        // shadow goes further down, away from everything seen.
+        let below = unit_at(0.0, -8.0, 0.0);
+        let c = casting(&vp, &light, &[visible, above, beside, below], None);
+        assert_eq!(c, vec![true, true, false, false]);
+        assert!(!in_view(&vp, &above) && !in_view(&vp, &beside) && !in_view(&vp, &below));
+    }
+
+    /// The backdrop is a receiver where it is seen: a caster over the seen
+    /// floor casts, over a floor out of view does not.
+    #[test]
+    fn the_seen_backdrop_receives() {
+        let vp = camera();
+        let light = shadow_frame(Vec3::Y, Vec3::ZERO, 200.0).view_proj;
+        let floor = Aabb {
+            min: Vec3::new(-100.0, -3.1, -100.0),
+            max: Vec3::new(100.0, -3.0, 100.0),
+        };
+        // Above the frame (out of view), over the seen floor.
+        let over_seen = unit_at(0.0, 8.0, 0.0);
+        // Out of view to the side, over floor no ray of the camera reaches.
+        let over_unseen = unit_at(80.0, 8.0, 0.0);
+        assert_eq!(
+            casting(&vp, &light, &[over_seen, over_unseen], Some(&floor)),
+            vec![true, false]
+        );
+        // Without the floor, nothing seen is under either.
+        assert_eq!(
+            casting(&vp, &light, &[over_seen, over_unseen], None),
+            vec![false, false]
+        );
+    }
+
+    /// A caster behind its receiver (further from the light) casts nothing
+    /// onto it, whatever the overlap across the map.
+    #[test]
+    fn a_caster_behind_the_receiver_does_not_cast_onto_it() {
+        let vp = camera();
+        // Light from +x: depth grows toward -x.
+        let light = shadow_frame(Vec3::X, Vec3::ZERO, 60.0).view_proj;
+        let visible = unit_at(0.0, 0.0, 0.0);
+        // Out of view at -x (the shadow side), in line with the visible box.
+        let shadow_side = unit_at(-30.0, 0.0, 0.0);
+        // Out of view at +x (toward the light), in line: it shades the box.
+        let light_side = unit_at(30.0, 0.0, 0.0);
+        assert_eq!(
+            casting(&vp, &light, &[visible, shadow_side, light_side], None),
+            vec![true, false, true]
+        );
+    }
+
+    #[test]
+    fn a_degenerate_camera_keeps_every_caster() {
+        let light = shadow_frame(Vec3::Y, Vec3::ZERO, 60.0).view_proj;
+        let b = [unit_at(0.0, 50.0, 0.0)];
+        assert_eq!(casting(&Mat4::ZERO, &light, &b, None), vec![true]);
+    }
+}

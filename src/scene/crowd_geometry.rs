@@ -1,0 +1,219 @@
+//! What each character of a frame draws: its level of detail (`lod`) and
+//! whether it casts into the shadow map (`casters`). One rule, used by the
+//! frame when it chooses for itself and by `dermis plan`, which writes the
+//! choice into the plan file for `render --plan` to draw. Pure: no device.
+
+use glam::{Mat4, Vec3};
+
+use super::camera::Camera;
+use super::casters;
+use super::crowd_motion::Motion;
+use super::lod;
+use super::mesh::Aabb;
+use super::morph::Morph;
+use super::Scene;
+
+/// One character's geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CharacterGeometry {
+    /// Its level of detail: 0 the full meshes, `i` the `i`-th simplified
+    /// level of each of its meshes (a mesh with fewer levels its coarsest).
+    pub level: u8,
+    /// Whether the shadow map draws it (its shadow can land on a receiver
+    /// in view).
+    pub casts_shadow: bool,
+}
+
+/// What the choice sees of the frame.
+pub struct GeometryView<'a> {
+    pub camera: &'a Camera,
+    pub width: u32,
+    pub height: u32,
+    /// The key light's shadow-map projection.
+    pub light_view_proj: Mat4,
+    /// The backdrop's model matrix.
+    pub backdrop: Mat4,
+}
+
+/// The characters' models with each one's rigid turn beyond the scene's
+/// pose (a crowd of characters without animation, `Scene::tracks`), about
+/// the head's centre: what the frame draws them with.
+pub fn turned(scene: &Scene, mut models: Vec<Mat4>) -> Vec<Mat4> {
+    if let Some(t) = scene.tracks.as_ref().filter(|t| t.motion == Motion::Rigid) {
+        if models.len() > 1 {
+            let c = scene.head_center();
+            for (i, m) in models.iter_mut().enumerate() {
+                *m = *m
+                    * Mat4::from_translation(c)
+                    * Mat4::from_quat(t.turn(i))
+                    * Mat4::from_translation(-c);
+            }
+        }
+    }
+    models
+}
+
+/// How far a morph's targets can move a vertex, per axis: the sum over its
+/// targets of each one's largest offset, times the largest weight it can
+/// take (`max_weight`).
+fn morph_reach(morph: &Morph, max_weight: f32) -> Vec3 {
+    morph
+        .targets
+        .iter()
+        .map(|t| {
+            t.position
+                .iter()
+                .fold(Vec3::ZERO, |m, d| m.max(Vec3::from(*d).abs()))
+        })
+        .sum::<Vec3>()
+        * max_weight
+}
+
+/// The largest weight a crowd's characters give a morph: the scene's own,
+/// the crowd clip's keys (tangents included), and at least 1.
+fn max_weight(scene: &Scene) -> f32 {
+    let own = scene
+        .head
+        .morph
+        .weights
+        .iter()
+        .fold(1.0f32, |m, w| m.max(w.abs()));
+    match scene.tracks.as_ref().map(|t| &t.motion) {
+        Some(Motion::Weights(clip)) => clip
+            .channels
+            .iter()
+            .flat_map(|c| c.values.iter())
+            .fold(own, |m, w| m.max(w.abs())),
+        _ => own,
+    }
+}
+
+/// The model-space box of everything a character draws: every vertex of
+/// its head and parts as posed, widened by how far the crowd's morph
+/// weights can move them (a character of a moving crowd is at another
+/// phase than the posed one).
+pub fn drawn_bounds(scene: &Scene) -> Aabb {
+    let w = max_weight(scene);
+    std::iter::once(&scene.head)
+        .chain(&scene.parts)
+        .map(|o| {
+            let b = o.mesh.bounds();
+            let reach = morph_reach(&o.morph, w);
+            Aabb {
+                min: b.min - reach,
+                max: b.max + reach,
+            }
+        })
+        .reduce(|a, b| a.union(&b))
+        .unwrap_or(scene.head_bounds)
+}
+
+/// Pixels an object unit covers at each character's nearest point (its
+/// centre's view depth less half its bounds' diagonal, times its model's
+/// largest axis scale): a level's error is judged there (a lateral extent
+/// projects by depth, not by distance).
+pub fn pixels_per_unit(scene: &Scene, models: &[Mat4], camera: &Camera, height: u32) -> Vec<f32> {
+    let centre = scene.head_center();
+    let radius = 0.5 * scene.head_bounds.size().length();
+    let forward = (camera.target - camera.eye).normalize_or_zero();
+    models
+        .iter()
+        .map(|m| {
+            let scale = m
+                .x_axis
+                .truncate()
+                .length()
+                .max(m.y_axis.truncate().length())
+                .max(m.z_axis.truncate().length());
+            let depth = (m.transform_point3(centre) - camera.eye).dot(forward) - radius * scale;
+            lod::pixels_per_unit(depth.max(camera.near), camera.fovy_rad, height) * scale
+        })
+        .collect()
+}
+
+/// A character's level: the coarsest level at which every one of its
+/// meshes (`errors`: each mesh's level errors, full mesh first) strays at
+/// most `max_pixels` on screen at `px_per_unit`; 0 when levels are off
+/// (`max_pixels` 0) or a mesh has none.
+pub fn character_level(errors: &[Vec<f32>], px_per_unit: f32, max_pixels: f32) -> u8 {
+    if max_pixels <= 0.0 || errors.is_empty() {
+        return 0;
+    }
+    let deepest = errors.iter().map(Vec::len).max().unwrap_or(1);
+    (0..deepest)
+        .rev()
+        .find(|&l| {
+            errors.iter().all(|e| {
+                e.get(l.min(e.len().saturating_sub(1)))
+                    .is_none_or(|&err| err * px_per_unit <= max_pixels)
+            })
+        })
+        .unwrap_or(0) as u8
+}
+
+/// Every character's geometry: `models` are the characters' (turned) model
+/// matrices in frame order; `errors` the level errors of each mesh a
+/// character draws (empty when levels are off).
+pub fn choose(
+    scene: &Scene,
+    models: &[Mat4],
+    view: &GeometryView,
+    errors: &[Vec<f32>],
+    lod_pixels: f32,
+) -> Vec<CharacterGeometry> {
+    let drawn = drawn_bounds(scene);
+    let boxes: Vec<Aabb> = models.iter().map(|m| drawn.transformed(m)).collect();
+    let backdrop = scene
+        .backdrop
+        .as_ref()
+        .map(|b| b.mesh.bounds().transformed(&view.backdrop));
+    let aspect = view.width as f32 / view.height.max(1) as f32;
+    let cast = casters::casting(
+        &view.camera.view_proj(aspect),
+        &view.light_view_proj,
+        &boxes,
+        backdrop.as_ref(),
+    );
+    let ppu = pixels_per_unit(scene, models, view.camera, view.height);
+    ppu.iter()
+        .zip(cast)
+        .map(|(&p, casts_shadow)| CharacterGeometry {
+            level: character_level(errors, p, lod_pixels),
+            casts_shadow,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_character_takes_the_coarsest_level_every_mesh_allows() {
+        let head = vec![0.0, 0.01, 0.02, 0.04];
+        let eyes = vec![0.0, 0.03];
+        // 100 px a unit, 2.5 px allowed: the head alone could take level 2
+        // (0.02 -> 2 px); the eyes' coarsest (0.03 -> 3 px) is too coarse at
+        // level 1 and past it (a mesh with fewer levels keeps its last).
+        assert_eq!(character_level(std::slice::from_ref(&head), 100.0, 2.5), 2);
+        assert_eq!(character_level(&[head.clone(), eyes.clone()], 100.0, 2.5), 0);
+        assert_eq!(character_level(&[head.clone(), eyes], 100.0, 3.0), 2);
+        assert_eq!(character_level(std::slice::from_ref(&head), 100.0, 0.0), 0);
+        assert_eq!(character_level(&[head], 1.0, 1.0), 3);
+        assert_eq!(character_level(&[], 1.0, 1.0), 0);
+    }
+
+    #[test]
+    fn the_drawn_bounds_hold_every_target_at_full_weight() {
+        let scene = crate::scene::default_scene();
+        let b = drawn_bounds(&scene);
+        let m = &scene.head.morph;
+        assert!(!m.targets.is_empty(), "the face has its expressions");
+        for t in &m.targets {
+            for (i, d) in t.position.iter().enumerate() {
+                let p = Vec3::from(m.rest[t.first + i].position) + Vec3::from(*d);
+                assert!(p.cmpge(b.min).all() && p.cmple(b.max).all(), "{p}");
+            }
+        }
+    }
+}
