@@ -34,6 +34,11 @@ struct Influence { uvec4 j0; uvec4 j1; vec4 w0; vec4 w1; };
 layout(set = 0, binding = 5, std430) readonly buffer Influences { Influence influences[]; };
 // The joint matrices at this frame's pose, then at the previous frame's.
 layout(set = 0, binding = 6, std430) readonly buffer Joints { mat4 joints[]; };
+// Which vertices each copy deforms (a crowd's copy, drawn at a level of
+// detail, only that level's): a (first, count) pair per copy, then the
+// lists. Count ALL: every vertex, in order, no list read.
+layout(set = 0, binding = 8, std430) readonly buffer Lists { uint lists[]; };
+const uint ALL = 0xffffffffu;
 // skinSlots: 0 (no skin), 4 or 8; jointCount: where the previous matrices start.
 layout(push_constant) uniform Push {
     uint vertexCount; uint targetCount; uint skinSlots; uint jointCount; uint copies;
@@ -63,9 +68,16 @@ vec3 direction(mat4 m, vec3 v) {
 }
 
 void main() {
-    uint v = gl_GlobalInvocationID.x;
+    uint x = gl_GlobalInvocationID.x;
     uint copy = gl_GlobalInvocationID.y;
-    if (v >= pc.vertexCount) return;
+    uint listed = lists[2u * copy + 1u];
+    uint v = x;
+    if (listed == ALL) {
+        if (v >= pc.vertexCount) return;
+    } else {
+        if (x >= listed) return;
+        v = lists[lists[2u * copy] + x];
+    }
     uint b = v * STRIDE;
     precise vec3 p = vec3(rest[b], rest[b + 1u], rest[b + 2u]);
     precise vec3 n = vec3(rest[b + 3u], rest[b + 4u], rest[b + 5u]);

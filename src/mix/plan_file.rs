@@ -58,8 +58,8 @@ pub struct PlannedCharacter {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlannedGeometry {
-    /// 0: the full meshes; `i`: each mesh's `i`-th simplified level (its
-    /// coarsest where it has fewer).
+    /// 0: the full meshes; `i`: the head's `i`-th simplified level, and
+    /// each other mesh its coarsest that strays no more than that one.
     pub level: u8,
     pub casts_shadow: bool,
     /// Triangles the character submits to the geometry pass at its level

@@ -24,9 +24,12 @@ struct MeshLevels {
 }
 
 impl MeshLevels {
-    fn triangles_at(&self, level: u8) -> u64 {
-        let l = (level as usize).min(self.triangles.len() - 1);
-        self.triangles[l]
+    /// Its triangles in a character at `level` (`head`: the head's errors).
+    fn triangles_at(&self, head: &[f32], level: u8) -> u64 {
+        if self.errors.is_empty() {
+            return self.triangles[0];
+        }
+        self.triangles[crowd_geometry::mesh_level(&self.errors, head, level) as usize]
     }
 }
 
@@ -146,7 +149,13 @@ pub fn plan_geometry(
         &errors,
         settings.lod_pixels,
     );
-    let at = |level: u8| meshes.iter().map(|m| m.triangles_at(level)).sum::<u64>();
+    let head = errors.first().cloned().unwrap_or_default();
+    let at = |level: u8| {
+        meshes
+            .iter()
+            .map(|m| m.triangles_at(&head, level))
+            .sum::<u64>()
+    };
     let full_triangles = at(0);
     let triangles: Vec<u64> = characters.iter().map(|c| at(c.level)).collect();
     let n = characters.len() as u64;

@@ -33,6 +33,8 @@ pub const SHADER: &str = "deform.comp";
 const GROUP: u32 = crate::shader_constants::DEFORM_GROUP_SIZE;
 /// Floats per vertex (`Vertex`: position, normal, uv, tangent).
 const VERTEX_FLOATS: u64 = 12;
+/// A copy's list count meaning every vertex (deform.comp's ALL).
+const ALL: u32 = u32::MAX;
 
 /// std430 `Target` of the shader.
 #[repr(C)]
@@ -65,6 +67,45 @@ struct DeformPush {
     copies: u32,
 }
 
+/// Which vertices each copy deforms: copy `c` (instance slot `c`) those of
+/// level `copy_levels[c]` (`level_vertices`: sorted, once each).
+pub struct Lists<'a> {
+    pub copy_levels: &'a [u8],
+    pub level_vertices: &'a [Vec<u32>],
+}
+
+/// The `Lists` buffer of the shader: a (first, count) pair per copy (count
+/// `ALL`: every vertex, no list read), then each used level's vertices
+/// once; the most vertices a copy deforms; and their sum over the copies.
+fn flatten_lists(lists: Option<Lists>, copies: u32, vertex_count: u32) -> (Vec<u32>, u32, u64) {
+    let Some(l) = lists else {
+        let out = (0..copies).flat_map(|_| [0, ALL]).collect();
+        return (out, vertex_count, u64::from(vertex_count) * u64::from(copies));
+    };
+    let mut out = vec![0u32; 2 * copies as usize];
+    let mut first_of: Vec<Option<u32>> = vec![None; l.level_vertices.len()];
+    let (mut most, mut sum) = (0u32, 0u64);
+    for c in 0..copies as usize {
+        let level = l.copy_levels.get(c).map_or(0, |&x| x as usize);
+        let level = level.min(l.level_vertices.len() - 1);
+        let verts = &l.level_vertices[level];
+        let first = match first_of[level] {
+            Some(f) => f,
+            None => {
+                let f = out.len() as u32;
+                out.extend_from_slice(verts);
+                first_of[level] = Some(f);
+                f
+            }
+        };
+        out[2 * c] = first;
+        out[2 * c + 1] = verts.len() as u32;
+        most = most.max(verts.len() as u32);
+        sum += verts.len() as u64;
+    }
+    (out, most, sum)
+}
+
 /// One morphing object's buffers on the GPU.
 #[derive(Default)]
 pub struct DeformObject {
@@ -75,6 +116,7 @@ pub struct DeformObject {
     deltas: Buffer,
     influences: Buffer,
     joints: Buffer,
+    lists: Buffer,
     previous: Buffer,
     /// The object's vertex buffer (written here, drawn by the frame).
     pub vertices: BufferId,
@@ -85,6 +127,10 @@ pub struct DeformObject {
     skin_slots: u32,
     joint_count: u32,
     copies: u32,
+    /// The most vertices a copy deforms (the dispatch's width), and the
+    /// share of the dispatched invocations that deform one.
+    listed_most: u32,
+    listed_share: f64,
     /// Offsets read per vertex, on average (what the work declares).
     offsets_per_vertex: f64,
 }
@@ -189,15 +235,16 @@ impl Deform {
         &mut self,
         ctx: &Context,
         res: &mut Resources,
-        name: &str,
-        vertices: vk::Buffer,
+        (name, vertices): (&str, vk::Buffer),
         morph: &Morph,
         copies: &[Vec<f32>],
+        lists: Option<Lists>,
     ) -> Result<BufferId> {
         let n = morph.rest.len() as u64;
         let (deltas, rows) = flatten(morph);
         let weights = flatten_weights(morph, copies);
         let c = copies.len().max(1) as u64;
+        let (list_words, listed_most, listed_sum) = flatten_lists(lists, c as u32, n as u32);
         let (influences, joints) = flatten_skin(morph.skin.as_ref());
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // Read back by tests (`read_back`).
@@ -210,6 +257,9 @@ impl Deform {
             skin_slots: morph.skin.as_ref().map_or(0, |s| s.slots as u32),
             joint_count: morph.skin.as_ref().map_or(0, |s| s.matrices.len() as u32),
             copies: c as u32,
+            listed_most,
+            listed_share: listed_sum as f64
+                / (u64::from(listed_most.div_ceil(GROUP) * GROUP) * c).max(1) as f64,
             offsets_per_vertex: rows.iter().map(|r| r.count as f64).sum::<f64>() / n.max(1) as f64,
             ..Default::default()
         };
@@ -222,6 +272,7 @@ impl Deform {
         o.deltas = upload("morph offsets", bytemuck::cast_slice(&deltas))?;
         o.influences = upload("joint influences", bytemuck::cast_slice(&influences))?;
         o.joints = upload("joint matrices", bytemuck::cast_slice(&joints))?;
+        o.lists = upload("vertex lists", bytemuck::cast_slice(&list_words))?;
         let zeros = vec![0f32; (3 * n * c) as usize];
         o.previous = device_buffer(
             ctx,
@@ -263,6 +314,7 @@ impl Deform {
                     ),
                 ),
                 ("Joints", whole(&o.joints, 64 * joints.len() as u64)),
+                ("Lists", whole(&o.lists, 4 * list_words.len() as u64)),
                 (
                     "Deformed",
                     Binding::StorageBuffer {
@@ -307,16 +359,19 @@ impl Deform {
                 // offsets (position, normal, tangent at most), the
                 // influences and two matrices a slot (as many as are used:
                 // the slots' count is the upper bound); the vertex and its
-                // previous position written.
-                storage_read_bytes: 4.0 * VERTEX_FLOATS as f64
+                // previous position written; with vertex lists, the list
+                // entry too, and only for the invocations that deform one
+                // (the rest of a copy's row return at once).
+                storage_read_bytes: o.listed_share
+                    * (8.0 + 4.0 * VERTEX_FLOATS as f64
                     + 24.0 * o.target_count as f64
                     + 36.0 * o.offsets_per_vertex
                     + if o.skin_slots > 0 {
                         std::mem::size_of::<InfluenceRow>() as f64 + 128.0 * o.skin_slots as f64
                     } else {
                         0.0
-                    },
-                storage_write_bytes: 4.0 * VERTEX_FLOATS as f64 + 12.0,
+                    }),
+                storage_write_bytes: o.listed_share * (4.0 * VERTEX_FLOATS as f64 + 12.0),
                 shared_bytes: 0.0,
             };
             let push = DeformPush {
@@ -330,7 +385,7 @@ impl Deform {
             let mut pass = Pass::new(format!("deform {}", o.name), PassRole::Geometry);
             let set = pass.set(&o.set);
             passes.push(
-                pass.dispatch(work, [o.vertex_count.div_ceil(GROUP), o.copies, 1], GROUP)
+                pass.dispatch(work, [o.listed_most.div_ceil(GROUP), o.copies, 1], GROUP)
                     .record(move |pc: &PassContext| {
                         pc.bind(&self.pipeline, &[set]);
                         self.pipeline.push(pc.ctx, pc.cmd, &push);
@@ -402,6 +457,7 @@ impl Deform {
                 &mut o.deltas,
                 &mut o.influences,
                 &mut o.joints,
+                &mut o.lists,
                 &mut o.previous,
             ] {
                 b.destroy(ctx);

@@ -620,7 +620,18 @@ impl Frame {
                         r,
                     );
                 };
-                for obj in &self.objects {
+                // The characters first, front row first, and the backdrop
+                // last: early depth testing then rejects the backdrop's
+                // hidden pixels instead of shading them and drawing over
+                // them (a crowd covers half the screen). The nearest
+                // surface and its stencil code win in any order: the same
+                // bits.
+                let order = self
+                    .objects
+                    .iter()
+                    .filter(|o| o.kind != ObjectKind::Backdrop)
+                    .chain(self.objects.iter().filter(|o| o.kind == ObjectKind::Backdrop));
+                for obj in order {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
                     // The backdrop once, a character's other parts with
                     // every character: no skin bit, so no SSS pass reads them.

@@ -186,9 +186,10 @@ impl<'c> Renderer<'c> {
                 })
                 .collect(),
         )?;
-        // After the groups: a crowd's copies are in their instance slots.
-        frame.enable_deform(ctx, scene, &mut resources)?;
+        // After the groups: a crowd's copies are in their instance slots;
+        // the levels first, so a copy deforms only its level's vertices.
         frame.choose_geometry(scene);
+        frame.enable_deform(ctx, scene, &mut resources)?;
         let groups = build_groups(ctx, &mut resources, &frame, scene, specs)?;
         let mut groups = Guard::new(ctx, groups);
         let sss_output = groups::passes::output(&groups, &frame.targets);

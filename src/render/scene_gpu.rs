@@ -49,6 +49,9 @@ pub struct GpuObject {
     /// Each level of detail's error (object units), the full mesh's 0 first;
     /// empty without levels.
     pub level_errors: Vec<f32>,
+    /// Each level's vertices (sorted, once each): what the deform pass
+    /// writes for a copy drawn at that level.
+    pub level_vertices: Vec<Vec<u32>>,
     textures: Vec<Image>,
     uniforms: Buffer,
     pub material_set: vk::DescriptorSet,
@@ -119,6 +122,7 @@ impl GpuObject {
                 kind,
                 deformed: None,
                 level_errors: Vec::new(),
+                level_vertices: Vec::new(),
                 textures: Vec::new(),
                 uniforms: Buffer::default(),
                 material_set: vk::DescriptorSet::null(),
@@ -170,6 +174,15 @@ impl GpuObject {
             }
             self.mesh.index_count = mesh.indices.len() as u32;
             self.level_errors = levels.iter().map(|l| l.error).collect();
+            self.level_vertices = levels
+                .iter()
+                .map(|l| {
+                    let mut v = l.indices.clone();
+                    v.sort_unstable();
+                    v.dedup();
+                    v
+                })
+                .collect();
         }
         let m: &Material = &object.material;
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.

@@ -16,8 +16,8 @@ use super::Scene;
 /// One character's geometry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CharacterGeometry {
-    /// Its level of detail: 0 the full meshes, `i` the `i`-th simplified
-    /// level of each of its meshes (a mesh with fewer levels its coarsest).
+    /// Its level of detail: 0 the full meshes, `i` the head's `i`-th
+    /// simplified level, each other mesh at [`mesh_level`].
     pub level: u8,
     /// Whether the shadow map draws it (its shadow can land on a receiver
     /// in view).
@@ -131,24 +131,29 @@ pub fn pixels_per_unit(scene: &Scene, models: &[Mat4], camera: &Camera, height: 
         .collect()
 }
 
-/// A character's level: the coarsest level at which every one of its
-/// meshes (`errors`: each mesh's level errors, full mesh first) strays at
-/// most `max_pixels` on screen at `px_per_unit`; 0 when levels are off
-/// (`max_pixels` 0) or a mesh has none.
+/// A character's level: the coarsest level of its first mesh (its head:
+/// `errors[0]`, that mesh's level errors, full mesh first) whose error
+/// covers at most `max_pixels` on screen at `px_per_unit`; 0 when levels
+/// are off (`max_pixels` 0) or it has none. Its other meshes take
+/// [`mesh_level`] of that level's error.
 pub fn character_level(errors: &[Vec<f32>], px_per_unit: f32, max_pixels: f32) -> u8 {
-    if max_pixels <= 0.0 || errors.is_empty() {
-        return 0;
+    match errors.first() {
+        Some(head) if max_pixels > 0.0 => lod::choose(head, px_per_unit, max_pixels) as u8,
+        _ => 0,
     }
-    let deepest = errors.iter().map(Vec::len).max().unwrap_or(1);
-    (0..deepest)
-        .rev()
-        .find(|&l| {
-            errors.iter().all(|e| {
-                e.get(l.min(e.len().saturating_sub(1)))
-                    .is_none_or(|&err| err * px_per_unit <= max_pixels)
-            })
-        })
-        .unwrap_or(0) as u8
+}
+
+/// The level a mesh of level errors `errors` takes in a character at
+/// `level`: its coarsest whose error is at most the head's at that level
+/// (`head`: the head's errors), so every mesh strays as little as the head
+/// does (a small part, simplified alone, strays more at the same ratio).
+pub fn mesh_level(errors: &[f32], head: &[f32], level: u8) -> u8 {
+    let allowed = head
+        .get(level as usize)
+        .or(head.last())
+        .copied()
+        .unwrap_or(0.0);
+    errors.iter().rposition(|&e| e <= allowed).unwrap_or(0) as u8
 }
 
 /// Every character's geometry: `models` are the characters' (turned) model
@@ -189,18 +194,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_character_takes_the_coarsest_level_every_mesh_allows() {
+    fn a_character_takes_its_heads_level_and_its_parts_follow_its_error() {
         let head = vec![0.0, 0.01, 0.02, 0.04];
-        let eyes = vec![0.0, 0.03];
-        // 100 px a unit, 2.5 px allowed: the head alone could take level 2
-        // (0.02 -> 2 px); the eyes' coarsest (0.03 -> 3 px) is too coarse at
-        // level 1 and past it (a mesh with fewer levels keeps its last).
-        assert_eq!(character_level(std::slice::from_ref(&head), 100.0, 2.5), 2);
-        assert_eq!(character_level(&[head.clone(), eyes.clone()], 100.0, 2.5), 0);
-        assert_eq!(character_level(&[head.clone(), eyes], 100.0, 3.0), 2);
+        let eyes = vec![0.0, 0.015, 0.05];
+        // 100 px a unit, 2.5 px allowed: the head's 0.02 -> 2 px.
+        assert_eq!(character_level(&[head.clone(), eyes.clone()], 100.0, 2.5), 2);
         assert_eq!(character_level(std::slice::from_ref(&head), 100.0, 0.0), 0);
-        assert_eq!(character_level(&[head], 1.0, 1.0), 3);
+        assert_eq!(character_level(std::slice::from_ref(&head), 1.0, 1.0), 3);
         assert_eq!(character_level(&[], 1.0, 1.0), 0);
+        // The eyes at the head's level 2 (0.02): their level 1 (0.015).
+        assert_eq!(mesh_level(&eyes, &head, 2), 1);
+        assert_eq!(mesh_level(&eyes, &head, 0), 0);
+        assert_eq!(mesh_level(&eyes, &head, 3), 1);
+        assert_eq!(mesh_level(&head, &head, 3), 3);
     }
 
     #[test]

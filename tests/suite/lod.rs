@@ -65,19 +65,20 @@ fn a_crowd_draws_fewer_triangles_within_a_stated_error() {
     let (shadow_full, geometry_full) = triangles("0");
     let (shadow, geometry) = triangles(&LOD_PX.to_string());
     // The far characters of a 16-head crowd at 320 x 180 are a few dozen
-    // pixels tall: their coarsest levels (a sixteenth of the triangles).
+    // pixels tall: their coarse levels (a sixteenth to a thirty-second of
+    // the triangles).
     assert!(
         geometry * 4 < geometry_full,
         "{geometry} of {geometry_full}"
     );
     assert!(shadow * 4 < shadow_full, "{shadow} of {shadow_full}");
     // The frame against the full meshes': the same skin pixels but a few
-    // along the silhouettes (lavapipe: 24 357 against 24 347), and the
-    // diffuse light over skin within a relative RMSE of 0.12 (lavapipe
-    // measured 0.096 at 1 px and 0.080 at 0.25 px: the shading of a coarse
-    // level's larger triangles, interpolating the full mesh's normals, and
-    // not its outline, is most of it, which is why the levels are off by
-    // default).
+    // along the silhouettes (lavapipe: 24 333 against 24 347), and the
+    // diffuse light over skin within a relative RMSE of 0.15 (lavapipe
+    // measured 0.127 at 1 px with levels down to 1/64 of the triangles,
+    // 0.096 when they stopped at 1/16: the shading of a coarse level's
+    // larger triangles, interpolating the full mesh's normals, and not its
+    // outline, is most of it, which is why the levels are off by default).
     let ctx = common::ctx();
     let full = Renderer::new(&ctx, &dermis::scene::default_scene(), &settings(0.0))
         .unwrap()
@@ -103,6 +104,6 @@ fn a_crowd_draws_fewer_triangles_within_a_stated_error() {
     eprintln!(
         "levels of detail at 1 px: relative RMSE {rmse:.4} over skin, {b} skin pixels of {a}"
     );
-    assert!(rmse < 0.12, "relative RMSE {rmse}");
+    assert!(rmse < 0.15, "relative RMSE {rmse}");
     assert!(rmse > 0.0, "the levels changed nothing");
 }

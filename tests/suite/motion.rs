@@ -487,6 +487,78 @@ fn a_moving_crowd_deforms_each_character_at_its_own_phase() {
     assert_ne!(first.diffuse, other.diffuse);
 }
 
+/// A moving crowd drawn at levels of detail: each character's copy has
+/// its level's vertices deformed as the CPU blends them (to the bit) and
+/// every other vertex left as uploaded (the pass skipped it), and every
+/// index of the character's level names a deformed vertex.
+#[test]
+fn a_crowd_at_levels_deforms_only_what_its_levels_draw() {
+    use dermis::scene::source::SceneSource;
+    let ctx = common::ctx();
+    let scene = SceneSource {
+        time: Some(1.0),
+        ..SceneSource::default()
+    }
+    .load()
+    .unwrap();
+    let tracks = scene.tracks.clone().expect("a timed face has tracks");
+    let heads = 9;
+    let s = RenderSettings {
+        heads,
+        lod_pixels: 2.0,
+        ..settings()
+    };
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    r.capture(false).unwrap();
+    let head = r
+        .frame
+        .objects
+        .iter()
+        .find(|o| o.name == "head")
+        .expect("the head object");
+    let levels = head.mesh.slot_levels.clone();
+    let lists = head.level_vertices.clone();
+    assert_eq!(levels.len(), heads as usize);
+    assert!(levels.iter().any(|&l| l > 0), "no character at a level: {levels:?}");
+    let got = r.deformed().unwrap();
+    let n = scene.head.morph.rest.len();
+    let uploaded: &[f32] = bytemuck::cast_slice(&scene.head.mesh.vertices);
+    let mut skipped = 0usize;
+    for (c, copy) in got[0].vertices.chunks_exact(12 * n).enumerate() {
+        let mut m = scene.head.morph.clone();
+        if c > 0 {
+            m.weights = tracks.weights(c).unwrap();
+        }
+        let want = apply(&m.rest, &m);
+        let want: &[f32] = bytemuck::cast_slice(&want);
+        let listed = &lists[levels[c] as usize];
+        let mut is_listed = vec![false; n];
+        for &v in listed {
+            is_listed[v as usize] = true;
+        }
+        for v in 0..n {
+            let (got, cpu, up) = (
+                &copy[12 * v..12 * v + 12],
+                &want[12 * v..12 * v + 12],
+                &uploaded[12 * v..12 * v + 12],
+            );
+            if is_listed[v] {
+                assert!(got == cpu, "character {c}, vertex {v}: not the CPU's blend");
+            } else {
+                assert!(got == up, "character {c}, vertex {v}: written though unlisted");
+                skipped += 1;
+            }
+        }
+    }
+    assert!(skipped > 0, "every vertex deformed");
+    // A level's triangles name listed vertices only (what the draws read).
+    let full = dermis::scene::lod::levels(&scene.head.mesh);
+    for (l, level) in full.iter().enumerate() {
+        assert!(level.indices.iter().all(|i| lists[l].binary_search(i).is_ok()));
+    }
+    eprintln!("levels {levels:?}: {skipped} vertex copies skipped");
+}
+
 /// A public sample no code of ours wrote: the glTF tutorial's SimpleSkin
 /// (tests/fixtures/khronos). At the 1 s key the upper joint (at y = 1) has
 /// turned 90 degrees about +Z (the file's quaternion (0, 0, 0.707, 0.707)),

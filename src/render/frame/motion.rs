@@ -3,6 +3,7 @@
 //! of the head, their rigid turns). A child of `frame`, whose fields it sets.
 
 use super::*;
+use crate::render::deform::Lists;
 use crate::scene::crowd_motion::Motion;
 use crate::scene::crowd_geometry::{self, CharacterGeometry, GeometryView};
 
@@ -47,15 +48,17 @@ impl Frame {
             by_slot[s as usize] = self.geometry[c];
         }
         self.casters = by_slot.iter().map(|g| g.casts_shadow).collect();
+        // The head's level; every other mesh the coarsest of its own that
+        // strays no more than the head's does.
+        let head = errors.first().cloned().unwrap_or_default();
         for o in self
             .objects
             .iter_mut()
-            .filter(|o| !o.level_errors.is_empty())
+            .filter(|o| o.kind.per_character() && !o.level_errors.is_empty())
         {
-            let last = o.level_errors.len() - 1;
             o.mesh.slot_levels = by_slot
                 .iter()
-                .map(|g| (g.level as usize).min(last) as u8)
+                .map(|g| crowd_geometry::mesh_level(&o.level_errors, &head, g.level))
                 .collect();
         }
     }
@@ -101,9 +104,22 @@ impl Frame {
                 &[]
             };
             if !morph.at_rest() || !copies.is_empty() {
-                let id =
-                    self.deform
-                        .add(ctx, res, &obj.name, obj.mesh.vertices.raw, morph, copies)?;
+                // A copy per character deforms its level's vertices only
+                // (`choose_geometry` set the slots' levels); one shared
+                // copy deforms every vertex.
+                let lists = (!copies.is_empty() && !obj.level_vertices.is_empty())
+                    .then(|| Lists {
+                        copy_levels: &obj.mesh.slot_levels,
+                        level_vertices: &obj.level_vertices,
+                    });
+                let id = self.deform.add(
+                    ctx,
+                    res,
+                    (&obj.name, obj.mesh.vertices.raw),
+                    morph,
+                    copies,
+                    lists,
+                )?;
                 obj.deformed = Some(id);
             }
         }
