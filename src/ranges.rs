@@ -303,6 +303,16 @@ pub const TIME: Range = range(
     "seconds",
 );
 
+/// The time a frame advances the animation (`--time-step`): above 0, at
+/// most a second (a frame a second is already a slide show).
+pub const TIME_STEP: Range = range(
+    "--time-step",
+    "time_step",
+    End::Excl(0.0),
+    End::Incl(1.0),
+    "seconds",
+);
+
 /// The levels of detail's error budget: 0 (off) to 64 pixels (a level that
 /// strays more is no longer the character).
 pub const LOD_PIXELS: Range = range(
@@ -314,7 +324,7 @@ pub const LOD_PIXELS: Range = range(
 );
 
 /// Every range above, in the order docs/usage.md lists them.
-pub const ALL: [&Range; 18] = [
+pub const ALL: [&Range; 19] = [
     &WIDTH,
     &HEIGHT,
     &SHADOW_SIZE,
@@ -332,6 +342,7 @@ pub const ALL: [&Range; 18] = [
     &FRAMES,
     &WARMUP,
     &TIME,
+    &TIME_STEP,
     &LOD_PIXELS,
 ];
 

@@ -124,6 +124,19 @@ pub fn run(
     run_request(ctx, &FrameRequest::new(scene, settings.clone())?, opts)
 }
 
+/// The note of a run stepping through the motion (`--time-step`): which
+/// time each frame is posed at, and the last one's (the image's).
+fn step_note(scene: &Scene, warmup: usize, measured: usize, capture: bool) {
+    if let Some((t0, dt)) = scene.tracks.as_ref().and_then(|t| Some((t.time, t.step?))) {
+        let last = (warmup + measured).saturating_sub(usize::from(!capture));
+        eprintln!(
+            "note: --time-step {dt}: frame k is posed at {t0} + k * {dt} s ({warmup} warm-up, {measured} measured{}); the last, frame {last}, at {} s",
+            if capture { ", then the captured one" } else { "" },
+            t0 + last as f32 * dt
+        );
+    }
+}
+
 /// Renders a checked frame: warm-up, measured frames, the capture, the
 /// report (with the frame's whole settings and the run header).
 pub fn run_request(ctx: &Context, request: &FrameRequest, opts: &RunOptions) -> Result<RunOutput> {
@@ -131,6 +144,7 @@ pub fn run_request(ctx: &Context, request: &FrameRequest, opts: &RunOptions) -> 
     let mut renderer = Renderer::build(ctx, request)?;
     let (warmup, measured) = (opts.frames.warmup(), opts.frames.measured());
     let total = warmup + measured;
+    step_note(scene, warmup, measured, opts.capture);
     let bar = if opts.progress && total > 20 {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(

@@ -404,6 +404,10 @@ pub struct FrameArgs {
     /// scene without animation, dermis's rigid turn and nod (4 s, looped).
     #[arg(long, value_name = "SECONDS", help = with_range("Pose the scene's animation at this time (a glTF's clip, the face's expressions, else a rigid turn and nod)", &ranges::TIME))]
     pub time: Option<f32>,
+    /// Advance the animation this many seconds every frame (warm-up, measured and
+    /// captured frames alike), from --time or 0: frame k is posed at time + k * step.
+    #[arg(long, value_name = "SECONDS", help = with_range("Advance the animation this much every frame, from --time (or 0): frame k at time + k * step", &ranges::TIME_STEP))]
+    pub time_step: Option<f32>,
     /// The glTF animation --time plays (default: the file's first). Not `--clip`:
     /// tsd's option of that name clips its unwrapped meshes.
     #[arg(long, value_name = "NAME", requires = "time")]

@@ -129,6 +129,7 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         time: a.time,
         clip: a.animation.clone(),
         crowd_seed: a.crowd_seed,
+        time_step: a.time_step,
     }
 }
 

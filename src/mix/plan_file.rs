@@ -183,7 +183,11 @@ impl PlanFile {
         }
         // Geometry for every character or for none (the frame cannot mix its
         // own choice with a plan's).
-        let with = self.assignments.iter().filter(|a| a.geometry.is_some()).count();
+        let with = self
+            .assignments
+            .iter()
+            .filter(|a| a.geometry.is_some())
+            .count();
         if with != 0 && with != self.assignments.len() {
             let a = self.assignments.iter().find(|a| a.geometry.is_none());
             bail!(

@@ -23,7 +23,8 @@ use crate::budget::profile::Profile;
 use crate::method::path::{self, Path as SssPath};
 use crate::method::METHODS;
 use crate::mix::plan_file::{
-    PlanFile, PlannedCharacter, PlannedGeometry as PlannedGeometryFile, PredictedError, PLAN_VERSION,
+    PlanFile, PlannedCharacter, PlannedGeometry as PlannedGeometryFile, PredictedError,
+    PLAN_VERSION,
 };
 use crate::mix::Choice;
 use crate::render::RenderSettings;

@@ -80,7 +80,11 @@ pub struct Lists<'a> {
 fn flatten_lists(lists: Option<Lists>, copies: u32, vertex_count: u32) -> (Vec<u32>, u32, u64) {
     let Some(l) = lists else {
         let out = (0..copies).flat_map(|_| [0, ALL]).collect();
-        return (out, vertex_count, u64::from(vertex_count) * u64::from(copies));
+        return (
+            out,
+            vertex_count,
+            u64::from(vertex_count) * u64::from(copies),
+        );
     };
     let mut out = vec![0u32; 2 * copies as usize];
     let mut first_of: Vec<Option<u32>> = vec![None; l.level_vertices.len()];
@@ -268,7 +272,14 @@ impl Deform {
         };
         o.rest = upload("rest vertices", bytemuck::cast_slice(&morph.rest))?;
         o.targets = upload("morph targets", bytemuck::cast_slice(&rows))?;
-        o.weights = upload("morph weights", bytemuck::cast_slice(&weights))?;
+        // Host-visible: a frame stepping through a clip rewrites it between
+        // frames (`set_weights`).
+        o.weights = Buffer::with_data(
+            ctx,
+            &format!("{name} morph weights"),
+            bytemuck::cast_slice(&weights),
+            usage,
+        )?;
         o.deltas = upload("morph offsets", bytemuck::cast_slice(&deltas))?;
         o.influences = upload("joint influences", bytemuck::cast_slice(&influences))?;
         o.joints = upload("joint matrices", bytemuck::cast_slice(&joints))?;
@@ -340,6 +351,32 @@ impl Deform {
         Ok(id)
     }
 
+    /// Object `index`'s weights for the next frame: `now` and `previous`
+    /// per copy (each a weight per target), between frames (no frame in
+    /// flight: the buffer is host-visible).
+    pub fn set_weights(
+        &mut self,
+        index: usize,
+        now: &[Vec<f32>],
+        previous: &[Vec<f32>],
+    ) -> Result<()> {
+        let o = &mut self.objects[index];
+        let pairs: Vec<[f32; 2]> = now
+            .iter()
+            .zip(previous)
+            .flat_map(|(n, p)| n.iter().zip(p).map(|(&n, &p)| [n, p]))
+            .collect();
+        anyhow::ensure!(
+            pairs.len() == (o.copies * o.target_count) as usize,
+            "{}: {} weights for {} copies of {} targets",
+            o.name,
+            pairs.len(),
+            o.copies,
+            o.target_count
+        );
+        o.weights.write(bytemuck::cast_slice(&pairs))
+    }
+
     /// Writes the objects' sets (once the frame's pool exists).
     pub fn bind(&mut self, ctx: &Context, pool: &DescriptorPool, res: &Resources) -> Result<()> {
         for o in &mut self.objects {
@@ -363,14 +400,15 @@ impl Deform {
                 // entry too, and only for the invocations that deform one
                 // (the rest of a copy's row return at once).
                 storage_read_bytes: o.listed_share
-                    * (8.0 + 4.0 * VERTEX_FLOATS as f64
-                    + 24.0 * o.target_count as f64
-                    + 36.0 * o.offsets_per_vertex
-                    + if o.skin_slots > 0 {
-                        std::mem::size_of::<InfluenceRow>() as f64 + 128.0 * o.skin_slots as f64
-                    } else {
-                        0.0
-                    }),
+                    * (8.0
+                        + 4.0 * VERTEX_FLOATS as f64
+                        + 24.0 * o.target_count as f64
+                        + 36.0 * o.offsets_per_vertex
+                        + if o.skin_slots > 0 {
+                            std::mem::size_of::<InfluenceRow>() as f64 + 128.0 * o.skin_slots as f64
+                        } else {
+                            0.0
+                        }),
                 storage_write_bytes: o.listed_share * (4.0 * VERTEX_FLOATS as f64 + 12.0),
                 shared_bytes: 0.0,
             };

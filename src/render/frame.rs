@@ -23,6 +23,7 @@ mod character_ids;
 mod motion;
 mod shadow;
 pub use motion::head_copies;
+use motion::Stepping;
 
 use super::deform::Deform;
 use super::groups::merge::Merge;
@@ -42,6 +43,7 @@ use crate::method::region::PixelRect;
 use crate::method::{FrameTargets, FrameView, ViewInfo, STENCIL_SKIN};
 use crate::post::{PostBind, PostChain, PostSetup};
 use crate::scene::camera::Camera;
+use crate::scene::crowd_geometry::{turned, CharacterGeometry};
 use crate::scene::framing::Framing;
 use crate::scene::light::LightFrame;
 use crate::scene::Scene;
@@ -55,7 +57,6 @@ use crate::vk::pipeline::{
 };
 use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload;
-use crate::scene::crowd_geometry::{turned, CharacterGeometry};
 
 /// Descriptor sets the frame's pool holds: the frame's and the objects' few,
 /// and every method's (the reference's sets grow with its sample chunks).
@@ -109,6 +110,9 @@ pub struct Frame {
     /// shadow map draws by.
     pub geometry: Vec<CharacterGeometry>,
     casters: Vec<bool>,
+    /// A frame stepping through the motion (`--time-step`): what each
+    /// frame's pose is made from.
+    stepping: Option<Stepping>,
     /// The characters of each group with its stencil code, in group order:
     /// the geometry pass draws each group's heads with its code as the
     /// stencil reference (one group of every character, code 1, until
@@ -146,6 +150,7 @@ impl Frame {
         };
         let full = PixelRect::full(extent.width, extent.height);
         let every = (0..framing.instances.len()).collect();
+        let stepping = Stepping::new(scene, &framing.instances);
         let instances = turned(scene, framing.instances);
         let f = Frame {
             settings: settings.clone(),
@@ -172,6 +177,7 @@ impl Frame {
             deform: Deform::default(),
             geometry: Vec::new(),
             casters: Vec::new(),
+            stepping,
             skin_groups: vec![SkinGroup {
                 stencil: STENCIL_SKIN,
                 characters: every,
@@ -630,7 +636,11 @@ impl Frame {
                     .objects
                     .iter()
                     .filter(|o| o.kind != ObjectKind::Backdrop)
-                    .chain(self.objects.iter().filter(|o| o.kind == ObjectKind::Backdrop));
+                    .chain(
+                        self.objects
+                            .iter()
+                            .filter(|o| o.kind == ObjectKind::Backdrop),
+                    );
                 for obj in order {
                     p.bind_sets(ctx, cmd, 1, &[obj.material_set]);
                     // The backdrop once, a character's other parts with

@@ -41,18 +41,8 @@ impl Instances {
         models: &[Mat4],
         backdrop: Mat4,
     ) -> Result<Self> {
-        let mut data: Vec<[[f32; 4]; 4]> = Vec::new();
-        let mut group_slots = Vec::new();
-        let mut character_slots = vec![0; models.len()];
-        for g in groups {
-            group_slots.push((data.len() as u32, g.characters.len() as u32));
-            for &c in &g.characters {
-                character_slots[c] = data.len() as u32;
-                data.push(models[c].to_cols_array_2d());
-            }
-        }
-        let backdrop_slot = data.len() as u32;
-        data.push(backdrop.to_cols_array_2d());
+        let (data, group_slots, character_slots) = layout(groups, models, backdrop);
+        let backdrop_slot = data.len() as u32 - 1;
         let buffer = Buffer::with_data(
             ctx,
             "character instances",
@@ -66,6 +56,19 @@ impl Instances {
             backdrop_slot,
             character_slots,
         })
+    }
+
+    /// Rewrites the models (the same groups: a frame stepping through a
+    /// rigid motion, between frames: the buffer is host-visible and no
+    /// frame is in flight).
+    pub fn write_models(
+        &mut self,
+        groups: &[SkinGroup],
+        models: &[Mat4],
+        backdrop: Mat4,
+    ) -> Result<()> {
+        let (data, _, _) = layout(groups, models, backdrop);
+        self.buffer.write(bytemuck::cast_slice(&data))
     }
 
     /// The buffer as the shaders' `Instances` binding.
@@ -82,4 +85,28 @@ impl Instances {
     pub fn destroy(&mut self, ctx: &Context) {
         self.buffer.destroy(ctx);
     }
+}
+
+/// A model matrix as the buffer holds it (columns).
+type Model = [[f32; 4]; 4];
+
+/// The buffer's models (group after group, then the backdrop), each
+/// group's (first slot, count) and each character's slot.
+fn layout(
+    groups: &[SkinGroup],
+    models: &[Mat4],
+    backdrop: Mat4,
+) -> (Vec<Model>, Vec<(u32, u32)>, Vec<u32>) {
+    let mut data: Vec<Model> = Vec::new();
+    let mut group_slots = Vec::new();
+    let mut character_slots = vec![0; models.len()];
+    for g in groups {
+        group_slots.push((data.len() as u32, g.characters.len() as u32));
+        for &c in &g.characters {
+            character_slots[c] = data.len() as u32;
+            data.push(models[c].to_cols_array_2d());
+        }
+    }
+    data.push(backdrop.to_cols_array_2d());
+    (data, group_slots, character_slots)
 }

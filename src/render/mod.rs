@@ -294,6 +294,8 @@ impl<'c> Renderer<'c> {
     /// Records, submits and waits for one frame; returns its per-pass samples.
     /// [`Renderer::last_record_ms`] is then its CPU recording time.
     fn run_frame(&mut self, plan: Option<&mut ReadbackPlan>) -> Result<Vec<PassSample>> {
+        // A run stepping through the motion poses this frame first.
+        self.frame.advance()?;
         let start = std::time::Instant::now();
         self.begin_frame();
         let mut passes = self

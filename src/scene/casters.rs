@@ -62,10 +62,7 @@ fn frustum_corners(view_proj: &Mat4) -> Option<[Vec3; 8]> {
         let p = inv * ndc;
         p.xyz() / p.w
     });
-    corners
-        .iter()
-        .all(|c| c.is_finite())
-        .then_some(corners)
+    corners.iter().all(|c| c.is_finite()).then_some(corners)
 }
 
 /// A box in the light's space (map x, y and depth).

@@ -3,7 +3,7 @@
 //! frame when it chooses for itself and by `dermis plan`, which writes the
 //! choice into the plan file for `render --plan` to draw. Pure: no device.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
 
 use super::camera::Camera;
 use super::casters;
@@ -38,17 +38,20 @@ pub struct GeometryView<'a> {
 /// The characters' models with each one's rigid turn beyond the scene's
 /// pose (a crowd of characters without animation, `Scene::tracks`), about
 /// the head's centre: what the frame draws them with.
-pub fn turned(scene: &Scene, mut models: Vec<Mat4>) -> Vec<Mat4> {
-    if let Some(t) = scene.tracks.as_ref().filter(|t| t.motion == Motion::Rigid) {
-        if models.len() > 1 {
-            let c = scene.head_center();
-            for (i, m) in models.iter_mut().enumerate() {
-                *m = *m
-                    * Mat4::from_translation(c)
-                    * Mat4::from_quat(t.turn(i))
-                    * Mat4::from_translation(-c);
-            }
-        }
+pub fn turned(scene: &Scene, models: Vec<Mat4>) -> Vec<Mat4> {
+    match scene.tracks.as_ref().filter(|t| t.motion == Motion::Rigid) {
+        Some(t) if models.len() > 1 => turned_by(models, scene.head_center(), |i| t.turn(i)),
+        _ => models,
+    }
+}
+
+/// `models` each turned by `turn(i)` about `pivot` (model space).
+pub fn turned_by(mut models: Vec<Mat4>, pivot: Vec3, turn: impl Fn(usize) -> Quat) -> Vec<Mat4> {
+    for (i, m) in models.iter_mut().enumerate() {
+        *m = *m
+            * Mat4::from_translation(pivot)
+            * Mat4::from_quat(turn(i))
+            * Mat4::from_translation(-pivot);
     }
     models
 }
@@ -91,10 +94,10 @@ fn max_weight(scene: &Scene) -> f32 {
 /// The model-space box of everything a character draws: every vertex of
 /// its head and parts as posed, widened by how far the crowd's morph
 /// weights can move them (a character of a moving crowd is at another
-/// phase than the posed one).
+/// phase than the posed one), and by every turn of a turning one.
 pub fn drawn_bounds(scene: &Scene) -> Aabb {
     let w = max_weight(scene);
-    std::iter::once(&scene.head)
+    let posed = std::iter::once(&scene.head)
         .chain(&scene.parts)
         .map(|o| {
             let b = o.mesh.bounds();
@@ -105,7 +108,21 @@ pub fn drawn_bounds(scene: &Scene) -> Aabb {
             }
         })
         .reduce(|a, b| a.union(&b))
-        .unwrap_or(scene.head_bounds)
+        .unwrap_or(scene.head_bounds);
+    // A character that turns (dermis's rigid clip, at any phase or step)
+    // sweeps its box about the head's centre: the cube around the sphere
+    // that holds every turn of it.
+    match scene.tracks.as_ref().map(|t| &t.motion) {
+        Some(Motion::Rigid) => {
+            let c = scene.head_center();
+            let r = (posed.min - c).abs().max((posed.max - c).abs()).length();
+            Aabb {
+                min: c - Vec3::splat(r),
+                max: c + Vec3::splat(r),
+            }
+        }
+        _ => posed,
+    }
 }
 
 /// Pixels an object unit covers at each character's nearest point (its
@@ -198,7 +215,10 @@ mod tests {
         let head = vec![0.0, 0.01, 0.02, 0.04];
         let eyes = vec![0.0, 0.015, 0.05];
         // 100 px a unit, 2.5 px allowed: the head's 0.02 -> 2 px.
-        assert_eq!(character_level(&[head.clone(), eyes.clone()], 100.0, 2.5), 2);
+        assert_eq!(
+            character_level(&[head.clone(), eyes.clone()], 100.0, 2.5),
+            2
+        );
         assert_eq!(character_level(std::slice::from_ref(&head), 100.0, 0.0), 0);
         assert_eq!(character_level(std::slice::from_ref(&head), 1.0, 1.0), 3);
         assert_eq!(character_level(&[], 1.0, 1.0), 0);

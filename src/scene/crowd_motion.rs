@@ -28,6 +28,9 @@ pub struct Tracks {
     pub time: f32,
     pub seed: u64,
     pub motion: Motion,
+    /// The time each frame advances it (`--time-step`); `None`: every
+    /// frame at `time`.
+    pub step: Option<f32>,
 }
 
 /// SplitMix64's finaliser: a well-mixed 64-bit hash of `x`.
@@ -79,6 +82,27 @@ impl Tracks {
         }
     }
 
+    /// The motion `frame` frames on (`step` each), from `time`: what a
+    /// renderer stepping through it draws at that frame (`None` without a
+    /// step).
+    pub fn at_frame(&self, frame: u64) -> Option<Tracks> {
+        let step = self.step?;
+        Some(Tracks {
+            time: self.time + frame as f32 * step,
+            ..self.clone()
+        })
+    }
+
+    /// The turn character `c` makes beyond a pose made at `posed` (the
+    /// scene's mesh turned at that time): its whole rigid pose at this time
+    /// less that one (identity for a clip of weights).
+    pub fn turn_from(&self, c: usize, posed: f32) -> Quat {
+        match self.motion {
+            Motion::Rigid => rigid_rotation(self.time_of(c)) * rigid_rotation(posed).inverse(),
+            _ => Quat::IDENTITY,
+        }
+    }
+
     /// The turn character `c` makes beyond the scene's own pose (identity
     /// for character 0 and for a clip of weights).
     pub fn turn(&self, c: usize) -> Quat {
@@ -122,6 +146,7 @@ mod tests {
             time: 1.0,
             seed: DEFAULT_SEED,
             motion: Motion::Weights(expression_clip()),
+            step: None,
         };
         let clip = expression_clip();
         assert_eq!(t.weights(0), animated_weights(&clip, 0, 1.0));
@@ -141,5 +166,30 @@ mod tests {
         let c = 5;
         let whole = r.turn(c) * rigid_rotation(r.time);
         assert!(whole.angle_between(rigid_rotation(r.time_of(c))) < 1e-5);
+        assert!(r.turn_from(c, r.time).angle_between(r.turn(c)) < 1e-6);
+    }
+
+    #[test]
+    fn a_step_moves_every_character_along_its_own_track() {
+        let t = Tracks {
+            time: 1.0,
+            seed: DEFAULT_SEED,
+            motion: Motion::Rigid,
+            step: Some(0.25),
+        };
+        assert_eq!(t.at_frame(0).unwrap(), t);
+        let f3 = t.at_frame(3).unwrap();
+        assert_eq!(f3.time, 1.75);
+        // Character 0 turns from the posed mesh by the clip's change.
+        let q = f3.turn_from(0, t.time) * rigid_rotation(1.0);
+        assert!(q.angle_between(rigid_rotation(1.75)) < 1e-5);
+        for c in 1..5 {
+            let q = f3.turn_from(c, t.time) * rigid_rotation(1.0);
+            assert!(q.angle_between(rigid_rotation(f3.time_of(c))) < 1e-5);
+            // Each keeps its phase: its time moved by the step sum.
+            let d = (f3.time_of(c) - t.time_of(c)).rem_euclid(RIGID_PERIOD_S);
+            assert!((d - 0.75).abs() < 1e-4, "{d}");
+        }
+        assert!(Tracks { step: None, ..t }.at_frame(1).is_none());
     }
 }

@@ -148,6 +148,7 @@ impl Scene {
             time: t,
             seed: crowd_motion::DEFAULT_SEED,
             motion,
+            step: None,
         });
     }
 
@@ -373,6 +374,7 @@ pub fn load_gltf_scene(
             time: t,
             seed: crowd_motion::DEFAULT_SEED,
             motion: crowd_motion::Motion::Rigid,
+            step: None,
         });
     }
     scene.source = Some(source::SceneSource {
@@ -388,6 +390,7 @@ pub fn load_gltf_scene(
         time: overrides.time,
         clip: overrides.clip.clone(),
         crowd_seed: None,
+        time_step: None,
     });
     Ok(scene)
 }

@@ -46,6 +46,10 @@ pub struct SceneSource {
     pub time: Option<f32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clip: Option<String>,
+    /// The time each frame advances the animation (`--time-step`; from
+    /// `time`, or 0): frame k of a run is posed at time + k * step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_step: Option<f32>,
     /// The seed of a crowd's phases (`crowd_motion`; default its
     /// `DEFAULT_SEED`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -99,6 +103,20 @@ impl SceneSource {
         if let Some(t) = self.time {
             crate::ranges::TIME.check(t)?;
         }
+        if let Some(dt) = self.time_step {
+            crate::ranges::TIME_STEP.check(dt)?;
+            if !self.morph_weights.is_empty() {
+                anyhow::bail!("--morph-weights poses one frame: it cannot be given with --time-step (the clip gives every frame's weights)");
+            }
+            if self.time.is_none() {
+                // Stepping starts at 0 unless --time says.
+                return SceneSource {
+                    time: Some(0.0),
+                    ..self.clone()
+                }
+                .load();
+            }
+        }
         if self.clip.is_some() && self.gltf().is_none() {
             anyhow::bail!("--animation names an animation of a glTF --scene; the built-in scenes have one clip each");
         }
@@ -116,6 +134,13 @@ impl SceneSource {
         }
         if let Some(tracks) = &mut scene.tracks {
             tracks.seed = self.crowd_seed.unwrap_or(super::crowd_motion::DEFAULT_SEED);
+            tracks.step = self.time_step;
+        }
+        if let (Some(_), None, Some(path)) = (self.time_step, &scene.tracks, self.gltf()) {
+            anyhow::bail!(
+                "--time-step: {}'s own clip is posed once, as the file loads (its skeleton is not kept to pose it again): give --time alone",
+                path.display()
+            );
         }
         scene.set_morph_weights(&weights)?;
         if let Some(src) = &mut scene.source {
@@ -123,6 +148,7 @@ impl SceneSource {
             src.time = self.time;
             src.clip = self.clip.clone();
             src.crowd_seed = self.crowd_seed;
+            src.time_step = self.time_step;
         }
         Ok(scene)
     }

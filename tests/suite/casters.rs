@@ -120,7 +120,10 @@ fn culled_casters_change_no_pixel_and_save_their_triangles() {
         .capture(false)
         .unwrap();
     assert_eq!(primitives(&c, "shadow map"), 0);
-    assert!(c.diffuse != a.diffuse, "a frame without shadows is the same");
+    assert!(
+        c.diffuse != a.diffuse,
+        "a frame without shadows is the same"
+    );
 }
 
 /// `dermis plan` chooses every character's level and caster flag, and
@@ -151,18 +154,31 @@ fn render_draws_the_plans_levels_and_casters() {
         .arg(&plan_dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("cast onto a receiver in view"), "{stdout}");
     let file = PlanFile::load(&plan_dir.join("plan.json")).unwrap();
     let geometry: Vec<PlannedGeometry> = file
         .assignments
         .iter()
-        .map(|a| a.geometry.expect("the plan gives every character's geometry"))
+        .map(|a| {
+            a.geometry
+                .expect("the plan gives every character's geometry")
+        })
         .collect();
     let tri = |g: &PlannedGeometry| g.triangles.unwrap();
-    assert!(geometry.iter().any(|g| g.level > 0), "no character at a level");
-    assert!(geometry.iter().any(|g| !g.casts_shadow), "every character casts");
+    assert!(
+        geometry.iter().any(|g| g.level > 0),
+        "no character at a level"
+    );
+    assert!(
+        geometry.iter().any(|g| !g.casts_shadow),
+        "every character casts"
+    );
     let render = |extra: &[&str], name: &str| -> serde_json::Value {
         let out_dir = dir.path().join(name);
         let out = common::dermis()
@@ -173,7 +189,11 @@ fn render_draws_the_plans_levels_and_casters() {
             .arg(&out_dir)
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         serde_json::from_slice(&std::fs::read(out_dir.join("report.json")).unwrap()).unwrap()
     };
     let prims = |r: &serde_json::Value, pass: &str| {
@@ -195,7 +215,11 @@ fn render_draws_the_plans_levels_and_casters() {
     let full = render(&[], "full");
     let casters = geometry.iter().filter(|g| g.casts_shadow).count() as u64;
     let shadow_full = prims(&full, "shadow map");
-    assert_eq!(shadow_full % casters, 0, "{shadow_full} over {casters} casters");
+    assert_eq!(
+        shadow_full % casters,
+        0,
+        "{shadow_full} over {casters} casters"
+    );
     let full_character = shadow_full / casters;
     for g in geometry.iter().filter(|g| g.level == 0) {
         assert_eq!(tri(g), full_character);

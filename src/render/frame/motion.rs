@@ -1,11 +1,15 @@
 //! What moves in the frame: the deform pass of every object that morphs or
-//! is skinned, and a crowd's characters each at its own phase (their copies
-//! of the head, their rigid turns). A child of `frame`, whose fields it sets.
+//! is skinned, a crowd's characters each at its own phase (their copies of
+//! the head, their rigid turns), and a run stepping through the motion
+//! frame by frame (`--time-step`: [`Stepping`]). A child of `frame`, whose
+//! fields it sets.
 
 use super::*;
 use crate::render::deform::Lists;
-use crate::scene::crowd_motion::Motion;
+use crate::scene::crowd_geometry::turned_by;
 use crate::scene::crowd_geometry::{self, CharacterGeometry, GeometryView};
+use crate::scene::crowd_motion::{Motion, Tracks};
+use glam::Vec3;
 
 impl Frame {
     /// Each character's level of detail and whether it casts into the
@@ -40,10 +44,13 @@ impl Frame {
             )
         });
         let slots = &self.instance_buffer.character_slots;
-        let mut by_slot = vec![CharacterGeometry {
-            level: 0,
-            casts_shadow: true,
-        }; slots.len()];
+        let mut by_slot = vec![
+            CharacterGeometry {
+                level: 0,
+                casts_shadow: true,
+            };
+            slots.len()
+        ];
         for (c, &s) in slots.iter().enumerate() {
             by_slot[s as usize] = self.geometry[c];
         }
@@ -90,6 +97,12 @@ impl Frame {
                 .collect(),
             _ => Vec::new(),
         };
+        // Stepping through a clip of weights: the head deforms every frame,
+        // even from a pose whose weights are all 0.
+        let steps_weights = self
+            .stepping
+            .as_ref()
+            .is_some_and(|s| matches!(s.tracks.motion, Motion::Weights(_)));
         let morphs = scene
             .backdrop
             .iter()
@@ -103,15 +116,15 @@ impl Frame {
             } else {
                 &[]
             };
-            if !morph.at_rest() || !copies.is_empty() {
+            let stepped = steps_weights && obj.name == "head";
+            if !morph.at_rest() || !copies.is_empty() || stepped {
                 // A copy per character deforms its level's vertices only
                 // (`choose_geometry` set the slots' levels); one shared
                 // copy deforms every vertex.
-                let lists = (!copies.is_empty() && !obj.level_vertices.is_empty())
-                    .then(|| Lists {
-                        copy_levels: &obj.mesh.slot_levels,
-                        level_vertices: &obj.level_vertices,
-                    });
+                let lists = (!copies.is_empty() && !obj.level_vertices.is_empty()).then(|| Lists {
+                    copy_levels: &obj.mesh.slot_levels,
+                    level_vertices: &obj.level_vertices,
+                });
                 let id = self.deform.add(
                     ctx,
                     res,
@@ -121,9 +134,101 @@ impl Frame {
                     lists,
                 )?;
                 obj.deformed = Some(id);
+                if let (true, Some(st)) = (stepped, self.stepping.as_mut()) {
+                    st.head = Some(self.deform.objects.len() - 1);
+                    st.copy_characters = if copies.is_empty() {
+                        vec![0]
+                    } else {
+                        by_slot.clone()
+                    };
+                    st.last = if copies.is_empty() {
+                        vec![morph.weights.clone()]
+                    } else {
+                        copies.to_vec()
+                    };
+                }
             }
         }
         Ok(())
+    }
+}
+
+/// A run stepping through the motion (`--time-step`): frame k is posed at
+/// the scene's time + k * step, whatever ran before it. A clip of weights
+/// rewrites each copy's weights (this frame's and the last's: the deform
+/// pass's velocity); a rigid motion rewrites the models (every character,
+/// the first too, turns from the pose its mesh was made at). The frame's
+/// framing, levels and shadow casters stay those of frame 0.
+pub struct Stepping {
+    /// The motion at frame 0.
+    pub tracks: Tracks,
+    /// Frames run so far.
+    frame: u64,
+    /// The characters' models before any turn, and the turn's pivot.
+    base: Vec<Mat4>,
+    pivot: Vec3,
+    /// The head's deform object, each of its copies' character and the
+    /// weights it was last given.
+    head: Option<usize>,
+    copy_characters: Vec<usize>,
+    last: Vec<Vec<f32>>,
+}
+
+impl Stepping {
+    /// Stepping for `scene` when its motion has a step; `models` the
+    /// characters' models before any turn.
+    pub fn new(scene: &Scene, models: &[Mat4]) -> Option<Stepping> {
+        let tracks = scene.tracks.clone().filter(|t| t.step.is_some())?;
+        Some(Stepping {
+            tracks,
+            frame: 0,
+            base: models.to_vec(),
+            pivot: scene.head_center(),
+            head: None,
+            copy_characters: Vec::new(),
+            last: Vec::new(),
+        })
+    }
+}
+
+impl Frame {
+    /// Poses the next frame of a stepping run (nothing for frame 0, posed
+    /// as the frame was built, or without a step). Between frames: no frame
+    /// is in flight.
+    pub fn advance(&mut self) -> Result<()> {
+        let Some(mut st) = self.stepping.take() else {
+            return Ok(());
+        };
+        let k = st.frame;
+        st.frame += 1;
+        let result = match st.tracks.at_frame(k).filter(|_| k > 0) {
+            None => Ok(()),
+            Some(t) => match (&t.motion, st.head) {
+                (Motion::Weights(_), Some(head)) => {
+                    let now: Vec<Vec<f32>> = st
+                        .copy_characters
+                        .iter()
+                        .map(|&c| t.weights(c).unwrap_or_default())
+                        .collect();
+                    let r = self.deform.set_weights(head, &now, &st.last);
+                    st.last = now;
+                    r
+                }
+                (Motion::Rigid, _) => {
+                    let posed = st.tracks.time;
+                    self.instances =
+                        turned_by(st.base.clone(), st.pivot, |i| t.turn_from(i, posed));
+                    self.instance_buffer.write_models(
+                        &self.skin_groups,
+                        &self.instances,
+                        self.backdrop,
+                    )
+                }
+                _ => Ok(()),
+            },
+        };
+        self.stepping = Some(st);
+        result
     }
 }
 
