@@ -39,6 +39,7 @@
 mod animations;
 mod checks;
 pub mod fixture;
+mod instancing;
 mod nodes;
 mod primitives;
 mod skins;
@@ -295,9 +296,8 @@ fn unsupported_features(src: &super::gltf_source::Source, warn: &mut Warnings) {
     for e in used.filter(|e| !super::gltf_source::SUPPORTED_REQUIRED_EXTENSIONS.contains(e)) {
         let e = super::gltf_source::short(e);
         match e.as_ref() {
-            "EXT_mesh_gpu_instancing" => warn.push(format!(
-                "{e} is not supported: each instanced mesh is drawn once, at its node, without its instances"
-            )),
+            // Drawn: each instanced node says its count (`instancing`).
+            "EXT_mesh_gpu_instancing" => {}
             "KHR_lights_punctual" => warn.note(format!(
                 "{e}: the file's lights are not used (dermis lights every scene with its own key light)"
             )),

@@ -310,8 +310,8 @@ fn a_clip_keeps_the_scale_of_its_rest_pose() {
     }
 }
 
-/// What a file has that dermis does not draw is said: instancing, vertex
-/// colours, cameras, lights, other extensions.
+/// What a file has that dermis does not draw is said: vertex colours,
+/// cameras, lights, other extensions.
 #[test]
 fn what_is_not_drawn_is_said() {
     let dir = temp_dir("unsaid");
@@ -331,7 +331,6 @@ fn what_is_not_drawn_is_said() {
     let l = load_head_with_notes(&path, &TextureOverrides::default()).unwrap();
     let all: Vec<&String> = l.warnings.iter().chain(&l.notes).collect();
     for says in [
-        "EXT_mesh_gpu_instancing is not supported: each instanced mesh is drawn once",
         "KHR_lights_punctual: the file's lights are not used",
         "KHR_materials_sheen is not supported: drawn without it",
         "the file's 1 camera(s) are not used",
@@ -339,4 +338,72 @@ fn what_is_not_drawn_is_said() {
     ] {
         assert!(all.iter().any(|w| w.contains(says)), "{says}: {all:?}");
     }
+}
+
+/// EXT_mesh_gpu_instancing draws every instance: a quad of three instances
+/// (at the origin; 5 along x, turned a quarter about z; 5 up, scaled 2)
+/// places its corners where T * R * S of the file's values puts them.
+#[test]
+fn an_instanced_node_draws_every_instance_where_the_file_puts_it() {
+    let dir = temp_dir("instanced");
+    let q = std::f32::consts::FRAC_1_SQRT_2;
+    let t = [0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 5.0, 0.0];
+    let r = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, q, q, 0.0, 0.0, 0.0, 1.0];
+    let sc = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0];
+    let prim = serde_json::json!({"attributes": attrs()});
+    let mut m = Model::quad(prim, serde_json::json!([]), &[], None);
+    let mut add = |vals: &[f32], ty: &str, n: usize| {
+        let view = m.add_view(&f32_bytes(vals), None);
+        m.add_accessor(
+            serde_json::json!({"bufferView": view, "componentType": 5126, "count": n, "type": ty}),
+        )
+    };
+    let (ta, ra, sa) = (add(&t, "VEC3", 3), add(&r, "VEC4", 3), add(&sc, "VEC3", 3));
+    m.json["extensionsUsed"] = serde_json::json!(["EXT_mesh_gpu_instancing"]);
+    m.json["nodes"][0]["extensions"] = serde_json::json!({"EXT_mesh_gpu_instancing":
+        {"attributes": {"TRANSLATION": ta, "ROTATION": ra, "SCALE": sa}}});
+    let path = write_gltf(&dir, "instanced.gltf", m.json.clone(), &m.buffer);
+    let l = load_head_with_notes(&path, &TextureOverrides::default()).unwrap();
+    assert!(
+        l.notes
+            .iter()
+            .any(|n| n.contains("its 3 instances drawn as copies")),
+        "{:?}",
+        l.notes
+    );
+    let got: Vec<Vec3> = l
+        .object
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| Vec3::from(v.position))
+        .collect();
+    assert_eq!(got.len(), 12, "three quads of four corners");
+    let corners = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+    // The closed forms: instance 1 turns (x, y) to (-y, x) then moves 5
+    // along x; instance 2 doubles then moves 5 up.
+    let want: Vec<Vec3> = corners
+        .iter()
+        .copied()
+        .chain(corners.iter().map(|p| Vec3::new(5.0 - p.y, p.x, 0.0)))
+        .chain(corners.iter().map(|p| Vec3::new(0.0, 5.0, 0.0) + 2.0 * *p))
+        .collect();
+    for w in &want {
+        assert!(
+            got.iter().any(|g| (*g - *w).length() < 1e-5),
+            "no vertex at {w}: {got:?}"
+        );
+    }
+    // Mismatched counts are one line.
+    let mut bad = m.json.clone();
+    bad["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] =
+        serde_json::json!(0);
+    let path = write_gltf(&dir, "bad.gltf", bad, &m.buffer);
+    let e = format!(
+        "{:#}",
+        load_head_with_notes(&path, &TextureOverrides::default())
+            .err()
+            .unwrap()
+    );
+    assert!(e.contains("different counts"), "{e}");
 }

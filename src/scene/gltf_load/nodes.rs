@@ -8,6 +8,7 @@ use std::collections::HashMap;
 use std::rc::Rc;
 
 use super::checks::{mesh_label, node_label};
+use super::instancing::instance_matrices;
 use super::primitives::{read_primitive, Part};
 use super::skins::{append_skinned, skin_matrices, SpanSkin};
 use super::Warnings;
@@ -426,10 +427,48 @@ pub(super) fn collect(
             .filter(|_| node.mesh().is_some())
             .map(|sk| skin_matrices(src, &sk, &worlds))
             .transpose()?;
-        if let Some(mesh) = node.mesh() {
+        // An instanced node (EXT_mesh_gpu_instancing) draws its mesh once
+        // per instance, placed by the node's world times the instance's.
+        let placements: Vec<DMat4> = match instance_matrices(src, node)? {
+            Some(list) if skin.is_some() => {
+                warn.push(format!(
+                    "{}: the {} instances of a skinned mesh are not drawn: it is drawn once, by its joints",
+                    node_label(node),
+                    list.len()
+                ));
+                vec![world]
+            }
+            Some(list) => {
+                warn.note(format!(
+                    "{}: EXT_mesh_gpu_instancing: its {} instances drawn as copies of its mesh",
+                    node_label(node),
+                    list.len()
+                ));
+                list.iter().map(|m| world * *m).collect()
+            }
+            None => vec![world],
+        };
+        let Some(mesh) = node.mesh() else {
+            stack.extend(
+                node.children()
+                    .map(|c| c.index())
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .rev(),
+            );
+            continue;
+        };
+        for (instance, &world) in placements.iter().enumerate() {
             for prim in mesh.primitives() {
                 let key = (mesh.index(), prim.index());
-                let label = format!("{} primitive {}", mesh_label(&mesh), prim.index());
+                let label = match placements.len() {
+                    1 => format!("{} primitive {}", mesh_label(&mesh), prim.index()),
+                    _ => format!(
+                        "{} primitive {} instance {instance}",
+                        mesh_label(&mesh),
+                        prim.index()
+                    ),
+                };
                 let part = match parts.get(&key) {
                     Some(p) => p.clone(),
                     None => {
