@@ -50,6 +50,7 @@ impl<'s> FrameRequest<'s> {
     /// Resolves the groups of checked settings in `scene`.
     pub fn of(scene: &'s Scene, settings: CheckedSettings) -> Result<Self> {
         let settings = settings.0;
+        check_in_view(scene, &settings)?;
         let groups = group_specs(scene, &settings)?;
         crate::checks::ran("groups");
         Ok(FrameRequest {
@@ -96,6 +97,37 @@ impl<'s> FrameRequest<'s> {
 /// Everything a frame is made from, as `report.json` records it (its
 /// `settings`) and `dermis render --settings` reads it back: the scene's
 /// source and the render settings, both whole, by serialisation.
+/// Refuses a frame that would show none of its characters: the framing
+/// (`render`'s shot) puts every triangle of every character outside the
+/// view (a model framed by a stray part, a scale far off, a crowd walked
+/// past the camera), which would render a frame of backdrop and exit 0.
+/// A character whose box misses the view is skipped at once; the first
+/// whose triangles reach it ends the search.
+fn check_in_view(scene: &Scene, settings: &RenderSettings) -> Result<()> {
+    use crate::scene::casters::{in_view, mesh_in_view};
+    use crate::scene::crowd_geometry::{drawn_bounds, turned};
+    let framing = crate::scene::framing::frame(scene, &super::groups::shot(scene, settings));
+    let aspect = settings.width as f32 / settings.height.max(1) as f32;
+    let view_proj = framing.camera.view_proj(aspect);
+    let drawn = drawn_bounds(scene);
+    let seen = turned(scene, framing.instances).iter().any(|m| {
+        in_view(&view_proj, &drawn.transformed(m))
+            && std::iter::once(&scene.head)
+                .chain(&scene.parts)
+                .any(|o| mesh_in_view(&view_proj, m, &o.mesh))
+    });
+    crate::checks::ran("in view");
+    if !seen {
+        let c = framing.camera;
+        anyhow::bail!(
+            "no character is in view: none of their triangles reaches the frame (the camera at {:.3?} looks at {:.3?}); check the model's scale (--mm-per-unit) and the shot (--distance, --crowd-walked)",
+            c.eye.to_array(),
+            c.target.to_array()
+        );
+    }
+    Ok(())
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameSettings {

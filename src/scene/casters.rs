@@ -49,6 +49,31 @@ pub fn in_view(view_proj: &Mat4, b: &Aabb) -> bool {
     !planes.iter().any(|outside| clip.iter().all(outside))
 }
 
+/// Whether any of the triangles of `mesh`, placed by `model`, can reach
+/// the frustum of `view_proj`: a vertex inside it, or else a triangle whose
+/// box [`in_view`] passes (a large triangle can cross the view with every
+/// corner outside). False only when nothing of the mesh can be seen.
+pub fn mesh_in_view(view_proj: &Mat4, model: &Mat4, mesh: &super::mesh::Mesh) -> bool {
+    let m = *view_proj * *model;
+    let clip: Vec<Vec4> = mesh
+        .vertices
+        .iter()
+        .map(|v| m * Vec3::from(v.position).extend(1.0))
+        .collect();
+    let inside =
+        |c: &Vec4| c.w > 0.0 && c.x.abs() <= c.w && c.y.abs() <= c.w && c.z >= 0.0 && c.z <= c.w;
+    if clip.iter().any(inside) {
+        return true;
+    }
+    mesh.indices.chunks_exact(3).any(|t| {
+        Aabb::from_points(
+            t.iter()
+                .map(|&i| Vec3::from(mesh.vertices[i as usize].position)),
+        )
+        .is_some_and(|b| in_view(&m, &b))
+    })
+}
+
 /// The world points of the frustum of `view_proj` (its eight corners).
 fn frustum_corners(view_proj: &Mat4) -> Option<[Vec3; 8]> {
     let inv = view_proj.inverse();
@@ -218,6 +243,41 @@ mod tests {
             casting(&vp, &light, &[visible, shadow_side, light_side], None),
             vec![true, false, true]
         );
+    }
+
+    #[test]
+    fn a_mesh_is_in_view_by_a_vertex_or_a_triangle_across_it() {
+        use crate::scene::mesh::{Mesh, Vertex};
+        let vp = camera();
+        let tri = |p: [[f32; 3]; 3]| Mesh {
+            vertices: p
+                .iter()
+                .map(|&position| Vertex {
+                    position,
+                    ..Default::default()
+                })
+                .collect(),
+            indices: vec![0, 1, 2],
+        };
+        let id = Mat4::IDENTITY;
+        assert!(mesh_in_view(
+            &vp,
+            &id,
+            &tri([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        ));
+        // Behind the camera (z > 10): nothing seen.
+        let behind = tri([[0.0, 0.0, 20.0], [1.0, 0.0, 20.0], [0.0, 1.0, 20.0]]);
+        assert!(!mesh_in_view(&vp, &id, &behind));
+        // Moved in front by its model: seen.
+        let forward = Mat4::from_translation(Vec3::new(0.0, 0.0, -20.0));
+        assert!(mesh_in_view(&vp, &forward, &behind));
+        // A triangle far larger than the view, every corner outside it.
+        let huge = tri([
+            [-100.0, -100.0, 0.0],
+            [100.0, -100.0, 0.0],
+            [0.0, 100.0, 0.0],
+        ]);
+        assert!(mesh_in_view(&vp, &id, &huge));
     }
 
     #[test]

@@ -229,3 +229,22 @@ fn render_draws_the_plans_levels_and_casters() {
     assert_eq!(prims(&planned, "geometry"), drawn + backdrop);
     assert!(drawn < HEADS as u64 * full_character);
 }
+
+/// A frame that would show none of its characters is refused with one
+/// line before anything is written: a crowd walked past the camera.
+#[test]
+fn a_frame_with_no_character_in_view_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::dermis()
+        .args(["render", "--heads", "4", "--crowd-walked", "200"])
+        .args(["--width", "64", "--height", "36", "--out"])
+        .arg(dir.path().join("r"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains("no character is in view"), "{err}");
+    assert!(!dir.path().join("r").exists(), "something was written");
+}

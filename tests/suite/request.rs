@@ -238,6 +238,7 @@ fn every_check_of_a_command_runs_once() {
         let mut want = vec![
             "device-limits",
             "groups",
+            "in-view",
             "output-paths",
             "scene",
             "settings",
