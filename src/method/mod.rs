@@ -166,6 +166,9 @@ pub struct MethodSetup<'a> {
     /// ground truth samples the skin surface itself; tsd draws these heads.
     pub scene: &'a Scene,
     pub instances: &'a [Mat4],
+    /// The frame index of each of `instances` (a moving crowd's character
+    /// has its own pose: `Scene::character_head`).
+    pub characters: &'a [usize],
     /// Set 0 of `lighting.glsl` (the frame: uniforms, shadow map, samplers,
     /// Beckmann), for methods that shade surfaces.
     pub frame_binds: Vec<(&'static str, Binding)>,

@@ -56,22 +56,30 @@ pub fn sample_count(mesh: &Mesh, transforms: &[Mat4], mm_per_unit: f32, density:
     total
 }
 
-/// `sample_surface`, refused when it would make more than `max_samples`
-/// (counted first: a far, corrupt vertex makes a triangle of astronomical area).
-pub fn sample_surface_within(
-    mesh: &Mesh,
-    transforms: &[Mat4],
+/// `sample_surface` of each (mesh, transform) in turn (a moving crowd's
+/// characters each with its own pose; the same samples, in the same order,
+/// as one call with every transform when the meshes are one), refused when
+/// it would make more than `max_samples` (counted first: a far, corrupt
+/// vertex makes a triangle of astronomical area).
+pub fn sample_characters_within(
+    characters: &[(&Mesh, Mat4)],
     mm_per_unit: f32,
     density: f32,
     max_samples: u64,
 ) -> anyhow::Result<Vec<SurfaceSample>> {
-    let wanted = sample_count(mesh, transforms, mm_per_unit, density);
+    let wanted: f64 = characters
+        .iter()
+        .map(|(mesh, m)| sample_count(mesh, &[*m], mm_per_unit, density))
+        .sum();
     if wanted > max_samples.min(u32::MAX as u64) as f64 {
         anyhow::bail!(
             "the reference would take {wanted:.3e} samples at {density} per mm^2, more than this device holds ({max_samples}); lower --density or the number of heads (or check the mesh for far outlier vertices)"
         );
     }
-    Ok(sample_surface(mesh, transforms, mm_per_unit, density))
+    Ok(characters
+        .iter()
+        .flat_map(|(mesh, m)| sample_surface(mesh, &[*m], mm_per_unit, density))
+        .collect())
 }
 
 /// Area of a triangle in mm^2, in f64 (f32 overflows on a far vertex).
@@ -222,6 +230,33 @@ mod tests {
         assert!(s
             .iter()
             .all(|x| (0.0..=2.0).contains(&x.pos_area[0]) && (0.0..=2.0).contains(&x.pos_area[1])));
+    }
+
+    /// Characters sampled one by one are the samples of one call over
+    /// every transform when their meshes are one (the same bits, the same
+    /// order: a still crowd's truth is unchanged), and each character's
+    /// samples lie on its own mesh when they differ.
+    #[test]
+    fn characters_sampled_in_turn_keep_their_own_meshes() {
+        let (a, b) = (quad(2.0), quad(3.0));
+        let moved = Mat4::from_translation(glam::Vec3::new(10.0, 0.0, 0.0));
+        let one = sample_surface(&a, &[Mat4::IDENTITY, moved], 10.0, 4.0);
+        let each =
+            sample_characters_within(&[(&a, Mat4::IDENTITY), (&a, moved)], 10.0, 4.0, u64::MAX)
+                .unwrap();
+        assert!(one == each);
+        let mixed =
+            sample_characters_within(&[(&a, Mat4::IDENTITY), (&b, moved)], 10.0, 4.0, u64::MAX)
+                .unwrap();
+        let (first, second): (Vec<_>, Vec<_>) = mixed.iter().partition(|x| x.pos_area[0] < 5.0);
+        let area = |v: &[&SurfaceSample]| v.iter().map(|x| x.pos_area[3]).sum::<f32>();
+        assert!((area(&first) - 400.0).abs() < 1e-2);
+        assert!((area(&second) - 900.0).abs() < 1e-2, "{}", area(&second));
+        assert!(second
+            .iter()
+            .all(|x| (10.0..=13.0).contains(&x.pos_area[0])));
+        // Refused past the budget, before any sample is made.
+        assert!(sample_characters_within(&[(&a, Mat4::IDENTITY)], 10.0, 4.0, 100).is_err());
     }
 
     /// The sampled (wide) part of the profile at squared distance `r2` (mm^2), f64

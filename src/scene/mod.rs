@@ -152,6 +152,25 @@ impl Scene {
         });
     }
 
+    /// Character `c`'s head as a crowd at the scene's time draws it: its
+    /// own phase of a clip of weights (`tracks`), posed on the CPU as the
+    /// deform pass poses its copy; `None` where it is the scene's head
+    /// (character 0, a still or rigid crowd, a head without targets).
+    pub fn character_head(&self, c: usize) -> Option<mesh::Mesh> {
+        let t = self.tracks.as_ref().filter(|_| c > 0)?;
+        if !matches!(t.motion, crowd_motion::Motion::Weights(_))
+            || self.head.morph.targets.is_empty()
+        {
+            return None;
+        }
+        let mut m = self.head.morph.clone();
+        m.weights = t.weights(c)?;
+        Some(mesh::Mesh {
+            vertices: morph::posed(&m.rest, &m),
+            indices: self.head.mesh.indices.clone(),
+        })
+    }
+
     /// Turns the character (its head and parts, their morphs' rest shapes and
     /// offsets too) by `q` about the head's centre, the camera and light
     /// left where they are (they were placed from the rest pose).
@@ -453,6 +472,42 @@ pub fn scene_from_character(
 mod tests {
     use super::gltf_load::tests::{lps_path, temp_dir, tiny_gltf};
     use super::*;
+
+    /// A moving crowd's character draws its own phase of the face's clip:
+    /// its head is the CPU's blend at its weights, not the first's.
+    #[test]
+    fn a_moving_crowds_characters_have_their_own_heads() {
+        let scene = source::SceneSource {
+            time: Some(1.0),
+            ..Default::default()
+        }
+        .load()
+        .unwrap();
+        assert!(
+            scene.character_head(0).is_none(),
+            "character 0 is the scene's head"
+        );
+        let t = scene.tracks.clone().unwrap();
+        let (h1, h2) = (
+            scene.character_head(1).unwrap(),
+            scene.character_head(2).unwrap(),
+        );
+        assert_ne!(h1.vertices, h2.vertices);
+        assert_ne!(h1.vertices, scene.head.mesh.vertices);
+        let mut m = scene.head.morph.clone();
+        m.weights = t.weights(1).unwrap();
+        assert_eq!(h1.vertices, morph::posed(&m.rest, &m));
+        // A still scene and a rigid crowd: the scene's head for everyone.
+        assert!(default_scene().character_head(1).is_none());
+        let egg = source::SceneSource {
+            scene: Some("builtin:egg".into()),
+            time: Some(1.0),
+            ..Default::default()
+        }
+        .load()
+        .unwrap();
+        assert!(egg.character_head(1).is_none());
+    }
 
     #[test]
     fn builtin_scenes_are_consistent() {

@@ -160,6 +160,9 @@ struct Surface {
     index_count: u32,
     /// The skin's indices, first in `indices` (the parts' follow).
     skin_index_count: u32,
+    /// Each instance's first vertex in `vertices` (0 for all but in a
+    /// moving crowd, where each has its own posed copy).
+    copy_offsets: Vec<i32>,
     /// The largest narrow window radius (subsamples) any skin pixel uses.
     max_radius: u32,
     mm_per_subsample_per_depth: f32,

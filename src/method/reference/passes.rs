@@ -157,7 +157,7 @@ impl Reference {
                     );
                 }
                 let (skin, all) = (self.surf.skin_index_count, self.surf.index_count);
-                for m in &self.instances {
+                for (m, &offset) in self.instances.iter().zip(&self.surf.copy_offsets) {
                     // The skin with its subsamples' area; the parts with
                     // none: occluders only.
                     for (first, count, scale) in [
@@ -175,7 +175,7 @@ impl Reference {
                                 mm_per_subsample_per_depth: scale,
                             },
                         );
-                        unsafe { ctx.device.cmd_draw_indexed(cmd, count, 1, first, 0, 0) };
+                        unsafe { ctx.device.cmd_draw_indexed(cmd, count, 1, first, offset, 0) };
                     }
                 }
             })

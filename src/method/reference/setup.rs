@@ -14,7 +14,8 @@ use crate::method::profile::Profile;
 use crate::method::MethodSetup;
 use crate::reference::chunks::{max_slab_candidates, plan_chunks, ChunkLimits, RADIANCE_WIDTH};
 use crate::reference::narrow::{radius, supersampling};
-use crate::reference::sampling::{build_grid, cutoff_mm, sample_surface_within};
+use crate::reference::sampling::{build_grid, cutoff_mm, sample_characters_within};
+use crate::scene::mesh::Mesh;
 use crate::skin::tissue::TISSUE_TOLERANCE;
 use crate::vk::barrier::AccessKind;
 use crate::vk::guard::Guard;
@@ -61,7 +62,25 @@ impl Reference {
         // otherwise ask for billions).
         let f = &s.ctx.facts;
         let budget = sample_budget(f);
-        let mut surface = sample_surface_within(&skin.mesh, s.instances, mm, self.density, budget)?;
+        // Each character's own pose: a moving crowd's head copies
+        // (`Scene::character_head`), else the scene's skin for all.
+        let own: Vec<Option<Mesh>> = if std::ptr::eq(skin, &s.scene.head) {
+            s.characters
+                .iter()
+                .map(|&c| s.scene.character_head(c))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let meshes: Vec<&Mesh> = (0..s.instances.len())
+            .map(|i| own.get(i).and_then(Option::as_ref).unwrap_or(&skin.mesh))
+            .collect();
+        let characters: Vec<(&Mesh, glam::Mat4)> = meshes
+            .iter()
+            .copied()
+            .zip(s.instances.iter().copied())
+            .collect();
+        let mut surface = sample_characters_within(&characters, mm, self.density, budget)?;
         if surface.is_empty() {
             bail!("the reference found no skin surface to sample");
         }
@@ -78,7 +97,7 @@ impl Reference {
         if cells_bytes > f.max_storage_buffer_range as u64 {
             bail!("the reference grid has {} cells, more than this device's storage-buffer range holds", grid.cell_start.len());
         }
-        self.plan_surface(s, skin)?;
+        self.plan_surface(s, skin, &meshes)?;
         self.irradiance = Pipeline::graphics(
             s.ctx,
             &GraphicsDesc::fullscreen("reference irradiance", IRRADIANCE_SHADER, SURFACE_FORMAT),
@@ -229,6 +248,8 @@ impl Reference {
         &mut self,
         s: &mut MethodSetup,
         skin: &crate::scene::mesh::Object,
+        // Each instance's skin mesh (its own pose in a moving crowd).
+        meshes: &[&Mesh],
     ) -> Result<()> {
         let eye = s.view.camera.eye;
         let bounds = skin.mesh.bounds();
@@ -277,9 +298,26 @@ impl Reference {
         // The skin, then the character's other parts: drawn with no area,
         // they hide the skin behind them (an eyeball in its socket) and are
         // no surface to the narrow part (area 0 is "none").
-        let mut mesh = skin.mesh.clone();
-        for part in &s.scene.parts {
-            mesh.append(&part.mesh);
+        // One copy of skin and parts per distinct pose: the first's for
+        // every instance unless a moving crowd gives each its own, drawn
+        // from its copy (`copy_offsets`, in vertices).
+        let one = |skin: &Mesh| {
+            let mut mesh = skin.clone();
+            for part in &s.scene.parts {
+                mesh.append(&part.mesh);
+            }
+            mesh
+        };
+        let shared = meshes.iter().all(|m| std::ptr::eq(*m, &skin.mesh));
+        let mut mesh = one(&skin.mesh);
+        let copy_vertices = mesh.vertices.len() as i32;
+        self.surf.copy_offsets = vec![0; s.instances.len()];
+        if !shared {
+            mesh.vertices.clear();
+            for (i, m) in meshes.iter().enumerate() {
+                self.surf.copy_offsets[i] = i as i32 * copy_vertices;
+                mesh.vertices.extend(one(m).vertices);
+            }
         }
         self.surf.skin_index_count = skin.mesh.indices.len() as u32;
         self.surf.vertices = device_buffer(

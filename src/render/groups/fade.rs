@@ -49,7 +49,8 @@ impl FadeMethod {
         scene: &Scene,
         index: usize,
         spec: FadeSpec,
-        instances: &[Mat4],
+        // The fading characters' models and frame indices.
+        (instances, characters): (&[Mat4], &[usize]),
     ) -> Result<FadeMethod> {
         let diffuse = frame.targets.diffuse;
         let depth_stencil_format = res.format(frame.targets.depth_stencil);
@@ -72,6 +73,7 @@ impl FadeMethod {
             depth_stencil_format,
             scene,
             instances,
+            characters,
             frame_binds: frame.frame_binds(),
         })
         .with_context(|| format!("setting up the fade from {}", spec.label));

@@ -53,6 +53,7 @@ pub fn build_groups(
             depth_stencil_format,
             scene,
             instances: &instances,
+            characters: &spec.characters,
             frame_binds: frame.frame_binds(),
         })
         .with_context(|| format!("setting up {}", spec.label));
@@ -86,7 +87,7 @@ pub fn build_groups(
                 scene,
                 i,
                 f,
-                &g.instances,
+                (&g.instances, &g.spec.characters),
             )?);
         } else {
             groups.push(g);
