@@ -1,7 +1,10 @@
 //! The characters' model matrices as the shadow, geometry and id passes draw
 //! them: one buffer, group after group (so the geometry pass draws each
 //! group's heads in one instanced draw with its stencil code), then the
-//! backdrop's; and where each character's and each group's lie in it.
+//! backdrop's; and where each character's and each group's lie in it. The
+//! previous frame's models follow, slot for slot (a rigid motion's velocity:
+//! the temporal anti-aliasing's previous position of a vertex is the
+//! previous model times it).
 
 use anyhow::Result;
 use ash::vk;
@@ -23,7 +26,7 @@ pub struct SkinGroup {
 #[derive(Default)]
 pub struct Instances {
     buffer: Buffer,
-    /// Models in the buffer.
+    /// Models of one frame in the buffer (the previous frame's follow).
     count: usize,
     /// Each group's first slot and count, in group order.
     pub group_slots: Vec<(u32, u32)>,
@@ -41,8 +44,10 @@ impl Instances {
         models: &[Mat4],
         backdrop: Mat4,
     ) -> Result<Self> {
-        let (data, group_slots, character_slots) = layout(groups, models, backdrop);
+        let (mut data, group_slots, character_slots) = layout(groups, models, backdrop);
         let backdrop_slot = data.len() as u32 - 1;
+        // No frame before the first: the previous models are these.
+        data.extend_from_within(..);
         let buffer = Buffer::with_data(
             ctx,
             "character instances",
@@ -51,7 +56,7 @@ impl Instances {
         )?;
         Ok(Instances {
             buffer,
-            count: data.len(),
+            count: data.len() / 2,
             group_slots,
             backdrop_slot,
             character_slots,
@@ -64,11 +69,23 @@ impl Instances {
     pub fn write_models(
         &mut self,
         groups: &[SkinGroup],
-        models: &[Mat4],
+        (models, previous): (&[Mat4], &[Mat4]),
         backdrop: Mat4,
     ) -> Result<()> {
-        let (data, _, _) = layout(groups, models, backdrop);
+        let (mut data, _, _) = layout(groups, models, backdrop);
+        data.extend(layout(groups, previous, backdrop).0);
         self.buffer.write(bytemuck::cast_slice(&data))
+    }
+
+    /// The models as the buffer holds them, slot by slot: this frame's and
+    /// the previous frame's (tests).
+    pub fn read_models(&self) -> Result<(Vec<Mat4>, Vec<Mat4>)> {
+        let all: Vec<Mat4> = bytemuck::cast_slice::<u8, Model>(self.buffer.read()?)
+            .iter()
+            .map(Mat4::from_cols_array_2d)
+            .collect();
+        let (now, before) = all.split_at(self.count);
+        Ok((now.to_vec(), before.to_vec()))
     }
 
     /// The buffer as the shaders' `Instances` binding.
@@ -77,7 +94,8 @@ impl Instances {
             "Instances",
             Bind::Uniform {
                 buffer: self.buffer.raw,
-                size: (self.count * std::mem::size_of::<[[f32; 4]; 4]>()) as u64,
+                // This frame's models and the previous frame's after them.
+                size: (2 * self.count * std::mem::size_of::<[[f32; 4]; 4]>()) as u64,
             },
         )
     }

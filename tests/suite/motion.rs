@@ -637,7 +637,9 @@ fn stepping_poses_each_frame_at_its_time_whatever_came_before() {
 
 /// A rigid motion steps too (a scene without animation: the egg): every
 /// character, the first included, turns from the pose its mesh was made
-/// at, and 1 s reached by two steps or by one is the same frame.
+/// at, and 1 s reached by two steps or by one is the same frame. The
+/// instance buffer keeps the frame before's models beside (the velocity of
+/// a rigid motion).
 #[test]
 fn stepping_turns_a_rigid_crowd_whatever_came_before() {
     use dermis::scene::animation::rigid_rotation;
@@ -659,7 +661,14 @@ fn stepping_turns_a_rigid_crowd_whatever_came_before() {
         let base = r.frame.instances.clone();
         let first = r.capture(false).unwrap();
         r.run_frames(frames - 1, |_| {}).unwrap();
+        let before = r.frame.instances.clone();
         let last = r.capture(false).unwrap();
+        // The instance buffer holds this frame's models and, after them,
+        // the frame before's (one group: slot k is character k).
+        let (now, previous) = r.frame.instance_models().unwrap();
+        assert_eq!(now[..3], r.frame.instances[..]);
+        assert_eq!(previous[..3], before[..]);
+        assert_ne!(now[..3], previous[..3]);
         (first, last, base, r.frame.instances.clone())
     };
     let (first, a, base, moved) = run(0.5, 2);

@@ -216,11 +216,13 @@ impl Frame {
                 }
                 (Motion::Rigid, _) => {
                     let posed = st.tracks.time;
-                    self.instances =
-                        turned_by(st.base.clone(), st.pivot, |i| t.turn_from(i, posed));
+                    let previous = std::mem::replace(
+                        &mut self.instances,
+                        turned_by(st.base.clone(), st.pivot, |i| t.turn_from(i, posed)),
+                    );
                     self.instance_buffer.write_models(
                         &self.skin_groups,
-                        &self.instances,
+                        (&self.instances, &previous),
                         self.backdrop,
                     )
                 }
@@ -229,6 +231,14 @@ impl Frame {
         };
         self.stepping = Some(st);
         result
+    }
+}
+
+impl Frame {
+    /// The instance buffer's models, slot by slot: this frame's and the
+    /// previous frame's (tests).
+    pub fn instance_models(&self) -> Result<(Vec<Mat4>, Vec<Mat4>)> {
+        self.instance_buffer.read_models()
     }
 }
 
