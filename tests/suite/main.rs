@@ -47,6 +47,7 @@ mod scenes;
 mod screen;
 mod separable;
 mod stability;
+mod stepping;
 mod tsd;
 
 mod cli;

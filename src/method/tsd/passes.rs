@@ -48,8 +48,22 @@ impl Tsd {
         self.mesh.triangles()
     }
 
-    fn draw_head(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        self.mesh.bind_and_draw(ctx, cmd);
+    /// Character `k`'s head: its own posed copy in a moving crowd
+    /// (`copies` > 1: copy k, from its vertex offset), else the one mesh.
+    fn draw_head(&self, ctx: &Context, cmd: vk::CommandBuffer, k: usize) {
+        if self.mesh.copies <= 1 {
+            return self.mesh.bind_and_draw(ctx, cmd);
+        }
+        let m = &self.mesh;
+        unsafe {
+            ctx.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[m.vertices.raw], &[0]);
+            ctx.device
+                .cmd_bind_index_buffer(cmd, m.indices.raw, 0, vk::IndexType::UINT32);
+            let offset = (k as u32 * m.vertex_count) as i32;
+            ctx.device
+                .cmd_draw_indexed(cmd, m.index_count, 1, 0, offset, 0);
+        }
     }
 
     /// The mask as the texture-space passes after the mask pass test it:
@@ -101,12 +115,12 @@ impl Tsd {
                 pc.bind(&p.mask_depth, frame[0].as_slice());
                 p.mask_depth.bind_sets(ctx, cmd, 2, &[c.uv_sets[0]]);
                 p.mask_depth.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
-                self.draw_head(ctx, cmd);
+                self.draw_head(ctx, cmd, k);
                 pc.bind(&p.mask_backface, frame[1].as_slice());
                 p.mask_backface.bind_sets(ctx, cmd, 2, &[c.uv_sets[1]]);
                 p.mask_backface
                     .push(ctx, cmd, &uv_push(1.0, -BACKFACE_BIAS, 0.0));
-                self.draw_head(ctx, cmd);
+                self.draw_head(ctx, cmd, k);
             }
             if cfg.cull == Cull::Stencil {
                 pc.bind(&p.mask_cull, frame[2].as_slice());
@@ -121,7 +135,7 @@ impl Tsd {
                     )
                 };
                 p.mask_cull.push(ctx, cmd, &uv_push(0.0, CULL_COS, 1.0));
-                self.draw_head(ctx, cmd);
+                self.draw_head(ctx, cmd, k);
             }
         })
     }
@@ -173,7 +187,7 @@ impl Tsd {
                 p.bind_sets(ctx, cmd, 1, &[self.sets.material]);
                 p.bind_sets(ctx, cmd, 2, &[self.characters[k].uv_sets[3]]);
                 p.push(ctx, cmd, &uv_push(0.0, 0.0, 0.0));
-                self.draw_head(ctx, cmd);
+                self.draw_head(ctx, cmd, k);
             })
     }
 
@@ -309,10 +323,10 @@ impl Tsd {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.pipelines.final_pass;
                 pc.bind(p, frame.as_slice());
-                for (c, &map) in self.characters.iter().zip(&maps) {
+                for (k, (c, &map)) in self.characters.iter().zip(&maps).enumerate() {
                     pc.bind_sets(p, 1, &[map]);
                     p.push(ctx, cmd, &c.model.to_cols_array_2d());
-                    self.draw_head(ctx, cmd);
+                    self.draw_head(ctx, cmd, k);
                 }
             })
     }

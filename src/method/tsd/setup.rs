@@ -174,13 +174,27 @@ impl Tsd {
         Ok(())
     }
 
-    /// The head's vertices with each tangent's w carrying its atlas island.
+    /// The head's vertices with each tangent's w carrying its atlas island:
+    /// one copy, or in a moving crowd one per character at its own pose
+    /// (`Scene::character_head`: its stretch maps follow its expression),
+    /// character k's drawn from copy k.
     fn upload_mesh(&mut self, s: &MethodSetup) -> Result<()> {
         let mesh = &s.scene.head.mesh;
-        let vertices: Vec<Vertex> = mesh
-            .vertices
+        let own: Vec<Option<crate::scene::mesh::Mesh>> = s
+            .characters
             .iter()
-            .zip(&self.atlas.island_of)
+            .map(|&c| s.scene.character_head(c))
+            .collect();
+        let copies: Vec<&[Vertex]> = if own.iter().any(Option::is_some) {
+            own.iter()
+                .map(|m| m.as_ref().map_or(&mesh.vertices[..], |m| &m.vertices[..]))
+                .collect()
+        } else {
+            vec![&mesh.vertices[..]]
+        };
+        let vertices: Vec<Vertex> = copies
+            .iter()
+            .flat_map(|c| c.iter().zip(&self.atlas.island_of))
             .map(|(v, &i)| {
                 let hand = if v.tangent[3] < 0.0 { -1.0 } else { 1.0 };
                 Vertex {
@@ -195,6 +209,8 @@ impl Tsd {
             })
             .collect();
         self.mesh = GpuMesh::upload(s.ctx, "tsd head", &vertices, &mesh.indices)?;
+        self.mesh.vertex_count = mesh.vertices.len() as u32;
+        self.mesh.copies = copies.len() as u32;
         Ok(())
     }
 }

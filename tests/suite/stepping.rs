@@ -1,0 +1,193 @@
+//! A run stepping through the motion (`--time-step`, issue 29 item 2) and
+//! what sees each character of a moving crowd at its own pose (item 5), on
+//! lavapipe with validation on: a frame depends only on its time, the
+//! velocity is the frame before's, and texture space stretches each
+//! character's own expression.
+
+use crate::common;
+use crate::motion::settings;
+
+use dermis::render::{RenderSettings, Renderer};
+use dermis::scene::morph::apply;
+
+/// `--time-step`: frame k of a run is posed at time + k * step, whatever
+/// ran before it. Two runs of a moving crowd with different histories
+/// reach 1.75 s (three steps of 0.25 s, one of 0.75 s): the same frame, bit
+/// for bit. Each copy of the head holds the CPU's blend at 1.75 s, and its
+/// previous positions the blend at the run's frame before (1.5 s, 1 s):
+/// the velocity the temporal anti-aliasing reads.
+#[test]
+fn stepping_poses_each_frame_at_its_time_whatever_came_before() {
+    use dermis::scene::crowd_motion::Tracks;
+    use dermis::scene::source::SceneSource;
+    let ctx = common::ctx();
+    let load = |step: f32| {
+        SceneSource {
+            time: Some(1.0),
+            time_step: Some(step),
+            ..SceneSource::default()
+        }
+        .load()
+        .unwrap()
+    };
+    let s = RenderSettings {
+        heads: 4,
+        ..settings()
+    };
+    let run = |step: f32, frames: usize| {
+        let scene = load(step);
+        let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+        let first = r.capture(false).unwrap();
+        r.run_frames(frames - 1, |_| {}).unwrap();
+        let last = r.capture(false).unwrap();
+        (scene, first, last, r.deformed().unwrap())
+    };
+    let (scene, first, a, got_a) = run(0.25, 3);
+    let (_, _, b, got_b) = run(0.75, 1);
+    assert!(
+        a.ldr == b.ldr && a.diffuse == b.diffuse,
+        "1.75 s differs by history"
+    );
+    assert!(first.diffuse != a.diffuse, "the frames did not move");
+    let at = |t: f32| Tracks {
+        time: t,
+        ..scene.tracks.clone().unwrap()
+    };
+    let blend = |t: f32, c: usize| {
+        let mut m = scene.head.morph.clone();
+        m.weights = at(t).weights(c).unwrap();
+        apply(&m.rest, &m)
+    };
+    let n = scene.head.morph.rest.len();
+    for (got, before) in [(&got_a, 1.5f32), (&got_b, 1.0)] {
+        for c in 0..4 {
+            let want = blend(1.75, c);
+            let want: &[f32] = bytemuck::cast_slice(&want);
+            let copy = &got[0].vertices[12 * n * c..12 * n * (c + 1)];
+            assert!(copy == want, "character {c}: not the CPU's blend at 1.75 s");
+            let prev: Vec<f32> = blend(before, c).iter().flat_map(|v| v.position).collect();
+            let got_prev = &got[0].previous[3 * n * c..3 * n * (c + 1)];
+            assert!(
+                got_prev == &prev[..],
+                "character {c}: previous not at {before} s"
+            );
+        }
+    }
+    // The velocity differs by history; the frame does not.
+    assert_ne!(got_a[0].previous, got_b[0].previous);
+}
+
+/// A rigid motion steps too (a scene without animation: the egg): every
+/// character, the first included, turns from the pose its mesh was made
+/// at, and 1 s reached by two steps or by one is the same frame. The
+/// instance buffer keeps the frame before's models beside (the velocity of
+/// a rigid motion).
+#[test]
+fn stepping_turns_a_rigid_crowd_whatever_came_before() {
+    use dermis::scene::animation::rigid_rotation;
+    use dermis::scene::source::SceneSource;
+    let ctx = common::ctx();
+    let s = RenderSettings {
+        heads: 3,
+        ..settings()
+    };
+    let run = |step: f32, frames: usize| {
+        let scene = SceneSource {
+            scene: Some("builtin:egg".into()),
+            time_step: Some(step),
+            ..SceneSource::default()
+        }
+        .load()
+        .unwrap();
+        let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+        let base = r.frame.instances.clone();
+        let first = r.capture(false).unwrap();
+        r.run_frames(frames - 1, |_| {}).unwrap();
+        let before = r.frame.instances.clone();
+        let last = r.capture(false).unwrap();
+        // The instance buffer holds this frame's models and, after them,
+        // the frame before's (one group: slot k is character k).
+        let (now, previous) = r.frame.instance_models().unwrap();
+        assert_eq!(now[..3], r.frame.instances[..]);
+        assert_eq!(previous[..3], before[..]);
+        assert_ne!(now[..3], previous[..3]);
+        (first, last, base, r.frame.instances.clone())
+    };
+    let (first, a, base, moved) = run(0.5, 2);
+    let (_, b, _, _) = run(1.0, 1);
+    assert!(
+        a.ldr == b.ldr && a.diffuse == b.diffuse,
+        "1 s differs by history"
+    );
+    assert!(first.diffuse != a.diffuse, "the frames did not move");
+    // Character 0 has turned by the clip's change from 0 s to 1 s.
+    let turn = (base[0].inverse() * moved[0])
+        .to_scale_rotation_translation()
+        .1;
+    let want = rigid_rotation(1.0) * rigid_rotation(0.0).inverse();
+    assert!(turn.angle_between(want) < 1e-4, "{turn} against {want}");
+}
+
+/// Texture space sees each character's own pose in a moving crowd: the
+/// stretch maps (the mesh's own derivatives, so one mesh gives one map
+/// wherever it stands) of two characters at different phases of the
+/// expression clip differ, and those of the same pose (a still crowd) do not.
+#[test]
+fn texture_space_stretches_each_character_at_its_own_pose() {
+    use dermis::scene::source::SceneSource;
+    let ctx = common::ctx();
+    let stretch = |time: Option<f32>| {
+        let scene = SceneSource {
+            time,
+            ..SceneSource::default()
+        }
+        .load()
+        .unwrap();
+        let s = RenderSettings {
+            heads: 3,
+            width: 160,
+            height: 90,
+            shadow_size: 256,
+            ..RenderSettings::study()
+        }
+        .with(common::m("tsd"), &[("irradiance-size", "256")]);
+        let c = Renderer::new(&ctx, &scene, &s)
+            .unwrap()
+            .capture(true)
+            .unwrap();
+        // The stretch map each character's irradiance pass wrote, in order.
+        let maps: Vec<Vec<[f32; 4]>> = c
+            .dumps
+            .iter()
+            .filter(|d| d.image == "tsd stretch u")
+            .map(|d| d.rgba.clone())
+            .collect();
+        assert_eq!(
+            maps.len(),
+            3,
+            "{:?}",
+            c.dumps
+                .iter()
+                .map(|d| (&d.pass, &d.image))
+                .collect::<Vec<_>>()
+        );
+        maps
+    };
+    let diff = |a: &[[f32; 4]], b: &[[f32; 4]]| {
+        let (mut num, mut den) = (0.0f64, 0.0f64);
+        for (p, q) in a.iter().zip(b) {
+            num += f64::from(p[0] - q[0]).powi(2);
+            den += f64::from(p[0]).powi(2);
+        }
+        (num / den.max(1e-30)).sqrt()
+    };
+    let moving = stretch(Some(1.0));
+    let still = stretch(None);
+    let (m12, s12) = (diff(&moving[1], &moving[2]), diff(&still[1], &still[2]));
+    eprintln!("stretch maps of characters 1 and 2: moving {m12:.3e}, still {s12:.3e}");
+    assert!(s12 < 1e-3, "one pose, two maps: {s12}");
+    assert!(
+        m12 > 10.0 * s12.max(1e-5),
+        "the poses' maps are alike: {m12} against {s12}"
+    );
+}
