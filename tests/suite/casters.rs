@@ -62,6 +62,17 @@ fn settings(plan: PlanFile) -> RenderSettings {
     s
 }
 
+/// Runs a command that must succeed, its standard error the message.
+fn succeed(c: &mut std::process::Command) -> std::process::Output {
+    let out = c.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn primitives(c: &Capture, pass: &str) -> u64 {
     c.samples
         .iter()
@@ -147,17 +158,12 @@ fn render_draws_the_plans_levels_and_casters() {
         "90",
     ];
     let plan_dir = dir.path().join("plan");
-    let out = common::dermis()
-        .args(["plan", "--profile", "xbox360", "--budget-ms", "2"])
-        .args(frame)
-        .args(["--lod-pixels", "1", "--out"])
-        .arg(&plan_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeed(
+        common::dermis()
+            .args(["plan", "--profile", "xbox360", "--budget-ms", "2"])
+            .args(frame)
+            .args(["--lod-pixels", "1", "--out"])
+            .arg(&plan_dir),
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("cast onto a receiver in view"), "{stdout}");
@@ -181,18 +187,13 @@ fn render_draws_the_plans_levels_and_casters() {
     );
     let render = |extra: &[&str], name: &str| -> serde_json::Value {
         let out_dir = dir.path().join(name);
-        let out = common::dermis()
-            .arg("render")
-            .args(frame)
-            .args(extra)
-            .args(["--frames", "1", "--warmup", "0", "--out"])
-            .arg(&out_dir)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        succeed(
+            common::dermis()
+                .arg("render")
+                .args(frame)
+                .args(extra)
+                .args(["--frames", "1", "--warmup", "0", "--out"])
+                .arg(&out_dir),
         );
         serde_json::from_slice(&std::fs::read(out_dir.join("report.json")).unwrap()).unwrap()
     };

@@ -448,17 +448,8 @@ pub(super) fn collect(
             }
             None => vec![world],
         };
-        let Some(mesh) = node.mesh() else {
-            stack.extend(
-                node.children()
-                    .map(|c| c.index())
-                    .collect::<Vec<_>>()
-                    .into_iter()
-                    .rev(),
-            );
-            continue;
-        };
         for (instance, &world) in placements.iter().enumerate() {
+            let Some(mesh) = node.mesh() else { break };
             for prim in mesh.primitives() {
                 let key = (mesh.index(), prim.index());
                 let label = match placements.len() {
