@@ -84,6 +84,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: None,
     no_mix: |_| None,
     no_sss: false,
+    poses_once: None,
 };
 
 /// The method's options, parsed.

@@ -293,6 +293,10 @@ pub struct MethodEntry {
     /// output the diffuse target as the geometry pass left it (a frame of
     /// several gives its group no region, a fade from it blends the skin).
     pub no_sss: bool,
+    /// Why the method cannot follow a run stepping through a motion
+    /// (`--time-step`: it reads the characters' meshes once, as it is
+    /// built); `None`: it reads only the frame's targets each frame.
+    pub poses_once: Option<&'static str>,
 }
 
 impl MethodEntry {

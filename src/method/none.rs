@@ -31,6 +31,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: None,
     no_mix: |_| None,
     no_sss: true,
+    poses_once: None,
 };
 
 pub struct NoSss {

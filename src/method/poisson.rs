@@ -65,6 +65,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: None,
     no_mix: |_| None,
     no_sss: false,
+    poses_once: None,
 };
 
 /// Levels for a target of `extent` (every level at least one texel).

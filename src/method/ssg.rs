@@ -94,6 +94,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: None,
     no_mix,
     no_sss: false,
+    poses_once: None,
 };
 
 /// The registry's `no_mix`: the shader's branch shades every pixel whose

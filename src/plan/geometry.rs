@@ -145,6 +145,8 @@ pub fn plan_geometry(
             height: settings.height,
             light_view_proj: framing.light.view_proj,
             backdrop: framing.backdrop,
+            shadow_size: settings.shadow_size,
+            reach_units: crate::reference::sampling::cutoff_mm() / scene.mm_per_unit,
         },
         &errors,
         settings.lod_pixels,

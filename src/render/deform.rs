@@ -361,6 +361,10 @@ impl Deform {
         previous: &[Vec<f32>],
     ) -> Result<()> {
         let o = &mut self.objects[index];
+        let per_copy = o.target_count as usize;
+        if let Some(w) = now.iter().chain(previous).find(|w| w.len() != per_copy) {
+            anyhow::bail!("{}: {} weights for {per_copy} targets", o.name, w.len());
+        }
         let pairs: Vec<[f32; 2]> = now
             .iter()
             .zip(previous)

@@ -626,12 +626,12 @@ impl Frame {
                         r,
                     );
                 };
-                // The characters first, front row first, and the backdrop
-                // last: early depth testing then rejects the backdrop's
-                // hidden pixels instead of shading them and drawing over
-                // them (a crowd covers half the screen). The nearest
-                // surface and its stencil code win in any order: the same
-                // bits.
+                // The characters first and the backdrop last: early depth
+                // testing then rejects the backdrop's hidden pixels instead
+                // of shading them and drawing over them (a crowd covers
+                // half the screen). The nearest surface and its stencil code
+                // win in either order (the same bits, but where a character
+                // and the backdrop meet at exactly one depth).
                 let order = self
                     .objects
                     .iter()

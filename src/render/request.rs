@@ -52,6 +52,7 @@ impl<'s> FrameRequest<'s> {
         let settings = settings.0;
         check_in_view(scene, &settings)?;
         let groups = group_specs(scene, &settings)?;
+        check_steps(scene, &groups)?;
         crate::checks::ran("groups");
         Ok(FrameRequest {
             scene,
@@ -97,6 +98,29 @@ impl<'s> FrameRequest<'s> {
 /// Everything a frame is made from, as `report.json` records it (its
 /// `settings`) and `dermis render --settings` reads it back: the scene's
 /// source and the render settings, both whole, by serialisation.
+/// Refuses `--time-step` with a method that reads the characters' meshes
+/// once, as it is built (it would draw frame 0's pose under every later
+/// frame's geometry).
+fn check_steps(scene: &Scene, groups: &[GroupSpec]) -> Result<()> {
+    if scene.tracks.as_ref().and_then(|t| t.step).is_none() {
+        return Ok(());
+    }
+    let entries = groups.iter().map(|g| g.entry).chain(
+        groups
+            .iter()
+            .filter_map(|g| g.fade.as_ref().map(|f| f.entry)),
+    );
+    for e in entries {
+        if let Some(why) = e.poses_once {
+            anyhow::bail!(
+                "--time-step cannot be given with {}: {why} (render each time with --time instead)",
+                e.name
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Refuses a frame that would show none of its characters: the framing
 /// (`render`'s shot) puts every triangle of every character outside the
 /// view (a model framed by a stray part, a scale far off, a crowd walked

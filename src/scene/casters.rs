@@ -103,23 +103,74 @@ fn intersect(a: &Aabb, b: &Aabb) -> Option<Aabb> {
     (min.cmple(max).all()).then_some(Aabb { min, max })
 }
 
+/// How far beyond the view and beyond a receiver a shadow still shows, in
+/// the light's space (map x, y and depth, the projection's units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Margin {
+    /// The reach of the scattering: a method that lights surface out of
+    /// view (the ground truth's samples, texture space's maps) carries a
+    /// shadow that far into the frame. The view is widened by it.
+    pub reach: Vec3,
+    /// The shadow filter's footprint on the map (the PCF's taps and their
+    /// bilinear comparisons): each receiver is widened by it across the map.
+    pub filter: Vec3,
+}
+
+impl Margin {
+    pub const NONE: Margin = Margin {
+        reach: Vec3::ZERO,
+        filter: Vec3::ZERO,
+    };
+
+    /// The margin for a map of `light` (an orthographic projection) of
+    /// `map_side` texels, with the shadow filter reaching `filter_texels`
+    /// texels and the scattering `reach_world` world units.
+    pub fn of(light: &Mat4, map_side: u32, filter_texels: f32, reach_world: f32) -> Margin {
+        // Light-space units per world unit along each of its axes.
+        let rows = Vec3::new(
+            light.row(0).truncate().length(),
+            light.row(1).truncate().length(),
+            light.row(2).truncate().length(),
+        );
+        let texel = 2.0 / map_side.max(1) as f32;
+        Margin {
+            reach: rows * reach_world.max(0.0),
+            filter: Vec3::new(filter_texels * texel, filter_texels * texel, 0.0),
+        }
+    }
+}
+
+fn grown(b: &Aabb, by: Vec3) -> Aabb {
+    Aabb {
+        min: b.min - by,
+        max: b.max + by,
+    }
+}
+
 /// Which of `characters` (world boxes, in frame order) cast a shadow the
 /// frame can show, for a camera of `view_proj` and the key light's map
 /// projection `light` (depth grows away from the light); `backdrop` is the
-/// backdrop's world box, a receiver where the camera sees it. A character
-/// in view always casts (onto itself); every caster is kept when the
-/// frustum cannot be measured (a degenerate projection).
+/// backdrop's world box, a receiver where the camera sees it (or within
+/// `margin`'s reach of the view). A character in view always casts (onto
+/// itself); every caster is kept when the frustum cannot be measured (a
+/// degenerate projection).
 pub fn casting(
     view_proj: &Mat4,
     light: &Mat4,
     characters: &[Aabb],
     backdrop: Option<&Aabb>,
+    margin: &Margin,
 ) -> Vec<bool> {
     let everyone = vec![true; characters.len()];
     let Some(frustum) = frustum_corners(view_proj).and_then(|c| light_box(light, &c)) else {
         return everyone;
     };
-    let lit = |b: &Aabb| light_box(light, &corners(b)).and_then(|l| intersect(&l, &frustum));
+    let frustum = grown(&frustum, margin.reach);
+    let lit = |b: &Aabb| {
+        light_box(light, &corners(b))
+            .and_then(|l| intersect(&l, &frustum))
+            .map(|r| grown(&r, margin.filter))
+    };
     let receivers: Vec<Aabb> = characters
         .iter()
         .chain(backdrop)
@@ -197,7 +248,13 @@ mod tests {
         // Out of view below the visible box: the light is above, so its
         // shadow goes further down, away from everything seen.
         let below = unit_at(0.0, -8.0, 0.0);
-        let c = casting(&vp, &light, &[visible, above, beside, below], None);
+        let c = casting(
+            &vp,
+            &light,
+            &[visible, above, beside, below],
+            None,
+            &Margin::NONE,
+        );
         assert_eq!(c, vec![true, true, false, false]);
         assert!(!in_view(&vp, &above) && !in_view(&vp, &beside) && !in_view(&vp, &below));
     }
@@ -217,12 +274,18 @@ mod tests {
         // Out of view to the side, over floor no ray of the camera reaches.
         let over_unseen = unit_at(80.0, 8.0, 0.0);
         assert_eq!(
-            casting(&vp, &light, &[over_seen, over_unseen], Some(&floor)),
+            casting(
+                &vp,
+                &light,
+                &[over_seen, over_unseen],
+                Some(&floor),
+                &Margin::NONE
+            ),
             vec![true, false]
         );
         // Without the floor, nothing seen is under either.
         assert_eq!(
-            casting(&vp, &light, &[over_seen, over_unseen], None),
+            casting(&vp, &light, &[over_seen, over_unseen], None, &Margin::NONE),
             vec![false, false]
         );
     }
@@ -240,7 +303,13 @@ mod tests {
         // Out of view at +x (toward the light), in line: it shades the box.
         let light_side = unit_at(30.0, 0.0, 0.0);
         assert_eq!(
-            casting(&vp, &light, &[visible, shadow_side, light_side], None),
+            casting(
+                &vp,
+                &light,
+                &[visible, shadow_side, light_side],
+                None,
+                &Margin::NONE
+            ),
             vec![true, false, true]
         );
     }
@@ -280,10 +349,57 @@ mod tests {
         assert!(mesh_in_view(&vp, &id, &huge));
     }
 
+    /// The margins: a caster whose shadow ends just beside a receiver is
+    /// kept once the filter's footprint reaches it, and one beside the
+    /// view once the scattering's reach does.
+    #[test]
+    fn margins_keep_shadows_the_filter_and_the_scattering_carry() {
+        let vp = camera();
+        let light = shadow_frame(Vec3::Y, Vec3::ZERO, 60.0).view_proj;
+        let visible = unit_at(0.0, 0.0, 0.0);
+        // Out of view above, its shadow ending 0.2 units beside the box.
+        let near_miss = unit_at(1.2, 8.0, 0.0);
+        assert_eq!(
+            casting(&vp, &light, &[visible, near_miss], None, &Margin::NONE),
+            vec![true, false]
+        );
+        // A 2048 map over 121 units: a texel is 0.059 units; 4 texels reach.
+        let m = Margin::of(&light, 2048, 4.0, 0.0);
+        assert_eq!(
+            casting(&vp, &light, &[visible, near_miss], None, &m),
+            vec![true, true]
+        );
+        // A camera whose far plane lies just past z = 0 sees a floor strip
+        // there to x = 3.9: a caster over x = 5 casts onto unseen floor,
+        // unless the scattering reaches 2 units into the view.
+        let short = Camera {
+            eye: Vec3::new(0.0, 0.0, 10.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_rad: 40f32.to_radians(),
+            near: 0.1,
+            far: 10.6,
+        }
+        .view_proj(1.0);
+        let floor = Aabb {
+            min: Vec3::new(-100.0, -1.1, -0.5),
+            max: Vec3::new(100.0, -1.0, 0.5),
+        };
+        let over = unit_at(5.0, 8.0, 0.0);
+        let seen_floor = Some(&floor);
+        let none = casting(&short, &light, &[over], seen_floor, &Margin::NONE);
+        let m = Margin::of(&light, 2048, 0.0, 2.0);
+        let reach = casting(&short, &light, &[over], seen_floor, &m);
+        assert_eq!((none, reach), (vec![false], vec![true]));
+    }
+
     #[test]
     fn a_degenerate_camera_keeps_every_caster() {
         let light = shadow_frame(Vec3::Y, Vec3::ZERO, 60.0).view_proj;
         let b = [unit_at(0.0, 50.0, 0.0)];
-        assert_eq!(casting(&Mat4::ZERO, &light, &b, None), vec![true]);
+        assert_eq!(
+            casting(&Mat4::ZERO, &light, &b, None, &Margin::NONE),
+            vec![true]
+        );
     }
 }

@@ -33,14 +33,25 @@ pub struct GeometryView<'a> {
     pub light_view_proj: Mat4,
     /// The backdrop's model matrix.
     pub backdrop: Mat4,
+    /// The shadow map's side (texels) and how far (world units) the
+    /// scattering carries a shadow: the caster test's margins.
+    pub shadow_size: u32,
+    pub reach_units: f32,
+}
+
+/// Texels the shadow filter reaches past its lookup: the PCF's taps
+/// (`PCF_RADIUS` each side) with their 2 x 2 comparisons, and one more.
+pub fn filter_texels() -> f32 {
+    crate::shader_constants::PCF_RADIUS as f32 + 2.0
 }
 
 /// The characters' models with each one's rigid turn beyond the scene's
 /// pose (a crowd of characters without animation, `Scene::tracks`), about
-/// the head's centre: what the frame draws them with.
+/// the point the scene's own turn was made about (`Tracks::pivot`): what
+/// the frame draws them with.
 pub fn turned(scene: &Scene, models: Vec<Mat4>) -> Vec<Mat4> {
     match scene.tracks.as_ref().filter(|t| t.motion == Motion::Rigid) {
-        Some(t) if models.len() > 1 => turned_by(models, scene.head_center(), |i| t.turn(i)),
+        Some(t) if models.len() > 1 => turned_by(models, t.pivot, |i| t.turn(i)),
         _ => models,
     }
 }
@@ -92,19 +103,28 @@ fn max_weight(scene: &Scene) -> f32 {
 }
 
 /// The model-space box of everything a character draws: every vertex of
-/// its head and parts as posed, widened by how far the crowd's morph
-/// weights can move them (a character of a moving crowd is at another
-/// phase than the posed one), and by every turn of a turning one.
+/// its head and parts as posed, and of their rest shapes widened by how
+/// far the crowd's morph weights can move them (a character of a moving
+/// crowd is at another phase than the posed one), and every turn of a
+/// turning one. A skinned mesh's crowd plays in step: its posed box.
 pub fn drawn_bounds(scene: &Scene) -> Aabb {
     let w = max_weight(scene);
     let posed = std::iter::once(&scene.head)
         .chain(&scene.parts)
         .map(|o| {
             let b = o.mesh.bounds();
-            let reach = morph_reach(&o.morph, w);
-            Aabb {
-                min: b.min - reach,
-                max: b.max + reach,
+            // From the rest shape, which every weight in [-w, w] moves by
+            // at most the reach (the posed shape is one such).
+            let rest = Aabb::from_points(o.morph.rest.iter().map(|v| Vec3::from(v.position)));
+            match rest.filter(|_| o.morph.skin.is_none()) {
+                Some(r) => {
+                    let reach = morph_reach(&o.morph, w);
+                    b.union(&Aabb {
+                        min: r.min - reach,
+                        max: r.max + reach,
+                    })
+                }
+                None => b,
             }
         })
         .reduce(|a, b| a.union(&b))
@@ -112,9 +132,9 @@ pub fn drawn_bounds(scene: &Scene) -> Aabb {
     // A character that turns (dermis's rigid clip, at any phase or step)
     // sweeps its box about the head's centre: the cube around the sphere
     // that holds every turn of it.
-    match scene.tracks.as_ref().map(|t| &t.motion) {
-        Some(Motion::Rigid) => {
-            let c = scene.head_center();
+    match scene.tracks.as_ref() {
+        Some(t) if t.motion == Motion::Rigid => {
+            let c = t.pivot;
             let r = (posed.min - c).abs().max((posed.max - c).abs()).length();
             Aabb {
                 min: c - Vec3::splat(r),
@@ -195,6 +215,12 @@ pub fn choose(
         &view.light_view_proj,
         &boxes,
         backdrop.as_ref(),
+        &casters::Margin::of(
+            &view.light_view_proj,
+            view.shadow_size,
+            filter_texels(),
+            view.reach_units,
+        ),
     );
     let ppu = pixels_per_unit(scene, models, view.camera, view.height);
     ppu.iter()

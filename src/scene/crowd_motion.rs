@@ -4,7 +4,7 @@
 //! what every CPU consumer reads. Pure: the renderer asks each character's
 //! morph weights and rigid turn of [`Tracks`].
 
-use glam::Quat;
+use glam::{Quat, Vec3};
 
 use super::animation::{animated_weights, rigid_rotation, Clip, RIGID_PERIOD_S};
 
@@ -31,6 +31,10 @@ pub struct Tracks {
     /// The time each frame advances it (`--time-step`); `None`: every
     /// frame at `time`.
     pub step: Option<f32>,
+    /// The point a rigid motion turns the character about (model space):
+    /// the head's centre before the scene's own turn, so a turn beyond it
+    /// composes with it exactly.
+    pub pivot: Vec3,
 }
 
 /// SplitMix64's finaliser: a well-mixed 64-bit hash of `x`.
@@ -63,14 +67,14 @@ impl Tracks {
     /// Character `c`'s time: the scene's plus its phase of the period,
     /// wrapped into the period (so every character stays on its loop).
     pub fn time_of(&self, c: usize) -> f32 {
-        if c == 0 {
-            return self.time;
-        }
         let p = self.period();
-        if p <= 0.0 {
-            return self.time;
+        match (c, &self.motion) {
+            // The rigid clip is periodic in itself.
+            (0, Motion::Rigid) => self.time,
+            _ if p <= 0.0 => self.time,
+            (0, _) => self.time.rem_euclid(p),
+            _ => (self.time + phase(self.seed, c) * p).rem_euclid(p),
         }
-        (self.time + phase(self.seed, c) * p).rem_euclid(p)
     }
 
     /// Character `c`'s morph weights (`None`: the scene's own, for a rigid
@@ -147,6 +151,7 @@ mod tests {
             seed: DEFAULT_SEED,
             motion: Motion::Weights(expression_clip()),
             step: None,
+            pivot: Vec3::ZERO,
         };
         let clip = expression_clip();
         assert_eq!(t.weights(0), animated_weights(&clip, 0, 1.0));
@@ -176,6 +181,7 @@ mod tests {
             seed: DEFAULT_SEED,
             motion: Motion::Rigid,
             step: Some(0.25),
+            pivot: Vec3::ZERO,
         };
         assert_eq!(t.at_frame(0).unwrap(), t);
         let f3 = t.at_frame(3).unwrap();
@@ -191,5 +197,24 @@ mod tests {
             assert!((d - 0.75).abs() < 1e-4, "{d}");
         }
         assert!(Tracks { step: None, ..t }.at_frame(1).is_none());
+    }
+
+    /// A clip of weights loops for the first character too: past its end
+    /// it plays from its start, as every other character does.
+    #[test]
+    fn the_first_character_loops_the_clip_as_the_others_do() {
+        let clip = expression_clip();
+        let p = clip.duration();
+        let t = Tracks {
+            time: p + 1.0,
+            seed: DEFAULT_SEED,
+            motion: Motion::Weights(clip.clone()),
+            step: None,
+            pivot: Vec3::ZERO,
+        };
+        assert!((t.time_of(0) - 1.0).abs() < 1e-5);
+        assert_eq!(t.weights(0), animated_weights(&clip, 0, t.time_of(0)));
+        let early = Tracks { time: 1.0, ..t.clone() };
+        assert_eq!(early.time_of(0), 1.0);
     }
 }

@@ -296,8 +296,6 @@ fn unsupported_features(src: &super::gltf_source::Source, warn: &mut Warnings) {
     for e in used.filter(|e| !super::gltf_source::SUPPORTED_REQUIRED_EXTENSIONS.contains(e)) {
         let e = super::gltf_source::short(e);
         match e.as_ref() {
-            // Drawn: each instanced node says its count (`instancing`).
-            "EXT_mesh_gpu_instancing" => {}
             "KHR_lights_punctual" => warn.note(format!(
                 "{e}: the file's lights are not used (dermis lights every scene with its own key light)"
             )),

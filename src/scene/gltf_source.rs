@@ -22,6 +22,8 @@ pub const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_materials_specular",
     "KHR_texture_transform",
+    // Drawn (`gltf_load::instancing`): gltfpack -mi requires it.
+    "EXT_mesh_gpu_instancing",
 ];
 
 /// The parsed file: document, the bytes of each buffer (exactly its declared

@@ -133,7 +133,10 @@ impl Scene {
     pub fn play_builtin(&mut self, t: f32) {
         let clip = expressions::expression_clip();
         let face = self.head.morph.targets.len() == expressions::EXPRESSIONS.len();
-        let motion = match animation::animated_weights(&clip, 0, t).filter(|_| face) {
+        // The clip loops, for the first character as for the crowd's others.
+        let looped = t.rem_euclid(clip.duration().max(f32::MIN_POSITIVE));
+        let pivot = self.head_center();
+        let motion = match animation::animated_weights(&clip, 0, looped).filter(|_| face) {
             Some(w) => {
                 self.head.morph.weights = w;
                 self.head.pose();
@@ -149,6 +152,7 @@ impl Scene {
             seed: crowd_motion::DEFAULT_SEED,
             motion,
             step: None,
+            pivot,
         });
     }
 
@@ -388,12 +392,14 @@ pub fn load_gltf_scene(
             path.display(),
             animation::RIGID_PERIOD_S
         );
+        let pivot = scene.head_center();
         scene.rotate_character(animation::rigid_rotation(t));
         scene.tracks = Some(crowd_motion::Tracks {
             time: t,
             seed: crowd_motion::DEFAULT_SEED,
             motion: crowd_motion::Motion::Rigid,
             step: None,
+            pivot,
         });
     }
     scene.source = Some(source::SceneSource {

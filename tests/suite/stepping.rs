@@ -191,3 +191,23 @@ fn texture_space_stretches_each_character_at_its_own_pose() {
         "the poses' maps are alike: {m12} against {s12}"
     );
 }
+
+/// A method that reads the characters' meshes once (texture space, the
+/// ground truth) refuses a step in one line, before anything runs.
+#[test]
+fn methods_that_pose_once_refuse_a_step() {
+    for method in ["tsd", "reference"] {
+        let out = common::dermis()
+            .args(["render", "--method", method, "--time", "1", "--time-step", "0.5"])
+            .args(["--width", "64", "--height", "36", "--out"])
+            .arg(std::env::temp_dir().join(format!("dermis-step-{method}")))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{method}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("--time-step cannot be given with {method}")),
+            "{method}: {err}"
+        );
+    }
+}

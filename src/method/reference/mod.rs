@@ -80,6 +80,9 @@ const OPTIONS: &[OptSpec] = &[
     profile::OPTION,
 ];
 
+/// Why the ground truth cannot step through a motion (`--time-step`).
+const POSES_ONCE: &str = "the ground truth samples each character's surface once, as it is built";
+
 pub static ENTRY: MethodEntry = MethodEntry {
     name: "reference",
     aliases: &["ground-truth"],
@@ -100,6 +103,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: Some("the ground truth renders its own single-sample surface and gathers over it, so its frame would alias whatever --msaa says; it is the reference, not a mode to antialias"),
     no_mix: |_| None,
     no_sss: false,
+    poses_once: Some(POSES_ONCE),
 };
 
 fn density(o: &Opts) -> Result<f32> {

@@ -164,6 +164,10 @@ const OPT_OPTIONS: &[OptSpec] = &[
 ];
 
 /// Why neither tsd entry runs with `--msaa` (docs/aa.md).
+/// Why texture space cannot step through a motion (`--time-step`).
+const POSES_ONCE: &str =
+    "texture space unwraps each character's head, and places its maps, once, as it is built";
+
 const NO_MSAA: Option<&str> = Some("texture-space diffusion shades in a second mesh pass, drawn depth-EQUAL against the frame's depth: with --msaa that depth is resolved from sample 0 and no single-sample redraw matches it (and the pass itself would alias)");
 
 pub static ENTRY: MethodEntry = MethodEntry {
@@ -189,6 +193,7 @@ pub static ENTRY: MethodEntry = MethodEntry {
     no_msaa: NO_MSAA,
     no_mix: |_| None,
     no_sss: false,
+    poses_once: Some(POSES_ONCE),
 };
 
 pub static OPT_ENTRY: MethodEntry = MethodEntry {
@@ -214,6 +219,7 @@ pub static OPT_ENTRY: MethodEntry = MethodEntry {
     no_msaa: NO_MSAA,
     no_mix: |_| None,
     no_sss: false,
+    poses_once: Some(POSES_ONCE),
 };
 
 /// How culled texels are skipped (thesis section 3.2).

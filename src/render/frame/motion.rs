@@ -13,9 +13,11 @@ use glam::Vec3;
 
 impl Frame {
     /// Each character's level of detail and whether it casts into the
-    /// shadow map (`crowd_geometry`): the plan's choice under `--plan` when
-    /// it made one, else the frame's own (levels at `--lod-pixels`, casters
-    /// whose shadow can reach a receiver in view); set per instance slot
+    /// shadow map (`crowd_geometry`): the frame's own choice (levels at
+    /// `--lod-pixels`, casters whose shadow can reach a receiver in view),
+    /// or under `--plan` the plan's levels, and its casters with every one
+    /// the frame's own test keeps (a plan made for another framing or
+    /// light never drops a shadow this frame shows); set per instance slot
     /// (after `set_skin_groups`).
     pub fn choose_geometry(&mut self, scene: &Scene) {
         let errors: Vec<Vec<f32>> = self
@@ -24,25 +26,36 @@ impl Frame {
             .filter(|o| o.kind.per_character() && !o.level_errors.is_empty())
             .map(|o| o.level_errors.clone())
             .collect();
-        let planned = self
+        let own = crowd_geometry::choose(
+            scene,
+            &self.instances,
+            &GeometryView {
+                camera: &self.camera,
+                width: self.extent.width,
+                height: self.extent.height,
+                light_view_proj: self.light_frame.view_proj,
+                backdrop: self.backdrop,
+                shadow_size: self.settings.shadow_size,
+                reach_units: crate::reference::sampling::cutoff_mm() / self.mm_per_unit,
+            },
+            &errors,
+            self.settings.lod_pixels,
+        );
+        self.geometry = match self
             .settings
             .planned_geometry()
-            .filter(|g| g.len() == self.instances.len());
-        self.geometry = planned.unwrap_or_else(|| {
-            crowd_geometry::choose(
-                scene,
-                &self.instances,
-                &GeometryView {
-                    camera: &self.camera,
-                    width: self.extent.width,
-                    height: self.extent.height,
-                    light_view_proj: self.light_frame.view_proj,
-                    backdrop: self.backdrop,
-                },
-                &errors,
-                self.settings.lod_pixels,
-            )
-        });
+            .filter(|g| g.len() == own.len())
+        {
+            Some(planned) => planned
+                .iter()
+                .zip(&own)
+                .map(|(p, o)| CharacterGeometry {
+                    level: p.level,
+                    casts_shadow: p.casts_shadow || o.casts_shadow,
+                })
+                .collect(),
+            None => own,
+        };
         let slots = &self.instance_buffer.character_slots;
         let mut by_slot = vec![
             CharacterGeometry {
@@ -180,10 +193,10 @@ impl Stepping {
     pub fn new(scene: &Scene, models: &[Mat4]) -> Option<Stepping> {
         let tracks = scene.tracks.clone().filter(|t| t.step.is_some())?;
         Some(Stepping {
-            tracks,
             frame: 0,
             base: models.to_vec(),
-            pivot: scene.head_center(),
+            pivot: tracks.pivot,
+            tracks,
             head: None,
             copy_characters: Vec::new(),
             last: Vec::new(),

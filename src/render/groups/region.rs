@@ -47,7 +47,10 @@ fn region_by(
         mm_per_unit: frame.mm_per_unit,
         max_strength: 1.0,
     };
-    if s.sss_region == RegionMode::Screen || reach(1.0, &probe).is_none() {
+    // A run stepping through the motion moves the skin after the region is
+    // made (frame 0's): the whole screen.
+    let steps = scene.tracks.as_ref().is_some_and(|t| t.step.is_some());
+    if s.sss_region == RegionMode::Screen || steps || reach(1.0, &probe).is_none() {
         return vec![full];
     }
     scene_region(
