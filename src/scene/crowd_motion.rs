@@ -214,7 +214,10 @@ mod tests {
         };
         assert!((t.time_of(0) - 1.0).abs() < 1e-5);
         assert_eq!(t.weights(0), animated_weights(&clip, 0, t.time_of(0)));
-        let early = Tracks { time: 1.0, ..t.clone() };
+        let early = Tracks {
+            time: 1.0,
+            ..t.clone()
+        };
         assert_eq!(early.time_of(0), 1.0);
     }
 }

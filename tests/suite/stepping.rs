@@ -198,7 +198,15 @@ fn texture_space_stretches_each_character_at_its_own_pose() {
 fn methods_that_pose_once_refuse_a_step() {
     for method in ["tsd", "reference"] {
         let out = common::dermis()
-            .args(["render", "--method", method, "--time", "1", "--time-step", "0.5"])
+            .args([
+                "render",
+                "--method",
+                method,
+                "--time",
+                "1",
+                "--time-step",
+                "0.5",
+            ])
             .args(["--width", "64", "--height", "36", "--out"])
             .arg(std::env::temp_dir().join(format!("dermis-step-{method}")))
             .output()
