@@ -124,13 +124,25 @@ impl GpuMesh {
 
     /// Binds the buffers and draws every triangle once.
     pub fn bind_and_draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        self.bind_and_draw_copy(ctx, cmd, 0);
+    }
+
+    /// [`GpuMesh::bind_and_draw`] from copy `copy` of the vertices (a mesh
+    /// of several copies: each character its own pose); the one copy when
+    /// there are no others.
+    pub fn bind_and_draw_copy(&self, ctx: &Context, cmd: vk::CommandBuffer, copy: u32) {
+        let offset = if self.copies > 1 {
+            (copy * self.vertex_count) as i32
+        } else {
+            0
+        };
         unsafe {
             ctx.device
                 .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
             ctx.device
                 .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
             ctx.device
-                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+                .cmd_draw_indexed(cmd, self.index_count, 1, 0, offset, 0);
         }
     }
 

@@ -209,13 +209,18 @@ mod tests {
 
     /// A camera at +z looking down -z with a 40-degree field, square frame.
     fn camera() -> Mat4 {
+        camera_to(100.0)
+    }
+
+    /// That camera with its far plane at `far`.
+    fn camera_to(far: f32) -> Mat4 {
         Camera {
             eye: Vec3::new(0.0, 0.0, 10.0),
             target: Vec3::ZERO,
             up: Vec3::Y,
             fovy_rad: 40f32.to_radians(),
             near: 0.1,
-            far: 100.0,
+            far,
         }
         .view_proj(1.0)
     }
@@ -372,15 +377,7 @@ mod tests {
         // A camera whose far plane lies just past z = 0 sees a floor strip
         // there to x = 3.9: a caster over x = 5 casts onto unseen floor,
         // unless the scattering reaches 2 units into the view.
-        let short = Camera {
-            eye: Vec3::new(0.0, 0.0, 10.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fovy_rad: 40f32.to_radians(),
-            near: 0.1,
-            far: 10.6,
-        }
-        .view_proj(1.0);
+        let short = camera_to(10.6);
         let floor = Aabb {
             min: Vec3::new(-100.0, -1.1, -0.5),
             max: Vec3::new(100.0, -1.0, 0.5),

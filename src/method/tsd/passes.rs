@@ -48,22 +48,10 @@ impl Tsd {
         self.mesh.triangles()
     }
 
-    /// Character `k`'s head: its own posed copy in a moving crowd
-    /// (`copies` > 1: copy k, from its vertex offset), else the one mesh.
+    /// Character `k`'s head: its own posed copy in a moving crowd, else
+    /// the one mesh.
     fn draw_head(&self, ctx: &Context, cmd: vk::CommandBuffer, k: usize) {
-        if self.mesh.copies <= 1 {
-            return self.mesh.bind_and_draw(ctx, cmd);
-        }
-        let m = &self.mesh;
-        unsafe {
-            ctx.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[m.vertices.raw], &[0]);
-            ctx.device
-                .cmd_bind_index_buffer(cmd, m.indices.raw, 0, vk::IndexType::UINT32);
-            let offset = (k as u32 * m.vertex_count) as i32;
-            ctx.device
-                .cmd_draw_indexed(cmd, m.index_count, 1, 0, offset, 0);
-        }
+        self.mesh.bind_and_draw_copy(ctx, cmd, k as u32);
     }
 
     /// The mask as the texture-space passes after the mask pass test it:
