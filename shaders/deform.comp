@@ -32,16 +32,20 @@ layout(set = 0, binding = 4, std430) buffer Previous { float previous[]; };
 // Per vertex: its joints and their weights (two sets of four; unused 0).
 struct Influence { uvec4 j0; uvec4 j1; vec4 w0; vec4 w1; };
 layout(set = 0, binding = 5, std430) readonly buffer Influences { Influence influences[]; };
-// The joint matrices at this frame's pose, then at the previous frame's.
+// The joint matrices at this frame's pose, then at the previous frame's;
+// copy after copy (jointStride apart) when each copy has its own pose.
 layout(set = 0, binding = 6, std430) readonly buffer Joints { mat4 joints[]; };
 // Which vertices each copy deforms (a crowd's copy, drawn at a level of
 // detail, only that level's): a (first, count) pair per copy, then the
 // lists. Count ALL: every vertex, in order, no list read.
 layout(set = 0, binding = 8, std430) readonly buffer Lists { uint lists[]; };
 const uint ALL = 0xffffffffu;
-// skinSlots: 0 (no skin), 4 or 8; jointCount: where the previous matrices start.
+// skinSlots: 0 (no skin), 4 or 8; jointCount: where the previous matrices
+// start; jointStride: matrices from one copy's palette to the next (0: one
+// palette shared).
 layout(push_constant) uniform Push {
     uint vertexCount; uint targetCount; uint skinSlots; uint jointCount; uint copies;
+    uint jointStride;
 } pc;
 
 const uint STRIDE = 12u;
@@ -109,6 +113,7 @@ void main() {
     }
     if (pc.skinSlots != 0u) {
         Influence inf = influences[v];
+        uint palette = copy * pc.jointStride;
         precise vec3 sp = vec3(0.0);
         precise vec3 sn = vec3(0.0);
         precise vec3 st = vec3(0.0);
@@ -117,14 +122,14 @@ void main() {
             float w = s < 4u ? inf.w0[s] : inf.w1[s - 4u];
             if (w == 0.0) continue;
             uint j = s < 4u ? inf.j0[s] : inf.j1[s - 4u];
-            mat4 m = joints[j];
+            mat4 m = joints[palette + j];
             precise vec3 a = point(m, p) * w;
             sp = sp + a;
             precise vec3 c = direction(m, n) * w;
             sn = sn + c;
             precise vec3 d = direction(m, t) * w;
             st = st + d;
-            precise vec3 e = point(joints[pc.jointCount + j], q) * w;
+            precise vec3 e = point(joints[palette + pc.jointCount + j], q) * w;
             sq = sq + e;
         }
         p = sp; n = sn; t = st; q = sq;

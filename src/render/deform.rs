@@ -26,6 +26,7 @@ use crate::vk::shader_stats::alu_estimate;
 use crate::vk::upload::device_buffer;
 use crate::work::{PassRole, ShaderWork};
 use bytemuck::Zeroable;
+use glam::Mat4;
 use gpu_allocator::MemoryLocation;
 
 pub const SHADER: &str = "deform.comp";
@@ -65,6 +66,25 @@ struct DeformPush {
     joint_count: u32,
     /// Copies deformed (one per crowd character, else 1).
     copies: u32,
+    /// Matrices between one copy's palette and the next's in `Joints`: 0
+    /// when the copies share one, else twice `joint_count`.
+    joint_stride: u32,
+}
+
+/// Each copy's pose (a crowd's characters, in instance-slot order): its
+/// morph weights and its skin's joint matrices, each list empty (every copy
+/// the object's own) or one per copy.
+#[derive(Default)]
+pub struct Copies {
+    pub weights: Vec<Vec<f32>>,
+    pub joints: Vec<Vec<Mat4>>,
+}
+
+impl Copies {
+    /// How many copies: the longer list's length, at least 1.
+    pub fn count(&self) -> usize {
+        self.weights.len().max(self.joints.len()).max(1)
+    }
 }
 
 /// Which vertices each copy deforms: copy `c` (instance slot `c`) those of
@@ -130,6 +150,7 @@ pub struct DeformObject {
     target_count: u32,
     skin_slots: u32,
     joint_count: u32,
+    joint_stride: u32,
     copies: u32,
     /// The most vertices a copy deforms (the dispatch's width), and the
     /// share of the dispatched invocations that deform one.
@@ -200,8 +221,10 @@ fn flatten_weights(morph: &Morph, copies: &[Vec<f32>]) -> Vec<[f32; 2]> {
 }
 
 /// A skin's influences as the shader reads them, and its matrices (the
-/// pose's, then the previous pose's); one zero row each without a skin.
-fn flatten_skin(skin: Option<&Skin>) -> (Vec<InfluenceRow>, Vec<[f32; 16]>) {
+/// pose's, then the previous pose's; per copy, copy after copy, when the
+/// copies have their own, the previous then the copy's own); one zero row
+/// each without a skin.
+fn flatten_skin(skin: Option<&Skin>, copies: &[Vec<Mat4>]) -> (Vec<InfluenceRow>, Vec<[f32; 16]>) {
     let Some(skin) = skin else {
         return (vec![InfluenceRow::zeroed()], vec![[0.0; 16]]);
     };
@@ -211,12 +234,19 @@ fn flatten_skin(skin: Option<&Skin>) -> (Vec<InfluenceRow>, Vec<[f32; 16]>) {
         .zip(&skin.weights)
         .map(|(&joints, &weights)| InfluenceRow { joints, weights })
         .collect();
-    let matrices = skin
-        .matrices
-        .iter()
-        .chain(&skin.previous)
-        .map(|m| m.to_cols_array())
-        .collect();
+    let matrices = if copies.is_empty() {
+        skin.matrices
+            .iter()
+            .chain(&skin.previous)
+            .map(|m| m.to_cols_array())
+            .collect()
+    } else {
+        copies
+            .iter()
+            .flat_map(|c| c.iter().chain(c))
+            .map(|m| m.to_cols_array())
+            .collect()
+    };
     (rows, matrices)
 }
 
@@ -241,15 +271,34 @@ impl Deform {
         res: &mut Resources,
         (name, vertices): (&str, vk::Buffer),
         morph: &Morph,
-        copies: &[Vec<f32>],
+        copies: &Copies,
         lists: Option<Lists>,
     ) -> Result<BufferId> {
         let n = morph.rest.len() as u64;
         let (deltas, rows) = flatten(morph);
-        let weights = flatten_weights(morph, copies);
-        let c = copies.len().max(1) as u64;
+        let c = copies.count() as u64;
+        let one = vec![morph.weights.clone(); c as usize];
+        let weights = flatten_weights(
+            morph,
+            if copies.weights.is_empty() && c > 1 {
+                &one
+            } else {
+                &copies.weights
+            },
+        );
         let (list_words, listed_most, listed_sum) = flatten_lists(lists, c as u32, n as u32);
-        let (influences, joints) = flatten_skin(morph.skin.as_ref());
+        let joint_count = morph.skin.as_ref().map_or(0, |s| s.matrices.len() as u32);
+        if let Some(bad) = copies
+            .joints
+            .iter()
+            .find(|j| j.len() != joint_count as usize)
+        {
+            anyhow::bail!(
+                "{name}: a copy has {} joint matrices for {joint_count}",
+                bad.len()
+            );
+        }
+        let (influences, joints) = flatten_skin(morph.skin.as_ref(), &copies.joints);
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // Read back by tests (`read_back`).
         let readable = usage | vk::BufferUsageFlags::TRANSFER_SRC;
@@ -259,7 +308,12 @@ impl Deform {
             vertex_count: n as u32,
             target_count: morph.targets.len() as u32,
             skin_slots: morph.skin.as_ref().map_or(0, |s| s.slots as u32),
-            joint_count: morph.skin.as_ref().map_or(0, |s| s.matrices.len() as u32),
+            joint_count,
+            joint_stride: if copies.joints.is_empty() {
+                0
+            } else {
+                2 * joint_count
+            },
             copies: c as u32,
             listed_most,
             listed_share: listed_sum as f64
@@ -282,7 +336,13 @@ impl Deform {
         )?;
         o.deltas = upload("morph offsets", bytemuck::cast_slice(&deltas))?;
         o.influences = upload("joint influences", bytemuck::cast_slice(&influences))?;
-        o.joints = upload("joint matrices", bytemuck::cast_slice(&joints))?;
+        // Host-visible too (`set_joints`).
+        o.joints = Buffer::with_data(
+            ctx,
+            &format!("{name} joint matrices"),
+            bytemuck::cast_slice(&joints),
+            usage,
+        )?;
         o.lists = upload("vertex lists", bytemuck::cast_slice(&list_words))?;
         let zeros = vec![0f32; (3 * n * c) as usize];
         o.previous = device_buffer(
@@ -381,6 +441,45 @@ impl Deform {
         o.weights.write(bytemuck::cast_slice(&pairs))
     }
 
+    /// Object `index`'s joint matrices for the next frame: `now` and
+    /// `previous`, one palette per copy (or one, when the copies share it),
+    /// between frames as [`Deform::set_weights`].
+    pub fn set_joints(
+        &mut self,
+        index: usize,
+        now: &[Vec<Mat4>],
+        previous: &[Vec<Mat4>],
+    ) -> Result<()> {
+        let o = &mut self.objects[index];
+        let palettes = if o.joint_stride == 0 { 1 } else { o.copies };
+        anyhow::ensure!(
+            now.len() == palettes as usize && previous.len() == now.len(),
+            "{}: {} palettes ({} previous) for {palettes}",
+            o.name,
+            now.len(),
+            previous.len()
+        );
+        if let Some(bad) = now
+            .iter()
+            .chain(previous)
+            .find(|j| j.len() != o.joint_count as usize)
+        {
+            anyhow::bail!(
+                "{}: {} joint matrices for {}",
+                o.name,
+                bad.len(),
+                o.joint_count
+            );
+        }
+        let m: Vec<[f32; 16]> = now
+            .iter()
+            .zip(previous)
+            .flat_map(|(n, p)| n.iter().chain(p))
+            .map(|m| m.to_cols_array())
+            .collect();
+        o.joints.write(bytemuck::cast_slice(&m))
+    }
+
     /// Writes the objects' sets (once the frame's pool exists).
     pub fn bind(&mut self, ctx: &Context, pool: &DescriptorPool, res: &Resources) -> Result<()> {
         for o in &mut self.objects {
@@ -422,6 +521,7 @@ impl Deform {
                 skin_slots: o.skin_slots,
                 joint_count: o.joint_count,
                 copies: o.copies,
+                joint_stride: o.joint_stride,
             };
             // Vertex work of the frame, with the geometry it feeds.
             let mut pass = Pass::new(format!("deform {}", o.name), PassRole::Geometry);

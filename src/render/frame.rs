@@ -22,7 +22,7 @@ use glam::Mat4;
 mod character_ids;
 mod motion;
 mod shadow;
-pub use motion::head_copies;
+pub use motion::object_copies;
 use motion::Stepping;
 
 use super::deform::Deform;
@@ -259,15 +259,19 @@ impl Frame {
                     .enumerate()
                     .map(|(i, p)| (format!("part {i}"), ObjectKind::Part, p)),
             );
-        let copies = head_copies(scene, self.instances.len());
-        for (name, kind, o) in objects {
+        let first = usize::from(scene.backdrop.is_some());
+        for (k, (name, kind, o)) in objects.enumerate() {
+            let copies = match k.checked_sub(first) {
+                Some(i) => object_copies(scene, i, self.instances.len()),
+                None => 1,
+            };
             let g = GpuObject::new(
                 ctx,
                 &name,
                 kind,
                 (
                     o,
-                    if name == "head" { copies } else { 1 },
+                    copies,
                     kind.per_character() && self.settings.wants_levels(),
                 ),
                 &self.pool,

@@ -106,7 +106,7 @@ fn max_weight(scene: &Scene) -> f32 {
 /// its head and parts as posed, and of their rest shapes widened by how
 /// far the crowd's morph weights can move them (a character of a moving
 /// crowd is at another phase than the posed one), and every turn of a
-/// turning one. A skinned mesh's crowd plays in step: its posed box.
+/// turning one, and every pose a file's clip gives it (`file_clip_bounds`).
 pub fn drawn_bounds(scene: &Scene) -> Aabb {
     let w = max_weight(scene);
     let posed = std::iter::once(&scene.head)
@@ -133,6 +133,7 @@ pub fn drawn_bounds(scene: &Scene) -> Aabb {
     // sweeps its box about the head's centre: the cube around the sphere
     // that holds every turn of it.
     match scene.tracks.as_ref() {
+        Some(t) if matches!(t.motion, Motion::File(_)) => posed.union(&file_clip_bounds(scene)),
         Some(t) if t.motion == Motion::Rigid => {
             let c = t.pivot;
             let r = (posed.min - c).abs().max((posed.max - c).abs()).length();
@@ -142,6 +143,49 @@ pub fn drawn_bounds(scene: &Scene) -> Aabb {
             }
         }
         _ => posed,
+    }
+}
+
+/// Samples of a file's clip between its keys (`rig::Rig::sample_times`).
+const CLIP_SAMPLES: usize = 32;
+
+/// A box's share added each side to what the clip's samples cover: between
+/// two samples a joint turns by at most the keys' slerp, which can carry a
+/// vertex a sliver past both.
+const CLIP_MARGIN: f32 = 0.05;
+
+/// The box of every object a file's clip moves, over the whole clip: each
+/// one posed at every key and [`CLIP_SAMPLES`] between, widened by
+/// [`CLIP_MARGIN`] of its size (no box without such a clip).
+fn file_clip_bounds(scene: &Scene) -> Aabb {
+    let objects: Vec<&super::mesh::Object> =
+        std::iter::once(&scene.head).chain(&scene.parts).collect();
+    let Some(Motion::File(rig)) = scene.tracks.as_ref().map(|t| &t.motion) else {
+        return scene.head_bounds;
+    };
+    let mut out: Option<Aabb> = None;
+    for t in rig.sample_times(CLIP_SAMPLES) {
+        for (i, pose) in rig.pose(t).iter().enumerate() {
+            let Some(o) = objects.get(i).filter(|_| rig.moves(i)) else {
+                continue;
+            };
+            let m = pose.applied(&o.morph);
+            let b = Aabb::from_points(
+                super::morph::deformed(&m.rest, &m)
+                    .iter()
+                    .map(|v| Vec3::from(v.position)),
+            );
+            out = match (out, b) {
+                (Some(a), Some(b)) => Some(a.union(&b)),
+                (a, b) => a.or(b),
+            };
+        }
+    }
+    let b = out.unwrap_or(scene.head_bounds);
+    let pad = b.size() * CLIP_MARGIN;
+    Aabb {
+        min: b.min - pad,
+        max: b.max + pad,
     }
 }
 

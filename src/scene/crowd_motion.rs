@@ -6,7 +6,10 @@
 
 use glam::{Quat, Vec3};
 
+use std::sync::Arc;
+
 use super::animation::{animated_weights, rigid_rotation, Clip, RIGID_PERIOD_S};
+use super::rig::{clip_time, ObjectPose, Rig};
 
 /// The seed a crowd's phases are drawn from unless `--crowd-seed` says.
 pub const DEFAULT_SEED: u64 = 0x5EED_0029;
@@ -19,6 +22,10 @@ pub enum Motion {
     Weights(Clip),
     /// dermis's rigid turn and nod (a character without animation).
     Rigid,
+    /// A glTF file's own clip: its skins' joints, the rigid parts under the
+    /// nodes it moves, and its weight channels (`rig`), looped over its
+    /// length.
+    File(Arc<Rig>),
 }
 
 /// The crowd's motion at one time.
@@ -61,6 +68,7 @@ impl Tracks {
         match &self.motion {
             Motion::Weights(clip) => clip.duration(),
             Motion::Rigid => RIGID_PERIOD_S,
+            Motion::File(rig) => rig.duration(),
         }
     }
 
@@ -72,6 +80,8 @@ impl Tracks {
             // The rigid clip is periodic in itself.
             (0, Motion::Rigid) => self.time,
             _ if p <= 0.0 => self.time,
+            // As the file was loaded: up to its end, then looped.
+            (0, Motion::File(_)) => clip_time(self.time, p),
             (0, _) => self.time.rem_euclid(p),
             _ => (self.time + phase(self.seed, c) * p).rem_euclid(p),
         }
@@ -82,7 +92,16 @@ impl Tracks {
     pub fn weights(&self, c: usize) -> Option<Vec<f32>> {
         match &self.motion {
             Motion::Weights(clip) => animated_weights(clip, 0, self.time_of(c)),
-            Motion::Rigid => None,
+            Motion::Rigid | Motion::File(_) => None,
+        }
+    }
+
+    /// Character `c`'s objects (head, then parts) posed by a file's clip
+    /// at its own time (`None`: another motion).
+    pub fn file_pose(&self, c: usize) -> Option<Vec<ObjectPose>> {
+        match &self.motion {
+            Motion::File(rig) => Some(rig.pose(self.time_of(c))),
+            _ => None,
         }
     }
 

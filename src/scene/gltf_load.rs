@@ -46,6 +46,7 @@ mod skins;
 mod textures;
 
 use super::mesh::Object;
+use super::rig::{clip_time, ObjectRig, Rig};
 use super::skin_rule;
 use anyhow::{anyhow, bail, Result};
 use std::path::Path;
@@ -97,6 +98,7 @@ impl Warnings {
             object,
             parts,
             animated: false,
+            rig: None,
             warnings: self.list,
             notes: self.notes,
         }
@@ -137,6 +139,9 @@ pub struct Loaded {
     pub parts: Vec<Object>,
     /// Whether one of the file's animations posed it (`--time`, `--animation`).
     pub animated: bool,
+    /// That animation, ready to pose again at any time (a crowd's phases, a
+    /// run's steps): the head's sources first, then the parts'.
+    pub rig: Option<Rig>,
     pub warnings: Vec<String>,
     pub notes: Vec<String>,
 }
@@ -173,16 +178,18 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
         (None, Some(_)) => clips.first(),
         (None, None) => None,
     };
-    let time = overrides.time.unwrap_or(0.0);
+    let asked = overrides.time.unwrap_or(0.0);
+    // Past its end the clip loops, as every character of a crowd loops it.
+    let time = clip.map_or(asked, |c| clip_time(asked, c.duration()));
     unsupported_features(&src, &mut warn);
     if let Some(c) = clip {
-        let past = if time > c.duration() {
-            " (past its end: its last pose)".to_string()
+        let past = if time != asked {
+            format!(" (past its end: looped, {time} s into it)")
         } else {
             String::new()
         };
         warn.note(format!(
-            "animation '{}' ({:.3} s, {} channels) posed at {time} s{past}",
+            "animation '{}' ({:.3} s, {} channels) posed at {asked} s{past}",
             c.name,
             c.duration(),
             c.channels.len()
@@ -236,6 +243,7 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     }
     let mut head_object = None;
     let mut parts = Vec::new();
+    let (mut head_rig, mut part_rigs) = (ObjectRig::default(), Vec::new());
     for (i, g) in groups.into_iter().enumerate() {
         if g.with_uvs > 0 && !g.without_uvs.is_empty() {
             // Skin needs texture coordinates where it is textured; an eye or a tooth
@@ -272,13 +280,22 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
             .map_err(|e| anyhow!("{}: {e:#}", facts[i].label()))?;
         if role.head {
             head_object = Some(object);
+            head_rig = g.rig;
         } else {
             parts.push(object);
+            part_rigs.push(g.rig);
         }
     }
     let object = head_object.ok_or_else(|| anyhow!("no triangle mesh in the default scene"))?;
     let mut loaded = warn.finish(object, parts);
     loaded.animated = clip.is_some();
+    loaded.rig = clip.map(|clip| Rig {
+        skeleton: c.skeleton,
+        clip: clip.clone(),
+        shift: c.shift,
+        loaded_time: time,
+        objects: std::iter::once(head_rig).chain(part_rigs).collect(),
+    });
     Ok(loaded)
 }
 

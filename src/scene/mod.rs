@@ -23,6 +23,7 @@ pub mod lod;
 pub mod mesh;
 pub mod morph;
 pub mod procedural;
+pub mod rig;
 pub mod robust_bounds;
 pub mod skin;
 pub mod skin_rule;
@@ -162,6 +163,16 @@ impl Scene {
     /// (character 0, a still or rigid crowd, a head without targets).
     pub fn character_head(&self, c: usize) -> Option<mesh::Mesh> {
         let t = self.tracks.as_ref().filter(|_| c > 0)?;
+        if let crowd_motion::Motion::File(rig) = &t.motion {
+            if !rig.moves(0) {
+                return None;
+            }
+            let m = t.file_pose(c)?[0].applied(&self.head.morph);
+            return Some(mesh::Mesh {
+                vertices: morph::posed(&m.rest, &m),
+                indices: self.head.mesh.indices.clone(),
+            });
+        }
         if !matches!(t.motion, crowd_motion::Motion::Weights(_))
             || self.head.morph.targets.is_empty()
         {
@@ -386,7 +397,18 @@ pub fn load_gltf_scene(
     if let Some((_, forward)) = rest {
         scene.forward = forward;
     }
-    if let (Some(t), false) = (overrides.time, loaded.animated) {
+    if let Some(rig) = loaded.rig {
+        let t = overrides.time.unwrap_or(0.0);
+        // A crowd plays the file's clip at each character's phase, and a
+        // run steps through it.
+        scene.tracks = Some(crowd_motion::Tracks {
+            time: t,
+            seed: crowd_motion::DEFAULT_SEED,
+            pivot: scene.head_center(),
+            motion: crowd_motion::Motion::File(std::sync::Arc::new(rig)),
+            step: None,
+        });
+    } else if let (Some(t), false) = (overrides.time, loaded.animated) {
         eprintln!(
             "note: {}: the file has no animation: --time {t} turns and nods it (dermis's rigid clip, {} s, looped)",
             path.display(),

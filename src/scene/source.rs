@@ -136,12 +136,6 @@ impl SceneSource {
             tracks.seed = self.crowd_seed.unwrap_or(super::crowd_motion::DEFAULT_SEED);
             tracks.step = self.time_step;
         }
-        if let (Some(_), None, Some(path)) = (self.time_step, &scene.tracks, self.gltf()) {
-            anyhow::bail!(
-                "--time-step: {}'s own clip is posed once, as the file loads (its skeleton is not kept to pose it again): give --time alone",
-                path.display()
-            );
-        }
         scene.set_morph_weights(&weights)?;
         if let Some(src) = &mut scene.source {
             src.morph_weights = self.morph_weights.clone();

@@ -219,3 +219,107 @@ fn methods_that_pose_once_refuse_a_step() {
         );
     }
 }
+
+/// A glTF file's own clip (the glTF tutorial's SimpleSkin, which no code of
+/// ours wrote) plays at each character's phase and steps: two runs that
+/// reach 1.75 s by different steps draw the same bits; each character's
+/// copy holds the CPU's skinning at its own time (the file re-posed by the
+/// kept skeleton), its previous positions the frame before's; character 0
+/// at 1.75 s is the file loaded at 1.75 s, to the bit; and at the 1 s key,
+/// reached by steps, the strip's top corner is where the file puts it.
+#[test]
+fn a_files_own_clip_plays_each_character_at_its_phase_and_steps() {
+    use dermis::scene::morph::deformed;
+    use dermis::scene::source::SceneSource;
+    use glam::Vec3;
+    let ctx = common::ctx();
+    let path = std::path::PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/khronos/SimpleSkin.gltf"
+    ));
+    let load = |time: f32, step: Option<f32>| {
+        SceneSource {
+            scene: Some(path.clone()),
+            time: Some(time),
+            time_step: step,
+            ..SceneSource::default()
+        }
+        .load()
+        .unwrap()
+    };
+    let s = RenderSettings {
+        heads: 4,
+        ..settings()
+    };
+    let run = |time: f32, step: f32, frames: usize| {
+        let scene = load(time, Some(step));
+        let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+        let first = r.capture(false).unwrap();
+        r.run_frames(frames - 1, |_| {}).unwrap();
+        let last = r.capture(false).unwrap();
+        (scene, first, last, r.deformed().unwrap())
+    };
+    let (scene, first, a, got_a) = run(1.0, 0.25, 3);
+    let (_, _, b, got_b) = run(1.0, 0.75, 1);
+    assert!(
+        a.ldr == b.ldr && a.diffuse == b.diffuse,
+        "1.75 s differs by history"
+    );
+    assert!(first.depth != a.depth, "the frames did not move");
+    let tracks = scene.tracks.clone().unwrap();
+    let at = |t: f32| dermis::scene::crowd_motion::Tracks {
+        time: t,
+        ..tracks.clone()
+    };
+    let m = &scene.head.morph;
+    let skinned = |t: f32, c: usize| {
+        let pose = at(t).file_pose(c).unwrap();
+        deformed(&m.rest, &pose[0].applied(m))
+    };
+    let n = m.rest.len();
+    // Four phases: four different shapes.
+    let shapes: Vec<Vec<f32>> = (0..4)
+        .map(|c| got_a[0].vertices[12 * n * c..12 * n * (c + 1)].to_vec())
+        .collect();
+    for c in 1..4 {
+        assert_ne!(shapes[0], shapes[c], "character {c} in step with 0");
+    }
+    for (got, before) in [(&got_a, 1.5f32), (&got_b, 1.0)] {
+        for c in 0..4 {
+            let want = skinned(1.75, c);
+            let want: &[f32] = bytemuck::cast_slice(&want);
+            let copy = &got[0].vertices[12 * n * c..12 * n * (c + 1)];
+            assert!(
+                copy == want,
+                "character {c}: not the CPU's skinning at 1.75 s"
+            );
+            let prev: Vec<f32> = skinned(before, c).iter().flat_map(|v| v.position).collect();
+            let got_prev = &got[0].previous[3 * n * c..3 * n * (c + 1)];
+            assert!(
+                got_prev == &prev[..],
+                "character {c}: previous not at {before} s"
+            );
+        }
+    }
+    // Character 0 at 1.75 s is the file as the loader poses it at 1.75 s.
+    let still = load(1.75, None);
+    let sm = &still.head.morph;
+    let want = deformed(&sm.rest, sm);
+    assert!(
+        got_a[0].vertices[..12 * n] == *bytemuck::cast_slice::<_, f32>(&want),
+        "character 0 is not the file loaded at 1.75 s"
+    );
+    // The 1 s key reached by two steps from 0 s: the top corner (0.5, 2),
+    // held by the upper joint alone, at (-1, 1.5) (the file's 90 degrees).
+    let (scene0, _, _, got) = run(0.0, 0.5, 3);
+    let rest = &scene0.head.morph.rest;
+    let mut found = 0;
+    for (k, v) in rest.iter().enumerate() {
+        if v.position == [0.5, 2.0, 0.0] {
+            let p = Vec3::from_slice(&got[0].vertices[12 * k..12 * k + 3]);
+            assert!((p - Vec3::new(-1.0, 1.5, 0.0)).length() < 1e-5, "{p}");
+            found += 1;
+        }
+    }
+    assert!(found > 0, "no vertex at the top corner");
+}

@@ -5,10 +5,11 @@
 //! fields it sets.
 
 use super::*;
-use crate::render::deform::Lists;
+use crate::render::deform::{Copies, Deform, Lists};
 use crate::scene::crowd_geometry::turned_by;
 use crate::scene::crowd_geometry::{self, CharacterGeometry, GeometryView};
 use crate::scene::crowd_motion::{Motion, Tracks};
+use crate::scene::rig::ObjectPose;
 use glam::Vec3;
 
 impl Frame {
@@ -84,9 +85,11 @@ impl Frame {
     }
 
     /// The deform pass of every object with a skin or morph weights not all
-    /// 0 (`scene`'s, in the order `build` made the objects); a crowd playing
-    /// a clip of weights deforms one copy of the head per character, each at
-    /// its own phase, in instance-slot order (after `set_skin_groups`).
+    /// 0 (`scene`'s, in the order `build` made the objects). A crowd that
+    /// moves deforms one copy of each moving object per character, each at
+    /// its own phase, in instance-slot order (after `set_skin_groups`): the
+    /// head's weights for a clip of weights, every object the file's clip
+    /// moves (weights and joints) for a file's clip.
     pub fn enable_deform(
         &mut self,
         ctx: &Context,
@@ -98,80 +101,133 @@ impl Frame {
         for (c, &s) in slots.iter().enumerate() {
             by_slot[s as usize] = c;
         }
-        let copy_weights: Vec<Vec<f32>> = match &scene.tracks {
-            Some(t) if head_copies(scene, slots.len()) > 1 => by_slot
-                .iter()
-                .map(|&c| match c {
-                    0 => scene.head.morph.weights.clone(),
-                    c => t
-                        .weights(c)
-                        .unwrap_or_else(|| scene.head.morph.weights.clone()),
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
-        // Stepping through a clip of weights: the head deforms every frame,
-        // even from a pose whose weights are all 0.
-        let steps_weights = self
-            .stepping
-            .as_ref()
-            .is_some_and(|s| matches!(s.tracks.motion, Motion::Weights(_)));
+        // The backdrop's deform object (if any) comes first.
+        let first = usize::from(scene.backdrop.is_some());
         let morphs = scene
             .backdrop
             .iter()
             .chain([&scene.head])
             .chain(&scene.parts)
             .map(|o| &o.morph);
+        let file_poses: Vec<Vec<ObjectPose>> = match &scene.tracks {
+            Some(t) if matches!(t.motion, Motion::File(_)) && slots.len() > 1 => by_slot
+                .iter()
+                .map(|&c| t.file_pose(c).unwrap_or_default())
+                .collect(),
+            _ => Vec::new(),
+        };
+        let stepping = self.stepping.as_ref().map(|s| s.tracks.motion.clone());
         self.deform = Deform::new(ctx)?;
-        for (obj, morph) in self.objects.iter_mut().zip(morphs) {
-            let copies: &[Vec<f32>] = if obj.mesh.copies > 1 {
-                &copy_weights
-            } else {
-                &[]
+        for (k, (obj, morph)) in self.objects.iter_mut().zip(morphs).enumerate() {
+            // Which character object it is: 0 the head, then the parts.
+            let Some(i) = k.checked_sub(first) else {
+                continue;
             };
-            let stepped = steps_weights && obj.name == "head";
-            if !morph.at_rest() || !copies.is_empty() || stepped {
-                // A copy per character deforms its level's vertices only
-                // (`choose_geometry` set the slots' levels); one shared
-                // copy deforms every vertex.
-                let lists = (!copies.is_empty() && !obj.level_vertices.is_empty()).then(|| Lists {
-                    copy_levels: &obj.mesh.slot_levels,
-                    level_vertices: &obj.level_vertices,
-                });
-                let id = self.deform.add(
-                    ctx,
-                    res,
-                    (&obj.name, obj.mesh.vertices.raw),
-                    morph,
-                    copies,
-                    lists,
-                )?;
-                obj.deformed = Some(id);
-                if let (true, Some(st)) = (stepped, self.stepping.as_mut()) {
-                    st.head = Some(self.deform.objects.len() - 1);
-                    st.copy_characters = if copies.is_empty() {
-                        vec![0]
-                    } else {
-                        by_slot.clone()
+            let copied = obj.mesh.copies > 1;
+            let copies = match &scene.tracks {
+                Some(t) if copied && matches!(t.motion, Motion::Weights(_)) => Copies {
+                    weights: by_slot
+                        .iter()
+                        .map(|&c| match c {
+                            0 => morph.weights.clone(),
+                            c => t.weights(c).unwrap_or_else(|| morph.weights.clone()),
+                        })
+                        .collect(),
+                    joints: Vec::new(),
+                },
+                Some(_) if copied && !file_poses.is_empty() => {
+                    // Character 0 is the scene as loaded: its own bits.
+                    let pose = |slot: usize| {
+                        (by_slot[slot] > 0).then(|| file_poses[slot][i].applied(morph))
                     };
-                    st.last = if copies.is_empty() {
+                    Copies {
+                        weights: (0..by_slot.len())
+                            .map(|s| pose(s).map_or_else(|| morph.weights.clone(), |m| m.weights))
+                            .collect(),
+                        joints: match &morph.skin {
+                            Some(own) => (0..by_slot.len())
+                                .map(|s| {
+                                    pose(s)
+                                        .and_then(|m| m.skin.map(|k| k.matrices))
+                                        .unwrap_or_else(|| own.matrices.clone())
+                                })
+                                .collect(),
+                            None => Vec::new(),
+                        },
+                    }
+                }
+                _ => Copies::default(),
+            };
+            // Stepping through a motion: what it moves deforms every frame,
+            // even from a pose whose weights are all 0.
+            let stepped = match &stepping {
+                Some(Motion::Weights(_)) => i == 0,
+                Some(Motion::File(rig)) => rig.moves(i),
+                _ => false,
+            };
+            if morph.at_rest() && !copied && !stepped {
+                continue;
+            }
+            // A copy per character deforms its level's vertices only
+            // (`choose_geometry` set the slots' levels); one shared copy
+            // deforms every vertex.
+            let lists = (copied && !obj.level_vertices.is_empty()).then(|| Lists {
+                copy_levels: &obj.mesh.slot_levels,
+                level_vertices: &obj.level_vertices,
+            });
+            let id = self.deform.add(
+                ctx,
+                res,
+                (&obj.name, obj.mesh.vertices.raw),
+                morph,
+                &copies,
+                lists,
+            )?;
+            obj.deformed = Some(id);
+            if let (true, Some(st)) = (stepped, self.stepping.as_mut()) {
+                let own_joints = morph.skin.as_ref().map(|s| s.matrices.clone());
+                st.objects.push(SteppedObject {
+                    deform: self.deform.objects.len() - 1,
+                    object: i,
+                    characters: if copied { by_slot.clone() } else { vec![0] },
+                    own_weights: morph.weights.clone(),
+                    last_weights: if copies.weights.is_empty() {
                         vec![morph.weights.clone()]
                     } else {
-                        copies.to_vec()
-                    };
-                }
+                        copies.weights
+                    },
+                    last_joints: match own_joints {
+                        Some(_) if !copies.joints.is_empty() => copies.joints,
+                        Some(own) => vec![own],
+                        None => Vec::new(),
+                    },
+                });
             }
         }
         Ok(())
     }
 }
 
+/// One object a stepping run poses again every frame: its deform object,
+/// which character object it is (0 the head, then the parts), each copy's
+/// character, its own weights (those no channel drives), and the weights
+/// and joints each copy was last given.
+struct SteppedObject {
+    deform: usize,
+    object: usize,
+    characters: Vec<usize>,
+    own_weights: Vec<f32>,
+    last_weights: Vec<Vec<f32>>,
+    last_joints: Vec<Vec<Mat4>>,
+}
+
 /// A run stepping through the motion (`--time-step`): frame k is posed at
 /// the scene's time + k * step, whatever ran before it. A clip of weights
-/// rewrites each copy's weights (this frame's and the last's: the deform
-/// pass's velocity); a rigid motion rewrites the models (every character,
-/// the first too, turns from the pose its mesh was made at). The frame's
-/// framing, levels and shadow casters stay those of frame 0.
+/// rewrites each copy's weights, a file's clip each moving object's weights
+/// and joints (this frame's and the last's: the deform pass's velocity); a
+/// rigid motion rewrites the models (every character, the first too, turns
+/// from the pose its mesh was made at). The frame's framing, levels and
+/// shadow casters stay those of frame 0.
 pub struct Stepping {
     /// The motion at frame 0.
     pub tracks: Tracks,
@@ -180,11 +236,8 @@ pub struct Stepping {
     /// The characters' models before any turn, and the turn's pivot.
     base: Vec<Mat4>,
     pivot: Vec3,
-    /// The head's deform object, each of its copies' character and the
-    /// weights it was last given.
-    head: Option<usize>,
-    copy_characters: Vec<usize>,
-    last: Vec<Vec<f32>>,
+    /// The objects it poses.
+    objects: Vec<SteppedObject>,
 }
 
 impl Stepping {
@@ -197,10 +250,47 @@ impl Stepping {
             base: models.to_vec(),
             pivot: tracks.pivot,
             tracks,
-            head: None,
-            copy_characters: Vec::new(),
-            last: Vec::new(),
+            objects: Vec::new(),
         })
+    }
+
+    /// Poses every stepped object at `t`: each copy's weights and joints
+    /// now, with the last frame's beside them.
+    fn pose(&mut self, deform: &mut Deform, t: &Tracks) -> Result<()> {
+        // Each character's pose once, whatever objects it moves.
+        let mut cache: std::collections::HashMap<usize, Option<Vec<ObjectPose>>> =
+            Default::default();
+        for o in &mut self.objects {
+            let poses: Vec<Option<Vec<ObjectPose>>> = o
+                .characters
+                .iter()
+                .map(|&c| cache.entry(c).or_insert_with(|| t.file_pose(c)).clone())
+                .collect();
+            let now: Vec<Vec<f32>> = o
+                .characters
+                .iter()
+                .zip(&poses)
+                .map(|(&c, pose)| match pose {
+                    Some(p) => p[o.object].weights_over(&o.own_weights),
+                    None => t.weights(c).unwrap_or_else(|| o.own_weights.clone()),
+                })
+                .collect();
+            if !o.own_weights.is_empty() {
+                deform.set_weights(o.deform, &now, &o.last_weights)?;
+            }
+            o.last_weights = now;
+            if !o.last_joints.is_empty() {
+                let now: Vec<Vec<Mat4>> = poses
+                    .iter()
+                    .take(o.last_joints.len())
+                    .map(|p| p.as_ref().map(|p| p[o.object].joints.clone()))
+                    .collect::<Option<_>>()
+                    .unwrap_or_else(|| o.last_joints.clone());
+                deform.set_joints(o.deform, &now, &o.last_joints)?;
+                o.last_joints = now;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -216,18 +306,9 @@ impl Frame {
         st.frame += 1;
         let result = match st.tracks.at_frame(k).filter(|_| k > 0) {
             None => Ok(()),
-            Some(t) => match (&t.motion, st.head) {
-                (Motion::Weights(_), Some(head)) => {
-                    let now: Vec<Vec<f32>> = st
-                        .copy_characters
-                        .iter()
-                        .map(|&c| t.weights(c).unwrap_or_default())
-                        .collect();
-                    let r = self.deform.set_weights(head, &now, &st.last);
-                    st.last = now;
-                    r
-                }
-                (Motion::Rigid, _) => {
+            Some(t) => match &t.motion {
+                Motion::Weights(_) | Motion::File(_) => st.pose(&mut self.deform, &t),
+                Motion::Rigid => {
                     let posed = st.tracks.time;
                     let previous = std::mem::replace(
                         &mut self.instances,
@@ -239,7 +320,6 @@ impl Frame {
                         self.backdrop,
                     )
                 }
-                _ => Ok(()),
             },
         };
         self.stepping = Some(st);
@@ -255,18 +335,19 @@ impl Frame {
     }
 }
 
-/// Copies of the head's vertices the frame deforms: one per character when
-/// a crowd of it plays a clip of morph weights, each at its own phase
-/// (`Scene::tracks`); else one shared by all.
-pub fn head_copies(scene: &Scene, characters: usize) -> u32 {
-    match &scene.tracks {
-        Some(t)
-            if characters > 1
-                && matches!(t.motion, Motion::Weights(_))
-                && !scene.head.morph.targets.is_empty() =>
-        {
-            characters as u32
-        }
-        _ => 1,
+/// Copies of a character object's vertices (`object`: 0 the head, then
+/// the parts) the frame deforms: one per character when a crowd moves it
+/// at each one's phase (`Scene::tracks`: the head under a clip of weights,
+/// every object a file's clip moves), else one shared by all.
+pub fn object_copies(scene: &Scene, object: usize, characters: usize) -> u32 {
+    let moved = match scene.tracks.as_ref().map(|t| &t.motion) {
+        Some(Motion::Weights(_)) => object == 0 && !scene.head.morph.targets.is_empty(),
+        Some(Motion::File(rig)) => rig.moves(object),
+        _ => false,
+    };
+    if characters > 1 && moved {
+        characters as u32
+    } else {
+        1
     }
 }

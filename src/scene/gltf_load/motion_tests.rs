@@ -121,9 +121,21 @@ fn animations_pose_nodes_and_weights_at_the_time_asked() {
     assert_eq!(l.object.morph.weights, [1.0]);
     // Just before: the weight is still 0 (STEP).
     assert_eq!(at(Some(0.999)).object.morph.weights, [0.0]);
-    // After the end: the last key (90 degrees), clamped.
-    let p = glam::Vec3::from(at(Some(5.0)).object.mesh.vertices[1].position);
+    // At its end: the last key (90 degrees); past it, looped (5 s of a
+    // 2 s clip is 1 s into it), as a crowd's characters loop it.
+    let p = glam::Vec3::from(at(Some(2.0)).object.mesh.vertices[1].position);
     assert!((p - glam::Vec3::new(0.0, 1.0, 2.0)).length() < 1e-5, "{p}");
+    let looped = at(Some(5.0));
+    let p = glam::Vec3::from(looped.object.mesh.vertices[1].position);
+    assert!((p - glam::Vec3::new(h, h, 2.0)).length() < 1e-5, "{p}");
+    assert!(
+        looped
+            .notes
+            .iter()
+            .any(|n| n.contains("posed at 5 s (past its end: looped, 1 s into it)")),
+        "{:?}",
+        looped.notes
+    );
     // A clip that does not exist, and times that do not increase, are one line.
     let o = TextureOverrides {
         time: Some(1.0),
@@ -406,4 +418,56 @@ fn an_instanced_node_draws_every_instance_where_the_file_puts_it() {
             .unwrap()
     );
     assert!(e.contains("different counts"), "{e}");
+}
+
+/// The kept skeleton poses the file again at any time as the loader poses
+/// it: a rigid primitive under the turning node (carried by a joint, the
+/// identity where it was loaded) and the weight channel, loaded at 0.5 s
+/// and posed at 1.5 s, give the mesh loaded at 1.5 s; a skin posed at its
+/// loaded time gives the loaded joint matrices to the bit.
+#[test]
+fn the_kept_skeleton_poses_the_clip_as_the_loader_does() {
+    let dir = temp_dir("rig");
+    let posed = |path: &Path, t: f32| {
+        let o = TextureOverrides {
+            time: Some(t),
+            ..Default::default()
+        };
+        load_head_with_notes(path, &o).unwrap()
+    };
+    let path = animated_quad(&dir, &[0.0, 2.0]);
+    let early = posed(&path, 0.5);
+    let rig = early.rig.as_ref().expect("a played clip keeps its rig");
+    assert!(rig.moves(0));
+    let obj = &early.object;
+    let skin = obj
+        .morph
+        .skin
+        .as_ref()
+        .expect("a moving rigid quad has a joint");
+    assert_eq!(skin.matrices, [glam::Mat4::IDENTITY]);
+    assert_eq!(rig.pose(0.5)[0].joints, [glam::Mat4::IDENTITY]);
+    let m = rig.pose(1.5)[0].applied(&obj.morph);
+    let got = crate::scene::morph::posed(&m.rest, &m);
+    let late = posed(&path, 1.5);
+    assert_eq!(late.object.morph.weights, m.weights);
+    for (g, w) in got.iter().zip(&late.object.mesh.vertices) {
+        let d = Vec3::from(g.position) - Vec3::from(w.position);
+        assert!(
+            d.length() < 1e-5,
+            "{:?} against {:?}",
+            g.position,
+            w.position
+        );
+    }
+    // Not played: no rig, no joint.
+    let rest = load_head_with_notes(&path, &Default::default()).unwrap();
+    assert!(rest.rig.is_none() && rest.object.morph.skin.is_none());
+    // A skin at its loaded time: the loaded matrices, bit for bit.
+    let path = skinned_quad(&dir, "rig.gltf", QUAD_JOINTS, QUAD_WEIGHTS, 2, true);
+    let l = posed(&path, 0.3);
+    let rig = l.rig.unwrap();
+    let skin = l.object.morph.skin.unwrap();
+    assert_eq!(rig.pose(0.3)[0].joints, skin.matrices);
+    assert_ne!(rig.pose(0.6)[0].joints, skin.matrices);
 }

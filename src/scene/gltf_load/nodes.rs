@@ -12,10 +12,11 @@ use super::instancing::instance_matrices;
 use super::primitives::{read_primitive, Part};
 use super::skins::{append_skinned, skin_matrices, SpanSkin};
 use super::Warnings;
-use crate::scene::animation::{animated_trs, animated_weights, Clip, Path};
+use crate::scene::animation::{animated_weights, Clip, Path};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
 use crate::scene::morph::{Morph, MorphTarget};
+use crate::scene::rig::{Joint, Local, ObjectRig, Skeleton};
 use crate::scene::robust_bounds::robust_bounds_f64;
 use crate::scene::skin::{Skin, SLOTS};
 
@@ -144,42 +145,51 @@ pub(super) fn append_part(
     Ok(())
 }
 
-/// A node's local transform with `clip`'s channels at `t` (its own local
-/// transform where none animates it). glTF animates only nodes written as
-/// translation, rotation and scale.
-fn animated_matrix(node: &gltf::Node, clip: &Clip, t: f32) -> Result<DMat4> {
-    let animates = clip
-        .channels
+/// The node graph as `rig::Skeleton` keeps it: each node's parent and rest
+/// transform, checked (finite, a non-zero rotation), and a node `clip`
+/// animates written as translation, rotation and scale (glTF animates no
+/// other).
+pub(super) fn skeleton(
+    nodes: &[gltf::Node],
+    parent: &[Option<usize>],
+    clip: Option<&Clip>,
+) -> Result<Skeleton> {
+    let locals = nodes
         .iter()
-        .any(|c| c.node == node.index() && c.path != Path::Weights);
-    // The rest transform checked as any node's is (finite, a non-zero
-    // rotation), whether or not a channel replaces part of it.
-    let rest_matrix = local_matrix(node)?;
-    if !animates {
-        return Ok(rest_matrix);
-    }
-    let gltf::scene::Transform::Decomposed {
-        translation,
-        rotation,
-        scale,
-    } = node.transform()
-    else {
-        bail!(
-            "{} is animated but written as a matrix, which glTF forbids",
-            node_label(node)
-        );
-    };
-    let rest = (
-        glam::Vec3::from(translation),
-        glam::Quat::from_array(rotation).normalize(),
-        glam::Vec3::from(scale),
-    );
-    let (tr, rot, sc) = animated_trs(clip, node.index(), t, rest);
-    Ok(DMat4::from_scale_rotation_translation(
-        sc.as_dvec3(),
-        rot.as_dquat(),
-        tr.as_dvec3(),
-    ))
+        .map(|node| {
+            // The rest transform checked as any node's is, whether or not
+            // a channel replaces part of it.
+            let matrix = local_matrix(node)?;
+            let animates = clip.is_some_and(|clip| {
+                clip.channels
+                    .iter()
+                    .any(|c| c.node == node.index() && c.path != Path::Weights)
+            });
+            match node.transform() {
+                gltf::scene::Transform::Decomposed {
+                    translation,
+                    rotation,
+                    scale,
+                } => Ok(Local::Trs {
+                    matrix,
+                    trs: (
+                        glam::Vec3::from(translation),
+                        glam::Quat::from_array(rotation).normalize(),
+                        glam::Vec3::from(scale),
+                    ),
+                }),
+                gltf::scene::Transform::Matrix { .. } if animates => bail!(
+                    "{} is animated but written as a matrix, which glTF forbids",
+                    node_label(node)
+                ),
+                gltf::scene::Transform::Matrix { .. } => Ok(Local::Matrix(matrix)),
+            }
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Skeleton {
+        parent: parent.to_vec(),
+        locals,
+    })
 }
 
 /// A primitive's morph targets placed by `world` (offsets are directions:
@@ -259,6 +269,10 @@ pub(super) struct Collected {
     pub(super) mesh: Mesh,
     pub(super) world_pos: Vec<DVec3>,
     pub(super) spans: Vec<Span>,
+    /// The node graph (what a `rig::Rig` poses again), and the shift
+    /// `place` moved the model by.
+    pub(super) skeleton: Skeleton,
+    pub(super) shift: DVec3,
 }
 
 /// One placed primitive in the merged mesh.
@@ -277,6 +291,10 @@ pub(super) struct Span {
     pub(super) weights: Vec<f32>,
     /// Its skin: its vertices stay in bind space, its joints place them.
     pub(super) skin: Option<SpanSkin>,
+    /// Its node, and (rigid, under a node the played clip moves) that
+    /// node's world at the loaded time: the clip moves it from there.
+    pub(super) node: usize,
+    pub(super) moved_from: Option<DMat4>,
 }
 
 /// The primitives of one material, merged: a mesh of its own (indices from 0).
@@ -287,6 +305,8 @@ pub(super) struct MaterialMesh {
     pub(super) without_uvs: Vec<String>,
     /// Its primitives' targets, each over its own vertices (rest: none yet).
     pub(super) morph: Morph,
+    /// Where the played clip takes its joints and weights from.
+    pub(super) rig: ObjectRig,
 }
 
 impl Collected {
@@ -296,6 +316,8 @@ impl Collected {
         // Where each material's rigid primitives' one identity joint is
         // (a material with a skinned primitive is skinned as a whole).
         let mut rigid_joint: Vec<Option<u32>> = Vec::new();
+        // Each material's joint per moving node of its rigid primitives.
+        let mut moving_joint: Vec<HashMap<usize, u32>> = Vec::new();
         for span in &self.spans {
             let k = match out.iter().position(|m| m.material == span.material) {
                 Some(k) => k,
@@ -306,15 +328,18 @@ impl Collected {
                         with_uvs: 0,
                         without_uvs: Vec::new(),
                         morph: Morph::default(),
+                        rig: ObjectRig::default(),
                     });
                     rigid_joint.push(None);
-                    let skinned = self
-                        .spans
-                        .iter()
-                        .filter(|s| s.material == span.material)
+                    moving_joint.push(HashMap::new());
+                    // Skinned when a primitive has a skin or the clip moves
+                    // one (a joint carries it); 4 slots where none has one.
+                    let same = || self.spans.iter().filter(|s| s.material == span.material);
+                    let skinned = same()
                         .filter_map(|s| s.skin.as_ref())
                         .map(|s| s.slots)
-                        .max();
+                        .max()
+                        .or_else(|| same().any(|s| s.moved_from.is_some()).then_some(4));
                     if let Some(slots) = skinned {
                         out.last_mut().expect("just pushed").morph.skin = Some(Skin {
                             slots,
@@ -327,20 +352,37 @@ impl Collected {
             let m = &mut out[k];
             if let Some(skin) = &mut m.morph.skin {
                 let n = span.vertices.len();
+                let joints = &mut m.rig.joints;
                 match &span.skin {
                     Some(s) => {
                         let base = skin.matrices.len() as u32;
                         skin.matrices.extend(s.matrices.iter().map(|j| j.as_mat4()));
+                        joints.extend(s.sources.iter().cloned());
                         skin.joints
                             .extend(s.joints.iter().map(|j| j.map(|i| i + base)));
                         skin.weights.extend_from_slice(&s.weights);
                     }
                     None => {
-                        // Placed in world space already: one identity joint.
-                        let j = *rigid_joint[k].get_or_insert_with(|| {
-                            skin.matrices.push(glam::Mat4::IDENTITY);
-                            skin.matrices.len() as u32 - 1
-                        });
+                        // Placed in world space already: one identity joint,
+                        // one per node the clip moves (the identity at the
+                        // loaded time).
+                        let j = match span.moved_from {
+                            Some(loaded) => {
+                                *moving_joint[k].entry(span.node).or_insert_with(|| {
+                                    skin.matrices.push(glam::Mat4::IDENTITY);
+                                    joints.push(Joint::Rigid {
+                                        node: span.node,
+                                        loaded,
+                                    });
+                                    skin.matrices.len() as u32 - 1
+                                })
+                            }
+                            None => *rigid_joint[k].get_or_insert_with(|| {
+                                skin.matrices.push(glam::Mat4::IDENTITY);
+                                joints.push(Joint::Fixed);
+                                skin.matrices.len() as u32 - 1
+                            }),
+                        };
                         let mut joints = [0; SLOTS];
                         joints[0] = j;
                         let mut weights = [0.0; SLOTS];
@@ -361,12 +403,13 @@ impl Collected {
                     .iter()
                     .map(|&i| i - first + base),
             );
-            for (t, &w) in span.targets.iter().zip(&span.weights) {
+            for (i, (t, &w)) in span.targets.iter().zip(&span.weights).enumerate() {
                 m.morph.targets.push(MorphTarget {
                     first: t.first + base as usize,
                     ..t.clone()
                 });
                 m.morph.weights.push(w);
+                m.rig.weights.push((span.node, i));
             }
             if span.has_uvs {
                 m.with_uvs += 1;
@@ -405,12 +448,16 @@ pub(super) fn collect(
         mesh: Mesh::default(),
         world_pos: Vec::new(),
         spans: Vec::new(),
+        skeleton: Skeleton::default(),
+        shift: DVec3::ZERO,
     };
     let mut parts: HashMap<(usize, usize), Option<Rc<Part>>> = HashMap::new();
     let mut visited = vec![false; nodes.len()];
     // Every node's world matrix first: a skin's joints may lie anywhere in
     // the hierarchy, before or after the meshes they move.
-    let worlds = node_worlds(&nodes, &parent, pose)?;
+    let skeleton = skeleton(&nodes, &parent, pose.map(|p| p.0))?;
+    let worlds = skeleton.worlds(pose);
+    let moved = pose.map(|(clip, _)| skeleton.moved_by(clip));
     let mut stack: Vec<usize> = roots.iter().rev().copied().collect();
     let mut said_unskinned = false;
     while let Some(ni) = stack.pop() {
@@ -502,12 +549,13 @@ pub(super) fn collect(
                         "{} has a skin but {label} has no JOINTS_0 and WEIGHTS_0",
                         node_label(node)
                     ),
-                    (Some(matrices), Some(inf)) => {
+                    (Some((matrices, sources)), Some(inf)) => {
                         let span_skin = SpanSkin {
                             joints: inf.joints.clone(),
                             weights: inf.weights.clone(),
                             slots: inf.slots,
                             matrices: matrices.clone(),
+                            sources: sources.clone(),
                         };
                         append_skinned(
                             &mut out.mesh,
@@ -529,7 +577,11 @@ pub(super) fn collect(
                     label,
                     targets,
                     weights,
+                    moved_from: (span_skin.is_none()
+                        && moved.as_ref().is_some_and(|m| m[node.index()]))
+                    .then_some(worlds[node.index()]),
                     skin: span_skin,
+                    node: node.index(),
                 });
             }
         }
@@ -541,39 +593,8 @@ pub(super) fn collect(
                 .rev(),
         );
     }
+    out.skeleton = skeleton;
     Ok(out)
-}
-
-/// Every node's world matrix, posed by `pose`: each node's local matrix
-/// computed once, each parent chain walked once (no recursion).
-fn node_worlds(
-    nodes: &[gltf::Node],
-    parent: &[Option<usize>],
-    pose: Option<(&Clip, f32)>,
-) -> Result<Vec<DMat4>> {
-    let mut world: Vec<Option<DMat4>> = vec![None; nodes.len()];
-    let mut chain = Vec::new();
-    for i in 0..nodes.len() {
-        chain.clear();
-        let mut c = Some(i);
-        while let Some(k) = c.filter(|&k| world[k].is_none()) {
-            chain.push(k);
-            c = parent[k];
-        }
-        let mut acc = c.and_then(|k| world[k]).unwrap_or(DMat4::IDENTITY);
-        for &k in chain.iter().rev() {
-            let local = match pose {
-                Some((clip, t)) => animated_matrix(&nodes[k], clip, t)?,
-                None => local_matrix(&nodes[k])?,
-            };
-            acc *= local;
-            world[k] = Some(acc);
-        }
-    }
-    Ok(world
-        .into_iter()
-        .map(|w| w.unwrap_or(DMat4::IDENTITY))
-        .collect())
 }
 
 /// Converts the f64 world positions into the mesh, moving the model to the origin when
@@ -605,6 +626,7 @@ pub(super) fn place(c: &mut Collected, warn: &mut Warnings) -> Result<()> {
     } else {
         DVec3::ZERO
     };
+    c.shift = shift;
     let mut bind = vec![false; c.mesh.vertices.len()];
     for span in c.spans.iter_mut() {
         if let Some(skin) = &mut span.skin {

@@ -10,6 +10,7 @@ use crate::scene::gltf_accessor::{read_floats, Use};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
 use crate::scene::morph::{Morph, MorphTarget};
+use crate::scene::rig::Joint;
 use crate::scene::skin::{Skin, SLOTS};
 
 /// A skinned primitive's influences and joint matrices (world times
@@ -20,15 +21,18 @@ pub(super) struct SpanSkin {
     pub(super) weights: Vec<[f32; SLOTS]>,
     pub(super) slots: usize,
     pub(super) matrices: Vec<DMat4>,
+    /// Where each matrix comes from (what a `rig::Rig` poses again).
+    pub(super) sources: Vec<Joint>,
 }
 
 /// A skin's joint matrices: each joint's world times its inverse bind
-/// matrix (identity where the skin gives none), checked finite.
+/// matrix (identity where the skin gives none), checked finite; and each
+/// one's node and inverse bind matrix.
 pub(super) fn skin_matrices(
     src: &Source,
     skin: &gltf::Skin,
     worlds: &[DMat4],
-) -> Result<Vec<DMat4>> {
+) -> Result<(Vec<DMat4>, Vec<Joint>)> {
     let label = format!(
         "skin {}{}",
         skin.index(),
@@ -78,7 +82,12 @@ pub(super) fn skin_matrices(
     }) {
         bail!("{label}: joint {k}'s matrix is beyond the f32 range");
     }
-    Ok(out)
+    let sources = joints
+        .iter()
+        .zip(inverse)
+        .map(|(&node, inverse_bind)| Joint::Skinned { node, inverse_bind })
+        .collect();
+    Ok((out, sources))
 }
 
 /// Appends a skinned primitive: its vertices in bind space (the deform pass
