@@ -42,6 +42,7 @@ pub mod fixture;
 mod instancing;
 mod nodes;
 mod primitives;
+mod skeleton;
 mod skins;
 mod textures;
 
@@ -289,12 +290,14 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     let object = head_object.ok_or_else(|| anyhow!("no triangle mesh in the default scene"))?;
     let mut loaded = warn.finish(object, parts);
     loaded.animated = clip.is_some();
-    loaded.rig = clip.map(|clip| Rig {
-        skeleton: c.skeleton,
-        clip: clip.clone(),
-        shift: c.shift,
-        loaded_time: time,
-        objects: std::iter::once(head_rig).chain(part_rigs).collect(),
+    loaded.rig = clip.map(|clip| {
+        Rig::new(
+            c.skeleton,
+            clip.clone(),
+            c.shift,
+            time,
+            std::iter::once(head_rig).chain(part_rigs).collect(),
+        )
     });
     Ok(loaded)
 }

@@ -174,6 +174,10 @@ pub struct Rig {
     pub shift: DVec3,
     pub loaded_time: f32,
     pub objects: Vec<ObjectRig>,
+    /// Computed once ([`Rig::new`]): every node's world at the loaded time,
+    /// and which nodes the clip moves.
+    loaded: Vec<DMat4>,
+    moved: Vec<bool>,
 }
 
 /// The time a clip of length `duration` plays at scene time `t`: `t` up to
@@ -187,6 +191,28 @@ pub fn clip_time(t: f32, duration: f32) -> f32 {
 }
 
 impl Rig {
+    /// A rig of `objects` posing `clip` over `skeleton`, loaded at
+    /// `loaded_time` and moved by `-shift` (the loader's recentring).
+    pub fn new(
+        skeleton: Skeleton,
+        clip: Clip,
+        shift: DVec3,
+        loaded_time: f32,
+        objects: Vec<ObjectRig>,
+    ) -> Rig {
+        let loaded = skeleton.worlds(Some((&clip, loaded_time)));
+        let moved = skeleton.moved_by(&clip);
+        Rig {
+            skeleton,
+            clip,
+            shift,
+            loaded_time,
+            objects,
+            loaded,
+            moved,
+        }
+    }
+
     /// The clip's length (seconds).
     pub fn duration(&self) -> f32 {
         self.clip.duration()
@@ -198,19 +224,22 @@ impl Rig {
         let Some(o) = self.objects.get(i) else {
             return false;
         };
-        o.joints.iter().any(|j| *j != Joint::Fixed)
-            || o.weights.iter().any(|&(node, _)| {
-                self.clip
-                    .channels
-                    .iter()
-                    .any(|c| c.node == node && c.path == Path::Weights)
-            })
+        let moved = |n: usize| self.moved.get(n).copied().unwrap_or(false);
+        o.joints.iter().any(|j| match j {
+            Joint::Fixed => false,
+            Joint::Skinned { node, .. } | Joint::Rigid { node, .. } => moved(*node),
+        }) || o.weights.iter().any(|&(node, _)| {
+            self.clip
+                .channels
+                .iter()
+                .any(|c| c.node == node && c.path == Path::Weights)
+        })
     }
 
     /// Every object at clip time `t` (already in the clip: [`clip_time`]).
     pub fn pose(&self, t: f32) -> Vec<ObjectPose> {
         let worlds = self.skeleton.worlds(Some((&self.clip, t)));
-        let loaded = self.skeleton.worlds(Some((&self.clip, self.loaded_time)));
+        let loaded = &self.loaded;
         let to_scene = DMat4::from_translation(-self.shift);
         let from_scene = DMat4::from_translation(self.shift);
         self.objects
@@ -230,7 +259,15 @@ impl Rig {
                             Mat4::IDENTITY
                         }
                         Joint::Rigid { node, loaded } => {
-                            (to_scene * worlds[*node] * loaded.inverse() * from_scene).as_mat4()
+                            let m = to_scene * worlds[*node] * loaded.inverse() * from_scene;
+                            // The loader keeps no part placed by a world without
+                            // an inverse (`gltf_load::nodes`); f32's range checked.
+                            let m = m.as_mat4();
+                            if m.is_finite() {
+                                m
+                            } else {
+                                Mat4::IDENTITY
+                            }
                         }
                     })
                     .collect(),
@@ -308,19 +345,19 @@ mod tests {
     fn a_skinned_joint_is_its_world_times_its_inverse_bind() {
         let (skeleton, clip) = skeleton_and_clip();
         // Joint 1's bind pose: at (0, 1, 0), under the root that turns.
-        let rig = Rig {
+        let rig = Rig::new(
             skeleton,
             clip,
-            shift: DVec3::new(0.0, 0.0, 2.0),
-            loaded_time: 0.0,
-            objects: vec![ObjectRig {
+            DVec3::new(0.0, 0.0, 2.0),
+            0.0,
+            vec![ObjectRig {
                 joints: vec![Joint::Skinned {
                     node: 1,
                     inverse_bind: DMat4::from_translation(DVec3::new(0.0, -1.0, 0.0)),
                 }],
                 weights: vec![(2, 1), (0, 0)],
             }],
-        };
+        );
         let p = rig.pose(1.0);
         let v = p[0].joints[0].transform_point3(Vec3::new(1.0, 1.0, 0.0));
         // The inverse bind cancels the joint's own offset, so the vertex
@@ -337,12 +374,12 @@ mod tests {
         let (skeleton, clip) = skeleton_and_clip();
         let loaded_at = 0.5;
         let loaded = skeleton.worlds(Some((&clip, loaded_at)));
-        let rig = Rig {
+        let rig = Rig::new(
             skeleton,
             clip,
-            shift: DVec3::ZERO,
-            loaded_time: loaded_at,
-            objects: vec![ObjectRig {
+            DVec3::ZERO,
+            loaded_at,
+            vec![ObjectRig {
                 joints: vec![
                     Joint::Rigid {
                         node: 1,
@@ -352,7 +389,7 @@ mod tests {
                 ],
                 weights: Vec::new(),
             }],
-        };
+        );
         // At the loaded time: exactly the identity.
         assert_eq!(rig.pose(loaded_at)[0].joints[0], Mat4::IDENTITY);
         // At 1 s: a point placed at 0.5 s (node 1's origin, turned 45
@@ -375,16 +412,23 @@ mod tests {
         assert_eq!(clip_time(1.0, 1.0), 1.0);
         assert_eq!(clip_time(2.5, 1.0), 0.5);
         assert_eq!(clip_time(3.0, 0.0), 3.0);
-        let rig = Rig {
+        let rig = Rig::new(
             skeleton,
             clip,
-            shift: DVec3::ZERO,
-            loaded_time: 0.0,
-            objects: vec![ObjectRig {
-                joints: vec![Joint::Fixed],
+            DVec3::ZERO,
+            0.0,
+            vec![ObjectRig {
+                // A skin's joint on node 2, which the clip does not move.
+                joints: vec![
+                    Joint::Fixed,
+                    Joint::Skinned {
+                        node: 2,
+                        inverse_bind: DMat4::IDENTITY,
+                    },
+                ],
                 weights: Vec::new(),
             }],
-        };
+        );
         assert!(!rig.moves(0));
         let t = rig.sample_times(4);
         assert_eq!(t, [0.0, 0.25, 0.5, 0.75, 1.0]);

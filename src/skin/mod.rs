@@ -28,3 +28,4 @@ pub mod tissue;
 pub mod transmittance;
 pub mod tsd;
 pub mod tsd_mirror;
+pub mod wrinkles;

@@ -323,3 +323,92 @@ fn a_files_own_clip_plays_each_character_at_its_phase_and_steps() {
     }
     assert!(found > 0, "no vertex at the top corner");
 }
+
+/// A file's clip that moves a rigid part (no skin): a skin quad that stands
+/// still and an "eye" quad beside it that the clip turns 90 degrees about
+/// +Z over 2 s. A crowd of three at 0.5 s deforms one copy of the eye per
+/// character (the part rides a joint, the identity where it was loaded),
+/// each the CPU's pose at its own phase, to the bit; the still skin is not
+/// deformed at all; and each copy's eye stands where the clip puts it.
+#[test]
+fn a_files_clip_moves_a_rigid_part_per_character() {
+    use dermis::scene::gltf_load::fixture::{f32_bytes, temp_dir, Container, Model};
+    use dermis::scene::morph::deformed;
+    use dermis::scene::source::SceneSource;
+    use glam::{Quat, Vec3};
+    let dir = temp_dir("rigid-part");
+    let prim = |material: usize| serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "material": material, "mode": 6});
+    let mut m = Model::quad(
+        prim(0),
+        serde_json::json!([]),
+        &[],
+        Some(serde_json::json!([{"mesh": 0}, {"mesh": 1, "translation": [1.5, 0.0, 0.0]}])),
+    );
+    m.json["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    m.json["meshes"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"name": "prop", "primitives": [prim(1)]}));
+    m.json["materials"] = serde_json::json!([{"name": "face skin"}, {"name": "eye"}]);
+    let q = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
+    let tv = m.add_view(&f32_bytes(&[0.0, 2.0]), None);
+    let ta = m.add_accessor(serde_json::json!({"bufferView": tv, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [2.0]}));
+    let rv = m.add_view(
+        &f32_bytes(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]]),
+        None,
+    );
+    let ra = m.add_accessor(
+        serde_json::json!({"bufferView": rv, "componentType": 5126, "count": 2, "type": "VEC4"}),
+    );
+    m.json["animations"] = serde_json::json!([{
+        "name": "spin",
+        "samplers": [{"input": ta, "output": ra, "interpolation": "LINEAR"}],
+        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]
+    }]);
+    m.json["buffers"] = serde_json::json!([{"byteLength": m.buffer.len()}]);
+    let path = m.write(Container::DataUri, dir.path(), "prop");
+    let scene = SceneSource {
+        scene: Some(path),
+        time: Some(0.5),
+        mm_per_unit: Some(100.0),
+        ..SceneSource::default()
+    }
+    .load()
+    .unwrap();
+    assert_eq!(scene.parts.len(), 1, "the eye is a part");
+    let tracks = scene.tracks.clone().unwrap();
+    let ctx = common::ctx();
+    let s = RenderSettings {
+        heads: 3,
+        ..settings()
+    };
+    let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
+    r.capture(false).unwrap();
+    let got = r.deformed().unwrap();
+    assert_eq!(got.len(), 1, "only the moving part deforms");
+    assert_eq!(got[0].name, "part 0");
+    let part = &scene.parts[0].morph;
+    let n = part.rest.len();
+    for c in 0..3 {
+        let want = match c {
+            0 => deformed(&part.rest, part),
+            c => deformed(&part.rest, &tracks.file_pose(c).unwrap()[1].applied(part)),
+        };
+        let copy = &got[0].vertices[12 * n * c..12 * n * (c + 1)];
+        assert!(
+            copy == bytemuck::cast_slice::<_, f32>(&want),
+            "character {c}: not the CPU's pose"
+        );
+        // The eye's node turns about its own origin (1.5, 0, 0): its first
+        // corner stays there, its second, (2.5, 0, 0) at rest, turns by the
+        // clip's angle at the character's time (45 degrees a second).
+        let corner = |k: usize| Vec3::from_slice(&copy[12 * k..12 * k + 3]);
+        let angle = std::f32::consts::FRAC_PI_4 * tracks.time_of(c);
+        let want = Vec3::new(1.5 + angle.cos(), angle.sin(), 0.0) - Vec3::new(1.5, 0.0, 0.0);
+        let d = corner(1) - corner(0);
+        assert!(
+            (d - want).length() < 1e-5,
+            "character {c}: {d} against {want}"
+        );
+    }
+}

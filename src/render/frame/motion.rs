@@ -119,8 +119,10 @@ impl Frame {
         let stepping = self.stepping.as_ref().map(|s| s.tracks.motion.clone());
         self.deform = Deform::new(ctx)?;
         for (k, (obj, morph)) in self.objects.iter_mut().zip(morphs).enumerate() {
-            // Which character object it is: 0 the head, then the parts.
+            // Which character object it is: 0 the head, then the parts. The
+            // backdrop never deforms (a still mesh, made by dermis).
             let Some(i) = k.checked_sub(first) else {
+                debug_assert!(morph.at_rest(), "the backdrop deforms");
                 continue;
             };
             let copied = obj.mesh.copies > 1;
@@ -137,19 +139,21 @@ impl Frame {
                 },
                 Some(_) if copied && !file_poses.is_empty() => {
                     // Character 0 is the scene as loaded: its own bits.
-                    let pose = |slot: usize| {
-                        (by_slot[slot] > 0).then(|| file_poses[slot][i].applied(morph))
-                    };
+                    let pose = |slot: usize| (by_slot[slot] > 0).then(|| &file_poses[slot][i]);
                     Copies {
                         weights: (0..by_slot.len())
-                            .map(|s| pose(s).map_or_else(|| morph.weights.clone(), |m| m.weights))
+                            .map(|s| match pose(s) {
+                                Some(p) => p.weights_over(&morph.weights),
+                                None => morph.weights.clone(),
+                            })
                             .collect(),
                         joints: match &morph.skin {
                             Some(own) => (0..by_slot.len())
-                                .map(|s| {
-                                    pose(s)
-                                        .and_then(|m| m.skin.map(|k| k.matrices))
-                                        .unwrap_or_else(|| own.matrices.clone())
+                                .map(|s| match pose(s) {
+                                    Some(p) if p.joints.len() == own.matrices.len() => {
+                                        p.joints.clone()
+                                    }
+                                    _ => own.matrices.clone(),
                                 })
                                 .collect(),
                             None => Vec::new(),

@@ -48,8 +48,14 @@ fn region_by(
         max_strength: 1.0,
     };
     // A run stepping through the motion moves the skin after the region is
-    // made (frame 0's): the whole screen.
-    let steps = scene.tracks.as_ref().is_some_and(|t| t.step.is_some());
+    // made (frame 0's), and a crowd playing a file's clip poses each
+    // character's skin apart from the scene's (a skeleton can carry it far
+    // from where the scene's mesh lies): the whole screen.
+    let steps = scene.tracks.as_ref().is_some_and(|t| {
+        t.step.is_some()
+            || matches!(t.motion, crate::scene::crowd_motion::Motion::File(_))
+                && instances.len() > 1
+    });
     if s.sss_region == RegionMode::Screen || steps || reach(1.0, &probe).is_none() {
         return vec![full];
     }

@@ -471,3 +471,62 @@ fn the_kept_skeleton_poses_the_clip_as_the_loader_does() {
     assert_eq!(rig.pose(0.3)[0].joints, skin.matrices);
     assert_ne!(rig.pose(0.6)[0].joints, skin.matrices);
 }
+
+/// Far from the origin (a model at 1e8, moved to the origin as it loads):
+/// the kept skeleton applies the same recentring, so a skin posed at its
+/// loaded time is the loaded matrices to the bit, and a rigid part posed at
+/// another time is the file loaded at that time.
+#[test]
+fn the_kept_skeleton_recentres_as_the_loader_does() {
+    let dir = temp_dir("rig-far");
+    let far = |path: PathBuf, node: usize| {
+        let mut json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        json["nodes"][node]["translation"] = serde_json::json!([1e8, -2e8, 3e8]);
+        std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+        path
+    };
+    let posed = |path: &Path, t: f32| {
+        let o = TextureOverrides {
+            time: Some(t),
+            ..Default::default()
+        };
+        load_head_with_notes(path, &o).unwrap()
+    };
+    let path = far(
+        skinned_quad(&dir, "far.gltf", QUAD_JOINTS, QUAD_WEIGHTS, 2, true),
+        1,
+    );
+    let l = posed(&path, 0.3);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("moved to the origin")),
+        "{:?}",
+        l.warnings
+    );
+    let rig = l.rig.unwrap();
+    assert_ne!(rig.shift, glam::DVec3::ZERO);
+    assert_eq!(
+        rig.pose(0.3)[0].joints,
+        l.object.morph.skin.unwrap().matrices
+    );
+    let path = far(animated_quad(&dir, &[0.0, 2.0]), 0);
+    let early = posed(&path, 0.5);
+    let rig = early.rig.as_ref().unwrap();
+    let m = rig.pose(1.5)[0].applied(&early.object.morph);
+    let got = crate::scene::morph::posed(&m.rest, &m);
+    let late = posed(&path, 1.5);
+    // Each load recentres by its own pose's centre: compare in the file's
+    // space.
+    let (s0, s1) = (rig.shift, late.rig.as_ref().unwrap().shift);
+    assert_ne!(s0, s1);
+    for (g, w) in got.iter().zip(&late.object.mesh.vertices) {
+        let at = |p: [f32; 3], s: glam::DVec3| Vec3::from(p).as_dvec3() + s;
+        let d = at(g.position, s0) - at(w.position, s1);
+        assert!(
+            d.length() < 1e-4,
+            "{:?} against {:?}",
+            g.position,
+            w.position
+        );
+    }
+}

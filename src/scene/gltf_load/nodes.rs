@@ -3,20 +3,21 @@
 //! from the origin for its size moved to it.
 
 use anyhow::{bail, Result};
-use glam::{DMat3, DMat4, DQuat, DVec3, Mat4};
+use glam::{DMat3, DMat4, DVec3, Mat4};
 use std::collections::HashMap;
 use std::rc::Rc;
 
 use super::checks::{mesh_label, node_label};
 use super::instancing::instance_matrices;
 use super::primitives::{read_primitive, Part};
+use super::skeleton::{invertible, skeleton};
 use super::skins::{append_skinned, skin_matrices, SpanSkin};
 use super::Warnings;
-use crate::scene::animation::{animated_weights, Clip, Path};
+use crate::scene::animation::{animated_weights, Clip};
 use crate::scene::gltf_source::Source;
 use crate::scene::mesh::Mesh;
 use crate::scene::morph::{Morph, MorphTarget};
-use crate::scene::rig::{Joint, Local, ObjectRig, Skeleton};
+use crate::scene::rig::{Joint, ObjectRig, Skeleton};
 use crate::scene::robust_bounds::robust_bounds_f64;
 use crate::scene::skin::{Skin, SLOTS};
 
@@ -24,46 +25,6 @@ use crate::scene::skin::{Skin, SLOTS};
 /// moved to the origin: f32 keeps 24 bits, and at 128 sizes away fewer than 16 of
 /// them would be left across the model.
 pub(super) const RECENTRE_RATIO: f64 = 128.0;
-
-/// A node's local transform in f64, refused when not finite. A TRS rotation is
-/// normalised (exporters write slightly off unit quaternions); a zero one is refused.
-pub(super) fn local_matrix(node: &gltf::Node) -> Result<DMat4> {
-    let label = || node_label(node);
-    let finite = |v: &[f32]| v.iter().all(|c| c.is_finite());
-    match node.transform() {
-        gltf::scene::Transform::Matrix { matrix } => {
-            if !matrix.iter().all(|c| finite(c)) {
-                bail!("{} has a non-finite matrix", label());
-            }
-            Ok(DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
-        }
-        gltf::scene::Transform::Decomposed {
-            translation,
-            rotation,
-            scale,
-        } => {
-            for (what, ok) in [
-                ("translation", finite(&translation)),
-                ("rotation", finite(&rotation)),
-                ("scale", finite(&scale)),
-            ] {
-                if !ok {
-                    bail!("{} has a non-finite {what}", label());
-                }
-            }
-            let q = DQuat::from_array(rotation.map(f64::from));
-            let len = q.length();
-            if len <= 1e-12 {
-                bail!("{} has a zero rotation quaternion", label());
-            }
-            Ok(DMat4::from_scale_rotation_translation(
-                DVec3::from_array(scale.map(f64::from)),
-                q / len,
-                DVec3::from_array(translation.map(f64::from)),
-            ))
-        }
-    }
-}
 
 /// Each node's parent, after checking the hierarchy is what glTF requires (3.5.3):
 /// disjoint strict trees, no node its own ancestor, no node with two parents. Checked
@@ -143,53 +104,6 @@ pub(super) fn append_part(
     placed.transform(&linear);
     mesh.append(&placed);
     Ok(())
-}
-
-/// The node graph as `rig::Skeleton` keeps it: each node's parent and rest
-/// transform, checked (finite, a non-zero rotation), and a node `clip`
-/// animates written as translation, rotation and scale (glTF animates no
-/// other).
-pub(super) fn skeleton(
-    nodes: &[gltf::Node],
-    parent: &[Option<usize>],
-    clip: Option<&Clip>,
-) -> Result<Skeleton> {
-    let locals = nodes
-        .iter()
-        .map(|node| {
-            // The rest transform checked as any node's is, whether or not
-            // a channel replaces part of it.
-            let matrix = local_matrix(node)?;
-            let animates = clip.is_some_and(|clip| {
-                clip.channels
-                    .iter()
-                    .any(|c| c.node == node.index() && c.path != Path::Weights)
-            });
-            match node.transform() {
-                gltf::scene::Transform::Decomposed {
-                    translation,
-                    rotation,
-                    scale,
-                } => Ok(Local::Trs {
-                    matrix,
-                    trs: (
-                        glam::Vec3::from(translation),
-                        glam::Quat::from_array(rotation).normalize(),
-                        glam::Vec3::from(scale),
-                    ),
-                }),
-                gltf::scene::Transform::Matrix { .. } if animates => bail!(
-                    "{} is animated but written as a matrix, which glTF forbids",
-                    node_label(node)
-                ),
-                gltf::scene::Transform::Matrix { .. } => Ok(Local::Matrix(matrix)),
-            }
-        })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(Skeleton {
-        parent: parent.to_vec(),
-        locals,
-    })
 }
 
 /// A primitive's morph targets placed by `world` (offsets are directions:
@@ -460,6 +374,7 @@ pub(super) fn collect(
     let moved = pose.map(|(clip, _)| skeleton.moved_by(clip));
     let mut stack: Vec<usize> = roots.iter().rev().copied().collect();
     let mut said_unskinned = false;
+    let mut said_degenerate = false;
     while let Some(ni) = stack.pop() {
         let node = &nodes[ni];
         if std::mem::replace(&mut visited[ni], true) {
@@ -569,6 +484,20 @@ pub(super) fn collect(
                         Some(span_skin)
                     }
                 };
+                let moved_from = (span_skin.is_none()
+                        && moved.as_ref().is_some_and(|m| m[node.index()]))
+                    .then_some(worlds[node.index()])
+                    .filter(|w| {
+                        // A part the clip has scaled to nothing at the loaded
+                        // time is loaded as a point: no move can restore it.
+                        let ok = invertible(w);
+                        if !ok && !std::mem::replace(&mut said_degenerate, true) {
+                            warn.push(format!(
+                                "{label}: its node's transform has no inverse at the loaded time (scaled to nothing): it stays as loaded while the clip plays"
+                            ));
+                        }
+                        ok
+                    });
                 out.spans.push(Span {
                     material: prim.material().index(),
                     vertices: v0..out.mesh.vertices.len(),
@@ -577,9 +506,7 @@ pub(super) fn collect(
                     label,
                     targets,
                     weights,
-                    moved_from: (span_skin.is_none()
-                        && moved.as_ref().is_some_and(|m| m[node.index()]))
-                    .then_some(worlds[node.index()]),
+                    moved_from,
                     skin: span_skin,
                     node: node.index(),
                 });

@@ -122,15 +122,19 @@ pub(super) fn append_skinned(
         weights: weights.to_vec(),
         skin: None,
     };
-    let posed = crate::scene::skin::apply(
-        &crate::scene::morph::apply(&part.mesh.vertices, &morph),
-        &check,
-    );
-    world_pos.extend(
-        posed
+    // The joints in f64, as a rigid primitive's node is: a skin far from
+    // the origin (joints at 1e8) keeps its shape until `place` recentres it.
+    let morphed = crate::scene::morph::apply(&part.mesh.vertices, &morph);
+    for (v, (j, w)) in morphed.iter().zip(skin.joints.iter().zip(&skin.weights)) {
+        let p = glam::Vec3::from(v.position).as_dvec3();
+        let q = j
             .iter()
-            .map(|v| glam::Vec3::from(v.position).as_dvec3()),
-    );
+            .zip(w)
+            .filter(|(_, &w)| w != 0.0)
+            .map(|(&j, &w)| skin.matrices[j as usize].transform_point3(p) * f64::from(w))
+            .sum::<DVec3>();
+        world_pos.push(q);
+    }
     mesh.append(&part.mesh);
     Ok(())
 }
