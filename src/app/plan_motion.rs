@@ -34,6 +34,7 @@ use crate::render::request::CheckedSettings;
 use crate::render::settings::Assignment;
 use crate::render::{FrameRequest, RenderSettings};
 use crate::report::device_header;
+use crate::scene::source::SceneSource;
 use crate::scene::Scene;
 use crate::vk::context::Context;
 
@@ -62,14 +63,15 @@ pub fn run(a: &PlanMotionArgs, given: &Given) -> Result<()> {
     let (source, base) = request::frame_settings(&a.frame, given)?;
     // The base frame's numbers before the scene loads.
     let base = CheckedSettings::new(base)?.get().clone();
-    let scene = request::load_scene(&source)?;
+    let scenes = frame_scenes(&source, walk.frames)?;
     // Every frame of the walk, its truth and no SSS: checked before any renders.
     for k in 0..walk.frames {
+        let scene = scene_of(&scenes, k);
         let s = frame_settings(&base, walk.at(k));
-        FrameRequest::new(&scene, s.clone()).with_context(|| format!("frame {k}"))?;
-        FrameRequest::new(&scene, truth_settings(&s)?)
+        FrameRequest::new(scene, s.clone()).with_context(|| format!("frame {k}"))?;
+        FrameRequest::new(scene, truth_settings(&s)?)
             .with_context(|| format!("frame {k}: the ground truth"))?;
-        FrameRequest::new(&scene, with_method(&s, crate::method::none().name, &[])?)
+        FrameRequest::new(scene, with_method(&s, crate::method::none().name, &[])?)
             .with_context(|| format!("frame {k}: no SSS"))?;
     }
     let acc = Measured::load_default(Measured::asset_of(source.gltf()))?;
@@ -79,7 +81,7 @@ pub fn run(a: &PlanMotionArgs, given: &Given) -> Result<()> {
     let ctx = request::context(&a.frame)?;
     let o = MotionOptions {
         base,
-        scene: &scene,
+        scenes: &scenes,
         accuracy: &acc,
         accuracy_source: acc.source(),
         profile,
@@ -97,6 +99,39 @@ pub fn run(a: &PlanMotionArgs, given: &Given) -> Result<()> {
     Ok(())
 }
 
+/// Each frame's scene: with a step, frame k's loaded at `--time` + k * step
+/// (a frame depends only on its time: no step carried, so the ground truth,
+/// which reads the meshes once, draws each); else the one scene.
+fn frame_scenes(source: &SceneSource, frames: usize) -> Result<Vec<Scene>> {
+    let Some(dt) = source.time_step else {
+        return Ok(vec![request::load_scene(source)?]);
+    };
+    crate::ranges::TIME_STEP.check(dt)?;
+    let t0 = source.time.unwrap_or(0.0);
+    let scenes = (0..frames)
+        .map(|k| {
+            let t = t0 + k as f32 * dt;
+            request::load_scene(&SceneSource {
+                time: Some(t),
+                time_step: None,
+                ..source.clone()
+            })
+            .with_context(|| format!("frame {k} at {t} s"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    eprintln!(
+        "note: --time-step {dt}: frame k of the sequence is posed at {t0} + k * {dt} s (the last, frame {}, at {} s)",
+        frames - 1,
+        t0 + (frames - 1) as f32 * dt
+    );
+    Ok(scenes)
+}
+
+/// Frame `k`'s scene.
+fn scene_of(scenes: &[Scene], k: usize) -> &Scene {
+    &scenes[k.min(scenes.len() - 1)]
+}
+
 /// A frame of the walk: the crowd walked `walk_heads`, one method for all
 /// (the frame's plan is given per frame).
 fn frame_settings(base: &RenderSettings, walk_heads: f32) -> RenderSettings {
@@ -112,7 +147,10 @@ pub struct MotionOptions<'a> {
     /// The scene options (size, heads, layout, distance, light; `--density`
     /// for the ground truth).
     pub base: RenderSettings,
-    pub scene: &'a Scene,
+    /// Each frame's scene (one: every frame's), posed at its time: with
+    /// `--time-step` frame k is the scene at `--time` + k * step, every
+    /// character at its own phase, as `render --time-step` draws it.
+    pub scenes: &'a [Scene],
     pub accuracy: &'a dyn Accuracy,
     pub accuracy_source: String,
     pub profile: Profile,
@@ -140,7 +178,7 @@ fn frame_inputs(o: &MotionOptions) -> Result<(Vec<RenderSettings>, Vec<FrameInpu
     // Per frame the fast inputs (the skin patches and the price grid),
     // what a game re-planning every frame would run.
     let mut per_frame = FrameInputs::new(
-        o.scene,
+        scene_of(o.scenes, 0),
         &models,
         reference,
         &o.profile,
@@ -182,7 +220,8 @@ fn render_frames(
     let mut before: Option<Previous> = None;
     let progress = indicatif::ProgressBar::new(o.walk.frames as u64);
     for (k, s) in frame_settings.iter().enumerate() {
-        let truth = render_truth(ctx, o.scene, s).with_context(|| format!("frame {k}"))?;
+        let scene = scene_of(o.scenes, k);
+        let truth = render_truth(ctx, scene, s).with_context(|| format!("frame {k}"))?;
         let fp = &with[k];
         let inp = &inputs[k];
         let mut file = plan_file(
@@ -225,7 +264,7 @@ fn render_frames(
         write_json(&plans_dir(o.out).join(format!("frame-{k:03}.json")), &file)?;
         let mut ps = s.clone();
         ps.assignment = Some(Assignment::Plan(file.clone()));
-        let planned = render(ctx, o.scene, &ps).with_context(|| format!("frame {k}: the plan"))?;
+        let planned = render(ctx, scene, &ps).with_context(|| format!("frame {k}: the plan"))?;
         let measured = truth.score(&planned.diffuse)?.weighted;
         // Each switch of this frame on screen: the frame again with the
         // character on its old setting, so the switch's own jump is told
@@ -247,7 +286,7 @@ fn render_frames(
                 (a.method, a.options, a.fade) = (method, options, None);
                 let mut cs = s.clone();
                 cs.assignment = Some(Assignment::Plan(f));
-                let kept = render(ctx, o.scene, &cs)
+                let kept = render(ctx, scene, &cs)
                     .with_context(|| format!("frame {k}: character {c} on its old setting"))?;
                 // The rendered frame holds (1 - w) of the new setting's
                 // difference from the old (w: the fade's weight, 0 without).

@@ -143,7 +143,7 @@ fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::moti
         &ctx,
         &MotionOptions {
             base,
-            scene: &scene,
+            scenes: std::slice::from_ref(&scene),
             accuracy: &acc,
             accuracy_source: acc.source(),
             profile: Profile::load("xbox360").unwrap(),
@@ -541,4 +541,73 @@ fn the_price_grid_against_direct_prices() {
         );
         assert!(worst_sum < 0.04, "{p}: {worst_sum}");
     }
+}
+
+/// `plan-motion --time-step` steps the crowd's motion with the walk: frame
+/// k is the scene at --time + k * step (each character at its own phase of
+/// the face's expression clip). Standing still (no walk), the truth's own
+/// change from frame to frame is 0 without a step, to the bit, and not 0
+/// with one: the faces move.
+#[test]
+fn plan_motion_steps_the_crowds_motion() {
+    let dir = tmp("steps");
+    let run = |step: Option<&str>, name: &str| {
+        let out = dir.join(name);
+        let mut args = vec![
+            "plan-motion",
+            "--profile",
+            "xbox360",
+            "--budget-ms",
+            "0.2",
+            "--frames",
+            "3",
+            "--walk-heads",
+            "0",
+            "--heads",
+            "4",
+            "--width",
+            "96",
+            "--height",
+            "54",
+            "--density",
+            "1",
+            "--time",
+            "1",
+        ];
+        if let Some(s) = step {
+            args.extend(["--time-step", s]);
+        }
+        let r = common::dermis()
+            .args(&args)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr).to_string();
+        assert!(r.status.success(), "{err}");
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("plan-motion.json")).unwrap())
+                .unwrap();
+        let changes: Vec<f64> = report["characters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|c| c["truth_change"].as_array().unwrap().clone())
+            .filter_map(|v| v.as_f64())
+            .collect();
+        (err, changes)
+    };
+    let (_, still) = run(None, "still");
+    assert!(
+        !still.is_empty() && still.iter().all(|&c| c == 0.0),
+        "{still:?}"
+    );
+    let (err, moving) = run(Some("0.5"), "moving");
+    assert!(
+        err.contains(
+            "frame k of the sequence is posed at 1 + k * 0.5 s (the last, frame 2, at 2 s)"
+        ),
+        "{err}"
+    );
+    assert!(moving.iter().any(|&c| c > 0.0), "{moving:?}");
 }
