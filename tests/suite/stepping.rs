@@ -332,10 +332,10 @@ fn a_files_own_clip_plays_each_character_at_its_phase_and_steps() {
 /// deformed at all; and each copy's eye stands where the clip puts it.
 #[test]
 fn a_files_clip_moves_a_rigid_part_per_character() {
-    use dermis::scene::gltf_load::fixture::{f32_bytes, temp_dir, Container, Model};
+    use dermis::scene::gltf_load::fixture::{temp_dir, Container, Model};
     use dermis::scene::morph::deformed;
     use dermis::scene::source::SceneSource;
-    use glam::{Quat, Vec3};
+    use glam::Vec3;
     let dir = temp_dir("rigid-part");
     let prim = |material: usize| serde_json::json!({"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "material": material, "mode": 6});
     let mut m = Model::quad(
@@ -350,21 +350,7 @@ fn a_files_clip_moves_a_rigid_part_per_character() {
         .unwrap()
         .push(serde_json::json!({"name": "prop", "primitives": [prim(1)]}));
     m.json["materials"] = serde_json::json!([{"name": "face skin"}, {"name": "eye"}]);
-    let q = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
-    let tv = m.add_view(&f32_bytes(&[0.0, 2.0]), None);
-    let ta = m.add_accessor(serde_json::json!({"bufferView": tv, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [2.0]}));
-    let rv = m.add_view(
-        &f32_bytes(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]]),
-        None,
-    );
-    let ra = m.add_accessor(
-        serde_json::json!({"bufferView": rv, "componentType": 5126, "count": 2, "type": "VEC4"}),
-    );
-    m.json["animations"] = serde_json::json!([{
-        "name": "spin",
-        "samplers": [{"input": ta, "output": ra, "interpolation": "LINEAR"}],
-        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]
-    }]);
+    m.quarter_turn_clip("spin", 1, 2.0);
     m.json["buffers"] = serde_json::json!([{"byteLength": m.buffer.len()}]);
     let path = m.write(Container::DataUri, dir.path(), "prop");
     let scene = SceneSource {

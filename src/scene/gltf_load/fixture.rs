@@ -308,6 +308,26 @@ impl Model {
         accs.len() - 1
     }
 
+    /// Sets the model's one animation `name`: node `node` turned from no
+    /// rotation to 90 degrees about +Z over `seconds` (LINEAR, two keys).
+    pub fn quarter_turn_clip(&mut self, name: &str, node: usize, seconds: f32) {
+        let q = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
+        let tv = self.add_view(&f32_bytes(&[0.0, seconds]), None);
+        let ta = self.add_accessor(json!({"bufferView": tv, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [seconds]}));
+        let rv = self.add_view(
+            &f32_bytes(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]]),
+            None,
+        );
+        let ra = self.add_accessor(
+            json!({"bufferView": rv, "componentType": 5126, "count": 2, "type": "VEC4"}),
+        );
+        self.json["animations"] = json!([{
+            "name": name,
+            "samplers": [{"input": ta, "output": ra, "interpolation": "LINEAR"}],
+            "channels": [{"sampler": 0, "target": {"node": node, "path": "rotation"}}]
+        }]);
+    }
+
     /// Moves node 0 by `offset`.
     pub fn translated(mut self, offset: [f32; 3]) -> Model {
         self.json["nodes"][0]["translation"] = json!(offset);

@@ -205,21 +205,7 @@ fn skinned_quad(
     let ba = m.add_accessor(serde_json::json!({"bufferView": bv, "componentType": 5126, "count": binds, "type": "MAT4"}));
     m.json["skins"] =
         serde_json::json!([{"name": "arm", "joints": [1, 2], "inverseBindMatrices": ba}]);
-    let q = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2).to_array();
-    let tv = m.add_view(&f32_bytes(&[0.0, 1.0]), None);
-    let ta = m.add_accessor(serde_json::json!({"bufferView": tv, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1.0]}));
-    let rv = m.add_view(
-        &f32_bytes(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]]),
-        None,
-    );
-    let ra = m.add_accessor(
-        serde_json::json!({"bufferView": rv, "componentType": 5126, "count": 2, "type": "VEC4"}),
-    );
-    m.json["animations"] = serde_json::json!([{
-        "name": "bend",
-        "samplers": [{"input": ta, "output": ra, "interpolation": "LINEAR"}],
-        "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}]
-    }]);
+    m.quarter_turn_clip("bend", 2, 1.0);
     write_gltf(dir, name, m.json, &m.buffer)
 }
 
