@@ -95,9 +95,6 @@ impl<'s> FrameRequest<'s> {
     }
 }
 
-/// Everything a frame is made from, as `report.json` records it (its
-/// `settings`) and `dermis render --settings` reads it back: the scene's
-/// source and the render settings, both whole, by serialisation.
 /// Refuses `--time-step` with a method that reads the characters' meshes
 /// once, as it is built (it would draw frame 0's pose under every later
 /// frame's geometry).
@@ -152,6 +149,9 @@ fn check_in_view(scene: &Scene, settings: &RenderSettings) -> Result<()> {
     Ok(())
 }
 
+/// Everything a frame is made from, as `report.json` records it (its
+/// `settings`) and `dermis render --settings` reads it back: the scene's
+/// source and the render settings, both whole, by serialisation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameSettings {

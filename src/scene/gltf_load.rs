@@ -98,7 +98,6 @@ impl Warnings {
         Loaded {
             object,
             parts,
-            animated: false,
             rig: None,
             warnings: self.list,
             notes: self.notes,
@@ -138,13 +137,19 @@ pub struct Loaded {
     pub object: Object,
     /// Its other materials' primitives, each with its own material.
     pub parts: Vec<Object>,
-    /// Whether one of the file's animations posed it (`--time`, `--animation`).
-    pub animated: bool,
-    /// That animation, ready to pose again at any time (a crowd's phases, a
-    /// run's steps): the head's sources first, then the parts'.
+    /// The animation that posed it (`--time`, `--animation`), ready to pose
+    /// again at any time (a crowd's phases, a run's steps): the head's
+    /// sources first, then the parts'.
     pub rig: Option<Rig>,
     pub warnings: Vec<String>,
     pub notes: Vec<String>,
+}
+
+impl Loaded {
+    /// Whether one of the file's animations posed it.
+    pub fn animated(&self) -> bool {
+        self.rig.is_some()
+    }
 }
 
 /// [`load_head_with_warnings`] with the notes.
@@ -289,7 +294,6 @@ fn load(path: &Path, overrides: &TextureOverrides) -> Result<Loaded> {
     }
     let object = head_object.ok_or_else(|| anyhow!("no triangle mesh in the default scene"))?;
     let mut loaded = warn.finish(object, parts);
-    loaded.animated = clip.is_some();
     loaded.rig = clip.map(|clip| {
         Rig::new(
             c.skeleton,

@@ -375,7 +375,8 @@ pub fn load_gltf_scene(
         .unwrap_or_else(|| path.display().to_string());
     // A posed clip is measured at its rest pose: one scale (the SSS's
     // millimetres) and one face direction for every time of the clip.
-    let rest = match (loaded.animated, mm_per_unit) {
+    let animated = loaded.animated();
+    let rest = match (animated, mm_per_unit) {
         (true, None) => {
             let still = gltf_load::TextureOverrides {
                 time: None,
@@ -408,7 +409,7 @@ pub fn load_gltf_scene(
             motion: crowd_motion::Motion::File(std::sync::Arc::new(rig)),
             step: None,
         });
-    } else if let (Some(t), false) = (overrides.time, loaded.animated) {
+    } else if let (Some(t), false) = (overrides.time, animated) {
         eprintln!(
             "note: {}: the file has no animation: --time {t} turns and nods it (dermis's rigid clip, {} s, looped)",
             path.display(),

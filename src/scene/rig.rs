@@ -43,29 +43,28 @@ pub struct Skeleton {
 }
 
 impl Skeleton {
-    /// Node `k`'s local matrix with `pose`'s channels at its time (its rest
-    /// where none animates its translation, rotation or scale).
-    fn local(&self, k: usize, pose: Option<(&Clip, f32)>) -> DMat4 {
+    /// Node `k`'s local matrix with `pose`'s channels at its time where
+    /// `animated[k]` (a channel moves its translation, rotation or scale),
+    /// its rest otherwise.
+    fn local(&self, k: usize, pose: Option<(&Clip, f32)>, animated: &[bool]) -> DMat4 {
         match (&self.locals[k], pose) {
-            (Local::Matrix(m), _) | (Local::Trs { matrix: m, .. }, None) => *m,
-            (Local::Trs { matrix, trs }, Some((clip, t))) => {
-                let animates = clip
-                    .channels
-                    .iter()
-                    .any(|c| c.node == k && c.path != Path::Weights);
-                if !animates {
-                    return *matrix;
-                }
+            (Local::Trs { trs, .. }, Some((clip, t))) if animated[k] => {
                 let (tr, rot, sc) = animated_trs(clip, k, t, *trs);
                 DMat4::from_scale_rotation_translation(sc.as_dvec3(), rot.as_dquat(), tr.as_dvec3())
             }
+            (Local::Matrix(m), _) | (Local::Trs { matrix: m, .. }, _) => *m,
         }
     }
 
-    /// Every node's world matrix posed by `pose`: each local computed once,
-    /// each parent chain walked once (no recursion: a chain of any depth).
+    /// Every node's world matrix posed by `pose`: which nodes its channels
+    /// move found once, each local computed once, each parent chain walked
+    /// once (no recursion: a chain of any depth).
     pub fn worlds(&self, pose: Option<(&Clip, f32)>) -> Vec<DMat4> {
         let n = self.locals.len();
+        let animated = match pose {
+            Some((clip, _)) => self.channel_nodes(clip),
+            None => vec![false; n],
+        };
         let mut world: Vec<Option<DMat4>> = vec![None; n];
         let mut chain = Vec::new();
         for i in 0..n {
@@ -77,7 +76,7 @@ impl Skeleton {
             }
             let mut acc = c.and_then(|k| world[k]).unwrap_or(DMat4::IDENTITY);
             for &k in chain.iter().rev() {
-                acc *= self.local(k, pose);
+                acc *= self.local(k, pose, &animated);
                 world[k] = Some(acc);
             }
         }
@@ -87,17 +86,23 @@ impl Skeleton {
             .collect()
     }
 
-    /// Which nodes the clip moves: those with a translation, rotation or
-    /// scale channel, and every node under one.
-    pub fn moved_by(&self, clip: &Clip) -> Vec<bool> {
-        let n = self.locals.len();
-        let mut own = vec![false; n];
+    /// The nodes a channel of `clip` moves itself (translation, rotation
+    /// or scale).
+    fn channel_nodes(&self, clip: &Clip) -> Vec<bool> {
+        let mut own = vec![false; self.locals.len()];
         for c in clip.channels.iter().filter(|c| c.path != Path::Weights) {
             if let Some(o) = own.get_mut(c.node) {
                 *o = true;
             }
         }
-        (0..n)
+        own
+    }
+
+    /// Which nodes the clip moves: those with a translation, rotation or
+    /// scale channel, and every node under one.
+    pub fn moved_by(&self, clip: &Clip) -> Vec<bool> {
+        let own = self.channel_nodes(clip);
+        (0..own.len())
             .map(|i| {
                 let mut c = Some(i);
                 while let Some(k) = c {

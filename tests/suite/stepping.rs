@@ -10,6 +10,41 @@ use crate::motion::settings;
 use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::morph::apply;
 
+/// `scene` (a file, or the default face) loaded at `time`, stepping by `step`.
+fn load_at(
+    scene: Option<std::path::PathBuf>,
+    time: f32,
+    step: Option<f32>,
+) -> dermis::scene::Scene {
+    dermis::scene::source::SceneSource {
+        scene,
+        time: Some(time),
+        time_step: step,
+        ..Default::default()
+    }
+    .load()
+    .unwrap()
+}
+
+/// `frames` frames of `scene`: the first's and the last's capture, and the
+/// deform pass's vertices after the last.
+fn run_steps(
+    ctx: &dermis::vk::context::Context,
+    scene: &dermis::scene::Scene,
+    s: &RenderSettings,
+    frames: usize,
+) -> (
+    dermis::render::Capture,
+    dermis::render::Capture,
+    Vec<dermis::render::deform::Deformed>,
+) {
+    let mut r = Renderer::new(ctx, scene, s).unwrap();
+    let first = r.capture(false).unwrap();
+    r.run_frames(frames - 1, |_| {}).unwrap();
+    let last = r.capture(false).unwrap();
+    (first, last, r.deformed().unwrap())
+}
+
 /// `--time-step`: frame k of a run is posed at time + k * step, whatever
 /// ran before it. Two runs of a moving crowd with different histories
 /// reach 1.75 s (three steps of 0.25 s, one of 0.75 s): the same frame, bit
@@ -19,28 +54,15 @@ use dermis::scene::morph::apply;
 #[test]
 fn stepping_poses_each_frame_at_its_time_whatever_came_before() {
     use dermis::scene::crowd_motion::Tracks;
-    use dermis::scene::source::SceneSource;
     let ctx = common::ctx();
-    let load = |step: f32| {
-        SceneSource {
-            time: Some(1.0),
-            time_step: Some(step),
-            ..SceneSource::default()
-        }
-        .load()
-        .unwrap()
-    };
     let s = RenderSettings {
         heads: 4,
         ..settings()
     };
     let run = |step: f32, frames: usize| {
-        let scene = load(step);
-        let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let first = r.capture(false).unwrap();
-        r.run_frames(frames - 1, |_| {}).unwrap();
-        let last = r.capture(false).unwrap();
-        (scene, first, last, r.deformed().unwrap())
+        let scene = load_at(None, 1.0, Some(step));
+        let (first, last, deformed) = run_steps(&ctx, &scene, &s, frames);
+        (scene, first, last, deformed)
     };
     let (scene, first, a, got_a) = run(0.25, 3);
     let (_, _, b, got_b) = run(0.75, 1);
@@ -230,34 +252,21 @@ fn methods_that_pose_once_refuse_a_step() {
 #[test]
 fn a_files_own_clip_plays_each_character_at_its_phase_and_steps() {
     use dermis::scene::morph::deformed;
-    use dermis::scene::source::SceneSource;
     use glam::Vec3;
     let ctx = common::ctx();
     let path = std::path::PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/fixtures/khronos/SimpleSkin.gltf"
     ));
-    let load = |time: f32, step: Option<f32>| {
-        SceneSource {
-            scene: Some(path.clone()),
-            time: Some(time),
-            time_step: step,
-            ..SceneSource::default()
-        }
-        .load()
-        .unwrap()
-    };
+    let load = |time: f32, step: Option<f32>| load_at(Some(path.clone()), time, step);
     let s = RenderSettings {
         heads: 4,
         ..settings()
     };
     let run = |time: f32, step: f32, frames: usize| {
         let scene = load(time, Some(step));
-        let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-        let first = r.capture(false).unwrap();
-        r.run_frames(frames - 1, |_| {}).unwrap();
-        let last = r.capture(false).unwrap();
-        (scene, first, last, r.deformed().unwrap())
+        let (first, last, deformed) = run_steps(&ctx, &scene, &s, frames);
+        (scene, first, last, deformed)
     };
     let (scene, first, a, got_a) = run(1.0, 0.25, 3);
     let (_, _, b, got_b) = run(1.0, 0.75, 1);

@@ -114,7 +114,7 @@ fn animations_pose_nodes_and_weights_at_the_time_asked() {
     // At 1 s: turned 45 degrees (the file states 0 and 90 at 0 and 2 s), the
     // weight stepped to 1 (its key at 1 s), so vertex 1 (1, 0, 0) lifted by 2.
     let l = at(Some(1.0));
-    assert!(l.animated);
+    assert!(l.animated());
     let p = glam::Vec3::from(l.object.mesh.vertices[1].position);
     let h = std::f32::consts::FRAC_1_SQRT_2;
     assert!((p - glam::Vec3::new(h, h, 2.0)).length() < 1e-5, "{p}");
