@@ -11,5 +11,6 @@ layout(set = 0, binding = 0) uniform FrameUniforms {
     vec4 ambient;       // rgb: constant ambient irradiance
     vec4 params;        // x: mm per unit, y: shadow depth range (units), z: normal shrink (units), w: transmittance on
     vec4 shadowParams;  // x: 1 / shadow map size, y: receiver depth bias (shadow depth units), z: T(s) exponent scale
+    vec4 shading;       // x: 1 for post-scatter texturing (the albedo applied after the SSS)
 } frame;
 #endif

@@ -17,6 +17,11 @@ layout(location = 2) out float outDepth;
 // View-space shading normal, for methods that weigh samples by normal difference.
 layout(location = 3) out vec4 outNormal;
 #endif
+#ifdef WRITE_ALBEDO
+// Post-scatter texturing: the albedo, which the composite applies after the SSS
+// (WRITE_ALBEDO is its attachment's location).
+layout(location = WRITE_ALBEDO) out vec4 outAlbedo;
+#endif
 
 void main() {
     COUNT_INVOCATION();
@@ -32,7 +37,9 @@ void main() {
     bool skin = material.params.w + NOT_UNIFORM_ZERO > 0.5;
     bool transmit = frame.params.w + NOT_UNIFORM_ZERO > 0.5;
 
-    vec3 diffuse = diffuseLight(albedo, N, shadow);
+    // Post-scatter texturing leaves the albedo to the composite.
+    vec3 scattered = scatteredAlbedo(albedo);
+    vec3 diffuse = diffuseLight(scattered, N, shadow);
 
     if (skin && transmit) {
         // Listing 5.1: shrink along the vertex normal, read the light-side depth,
@@ -41,17 +48,22 @@ void main() {
         float d1 = COUNTED(SITE(0, 1, FK_POINT), texture(sampler2D(shadowMap, nearestClamp), c.xy)).r;
         float sMm = abs(c.z - d1) * frame.params.y * frame.params.x;
         float E = max(0.3 + dot(-Nv, L), 0.0);
-        diffuse += transmittanceProfile(sMm) * light * albedo * E;
+        diffuse += transmittanceProfile(sMm) * light * scattered * E;
     }
 
-    float specMask = COUNTED(SITE(1, 2, FK_BILINEAR), texture(sampler2D(specTex, materialSampler), vUv)).r;
-    float spec = kelemenSzirmayKalos(N, L, V, material.params.x, material.params.y) * specMask;
+    // The per-texel parameters, one fetch (lighting.glsl's specTex).
+    vec3 texel = COUNTED(SITE(1, 2, FK_BILINEAR), texture(sampler2D(specTex, materialSampler), vUv)).rgb;
+    float m = material.maps.x > 0.5 ? texel.g : material.params.x;
+    float spec = kelemenSzirmayKalos(N, L, V, m, material.params.y) * texel.r;
 
-    outDiffuse = vec4(diffuse, skin ? material.params.z : 0.0);
+    outDiffuse = vec4(diffuse, skin ? material.params.z * texel.b : 0.0);
     outSpecular = vec4(light * spec * shadow, 1.0);
     outDepth = vViewDepth;
 #ifdef WRITE_NORMALS
     outNormal = vec4(normalize(mat3(frame.view) * N), 0.0);
+#endif
+#ifdef WRITE_ALBEDO
+    outAlbedo = vec4(albedo, 1.0);
 #endif
 }
 #endif

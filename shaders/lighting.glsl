@@ -18,9 +18,12 @@ layout(set = 1, binding = 0) uniform texture2D albedoTex;
 layout(set = 1, binding = 1) uniform texture2D normalTex;
 layout(set = 1, binding = 2) uniform texture2D specTex;
 layout(set = 1, binding = 4) uniform sampler materialSampler;
+// specTex holds the per-texel parameters (src/scene/texel_params.rs): R a factor
+// of rho_s, G the Beckmann m where maps.x is 1, B a factor of the SSS strength.
 layout(set = 1, binding = 3) uniform MaterialUniforms {
     vec4 baseColor;   // rgb linear factor
     vec4 params;      // x: Beckmann roughness m, y: rho_s, z: SSS strength, w: 1 if skin
+    vec4 maps;        // x: 1 if specTex's G is a roughness map
 } material;
 
 // Thesis eq. 5.12 with the six-Gaussian weights (Listing 5.1); s in millimetres.
@@ -90,6 +93,13 @@ vec3 shadingNormal(vec3 Nv, vec4 tangent, vec2 uv) {
 
 vec3 albedoAt(vec2 uv) {
     return COUNTED(SITE(1, 0, FK_BILINEAR), textureLod(sampler2D(albedoTex, materialSampler), uv, 0.0)).rgb * material.baseColor.rgb;
+}
+
+// The albedo the light is scattered with: the albedo itself (pre-scatter
+// texturing), or 1 when the composite applies it after the SSS (post-scatter;
+// frame.shading.x, src/render/settings.rs Texturing).
+vec3 scatteredAlbedo(vec3 albedo) {
+    return frame.shading.x > 0.5 ? vec3(1.0) : albedo;
 }
 
 // Diffuse radiance before scattering: albedo x (key light x N.L x shadow + ambient).

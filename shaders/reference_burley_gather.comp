@@ -56,7 +56,10 @@ void main() {
     vec2 ndc = (vec2(p) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 viewPos = vec3(ndc.x * params.view.x * params.view.y * z, -ndc.y * params.view.x * z, -z);
     vec3 xo = (params.invView * vec4(viewPos, 1.0)).xyz;
-    float mm = params.view.z;
+    // The pixel's SSS strength t scales the profile's radius (thesis eq.
+    // 4.3-4.4: R_t(r) = R(r / t) / t^2): distances are measured in units of
+    // t mm. Areas cancel in the normalised sums; the tissue test keeps real mm.
+    float mm = params.view.z / d0.a;
     float cutoff2 = params.view.w * params.view.w;
     ivec3 c = ivec3(floor((xo - params.gridOrigin.xyz) / params.gridOrigin.w));
     ivec3 dims = ivec3(params.gridDims.xyz);

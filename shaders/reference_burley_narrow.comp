@@ -48,7 +48,10 @@ void main() {
     ivec2 c = p * s + s / 2;
     ivec2 ssize = textureSize(surfPosition, 0);
     vec3 no = COUNTED(SITE(0, 5, FK_POINT), texelFetch(surfNormal, c, 0)).xyz;
-    float mm = params.view.z;
+    // The pixel's SSS strength t scales the profile's radius (thesis eq.
+    // 4.3-4.4: R_t(r) = R(r / t) / t^2): distances are measured in units of
+    // t mm. Areas cancel in the normalised sums; the tissue test keeps real mm.
+    float mm = params.view.z / d0.a;
     float pxPerMm = PX_PER_MM(float(size.y), z, params.view.x, mm);
     int r = int(min(max(ceil(BURLEY_NEAR_MM * pxPerMm * float(s)), 1.0), float(params.surface.y)));
     // The pixel's point on the subsample grid.
@@ -68,7 +71,7 @@ void main() {
             if (r2 >= BURLEY_NEAR_MM * BURLEY_NEAR_MM) continue;
             vec3 L = COUNTED(SITE(0, 3, FK_POINT), texelFetch(surfRadiance, q, 0)).rgb;
             vec2 o = vec2(q) + 0.5 - g;
-            float h = sqrt(pa.w);
+            float h = sqrt(pa.w) / d0.a;  // the cell side in units of t mm
             vec3 e = burleyInCellReach(o.x, o.y) ? burleyCellWeight(o.x, o.y, h) : burleyRingWeight(sqrt(r2), h);
             norm += e;
             sum += e * L;

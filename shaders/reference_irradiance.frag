@@ -29,5 +29,5 @@ void main() {
     vec3 Nv = normalize(s.normal.xyz);
     vec3 N = shadingNormal(Nv, s.tangent, s.uv.xy);
     float shadow = shadowPcf(s.posArea.xyz, Nv);
-    outRadiance = vec4(diffuseLight(albedoAt(s.uv.xy), N, shadow), 0.0);
+    outRadiance = vec4(diffuseLight(scatteredAlbedo(albedoAt(s.uv.xy)), N, shadow), 0.0);
 }

@@ -49,7 +49,10 @@ void main() {
     ivec2 c = p * s + s / 2;
     ivec2 ssize = textureSize(surfPosition, 0);
     vec3 no = COUNTED(SITE(0, 5, FK_POINT), texelFetch(surfNormal, c, 0)).xyz;
-    float mm = params.view.z;
+    // The pixel's SSS strength t scales the profile's radius (thesis eq.
+    // 4.3-4.4: R_t(r) = R(r / t) / t^2): distances are measured in units of
+    // t mm. Areas cancel in the normalised sums; the tissue test keeps real mm.
+    float mm = params.view.z / d0.a;
     float pxPerMm = PX_PER_MM(float(size.y), z, params.view.x, mm);
     int r = int(min(max(ceil(4.0 * SIGMA3 * pxPerMm * float(s)), 1.0), float(params.surface.y)));
     vec3 sum[NARROW_GAUSSIANS] = vec3[](vec3(0.0), vec3(0.0), vec3(0.0));

@@ -23,7 +23,10 @@ void main() {
     vec4 acc[WIDE_GAUSSIANS] = vec4[](imageLoad(accum4, p), imageLoad(accum5, p), imageLoad(accum6, p));
     vec3 m = imageLoad(outImage, p).rgb;
     for (int g = 0; g < WIDE_GAUSSIANS; g++) {
-        if (acc[g].a > 0.0) m += W[g] * (acc[g].rgb / acc[g].a);
+        // No weight reached the pixel (a strength so small the profile is
+        // narrower than the samples' spacing): its own light, as the narrow
+        // part falls back to.
+        m += W[g] * (acc[g].a > 0.0 ? acc[g].rgb / acc[g].a : d0.rgb);
     }
     imageStore(outImage, p, vec4(m, d0.a));
 }

@@ -22,7 +22,7 @@ void main() {
     vec3 Nv = normalize(vNormal);
     vec3 N = shadingNormal(Nv, vTangent, vUv);
     float shadow = shadowPcf(vWorldPos, Nv);
-    outRadiance = vec4(diffuseLight(albedoAt(vUv), N, shadow), 1.0);
+    outRadiance = vec4(diffuseLight(scatteredAlbedo(albedoAt(vUv)), N, shadow), 1.0);
     // The subsample's footprint on the surface: its side at this depth, over
     // the cosine between the (flat) surface and the view ray.
     vec3 geo = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));

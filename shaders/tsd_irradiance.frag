@@ -29,7 +29,7 @@ void main() {
     }
     vec3 Nv = normalize(vNormal);
     vec3 N = shadingNormal(Nv, vTangent, vUv);
-    vec3 albedo = albedoAt(vUv);
+    vec3 albedo = scatteredAlbedo(albedoAt(vUv));  // 1 with post-scatter texturing
     vec3 L = normalize(frame.lightDir.xyz);
     float shadow = shadowPcf(vWorldPos, Nv);
     vec3 irradiance = diffuseLight(albedo, N, shadow);

@@ -8,9 +8,9 @@
 //! one too big for memory, a failed readback). lavapipe, validation on.
 //!
 //! The first method fails at every one of its creation steps (136 for
-//! separable); the others, which share the frame's steps, at every second one
-//! (CI time: about 45 s on two cores). DERMIS_TEARDOWN_STRIDE=1 tries every step
-//! of every method (857 failed set-ups, about 70 s; all clean, see
+//! separable); the others, which share the frame's steps, at every fourth one,
+//! each from its own offset (`common::sweep_steps`). DERMIS_TEARDOWN_STRIDE=1
+//! tries every step of every method (`.ci/run` does; all clean, see
 //! docs/reliability.md).
 
 mod common;
@@ -92,11 +92,6 @@ fn every_method_tears_down_clean() {
 // Long because the failures are provoked method by method.
 #[test]
 fn every_setup_failure_tears_down_clean() {
-    let stride: usize = std::env::var("DERMIS_TEARDOWN_STRIDE")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(2)
-        .max(1);
     let t = std::time::Instant::now();
     let mut total = 0;
     for (i, m) in dermis::method::METHODS.iter().enumerate() {
@@ -106,9 +101,8 @@ fn every_setup_failure_tears_down_clean() {
         let before = ctx.creations();
         drop(Renderer::new(&ctx, &scene, &settings).expect("a clean set-up"));
         let steps = ctx.creations() - before;
-        let step = if i == 0 { 1 } else { stride };
         let mut tried = 0;
-        for k in (0..steps).step_by(step) {
+        for k in common::sweep_steps(i, steps) {
             ctx.fail_creation_after(Some(k));
             let e = match Renderer::new(&ctx, &scene, &settings) {
                 Ok(_) => panic!("{}: step {k} of {steps} did not fail", m.name),

@@ -12,7 +12,7 @@ use crate::aa::edges::Preset as SmaaPreset;
 use crate::method::{all_options, MethodOptions, OptKind};
 use crate::post::{AaMode, EdgeSource};
 use crate::ranges;
-use crate::render::settings::ShotPreset;
+use crate::render::settings::{ShotPreset, Texturing};
 use crate::render::RenderSettings;
 use crate::scene::layout::Layout;
 use crate::skin::kernel::Preset;
@@ -384,6 +384,13 @@ pub struct FrameArgs {
     pub normal_map: Option<PathBuf>,
     #[arg(long)]
     pub spec_map: Option<PathBuf>,
+    /// The skin's Beckmann roughness per texel, m in red (a glTF --scene only).
+    #[arg(long)]
+    pub roughness_map: Option<PathBuf>,
+    /// The skin's SSS strength per texel, a factor in red: 0 scatters nothing, as
+    /// under a beard (thesis eq. 4.3-4.4; a glTF --scene only).
+    #[arg(long)]
+    pub sss_map: Option<PathBuf>,
     /// Texture files beside the scene (or given above) are top-down; by default they
     /// are taken as bottom-up (OpenGL convention), as the Lee Perry-Smith head's are.
     #[arg(long)]
@@ -517,6 +524,10 @@ pub struct FrameArgs {
     /// distance (0: the full meshes).
     #[arg(long, default_value_t = defaults().lod_pixels, help = with_range("Levels of detail: the error a character's simplified meshes may cover on screen (0: full meshes)", &ranges::LOD_PIXELS))]
     pub lod_pixels: f32,
+    /// Where the albedo enters: pre (scattered with the light) or post (the light
+    /// scattered alone, the albedo applied after: d'Eon and Luebke, thesis ch. 7.6).
+    #[arg(long, value_enum, ignore_case = true, default_value_t = defaults().texturing)]
+    pub texturing: Texturing,
 }
 
 /// The options every registered method declares, one flag each, added from the

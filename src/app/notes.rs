@@ -71,6 +71,8 @@ pub fn ignored(command: &Command, given: &Given) -> Vec<String> {
                         "albedo",
                         "normal_map",
                         "spec_map",
+                        "roughness_map",
+                        "sss_map",
                         "sidecar_top_down",
                         "mm_per_unit",
                     ],

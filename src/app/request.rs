@@ -121,6 +121,8 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         albedo: a.albedo.clone(),
         normal_map: a.normal_map.clone(),
         spec_map: a.spec_map.clone(),
+        roughness_map: a.roughness_map.clone(),
+        sss_map: a.sss_map.clone(),
         sidecar_top_down: a.sidecar_top_down,
         mm_per_unit: a.mm_per_unit,
         skin: a.skin.clone(),
@@ -177,6 +179,7 @@ pub fn settings(a: &FrameArgs) -> Result<RenderSettings> {
     s.post.smaa_preset = a.smaa_preset;
     s.msaa = a.msaa;
     s.lod_pixels = a.lod_pixels;
+    s.texturing = a.texturing;
     Ok(s)
 }
 

@@ -74,6 +74,10 @@ pub struct FrameTargets {
     pub linear_depth: ImageId,
     /// View-space normals (only when a method needs them).
     pub normals: Option<ImageId>,
+    /// Each pixel's albedo (rgb), with post-scatter texturing only
+    /// (`render::settings::Texturing`): the composite multiplies the
+    /// scattered light by it.
+    pub albedo: Option<ImageId>,
     /// Depth/stencil with the skin bit.
     pub depth_stencil: ImageId,
     pub hdr: ImageId,
@@ -94,6 +98,7 @@ pub struct MsaaTargets {
     pub specular: ImageId,
     pub linear_depth: ImageId,
     pub normals: Option<ImageId>,
+    pub albedo: Option<ImageId>,
     pub depth_stencil: ImageId,
 }
 

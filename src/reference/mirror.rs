@@ -40,8 +40,13 @@ pub struct SurfaceImages<'a> {
 
 /// A skin pixel's point as both profiles' gathers see it: its position
 /// reconstructed from the linear depth, the normal of the subsample under
-/// its centre, and that subsample on the supersampled surface.
+/// its centre, and that subsample on the supersampled surface. Its SSS
+/// strength t scales the profile's radius (eq. 4.3-4.4): distances are
+/// measured in units of t mm, as the GPU passes measure them.
 struct PixelPoint {
+    /// Millimetres per scene unit over the strength (the tissue test keeps
+    /// the view's own).
+    mm_over_t: f64,
     x_o: DVec3,
     x_o32: [f32; 3],
     n_o: [f32; 3],
@@ -52,7 +57,13 @@ struct PixelPoint {
 }
 
 impl PixelPoint {
-    fn new(view: &GatherView, inv: &DMat4, surface: &SurfaceImages, z: f32, i: usize) -> Self {
+    fn new(
+        view: &GatherView,
+        inv: &DMat4,
+        surface: &SurfaceImages,
+        (z, strength): (f32, f32),
+        i: usize,
+    ) -> Self {
         let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
         let (x, y) = (i % view.width, i / view.width);
         let z = z as f64;
@@ -65,6 +76,7 @@ impl PixelPoint {
         let centre = cy * sw + cx;
         let n = surface.normal[centre];
         PixelPoint {
+            mm_over_t: (view.mm_per_unit / strength) as f64,
             x_o,
             x_o32: x_o.as_vec3().to_array(),
             n_o: [n[0], n[1], n[2]],
@@ -84,7 +96,7 @@ impl PixelPoint {
         r: i64,
         mut f: impl FnMut(i64, i64, usize, f64),
     ) {
-        let mm = view.mm_per_unit as f64;
+        let mm = self.mm_over_t;
         let s = surface.s as usize;
         let (sw, sh) = (view.width * s, view.height * s);
         for qy in (self.cy as i64 - r)..=(self.cy as i64 + r) {
@@ -120,7 +132,7 @@ impl PixelPoint {
     /// Calls `f(j, r2)` for every surface sample within the cut-off that
     /// light reaches through tissue, `r2` its squared distance in mm^2.
     fn far(&self, view: &GatherView, samples: &[SurfaceSample], mut f: impl FnMut(usize, f64)) {
-        let mm = view.mm_per_unit as f64;
+        let mm = self.mm_over_t;
         let cutoff2 = (cutoff_mm() as f64).powi(2);
         for (j, smp) in samples.iter().enumerate() {
             let pa = smp.pos_area;
@@ -170,9 +182,9 @@ pub fn gather_f64(
             if d0[3] <= 0.0 {
                 return d0.map(|v| v as f64);
             }
-            let pt = PixelPoint::new(view, &inv, surface, linear_depth[i], i);
+            let pt = PixelPoint::new(view, &inv, surface, (linear_depth[i], d0[3]), i);
             // Narrow part: windowed, weight-normalised sums per Gaussian.
-            let px_per_mm = scale.px_per_mm(linear_depth[i]);
+            let px_per_mm = scale.px_per_mm(linear_depth[i]) * d0[3];
             let r = radius(px_per_mm, surface.s) as i64;
             let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
             let mut norm = [0.0f64; NARROW_GAUSSIANS];
@@ -211,13 +223,16 @@ pub fn gather_f64(
                     w[3] += e;
                 }
             });
+            // A Gaussian no sample reached takes the pixel's own light
+            // (reference_resolve.comp).
             for (g, w) in wide.iter().enumerate() {
-                if w[3] > 0.0 {
-                    for ch in 0..3 {
-                        acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[NARROW_GAUSSIANS + g][ch] as f64
-                            * w[ch]
-                            / w[3];
-                    }
+                for ch in 0..3 {
+                    let m = if w[3] > 0.0 {
+                        w[ch] / w[3]
+                    } else {
+                        d0[ch] as f64
+                    };
+                    acc[ch] += SIX_GAUSSIAN_WEIGHTS_RGB[NARROW_GAUSSIANS + g][ch] as f64 * m;
                 }
             }
             [acc[0], acc[1], acc[2], d0[3] as f64]
@@ -252,11 +267,11 @@ pub fn gather_f64_burley(
             if d0[3] <= 0.0 {
                 return d0.map(|v| v as f64);
             }
-            let pt = PixelPoint::new(view, &inv, surface, linear_depth[i], i);
+            let pt = PixelPoint::new(view, &inv, surface, (linear_depth[i], d0[3]), i);
             let (x, y) = (i % view.width, i / view.width);
             // The pixel's point on the subsample grid (continuous coordinates).
             let (gx, gy) = ((x as f64 + 0.5) * s as f64, (y as f64 + 0.5) * s as f64);
-            let px_per_mm = scale.px_per_mm(linear_depth[i]);
+            let px_per_mm = scale.px_per_mm(linear_depth[i]) * d0[3];
             let r = burley::radius(px_per_mm, surface.s) as i64;
             let mut sum = [0.0f64; 3];
             let mut norm = [0.0f64; 3];
@@ -267,9 +282,9 @@ pub fn gather_f64_burley(
                 let (du, dv) = (qx as f64 + 0.5 - gx, qy as f64 + 0.5 - gy);
                 let area = surface.position[q][3] as f64;
                 let w = if burley::in_cell_reach(du, dv) {
-                    burley::cell_weight(bs, du, dv, area.sqrt())
+                    burley::cell_weight(bs, du, dv, area.sqrt() / d0[3] as f64)
                 } else {
-                    burley::ring_weight(bs, r2.sqrt(), area.sqrt())
+                    burley::ring_weight(bs, r2.sqrt(), area.sqrt() / d0[3] as f64)
                 };
                 for ch in 0..3 {
                     norm[ch] += w[ch];

@@ -32,7 +32,7 @@ use super::groups::{passes as groups, GroupMethod};
 use super::instances::{Instances, SkinGroup};
 use super::scene_gpu::{GpuObject, ObjectKind};
 use super::settings::RenderSettings;
-use super::targets::SHADOW_FORMAT;
+use super::targets::{composite_shader, geometry_shader, SHADOW_FORMAT};
 use super::uniforms::FrameUniforms;
 use crate::graph::draw::fullscreen;
 use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
@@ -66,7 +66,6 @@ const BECKMANN_SIZE: u32 = 256;
 /// Slope-scaled depth bias of the shadow pass (in units of the depth slope):
 /// the usual 1.5 against acne on curved skin at grazing light.
 const SHADOW_SLOPE_BIAS: f32 = 1.5;
-const COMPOSITE_SHADER: &str = "composite.frag";
 
 /// The geometry pass's vertex shader: geometry.vert (what tsd's final pass and
 /// the ground truth's surface pass draw one head with) with the model matrix
@@ -326,6 +325,7 @@ impl Frame {
             [targets.diffuse, targets.specular, targets.linear_depth]
                 .into_iter()
                 .chain(targets.normals)
+                .chain(targets.albedo)
                 .map(|t| res.format(t))
                 .collect();
         // At `--msaa N` it rasterises N samples a pixel into the
@@ -364,7 +364,11 @@ impl Frame {
         )?;
         self.composite_pipeline = Pipeline::graphics(
             ctx,
-            &GraphicsDesc::fullscreen("composite", COMPOSITE_SHADER, res.format(targets.hdr)),
+            &GraphicsDesc::fullscreen(
+                "composite",
+                composite_shader(&targets),
+                res.format(targets.hdr),
+            ),
         )?;
         Ok(())
     }
@@ -409,10 +413,17 @@ impl Frame {
             res,
             &self.composite_pipeline,
             0,
-            vec![
+            [
                 ("diffuseTex", Binding::Sampled(diffuse)),
                 ("specularTex", Binding::Sampled(self.targets.specular)),
-            ],
+            ]
+            .into_iter()
+            .chain(
+                self.targets
+                    .albedo
+                    .map(|a| ("albedoTex", Binding::Sampled(a))),
+            )
+            .collect(),
         );
     }
 
@@ -616,6 +627,9 @@ impl Frame {
         if let Some(n) = t.normals {
             pass = pass.color(clear(n, ms.and_then(|m| m.normals), [0.0; 4]));
         }
+        if let Some(a) = t.albedo {
+            pass = pass.color(clear(a, ms.and_then(|m| m.albedo), [0.0; 4]));
+        }
         passes.push(pass.draws(Some(work), self.triangles(|_| true)).record(
             move |pc: &PassContext| {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
@@ -691,10 +705,13 @@ impl Frame {
             coherent: true,
             spread: Vec::new(),
         };
+        let shader = composite_shader(&self.targets);
+        let mut fetches = vec![point(diffuse, "diffuseTex"), point(specular, "specularTex")];
+        fetches.extend(self.targets.albedo.map(|a| point(a, "albedoTex")));
         let work = ShaderWork {
-            shader: COMPOSITE_SHADER.into(),
-            fetches: vec![point(diffuse, "diffuseTex"), point(specular, "specularTex")],
-            alu: alu_estimate(COMPOSITE_SHADER, &[]),
+            shader: shader.into(),
+            fetches,
+            alu: alu_estimate(shader, &[]),
             ..Default::default()
         };
         let pipeline = &self.composite_pipeline;
@@ -752,15 +769,6 @@ impl Frame {
         }
         self.pool.destroy(ctx);
         self.samplers.destroy(ctx);
-    }
-}
-
-/// The geometry pass's fragment shader: with the normal MRT when a method needs it.
-fn geometry_shader(t: &FrameTargets) -> &'static str {
-    if t.normals.is_some() {
-        "geometry_normals.frag"
-    } else {
-        "geometry.frag"
     }
 }
 

@@ -50,8 +50,9 @@ pub struct Capture {
     /// Every pass output (with `dump`), linear float.
     pub dumps: Vec<DumpedImage>,
     pub samples: Vec<PassSample>,
-    /// The diffuse light after SSS (what the composite reads), linear float;
-    /// alpha is the SSS strength, so alpha > 0 marks skin.
+    /// The diffuse light after SSS (what the composite reads; with
+    /// post-scatter texturing times the albedo, as the composite applies
+    /// it), linear float; alpha is the SSS strength, so alpha > 0 marks skin.
     pub diffuse: Vec<[f32; 4]>,
     /// Linear view depth of every pixel, scene units (where the accuracy
     /// bands find depth steps).
@@ -377,6 +378,7 @@ impl<'c> Renderer<'c> {
             t.hdr,
         ];
         finals.extend(self.frame.character_ids);
+        finals.extend(t.albedo);
         let mut plan = ReadbackPlan::new(dump, &finals);
         let samples = match self.run_frame(Some(&mut plan)) {
             Ok(s) => s,
@@ -404,6 +406,17 @@ impl<'c> Renderer<'c> {
             None => None,
         };
         let hdr = float(hdr)?;
+        let mut diffuse = float(diffuse)?;
+        // Post-scatter texturing: the diffuse target holds the light alone;
+        // the capture's diffuse is what the composite adds, the albedo
+        // applied (so every consumer compares the same quantity either way).
+        if self.frame.targets.albedo.is_some() {
+            for (d, a) in diffuse.iter_mut().zip(float(next()?)?) {
+                for c in 0..3 {
+                    d[c] *= a[c];
+                }
+            }
+        }
         Ok(Capture {
             ldr: ldr.1,
             width: self.frame.extent.width,
@@ -413,7 +426,7 @@ impl<'c> Renderer<'c> {
                 .into_iter()
                 .filter(|s| s.role != PassRole::Readback)
                 .collect(),
-            diffuse: float(diffuse)?,
+            diffuse,
             depth: float(depth)?.iter().map(|p| p[0]).collect(),
             hdr_nonfinite: hdr
                 .iter()

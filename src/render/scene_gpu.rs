@@ -5,6 +5,7 @@ use ash::vk;
 
 use crate::graph::mesh::GpuMesh;
 use crate::scene::mesh::{Material, Object, Texture};
+use crate::scene::texel_params;
 use crate::vk::context::Context;
 use crate::vk::guard::{Destroy, Guard};
 use crate::vk::memory::{Buffer, Image};
@@ -17,6 +18,8 @@ use crate::vk::upload::texture;
 pub struct MaterialUniforms {
     pub base_color: [f32; 4],
     pub params: [f32; 4],
+    /// x: 1 when specTex's G holds a roughness map (`scene::texel_params`).
+    pub maps: [f32; 4],
 }
 
 /// What an object is to the frame: how often it is drawn and whether it
@@ -185,6 +188,12 @@ impl GpuObject {
                 .collect();
         }
         let m: &Material = &object.material;
+        // The per-texel parameters in one texture, read in one fetch.
+        let packed = texel_params::pack(
+            m.specular_map.as_ref(),
+            m.roughness_map.as_ref(),
+            m.sss_map.as_ref(),
+        );
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
         let maps = [
             (
@@ -200,8 +209,8 @@ impl GpuObject {
                 vk::Format::R8G8B8A8_UNORM,
             ),
             (
-                "specular map",
-                m.specular_map.as_ref(),
+                "texel parameters",
+                packed.as_ref().map(|p| &p.texture),
                 [255; 4],
                 vk::Format::R8G8B8A8_UNORM,
             ),
@@ -222,6 +231,16 @@ impl GpuObject {
                 m.specular_intensity,
                 m.sss_strength,
                 if m.skin { 1.0 } else { 0.0 },
+            ],
+            maps: [
+                if packed.is_some_and(|p| p.roughness_from_map) {
+                    1.0
+                } else {
+                    0.0
+                },
+                0.0,
+                0.0,
+                0.0,
             ],
         };
         self.uniforms = Buffer::with_data(

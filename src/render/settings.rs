@@ -128,10 +128,38 @@ pub struct RenderSettings {
     /// levels existed read back as the files they are.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub lod_pixels: f32,
+    /// Pre- or post-scatter texturing (`--texturing`; [`Texturing`]). Left
+    /// out of a report when pre, as reports before it were.
+    #[serde(default, skip_serializing_if = "Texturing::is_pre")]
+    pub texturing: Texturing,
 }
 
 fn is_zero(x: &f32) -> bool {
     *x == 0.0
+}
+
+/// Where the albedo enters the skin's light (d'Eon and Luebke 2007; thesis
+/// ch. 7.6, `--texturing`). Pre-scatter: the geometry pass multiplies the
+/// light by the albedo and the SSS blurs both, so the albedo is blurred too.
+/// Post-scatter: the SSS blurs the light alone and the composite multiplies
+/// the pixel's albedo in afterwards (a scanned albedo holds its own blur
+/// already; the thesis' ch. 7 renders so), from a target the geometry pass
+/// writes beside the others.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Texturing {
+    /// The albedo is scattered with the light (the default, every chapter
+    /// before 7).
+    #[default]
+    Pre,
+    /// The light is scattered, the albedo applied after.
+    Post,
+}
+
+impl Texturing {
+    pub fn is_pre(&self) -> bool {
+        *self == Texturing::Pre
+    }
 }
 
 /// The sample counts `--msaa` takes.
@@ -251,6 +279,7 @@ impl RenderSettings {
             post: PostOptions::default(),
             msaa: 1,
             lod_pixels: 0.0,
+            texturing: Texturing::Pre,
         }
     }
 

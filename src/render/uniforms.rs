@@ -25,6 +25,8 @@ pub struct FrameUniforms {
     pub ambient: [f32; 4],
     pub params: [f32; 4],
     pub shadow_params: [f32; 4],
+    /// x: 1 for post-scatter texturing (`settings::Texturing`).
+    pub shading: [f32; 4],
 }
 
 impl FrameUniforms {
@@ -68,6 +70,7 @@ impl FrameUniforms {
                 settings.transmittance_profile.exponent_scale(),
                 0.0,
             ],
+            shading: [(!settings.texturing.is_pre()) as u32 as f32, 0.0, 0.0, 0.0],
         }
     }
 }

@@ -113,6 +113,8 @@ pub fn eye_material() -> Material {
         base_color: Some(eye_texture()),
         normal_map: None,
         specular_map: None,
+        roughness_map: None,
+        sss_map: None,
         roughness: 0.12,
         specular_intensity: 0.35,
         sss_strength: 0.0,

@@ -721,6 +721,8 @@ fn backdrop_material() -> Material {
         base_color: None,
         normal_map: None,
         specular_map: None,
+        roughness_map: None,
+        sss_map: None,
         roughness: 0.6,
         specular_intensity: 0.02,
         sss_strength: 0.0,

@@ -130,6 +130,8 @@ pub fn lines_scene() -> Scene {
                 base_color: None,
                 normal_map: None,
                 specular_map: None,
+                roughness_map: None,
+                sss_map: None,
                 roughness: 0.7,
                 specular_intensity: 0.02,
                 sss_strength: 0.0,

@@ -149,8 +149,15 @@ pub struct Material {
     pub base_color: Option<Texture>,
     /// Linear tangent-space normal map (upload as `_UNORM`).
     pub normal_map: Option<Texture>,
-    /// Linear specular intensity in R (upload as `_UNORM`).
+    /// Linear specular intensity in R, a factor of `specular_intensity`
+    /// (upload as `_UNORM`).
     pub specular_map: Option<Texture>,
+    /// Beckmann roughness m in R, linear (replaces `roughness` where given;
+    /// Weyrich et al. 2006 measured it per region of the face).
+    pub roughness_map: Option<Texture>,
+    /// SSS strength in R, linear, a factor of `sss_strength` (thesis eq.
+    /// 4.3-4.4: 0 where nothing scatters, a beard or hair).
+    pub sss_map: Option<Texture>,
     /// Beckmann m; skin ~0.3.
     pub roughness: f32,
     /// rho_s; skin ~0.18.
@@ -169,10 +176,27 @@ impl Material {
             base_color: None,
             normal_map: None,
             specular_map: None,
+            roughness_map: None,
+            sss_map: None,
             roughness: 0.3,
             specular_intensity: 0.18,
             sss_strength: 1.0,
         }
+    }
+
+    /// The smallest strength at which any of its texels scatters (the
+    /// material's strength times its map's smallest non-zero texel; 0 when
+    /// nothing scatters): the narrowest the profile gets on it (eq. 4.3-4.4
+    /// scale its radius), what the ground truth's sampling must resolve.
+    pub fn min_scattering_strength(&self) -> f32 {
+        let least = self.sss_map.as_ref().map_or(Some(255), |m| {
+            m.rgba8
+                .chunks_exact(4)
+                .map(|t| t[0])
+                .filter(|&r| r > 0)
+                .min()
+        });
+        least.map_or(0.0, |r| self.sss_strength * r as f32 / 255.0)
     }
 }
 

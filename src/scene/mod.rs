@@ -28,6 +28,7 @@ pub mod robust_bounds;
 pub mod skin;
 pub mod skin_rule;
 pub mod source;
+pub mod texel_params;
 pub mod vertex;
 
 use anyhow::{bail, Context, Result};
@@ -280,10 +281,12 @@ pub fn builtin_scene(
     if o.albedo.is_some()
         || o.normal_map.is_some()
         || o.specular_map.is_some()
+        || o.roughness_map.is_some()
+        || o.sss_map.is_some()
         || o.sidecar_top_down
         || !o.skin.is_empty()
     {
-        bail!("--albedo, --normal-map, --spec-map, --sidecar-top-down, --skin and --not-skin apply to a glTF --scene, not to builtin:{name}");
+        bail!("--albedo, --normal-map, --spec-map, --roughness-map, --sss-map, --sidecar-top-down, --skin and --not-skin apply to a glTF --scene, not to builtin:{name}");
     }
     let mut s = builtin(name)?;
     if let Some(mm) = mm_per_unit {
@@ -329,6 +332,8 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
             base_color: None,
             normal_map: None,
             specular_map: None,
+            roughness_map: None,
+            sss_map: None,
             roughness: 0.6,
             specular_intensity: 0.02,
             sss_strength: 0.0,
@@ -430,6 +435,8 @@ pub fn load_gltf_scene(
         albedo: overrides.albedo.clone(),
         normal_map: overrides.normal_map.clone(),
         spec_map: overrides.specular_map.clone(),
+        roughness_map: overrides.roughness_map.clone(),
+        sss_map: overrides.sss_map.clone(),
         sidecar_top_down: overrides.sidecar_top_down,
         mm_per_unit,
         skin: overrides.skin.skin.clone(),

@@ -25,6 +25,11 @@ pub struct SceneSource {
     pub albedo: Option<PathBuf>,
     pub normal_map: Option<PathBuf>,
     pub spec_map: Option<PathBuf>,
+    /// The roughness and SSS-strength maps (`--roughness-map`, `--sss-map`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roughness_map: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sss_map: Option<PathBuf>,
     /// Texture files beside the scene (or given above) are top-down.
     pub sidecar_top_down: bool,
     /// Millimetres per scene unit (`None`: from a 230 mm chin-to-crown head).
@@ -86,6 +91,8 @@ impl SceneSource {
             albedo: self.albedo.clone(),
             normal_map: self.normal_map.clone(),
             specular_map: self.spec_map.clone(),
+            roughness_map: self.roughness_map.clone(),
+            sss_map: self.sss_map.clone(),
             sidecar_top_down: self.sidecar_top_down,
             skin: crate::scene::skin_rule::SkinChoice {
                 skin: self.skin.clone(),

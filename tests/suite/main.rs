@@ -48,6 +48,8 @@ mod screen;
 mod separable;
 mod stability;
 mod stepping;
+mod texel_params;
+mod texturing;
 mod tsd;
 
 mod cli;

@@ -78,6 +78,18 @@ fn declared_fetches_are_what_the_shaders_fetch() {
                 RenderSettings { msaa: 4, ..s },
             ));
         }
+        // Post-scatter texturing's geometry and composite variants, with the
+        // normal target (poisson) and without (the first method).
+        if std::ptr::eq(*m, METHODS[0]) || m.name == "poisson" {
+            let s = RenderSettings::study().with(m, &[]);
+            settings.push((
+                format!("{} --texturing post", m.name),
+                RenderSettings {
+                    texturing: dermis::render::settings::Texturing::Post,
+                    ..s
+                },
+            ));
+        }
         for (label, s) in settings {
             let s = RenderSettings {
                 width: 96,

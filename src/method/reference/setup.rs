@@ -262,8 +262,16 @@ impl Reference {
             })
             .fold(f32::INFINITY, f32::min)
             .max(s.view.camera.near);
+        // A strength below 1 narrows the profile as much as coming closer
+        // by its inverse would widen the pixels' view of it.
+        let strength = skin.material.min_scattering_strength();
         let px_per_mm = s.view.scale().px_per_mm(nearest);
-        let ss = supersampling(px_per_mm);
+        let t = if strength > 0.0 {
+            strength.min(1.0)
+        } else {
+            1.0
+        };
+        let ss = supersampling(px_per_mm * t);
         let extent = vk::Extent2D {
             width: s.view.extent.width * ss,
             height: s.view.extent.height * ss,

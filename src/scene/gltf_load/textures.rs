@@ -14,13 +14,20 @@
 //!    - albedo: `albedo`, `basecolor`, `col`, `color`, `colour`, `diffuse`;
 //!    - normal map: `normal`, `tangent` (a tangent-space normal map);
 //!    - specular: `spec`, `specular`;
+//!    - roughness (the Beckmann m in red): `rough`, `roughness`;
+//!    - SSS strength (red, a factor of the material's): `sss`, `scatter`,
+//!      `scattering`, `subsurface`;
 //! 3. and no other file there claims the same role.
 //!
 //! Words are whole: `collar.png`, `Normalized.png` and a displacement map
 //! (`..._Disp_...`) claim nothing. A file naming two roles (`col_normal.png`), or
 //! two files claiming one role, is ambiguous: nothing is taken for that role and
 //! a warning names the files (choose with `--albedo`, `--normal-map`,
-//! `--spec-map`). A role the glTF material fills itself, or the command line
+//! `--spec-map`, `--roughness-map`, `--sss-map`). The roughness and strength
+//! maps come only from beside the file or the command line: glTF has no such
+//! roles (its metallic-roughness texture is a perceptual roughness for
+//! another lobe). `crate::scene::texel_params` packs the specular, roughness
+//! and strength maps into the one texture the geometry pass reads. A role the glTF material fills itself, or the command line
 //! overrides, takes nothing from beside the file. Every file taken is named in
 //! a note on stderr; one that cannot be read or decoded (a FIFO, a corrupt
 //! file, an image too large to decode) is left out with a warning, so a file
@@ -47,6 +54,8 @@ pub struct TextureOverrides {
     pub albedo: Option<PathBuf>,
     pub normal_map: Option<PathBuf>,
     pub specular_map: Option<PathBuf>,
+    pub roughness_map: Option<PathBuf>,
+    pub sss_map: Option<PathBuf>,
     /// Textures found beside the file or given as overrides were not authored
     /// against the glTF's texture-coordinate convention (v = 0 at the top row).
     /// By default they are taken as bottom-up (OpenGL convention: the three.js
@@ -70,10 +79,21 @@ pub(super) enum Slot {
     Albedo,
     Normal,
     Specular,
+    Roughness,
+    Strength,
 }
 
+/// How many texture roles a skin material has.
+const SLOTS: usize = 5;
+
 impl Slot {
-    const ALL: [Slot; 3] = [Slot::Albedo, Slot::Normal, Slot::Specular];
+    const ALL: [Slot; SLOTS] = [
+        Slot::Albedo,
+        Slot::Normal,
+        Slot::Specular,
+        Slot::Roughness,
+        Slot::Strength,
+    ];
 
     /// The role's words in a file name (module docs).
     fn words(self) -> &'static [&'static str] {
@@ -81,6 +101,8 @@ impl Slot {
             Slot::Albedo => &["albedo", "basecolor", "col", "color", "colour", "diffuse"],
             Slot::Normal => &["normal", "tangent"],
             Slot::Specular => &["spec", "specular"],
+            Slot::Roughness => &["rough", "roughness"],
+            Slot::Strength => &["sss", "scatter", "scattering", "subsurface"],
         }
     }
 
@@ -89,6 +111,8 @@ impl Slot {
             Slot::Albedo => "albedo",
             Slot::Normal => "normal map",
             Slot::Specular => "specular",
+            Slot::Roughness => "roughness",
+            Slot::Strength => "SSS strength",
         }
     }
 
@@ -97,6 +121,8 @@ impl Slot {
             Slot::Albedo => "--albedo",
             Slot::Normal => "--normal-map",
             Slot::Specular => "--spec-map",
+            Slot::Roughness => "--roughness-map",
+            Slot::Strength => "--sss-map",
         }
     }
 }
@@ -124,7 +150,7 @@ pub(super) fn classify(file_name: &str) -> Vec<Slot> {
 /// claiming it (sorted by name); files claiming several roles apart.
 #[derive(Default)]
 pub(super) struct Beside {
-    pub(super) claims: [Vec<PathBuf>; 3],
+    pub(super) claims: [Vec<PathBuf>; SLOTS],
     pub(super) ambiguous: Vec<PathBuf>,
 }
 
@@ -274,7 +300,7 @@ pub(super) fn material(
         gltf_texture(src, index, what).map(Some)
     };
     let pbr = gltf_material.as_ref().map(|m| m.pbr_metallic_roughness());
-    let mut slots: [Option<Texture>; 3] = [
+    let mut slots: [Option<Texture>; SLOTS] = [
         from_gltf(
             pbr.as_ref()
                 .and_then(|p| p.base_color_texture())
@@ -294,6 +320,8 @@ pub(super) fn material(
                 .map(|i| (i, 0)),
             Slot::Specular.what(),
         )?,
+        None,
+        None,
     ];
     // The glTF's base colour factor tints the glTF's own texture (or is the colour when
     // there is none); a texture found beside the file was not authored against it (the
@@ -308,19 +336,20 @@ pub(super) fn material(
         );
     };
     if !role.head {
-        let [base_color, normal_map, specular_map] = slots;
         return Ok(part_material(
             src,
             c.material,
             role.skin,
             [factor[0], factor[1], factor[2]],
-            [base_color, normal_map, specular_map],
+            slots,
         ));
     }
     let given = [
         &overrides.albedo,
         &overrides.normal_map,
         &overrides.specular_map,
+        &overrides.roughness_map,
+        &overrides.sss_map,
     ];
     let beside = detect_beside(&src.dir);
     let name = |p: &Path| p.display().to_string();
@@ -415,13 +444,12 @@ pub(super) fn material(
                 .to_string(),
         );
     }
-    let [base_color, normal_map, specular_map] = slots;
     Ok(part_material(
         src,
         c.material,
         role.skin,
         [factor[0], factor[1], factor[2]],
-        [base_color, normal_map, specular_map],
+        slots,
     ))
 }
 
@@ -431,12 +459,14 @@ fn part_material(
     index: Option<usize>,
     skin: bool,
     factor: [f32; 3],
-    [base_color, normal_map, specular_map]: [Option<Texture>; 3],
+    [base_color, normal_map, specular_map, roughness_map, sss_map]: [Option<Texture>; SLOTS],
 ) -> Material {
     let mut m = Material {
         base_color,
         normal_map,
         specular_map,
+        roughness_map,
+        sss_map,
         ..Material::skin(factor)
     };
     if skin {
@@ -592,6 +622,14 @@ mod tests {
         }
         assert!(classify("Map-COL.tga").is_empty());
         assert_eq!(classify("col_normal.png"), [Albedo, Normal]);
+        // The per-texel parameters' roles (issue 30).
+        assert_eq!(classify("Head_Roughness.png"), [Roughness]);
+        assert_eq!(classify("face-rough.jpg"), [Roughness]);
+        assert_eq!(classify("Head_SSS.png"), [Strength]);
+        assert_eq!(classify("subsurface_mask.PNG"), [Strength]);
+        assert_eq!(classify("scatter.jpeg"), [Strength]);
+        assert!(classify("Roughly.png").is_empty());
+        assert_eq!(classify("spec_rough.png"), [Specular, Roughness]);
         let dir = temp_dir("beside");
         let scene = tiny_gltf(&dir, true, true, [0.0; 3]);
         image::RgbaImage::new(4, 4)
