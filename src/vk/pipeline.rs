@@ -27,6 +27,9 @@ pub enum Blend {
     /// blend constant `c` (thesis eq. 4.9; alpha takes the source: constant alpha 1);
     /// the other attachments are written unblended.
     ConstantMix(usize),
+    /// Attachment `n` mixes `src * a + dst * (1 - a)` with the source's own
+    /// alpha `a`, which it keeps; the others are written unblended.
+    AlphaMix(usize),
 }
 
 #[derive(Clone, Debug)]
@@ -302,6 +305,15 @@ impl Pipeline {
                     .color_blend_op(vk::BlendOp::ADD)
                     .src_alpha_blend_factor(vk::BlendFactor::CONSTANT_ALPHA)
                     .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_CONSTANT_ALPHA)
+                    .alpha_blend_op(vk::BlendOp::ADD)
+                    .color_write_mask(vk::ColorComponentFlags::RGBA),
+                Blend::AlphaMix(n) if n == i => vk::PipelineColorBlendAttachmentState::default()
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
                     .alpha_blend_op(vk::BlendOp::ADD)
                     .color_write_mask(vk::ColorComponentFlags::RGBA),
                 _ => vk::PipelineColorBlendAttachmentState::default()

@@ -284,3 +284,50 @@ fn neutral_maps_change_nothing_and_a_roughness_map_replaces_m() {
         "a smooth map left the highlight as it was ({changed} bytes)"
     );
 }
+
+// Texture-space diffusion mixes its map with the geometry pass's unblurred
+// light by the texel's strength (tsd_final.frag): at 0 everywhere every pixel
+// keeps the unscattered light exactly, at 255 the frame is the frame without
+// a map, bit for bit; both variants, on the face.
+#[test]
+fn texture_space_keeps_the_unscattered_light_at_strength_zero() {
+    let ctx = common::ctx();
+    let face = dermis::scene::default_scene();
+    let base = RenderSettings {
+        width: 160,
+        height: 90,
+        shadow_size: 512,
+        ..Default::default()
+    };
+    let diffuse = |scene: &Scene, s: &RenderSettings| {
+        let mut r = dermis::render::Renderer::new(&ctx, scene, s).unwrap();
+        r.capture(false).unwrap().diffuse
+    };
+    let with_map = |v: u8| {
+        let mut scene = face.clone();
+        scene.head.material.sss_map = Some(halves(v, v));
+        scene
+    };
+    let none = diffuse(&face, &base.clone().with(common::m("none"), &[]));
+    for method in ["tsd", "tsd-opt"] {
+        let s = base.clone().with(common::m(method), &[]);
+        let plain = diffuse(&face, &s);
+        let changed = plain.iter().zip(&none).filter(|(a, b)| a != b).count();
+        assert!(
+            changed > 100,
+            "{method} scattered nothing ({changed} pixels)"
+        );
+        assert!(
+            diffuse(&with_map(255), &s) == plain,
+            "{method}: a map of 255 changed the frame"
+        );
+        let zero = diffuse(&with_map(0), &s);
+        let off = zero
+            .iter()
+            .zip(&none)
+            .filter(|(a, b)| a[..3] != b[..3])
+            .count();
+        println!("{method}: {changed} pixels scattered without a map, {off} at strength 0");
+        assert_eq!(off, 0, "{method}: strength 0 scattered");
+    }
+}

@@ -290,14 +290,27 @@ impl Tsd {
     pub(super) fn final_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let ds = f.targets.depth_stencil;
         let first_map = self.characters[0].map;
+        // The map, and the strength of the material's per-texel parameters.
+        let texel = Fetch {
+            texture: "specTex".into(),
+            format: Format::Rgba8Unorm,
+            filter: Filter::Bilinear,
+            count: 1.0,
+            exact: true,
+            coherent: true,
+            spread: Vec::new(),
+        };
         let work = ShaderWork {
             shader: FINAL_SHADER.into(),
-            fetches: vec![fetch(f.res, first_map, "mapTex", Filter::Bilinear, 1.0)],
+            fetches: vec![
+                fetch(f.res, first_map, "mapTex", Filter::Bilinear, 1.0),
+                texel,
+            ],
             alu: alu_estimate(FINAL_SHADER, &[]),
             ..Default::default()
         };
         let mut pass = Pass::new("tsd final", PassRole::Sss)
-            .color(ColorTarget::new(self.diffuse, Load::Keep))
+            .color(ColorTarget::new(self.diffuse, Load::Keep).blended())
             .depth_stencil(DepthStencil::test_only(ds).depth_test(true));
         let frame = self.sets.frame[4].as_ref().map(|s| pass.set(s));
         // Each character's set samples its map.
@@ -311,6 +324,7 @@ impl Tsd {
                 let (ctx, cmd) = (pc.ctx, pc.cmd);
                 let p = &self.pipelines.final_pass;
                 pc.bind(p, frame.as_slice());
+                p.bind_sets(ctx, cmd, 2, &[self.sets.texel]);
                 for (k, (c, &map)) in self.characters.iter().zip(&maps).enumerate() {
                     pc.bind_sets(p, 1, &[map]);
                     p.push(ctx, cmd, &c.model.to_cols_array_2d());

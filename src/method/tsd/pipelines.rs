@@ -167,7 +167,9 @@ fn fill_pipelines(
             depth_compare: vk::CompareOp::LESS_OR_EQUAL,
             stencil: None,
             depth_bias: Some((FINAL_DEPTH_BIAS, 0.0)),
-            blend: Blend::None,
+            // The texel's SSS strength mixes the blurred light with the
+            // geometry pass's unblurred light (tsd_final.frag).
+            blend: Blend::AlphaMix(0),
         },
     )?;
     Ok(())

@@ -19,6 +19,9 @@ pub(super) struct SharedSets {
     /// (the frame's bindings each reads; `None`: a pipeline not built).
     pub(super) frame: [Option<GraphSet>; 5],
     pub(super) material: vk::DescriptorSet,
+    /// Set 2 of the final pass: the skin material's per-texel parameters
+    /// (its strength mixes the map in, tsd_final.frag).
+    pub(super) texel: vk::DescriptorSet,
     /// u from the irradiance map, u from `pong`, v from `temp`.
     pub(super) blur: [GraphSet; 3],
 }
@@ -90,6 +93,7 @@ impl Tsd {
         self.sets = SharedSets {
             frame,
             material: vk::DescriptorSet::null(),
+            texel: vk::DescriptorSet::null(),
             blur,
         };
     }
@@ -126,6 +130,13 @@ impl Tsd {
             }
         }
         self.sets.material = pool.write_set(ctx, &p.irradiance, 1, &b.skin_material_binds)?;
+        let texel: Vec<(&str, Bind)> = b
+            .skin_material_binds
+            .iter()
+            .filter(|(n, _)| p.final_pass.reflection.find(2, n).is_some())
+            .copied()
+            .collect();
+        self.sets.texel = pool.write_set(ctx, &p.final_pass, 2, &texel)?;
         for (set, pipe) in self
             .sets
             .blur
