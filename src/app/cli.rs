@@ -209,6 +209,11 @@ pub struct EvalArgs {
     /// and the no-SSS frame they are scored with are rendered as always.
     #[arg(long)]
     pub only: Vec<String>,
+    /// Sweep every setting twice, with pre- and post-scatter texturing (whatever
+    /// --texturing says), each scored against a ground truth that applies the albedo
+    /// the same way; adds texturing.png/svg, the two side by side.
+    #[arg(long)]
+    pub compare_texturing: bool,
     #[command(flatten)]
     pub frames: Frames<2, 10>,
 }

@@ -34,6 +34,7 @@ use crate::method::{ground_truth, lookup, none};
 use crate::output::paths::OutputPaths;
 use crate::output::write_json;
 use crate::render::request::CheckedSettings;
+use crate::render::settings::Texturing;
 use crate::render::{FrameRequest, RenderSettings};
 use crate::report::device_header;
 use crate::run::{run_request, FrameCounts, RunOptions};
@@ -55,13 +56,15 @@ pub const SCENE_SETS: [&str; 6] = [
 ];
 
 /// The files eval writes into its folder (the accuracy sets' own beside them).
-const FILES: [&str; 6] = [
+const FILES: [&str; 8] = [
     "eval.csv",
     "eval.json",
     "chart.png",
     "chart.svg",
     "distance.png",
     "distance.svg",
+    "texturing.png",
+    "texturing.svg",
 ];
 
 /// The named scene sets of `eval`.
@@ -118,14 +121,43 @@ pub fn run(a: &EvalArgs, given: &Given) -> Result<()> {
     };
     let scenes = load_scenes(&specs, &head_source)?;
     let configs = sweep::select(sweep::registry(), &a.only)?;
+    // --compare-texturing: the sweep once per texturing, each frame and its
+    // truth alike.
+    let (base, post) = if a.compare_texturing {
+        let with = |texturing| RenderSettings {
+            texturing,
+            ..base.clone()
+        };
+        (with(Texturing::Pre), Some(with(Texturing::Post)))
+    } else {
+        (base, None)
+    };
     let plan = plan_sweep(&specs, &scenes, &base, &configs)?;
+    let post_plan = post
+        .as_ref()
+        .map(|b| plan_sweep(&specs, &scenes, b, &configs))
+        .transpose()?;
     OutputPaths::new()
         .folder("--out", &a.out, &FILES, &[])
         .prepare()?;
     let ctx = request::context(&a.frame)?;
-    let outcome = sweep_and_write(&ctx, &plan, &base, counts, &a.out, a.scenes == "dolly");
-    let (summary, files) = ctx.finish_with(outcome)?;
+    let outcome = sweep_and_write(
+        &ctx,
+        (&plan, post_plan.as_deref()),
+        &base,
+        counts,
+        &a.out,
+        a.scenes == "dolly",
+    );
+    let (summary, post_summary, files) = ctx.finish_with(outcome)?;
+    if post_plan.is_some() {
+        println!("pre-scatter texturing:");
+    }
     print!("{}", sweep::summary_table(&summary));
+    if post_plan.is_some() {
+        println!("post-scatter texturing (the light scattered, the albedo applied after):");
+        print!("{}", sweep::summary_table(&post_summary));
+    }
     let names: Vec<String> = files
         .iter()
         .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
@@ -375,6 +407,7 @@ pub fn sweep(
                 rel_rmse_all_skin: rel_rmse,
                 bands: band_errors,
                 profile: *p,
+                texturing: f.settings().texturing,
             });
             if let Some(b) = &bar {
                 b.inc(1);
@@ -387,23 +420,32 @@ pub fn sweep(
     Ok(rows)
 }
 
-/// Runs the sweep of `plan` and writes eval.csv, eval.json, chart.png/svg
-/// (and for a dolly, distance.png/svg; for the accuracy sets their data)
-/// into `out`; returns the summary and the files written.
+/// Runs the sweep of `plan` (and of `post`, its post-scatter twin, with
+/// `--compare-texturing`) and writes eval.csv, eval.json, chart.png/svg (for
+/// a dolly, distance.png/svg; for the accuracy sets their data; with `post`,
+/// texturing.png/svg) into `out`; returns the summaries (the post-scatter
+/// one empty without `post`) and the files written.
+// Long because each output follows the sweep in turn.
 pub fn sweep_and_write(
     ctx: &Context,
-    plan: &[ViewPlan],
+    (plan, post): (&[ViewPlan], Option<&[ViewPlan]>),
     base: &RenderSettings,
     counts: FrameCounts,
     out: &Path,
     dolly: bool,
-) -> Result<(Vec<sweep::SummaryRow>, Vec<PathBuf>)> {
+) -> Result<SweepOutcome> {
     let rows = sweep(ctx, plan, counts, true)?;
+    let post_rows = match post {
+        Some(p) => sweep(ctx, p, counts, true)?,
+        None => Vec::new(),
+    };
+    let post_summary = sweep::summarise(&post_rows);
     let specs: Vec<SceneSpec> = plan.iter().map(|v| v.spec.clone()).collect();
     let specs = &specs;
     let command = command_line();
     let mut files = vec![out.join("eval.csv"), out.join("eval.json")];
-    sweep::write_csv(&files[0], &rows)?;
+    let all_rows: Vec<EvalRow> = rows.iter().chain(&post_rows).cloned().collect();
+    sweep::write_csv(&files[0], &all_rows)?;
     let summary = sweep::summarise(&rows);
     // The ranking is made on the interior: the bands are shown beside it.
     let interior: Vec<EvalPoint> = summary.iter().map(|r| r.point(Band::Interior)).collect();
@@ -420,10 +462,20 @@ pub fn sweep_and_write(
             .iter()
             .map(|&i| summary[i].clone())
             .collect(),
-        rows: rows.clone(),
+        rows: all_rows,
         summary: summary.clone(),
+        post_scatter_summary: post_summary.clone(),
     };
     write_json(&files[1], &report)?;
+    let point = |r: &sweep::SummaryRow, band: Band| {
+        let mut p = r.point(band);
+        // Burley's settings (scored against Burley's truth) are their own
+        // legend entries, drawn hollow.
+        if !r.profile.is_six_gaussian() {
+            p.method = chart::profile_label(&p.method, r.profile.name());
+        }
+        p
+    };
     let panels: Vec<chart::Panel> = Band::ALL
         .iter()
         .map(|&band| chart::Panel {
@@ -435,15 +487,7 @@ pub fn sweep_and_write(
             points: summary
                 .iter()
                 .filter(|r| r.band(band).scenes > 0)
-                .map(|r| {
-                    let mut p = r.point(band);
-                    // Burley's settings (scored against Burley's truth) are
-                    // their own legend entries, drawn hollow.
-                    if !r.profile.is_six_gaussian() {
-                        p.method = chart::profile_label(&p.method, r.profile.name());
-                    }
-                    p
-                })
+                .map(|r| point(r, band))
                 .collect(),
             front: band == Band::Interior,
         })
@@ -461,6 +505,35 @@ pub fn sweep_and_write(
         &out.join("chart.svg"),
     )?;
     files.extend([out.join("chart.png"), out.join("chart.svg")]);
+    if post.is_some() {
+        // Each method's cost and interior error with the albedo scattered
+        // (left) and applied after (right), on the same axes and markers.
+        let panel = |title: &str, s: &[sweep::SummaryRow]| chart::Panel {
+            title: title.into(),
+            y_label: "err/none, interior".into(),
+            points: s
+                .iter()
+                .filter(|r| r.interior.scenes > 0)
+                .map(|r| point(r, Band::Interior))
+                .collect(),
+            front: true,
+        };
+        chart::panel_chart(
+            &[
+                panel("pre-scatter texturing", &summary),
+                panel("post-scatter texturing", &post_summary),
+            ],
+            &format!(
+                "Pre- against post-scatter texturing, each against its own truth ({}, {} scene(s))",
+                ctx.facts.name,
+                specs.len()
+            ),
+            "GPU ms (SSS passes, median)",
+            &out.join("texturing.png"),
+            &out.join("texturing.svg"),
+        )?;
+        files.extend([out.join("texturing.png"), out.join("texturing.svg")]);
+    }
     if dolly {
         // Error against distance: where a distance-driven switch changes the
         // image, the line steps.
@@ -514,5 +587,9 @@ pub fn sweep_and_write(
         println!("leave-one-scale-out prediction error (absolute err/none):\n{loso}");
         files.extend(written);
     }
-    Ok((summary, files))
+    Ok((summary, post_summary, files))
 }
+
+/// What [`sweep_and_write`] returns: the summary, the post-scatter one
+/// (empty without `--compare-texturing`) and the files written.
+pub type SweepOutcome = (Vec<sweep::SummaryRow>, Vec<sweep::SummaryRow>, Vec<PathBuf>);

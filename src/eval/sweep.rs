@@ -15,6 +15,7 @@ use super::pareto::EvalPoint;
 use crate::header::RunHeader;
 use crate::method::profile::Profile;
 use crate::method::{EvalSetting, MethodEntry, METHODS};
+use crate::render::settings::Texturing;
 use crate::render::RenderSettings;
 use crate::scene::gltf_load::TextureOverrides;
 use crate::scene::{default_scene, load_gltf_scene, Scene};
@@ -221,6 +222,10 @@ pub struct EvalRow {
     /// against (`method::profile::approximated`); absent: the six Gaussians.
     #[serde(default, skip_serializing_if = "Profile::is_six_gaussian")]
     pub profile: Profile,
+    /// Where the albedo entered, in the frame and its truth alike
+    /// (`eval --compare-texturing`); absent: pre-scatter.
+    #[serde(default, skip_serializing_if = "Texturing::is_pre")]
+    pub texturing: Texturing,
 }
 
 impl EvalRow {
@@ -294,6 +299,7 @@ fn band_key(band: Band) -> &'static str {
 /// the six Gaussians' (as eval.json writes the key only then).
 pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
     let profiles = rows.iter().any(|r| !r.profile.is_six_gaussian());
+    let texturing = rows.iter().any(|r| !r.texturing.is_pre());
     let mut header = EvalRow::csv_header();
     let fields: Vec<Vec<String>> = rows
         .iter()
@@ -302,11 +308,17 @@ pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
             if profiles {
                 f.push(r.profile.name().to_string());
             }
+            if texturing {
+                f.push(texturing_name(r.texturing).to_string());
+            }
             f
         })
         .collect();
     if profiles {
         header.push("profile".into());
+    }
+    if texturing {
+        header.push("texturing".into());
     }
     super::pareto::write_table(path, &header, &fields)
 }
@@ -325,6 +337,18 @@ pub struct EvalReport {
     pub rows: Vec<EvalRow>,
     pub summary: Vec<SummaryRow>,
     pub pareto_front: Vec<SummaryRow>,
+    /// `--compare-texturing`: the summary of the post-scatter sweep (`rows`
+    /// holds its rows too, marked); `summary` is then the pre-scatter one.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub post_scatter_summary: Vec<SummaryRow>,
+}
+
+/// The name `--texturing` gives `t`.
+pub fn texturing_name(t: Texturing) -> &'static str {
+    match t {
+        Texturing::Pre => "pre",
+        Texturing::Post => "post",
+    }
 }
 
 /// A view's scene: the embedded face, or the file (no textures given).
@@ -549,6 +573,7 @@ mod tests {
                 depth_step: band(0.4),
             },
             profile: Profile::SixGaussian,
+            texturing: Texturing::Pre,
         };
         let mut json_keys = Vec::new();
         leaves(&serde_json::to_value(&row).unwrap(), "", &mut json_keys);
@@ -657,6 +682,7 @@ mod tests {
                 depth_step: band(depth_step_pixels, 5.0),
             },
             profile: Profile::SixGaussian,
+            texturing: Texturing::Pre,
         };
         let s = summarise(&[row("a", 1.0, 0.1, 0), row("b", 3.0, 0.3, 2)]);
         assert_eq!(s.len(), 1);

@@ -386,6 +386,63 @@ fn reference_and_compare() {
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).starts_with("error: "));
 }
 
+// `eval --compare-texturing`: every setting swept twice, each texturing
+// against its own truth; the post-scatter rows marked in eval.json and
+// eval.csv, its summary apart, texturing.png/svg beside the chart.
+#[test]
+fn eval_compares_pre_and_post_scatter_texturing() {
+    let d = tmp("eval-texturing");
+    run_ok(&[
+        "eval",
+        "--validate",
+        "--device",
+        "llvmpipe",
+        "--scenes",
+        "quick",
+        "--only",
+        "none",
+        "--only",
+        "separable/33 samples",
+        "--compare-texturing",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--warmup",
+        "0",
+        "--frames",
+        "1",
+        "--density",
+        "8",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    let typed: dermis::eval::sweep::EvalReport =
+        serde_json::from_slice(&std::fs::read(d.join("eval.json")).unwrap()).unwrap();
+    use dermis::render::settings::Texturing;
+    let post = |t: Texturing| typed.rows.iter().filter(|r| r.texturing == t).count();
+    assert_eq!((post(Texturing::Pre), post(Texturing::Post)), (2, 2));
+    assert_eq!(typed.summary.len(), 2);
+    let err = |rows: &[dermis::eval::sweep::SummaryRow], m: &str| {
+        rows.iter()
+            .find(|r| r.method == m)
+            .unwrap()
+            .interior
+            .err_none
+    };
+    // Each against its own truth: no SSS scores 1 in both, separable under it.
+    for rows in [&typed.summary, &typed.post_scatter_summary] {
+        assert_eq!(err(rows, "none"), 1.0);
+        assert!(err(rows, "separable") < 1.0, "{rows:?}");
+    }
+    let csv = std::fs::read_to_string(d.join("eval.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",texturing"), "{csv}");
+    assert_eq!(csv.lines().filter(|l| l.ends_with(",post")).count(), 2);
+    for f in ["texturing.png", "texturing.svg", "chart.png"] {
+        assert!(d.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+}
+
 #[test]
 fn eval_writes_csv_json_and_chart() {
     let d = tmp("eval");
