@@ -53,7 +53,7 @@ void main() {
 
     // The per-texel parameters, one fetch (lighting.glsl's specTex).
     vec3 texel = COUNTED(SITE(1, 2, FK_BILINEAR), texture(sampler2D(specTex, materialSampler), vUv)).rgb;
-    float m = material.maps.x > 0.5 ? texel.g : material.params.x;
+    float m = material.maps.x + NOT_UNIFORM_ZERO > 0.5 ? texel.g : material.params.x;
     float spec = kelemenSzirmayKalos(N, L, V, m, material.params.y) * texel.r;
 
     outDiffuse = vec4(diffuse, skin ? material.params.z * texel.b : 0.0);

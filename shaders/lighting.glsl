@@ -9,6 +9,7 @@
 #include "frame_uniforms.glsl"
 #include "fetch_count.glsl"
 #include "shader_constants.glsl"
+#include "driver_workarounds.glsl"
 layout(set = 0, binding = 1) uniform texture2D shadowMap;
 layout(set = 0, binding = 2) uniform samplerShadow shadowCompare;  // LESS_OR_EQUAL, bilinear: 2x2 PCF
 layout(set = 0, binding = 3) uniform sampler nearestClamp;
@@ -98,8 +99,10 @@ vec3 albedoAt(vec2 uv) {
 // The albedo the light is scattered with: the albedo itself (pre-scatter
 // texturing), or 1 when the composite applies it after the SSS (post-scatter;
 // frame.shading.x, src/render/settings.rs Texturing).
+// (A uniform flag: NOT_UNIFORM_ZERO keeps lavapipe from compiling, and leaking,
+// a copy of each shader that calls this per bind; driver_workarounds.glsl.)
 vec3 scatteredAlbedo(vec3 albedo) {
-    return frame.shading.x > 0.5 ? vec3(1.0) : albedo;
+    return frame.shading.x + NOT_UNIFORM_ZERO > 0.5 ? vec3(1.0) : albedo;
 }
 
 // Diffuse radiance before scattering: albedo x (key light x N.L x shadow + ambient).

@@ -12,7 +12,7 @@
 //! Not here: `tests/soak.rs`, which measures this process's resident memory, so
 //! nothing may run beside it (its own binary, see Cargo.toml).
 //!
-//! `tests/teardown.rs` stays where issue 11 left it, byte for byte, included
+//! `tests/teardown.rs` stays where issue 11 left it (its path), included
 //! by `#[path]` with its own `mod common;` (a second copy of the fixtures).
 
 // teardown.rs's own `mod common;` (see above).
