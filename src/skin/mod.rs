@@ -12,6 +12,7 @@
 pub mod beckmann;
 pub mod burley;
 pub mod card;
+pub mod colour;
 pub mod diffusion;
 pub mod gather;
 pub mod jittered;
