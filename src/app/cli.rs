@@ -389,6 +389,10 @@ pub struct FrameArgs {
     pub normal_map: Option<PathBuf>,
     #[arg(long)]
     pub spec_map: Option<PathBuf>,
+    /// The skin's albedo from the two-layer skin model (thesis ch. 7) at a tone of the
+    /// melanin axis, for a skin without an albedo texture (the built-in face).
+    #[arg(long, value_enum, ignore_case = true)]
+    pub skin_tone: Option<crate::scene::source::SkinTone>,
     /// The skin's Beckmann roughness per texel, m in red (a glTF --scene only).
     #[arg(long)]
     pub roughness_map: Option<PathBuf>,

@@ -132,6 +132,7 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         clip: a.animation.clone(),
         crowd_seed: a.crowd_seed,
         time_step: a.time_step,
+        skin_tone: a.skin_tone,
     }
 }
 
@@ -185,7 +186,15 @@ pub fn settings(a: &FrameArgs) -> Result<RenderSettings> {
 
 /// Loads the scene a source names (once per command).
 pub fn load_scene(source: &SceneSource) -> Result<Scene> {
-    let scene = source.load()?;
+    let mut scene = source.load()?;
+    if let Some(tone) = source.skin_tone {
+        // The two-layer skin model's albedo (thesis ch. 7) for the tone.
+        let m = &mut scene.head.material;
+        if m.base_color.is_some() {
+            anyhow::bail!("--skin-tone sets the albedo of an untextured skin; the scene's skin has an albedo texture, its own colour");
+        }
+        m.base_color_factor = crate::skin::colour::lut::tone_albedo(tone).map(|c| c as f32);
+    }
     crate::checks::ran("scene");
     Ok(scene)
 }

@@ -446,6 +446,7 @@ pub fn load_gltf_scene(
         clip: overrides.clip.clone(),
         crowd_seed: None,
         time_step: None,
+        skin_tone: None,
     });
     Ok(scene)
 }

@@ -59,6 +59,26 @@ pub struct SceneSource {
     /// `DEFAULT_SEED`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_seed: Option<u64>,
+    /// The skin's albedo from the two-layer skin model at a tone of the
+    /// melanin axis (`--skin-tone`; `skin::colour::lut::tone_albedo`), for a
+    /// skin without an albedo texture. Applied by the command wing's
+    /// `load_scene` (the model lives above the scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skin_tone: Option<SkinTone>,
+}
+
+/// Three skin tones along the melanin axis (thesis ch. 7's model:
+/// `skin::colour::lut` gives each its melanin and albedo).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SkinTone {
+    Light,
+    Medium,
+    Dark,
+}
+
+impl SkinTone {
+    pub const ALL: [SkinTone; 3] = [SkinTone::Light, SkinTone::Medium, SkinTone::Dark];
 }
 
 impl SceneSource {
@@ -145,6 +165,7 @@ impl SceneSource {
         }
         scene.set_morph_weights(&weights)?;
         if let Some(src) = &mut scene.source {
+            src.skin_tone = self.skin_tone;
             src.morph_weights = self.morph_weights.clone();
             src.time = self.time;
             src.clip = self.clip.clone();

@@ -386,6 +386,56 @@ fn reference_and_compare() {
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).starts_with("error: "));
 }
 
+// `--skin-tone`: the face's skin takes the two-layer model's albedo for the
+// tone (thesis ch. 7; `skin::colour::lut`), the report keeps it, a darker
+// tone renders a darker face; a skin with an albedo texture refuses it in one
+// line.
+#[test]
+fn skin_tone_colours_the_face_from_the_skin_model() {
+    let mean = |tone: &str| {
+        let d = tmp(&format!("tone-{tone}"));
+        run_ok(&[
+            "render",
+            "--validate",
+            "--device",
+            "llvmpipe",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--warmup",
+            "0",
+            "--frames",
+            "1",
+            "--skin-tone",
+            tone,
+            "--out",
+            d.to_str().unwrap(),
+        ]);
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
+        assert_eq!(report["settings"]["scene"]["skin_tone"], tone, "{report}");
+        let img = image::open(d.join("frame.png")).unwrap().to_rgb8();
+        let centre = img.get_pixel(32, 24);
+        centre.0.iter().map(|&c| c as f64).sum::<f64>()
+    };
+    let (light, dark) = (mean("light"), mean("dark"));
+    assert!(light > dark + 30.0, "light {light} dark {dark}");
+    let dir = tmp("tone-textured");
+    let png = {
+        let mut out = std::io::Cursor::new(Vec::new());
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 150, 120, 255]))
+            .write_to(&mut out, image::ImageFormat::Png)
+            .unwrap();
+        out.into_inner()
+    };
+    let scene = Model::grid(4, png).write(Container::Glb, &dir, "textured");
+    fails_with(
+        &["--scene", scene.to_str().unwrap(), "--skin-tone", "dark"],
+        "--skin-tone sets the albedo of an untextured skin",
+    );
+}
+
 // `eval --compare-texturing`: every setting swept twice, each texturing
 // against its own truth; the post-scatter rows marked in eval.json and
 // eval.csv, its summary apart, texturing.png/svg beside the chart.

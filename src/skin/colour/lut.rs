@@ -12,6 +12,7 @@
 
 use super::colorimetry::linear_srgb;
 use super::layers::{reflectance, Chromophores};
+use crate::scene::source::SkinTone;
 
 /// Table 7.1's largest melanin and dermal haemoglobin fractions.
 pub const MAX_MELANIN: f64 = 0.5;
@@ -69,39 +70,29 @@ impl ColourTable {
     }
 }
 
-/// Three skin tones along the melanin axis, at a fair blood fraction (2%):
-/// the melanosome fractions of light, moderately and darkly pigmented skin
-/// (Jacques, OMLC: 1.3-6.3%, 11-16%, 18-43%; each range's middle).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Tone {
-    Light,
-    Medium,
-    Dark,
+/// A fair dermal blood fraction (2%) the tones share.
+pub const TONE_DERMAL_BLOOD: f64 = 0.02;
+
+/// The melanin fraction of each tone: the middle of the melanosome
+/// fractions of light, moderately and darkly pigmented skin (Jacques, OMLC:
+/// 1.3-6.3%, 11-16%, 18-43%).
+pub fn tone_melanin(t: SkinTone) -> f64 {
+    match t {
+        SkinTone::Light => 0.038,
+        SkinTone::Medium => 0.135,
+        SkinTone::Dark => 0.305,
+    }
 }
 
-impl Tone {
-    pub const ALL: [Tone; 3] = [Tone::Light, Tone::Medium, Tone::Dark];
-    pub const DERMAL_BLOOD: f64 = 0.02;
+/// The tone's table coordinates.
+pub fn tone_coordinates(t: SkinTone) -> (f64, f64) {
+    coordinates(tone_melanin(t), TONE_DERMAL_BLOOD)
+}
 
-    /// The tone's melanin fraction.
-    pub fn melanin(self) -> f64 {
-        match self {
-            Tone::Light => 0.038,
-            Tone::Medium => 0.135,
-            Tone::Dark => 0.305,
-        }
-    }
-
-    /// Its table coordinates.
-    pub fn coordinates(self) -> (f64, f64) {
-        coordinates(self.melanin(), Tone::DERMAL_BLOOD)
-    }
-
-    /// Its linear sRGB albedo.
-    pub fn albedo(self) -> [f64; 3] {
-        let (u, v) = self.coordinates();
-        colour(u, v)
-    }
+/// The tone's linear sRGB albedo.
+pub fn tone_albedo(t: SkinTone) -> [f64; 3] {
+    let (u, v) = tone_coordinates(t);
+    colour(u, v)
 }
 
 #[cfg(test)]
@@ -197,7 +188,7 @@ mod tests {
     // blue).
     #[test]
     fn three_tones_along_melanin() {
-        let [light, medium, dark] = Tone::ALL.map(Tone::albedo);
+        let [light, medium, dark] = SkinTone::ALL.map(tone_albedo);
         for c in 0..3 {
             assert!(
                 light[c] > medium[c] && medium[c] > dark[c],
