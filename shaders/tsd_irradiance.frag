@@ -33,7 +33,7 @@ void main() {
     vec3 L = normalize(frame.lightDir.xyz);
     float shadow = shadowPcf(vWorldPos, Nv);
     vec3 irradiance = diffuseLight(albedo, N, shadow);
-    if (frame.params.w > 0.5) {
+    if (frame.params.w + NOT_UNIFORM_ZERO > 0.5) {
         // Transmittance (thesis Listing 5.1), as the geometry pass adds it: part
         // of the light the maps blur.
         vec3 c = shadowCoord(vWorldPos - frame.params.z * Nv);

@@ -117,7 +117,11 @@ pub fn run(a: &EvalArgs, given: &Given) -> Result<()> {
     let head_source = if a.scenes.starts_with("accuracy") {
         SceneSource::default()
     } else {
-        source.clone()
+        // The views keep their scenes' own colours (a note says so).
+        SceneSource {
+            skin_tone: None,
+            ..source.clone()
+        }
     };
     let scenes = load_scenes(&specs, &head_source)?;
     let configs = sweep::select(sweep::registry(), &a.only)?;
@@ -294,6 +298,12 @@ pub fn sweep(
         );
         b
     });
+    let started = std::time::Instant::now();
+    let log_steps = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        ""
+    } else {
+        "eval"
+    };
     let once = RunOptions::capture_once("eval");
     let measured = RunOptions {
         frames: counts,
@@ -305,6 +315,16 @@ pub fn sweep(
         let step = |what: &str| {
             if let Some(b) = &bar {
                 b.set_message(format!("{}: {what}", spec.name));
+                // Without a terminal the bar draws nothing: a line per step
+                // keeps a log (a device run's) telling where the sweep is.
+                if !log_steps.is_empty() {
+                    eprintln!(
+                        "{log_steps}: {} s, {}/{total}: {}: {what}",
+                        started.elapsed().as_secs(),
+                        b.position(),
+                        spec.name
+                    );
+                }
             }
         };
         step("reference");

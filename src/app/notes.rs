@@ -59,6 +59,13 @@ pub fn ignored(command: &Command, given: &Given) -> Vec<String> {
                 &["light_azimuth", "light_elevation"],
                 "each view of eval's scene sets has its own key light",
             );
+            note(
+                &["skin_tone"],
+                "eval's views keep their scenes' own skin colours",
+            );
+            if e.compare_texturing {
+                note(&["texturing"], "--compare-texturing sweeps both texturings");
+            }
             if e.scenes != "quick" {
                 note(
                     &["distance", "shot"],

@@ -184,7 +184,12 @@ pub fn gather_f64(
             }
             let pt = PixelPoint::new(view, &inv, surface, (linear_depth[i], d0[3]), i);
             // Narrow part: windowed, weight-normalised sums per Gaussian.
-            let px_per_mm = scale.px_per_mm(linear_depth[i]) * d0[3];
+            // As the shaders: millimetres per unit over the strength first.
+            let px_per_mm = ViewScale {
+                mm_per_unit: view.mm_per_unit / d0[3],
+                ..scale
+            }
+            .px_per_mm(linear_depth[i]);
             let r = radius(px_per_mm, surface.s) as i64;
             let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
             let mut norm = [0.0f64; NARROW_GAUSSIANS];
@@ -271,7 +276,12 @@ pub fn gather_f64_burley(
             let (x, y) = (i % view.width, i / view.width);
             // The pixel's point on the subsample grid (continuous coordinates).
             let (gx, gy) = ((x as f64 + 0.5) * s as f64, (y as f64 + 0.5) * s as f64);
-            let px_per_mm = scale.px_per_mm(linear_depth[i]) * d0[3];
+            // As the shaders: millimetres per unit over the strength first.
+            let px_per_mm = ViewScale {
+                mm_per_unit: view.mm_per_unit / d0[3],
+                ..scale
+            }
+            .px_per_mm(linear_depth[i]);
             let r = burley::radius(px_per_mm, surface.s) as i64;
             let mut sum = [0.0f64; 3];
             let mut norm = [0.0f64; 3];

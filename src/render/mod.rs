@@ -52,7 +52,9 @@ pub struct Capture {
     pub samples: Vec<PassSample>,
     /// The diffuse light after SSS (what the composite reads; with
     /// post-scatter texturing times the albedo, as the composite applies
-    /// it), linear float; alpha is the SSS strength, so alpha > 0 marks skin.
+    /// it), linear float; alpha is the SSS strength, so alpha > 0 marks skin
+    /// that scatters (a texel of strength 0 reads as not skin: the scores
+    /// leave it out).
     pub diffuse: Vec<[f32; 4]>,
     /// Linear view depth of every pixel, scene units (where the accuracy
     /// bands find depth steps).

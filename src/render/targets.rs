@@ -117,15 +117,15 @@ pub fn declare(
     let post_scatter = !settings.texturing.is_pre();
     let albedo = post_scatter.then(|| res.declare(ImageDesc::new("albedo", extent, ALBEDO_FORMAT)));
     let multisampled = if msaa > 1 {
-        check_msaa(
-            ctx,
-            msaa,
-            &[
-                (DIFFUSE_FORMAT, false),
-                (LINEAR_DEPTH_FORMAT, false),
-                (ds_format, true),
-            ],
-        )?;
+        let mut formats = vec![
+            (DIFFUSE_FORMAT, false),
+            (LINEAR_DEPTH_FORMAT, false),
+            (ds_format, true),
+        ];
+        if post_scatter {
+            formats.push((ALBEDO_FORMAT, false));
+        }
+        check_msaa(ctx, msaa, &formats)?;
         let mut ms = |name: &str, format| {
             res.declare(
                 ImageDesc::new(&format!("{name} {msaa}x"), extent, format).with_samples(msaa),

@@ -290,13 +290,14 @@ impl Tsd {
     pub(super) fn final_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let ds = f.targets.depth_stencil;
         let first_map = self.characters[0].map;
-        // The map, and the strength of the material's per-texel parameters.
+        // The map, and the strength of the material's per-texel parameters
+        // (after the discard where no map is near: at most one a fragment).
         let texel = Fetch {
             texture: "specTex".into(),
             format: Format::Rgba8Unorm,
             filter: Filter::Bilinear,
             count: 1.0,
-            exact: true,
+            exact: false,
             coherent: true,
             spread: Vec::new(),
         };

@@ -150,14 +150,20 @@ pub fn slab(m: &Medium, d: f64, eta_lit: f64, eta_far: f64) -> (f64, f64) {
     (0.5 * a * r, 0.5 * a * t)
 }
 
+/// Total diffuse reflectance of an epidermis `EPIDERMIS_MM` thick over a
+/// semi-infinite dermis (module docs: the two-direction adding).
+pub fn stack(epi: &Medium, derm: &Medium) -> f64 {
+    // The interface between the layers matches (one index): A = A(1).
+    let (r_down, t_down) = slab(epi, EPIDERMIS_MM, ETA, 1.0);
+    let (r_up, t_up) = slab(epi, EPIDERMIS_MM, 1.0, ETA);
+    let r2 = semi_infinite_reflectance(derm, 1.0);
+    r_down + t_down * r2 * t_up / (1.0 - r_up * r2)
+}
+
 /// Total diffuse reflectance of skin `c` at sample `i`.
 pub fn reflectance_at(c: &Chromophores, i: usize) -> f64 {
     let (epi, derm) = layers(c, i);
-    // The interface between the layers matches (one index): A = A(1).
-    let (r_down, t_down) = slab(&epi, EPIDERMIS_MM, ETA, 1.0);
-    let (r_up, t_up) = slab(&epi, EPIDERMIS_MM, 1.0, ETA);
-    let r2 = semi_infinite_reflectance(&derm, 1.0);
-    r_down + t_down * r2 * t_up / (1.0 - r_up * r2)
+    stack(&epi, &derm)
 }
 
 /// The reflectance spectrum of skin `c`.
@@ -198,10 +204,10 @@ mod tests {
                 scattering,
             };
             let deep = semi_infinite_reflectance(&m, ETA);
+            let stack = stack(&m, &m);
+            // The one-direction adding, for the check that the test can fail.
             let (r_down, t_down) = slab(&m, EPIDERMIS_MM, ETA, 1.0);
-            let (r_up, t_up) = slab(&m, EPIDERMIS_MM, 1.0, ETA);
             let r2 = semi_infinite_reflectance(&m, 1.0);
-            let stack = r_down + t_down * r2 * t_up / (1.0 - r_up * r2);
             let same = r_down + t_down * r2 * t_down / (1.0 - r_down * r2);
             println!("sigma_a {absorption}, sigma_s' {scattering}: deep {deep:.4}, stacked {stack:.4}, one-direction {same:.4}");
             assert!((stack / deep - 1.0).abs() < 0.01, "{stack} vs {deep}");

@@ -6,9 +6,10 @@
 //! Table 7.1's ranges, so the table spans them edge to edge: C_m = 0.5 u^3,
 //! C_hd = 0.32 v^3, with the figure's 61% eumelanin and C_he = 0.25 C_hd.
 //! Each entry is the two-layer model's total diffuse reflectance (`layers`)
-//! under D65 (`colorimetry`). The renderer multiplies its scattered,
-//! colourless light by the entry at each texel's (u, v): post-scatter
-//! texturing, as the thesis renders.
+//! under D65 (`colorimetry`). The thesis multiplies its scattered,
+//! colourless light by the entry at each texel's (u, v), post-scatter
+//! texturing; dermis does not upload the table yet (`--skin-tone` takes one
+//! entry as an untextured skin's albedo).
 
 use super::colorimetry::linear_srgb;
 use super::layers::{reflectance, Chromophores};

@@ -2,7 +2,7 @@
 //! colorimetry from a reflectance spectrum to linear sRGB, the two-layer
 //! skin model's total diffuse reflectance and the skin-colour lookup table
 //! indexed by the cube roots of melanin and haemoglobin (eq. 7.7). Pure
-//! math: the renderer uploads the table.
+//! math; the renderer does not upload the table yet.
 
 pub mod colorimetry;
 pub mod layers;
