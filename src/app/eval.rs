@@ -279,6 +279,41 @@ pub fn plan_sweep<'s>(
         .collect()
 }
 
+/// The sweep's progress: a bar on a terminal; without one (a device run's
+/// log) the bar draws nothing, so a line per step tells where it is.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    log: bool,
+    started: std::time::Instant,
+}
+
+impl Progress {
+    fn new(total: usize) -> Progress {
+        let bar = indicatif::ProgressBar::new(total as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        Progress {
+            bar,
+            log: !std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            started: std::time::Instant::now(),
+        }
+    }
+
+    fn step(&self, view: &str, what: &str) {
+        self.bar.set_message(format!("{view}: {what}"));
+        if self.log {
+            eprintln!(
+                "eval: {} s, {}/{}: {view}: {what}",
+                self.started.elapsed().as_secs(),
+                self.bar.position(),
+                self.bar.length().unwrap_or(0)
+            );
+        }
+    }
+}
+
 /// Renders the sweep; one row per (view, config).
 pub fn sweep(
     ctx: &Context,
@@ -290,20 +325,7 @@ pub fn sweep(
         .iter()
         .map(|v| v.configs.len() + 1 + v.burley.is_some() as usize)
         .sum();
-    let bar = progress.then(|| {
-        let b = indicatif::ProgressBar::new(total as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg:<40} [{bar:30}] {pos}/{len} ({eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    });
-    let started = std::time::Instant::now();
-    let log_steps = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        ""
-    } else {
-        "eval"
-    };
+    let bar = progress.then(|| Progress::new(total));
     let once = RunOptions::capture_once("eval");
     let measured = RunOptions {
         frames: counts,
@@ -314,17 +336,7 @@ pub fn sweep(
         let spec = view.spec;
         let step = |what: &str| {
             if let Some(b) = &bar {
-                b.set_message(format!("{}: {what}", spec.name));
-                // Without a terminal the bar draws nothing: a line per step
-                // keeps a log (a device run's) telling where the sweep is.
-                if !log_steps.is_empty() {
-                    eprintln!(
-                        "{log_steps}: {} s, {}/{total}: {}: {what}",
-                        started.elapsed().as_secs(),
-                        b.position(),
-                        spec.name
-                    );
-                }
+                b.step(&spec.name, what);
             }
         };
         step("reference");
@@ -338,7 +350,7 @@ pub fn sweep(
                     .capture
                     .context("Burley's reference capture")?;
                 if let Some(b) = &bar {
-                    b.inc(1);
+                    b.bar.inc(1);
                 }
                 Some(c)
             }
@@ -385,7 +397,7 @@ pub fn sweep(
             mm_per_unit,
         ));
         if let Some(b) = &bar {
-            b.inc(1);
+            b.bar.inc(1);
         }
         for (i, (c, p, f)) in view.configs.iter().enumerate() {
             let out = match (none_at == Some(i)).then(|| none_run.take()).flatten() {
@@ -430,12 +442,12 @@ pub fn sweep(
                 texturing: f.settings().texturing,
             });
             if let Some(b) = &bar {
-                b.inc(1);
+                b.bar.inc(1);
             }
         }
     }
     if let Some(b) = bar {
-        b.finish_and_clear();
+        b.bar.finish_and_clear();
     }
     Ok(rows)
 }

@@ -227,9 +227,21 @@ pub fn raster_floor_ms(work: &Work, counts: Counts, c: &Ceilings) -> Option<f64>
         let writes_depth = depth_stencil.is_some_and(|d| d.depth_write);
         match c.fill_geometry_mrt_gpix {
             Some(rate)
-                if formats == GEOMETRY_MRT && writes_depth && !color.iter().any(|w| w.blend) =>
+                if formats.starts_with(&GEOMETRY_MRT)
+                    && writes_depth
+                    && !color.iter().any(|w| w.blend) =>
             {
                 fill_s = written / (rate * 1e9);
+                // Targets beyond the probed set (poisson's normals,
+                // post-scatter texturing's albedo) through the ROPs after
+                // it, each at its single-target rate. (Before, such a pass
+                // summed single-target rates alone and left the unprobed
+                // R32F out: its floor fell below the 3-target pass's.)
+                for w in &color[GEOMETRY_MRT.len()..] {
+                    if let Some(rate) = fill_rate(c, w) {
+                        fill_s += written / (rate * 1e9);
+                    }
+                }
                 counted = true;
             }
             _ => {
@@ -619,6 +631,27 @@ mod tests {
         };
         let ms = pass_floor(Some(&g), counts, &old).unwrap();
         assert!((ms - 1.0).abs() < 1e-9, "{ms}");
+        // A fourth target (post-scatter's albedo, RGBA16F) adds its own
+        // fill after the probed set's: never less than the 3-target pass.
+        let mut with_albedo = GEOMETRY_MRT
+            .iter()
+            .map(|&format| ColorWrite {
+                format,
+                blend: false,
+            })
+            .collect::<Vec<_>>();
+        with_albedo.push(ColorWrite {
+            format: Format::Rgba16Float,
+            blend: false,
+        });
+        let post = mesh_pass(g_shader_of(&g), with_albedo, ds, 200_000);
+        let ms = pass_floor(Some(&post), counts, &old).unwrap();
+        let single = 2e6 / (old.fill_rgba16f_gpix * 1e9) * 1e3;
+        assert!(
+            (ms - (1.0 + single)).abs() < 1e-9,
+            "{ms} vs {}",
+            1.0 + single
+        );
         // 20 M triangles: 10 ms, set-up bound.
         let dense = mesh_pass(
             g_shader_of(&g),
