@@ -154,22 +154,37 @@ pub(crate) fn energy_ratio_against(
             Output::PixelFilter => (left - right) * spread[c],
         };
         for y in 0..rows {
-            let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
-            let mean =
-                |r: std::ops::Range<usize>| r.clone().map(|x| row[x]).sum::<f64>() / r.len() as f64;
-            let (own_left, own_right) = (mean(2..6), mean(w - 6..w - 2));
-            let moved = Row {
-                values: &row,
-                edge_px: w / 2,
-                mm_per_px,
-            }
-            .energy_moved(own_right)
-                * (left - right)
-                / (own_left - own_right);
+            let (moved, ..) = row_moved(out, w, y, c, mm_per_px, left - right);
             ratio[c] += moved / exact / rows as f64;
         }
     }
     ratio
+}
+
+/// Row `y`'s energy moved across the step in channel `c`, measured against
+/// its own far levels (the mean of 4 pixels 2 from each end) and scaled to
+/// the unscattered `contrast`; also the row and its own levels, for
+/// pointwise checks.
+pub(crate) fn row_moved(
+    out: &[[f32; 4]],
+    w: usize,
+    y: usize,
+    c: usize,
+    mm_per_px: f64,
+    contrast: f64,
+) -> (f64, Vec<f64>, [f64; 2]) {
+    let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
+    let mean = |r: std::ops::Range<usize>| r.clone().map(|x| row[x]).sum::<f64>() / r.len() as f64;
+    let (own_left, own_right) = (mean(2..6), mean(w - 6..w - 2));
+    let moved = Row {
+        values: &row,
+        edge_px: w / 2,
+        mm_per_px,
+    }
+    .energy_moved(own_right)
+        * contrast
+        / (own_left - own_right);
+    (moved, row, [own_left, own_right])
 }
 
 pub(crate) fn render_card(
@@ -349,18 +364,8 @@ fn burley_truth_edge_response_against_its_closed_form() {
         }
         .energy_moved(right * burley.albedo[c]);
         for y in 0..rows {
-            let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
-            let mean =
-                |r: std::ops::Range<usize>| r.clone().map(|x| row[x]).sum::<f64>() / r.len() as f64;
-            let (own_left, own_right) = (mean(2..6), mean(w - 6..w - 2));
-            let moved = Row {
-                values: &row,
-                edge_px: w / 2,
-                mm_per_px,
-            }
-            .energy_moved(own_right)
-                * (left - right)
-                / (own_left - own_right);
+            let (moved, row, [own_left, own_right]) =
+                row_moved(&out, w, y, c, mm_per_px, left - right);
             ratio[c] += moved / want / rows as f64;
             // Pointwise, on rows away from the frame's top and bottom (where
             // the screen pass's window is cut off, as the six Gaussians' is):

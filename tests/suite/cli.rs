@@ -436,24 +436,16 @@ fn skin_tone_colours_the_face_from_the_skin_model() {
     );
 }
 
-// `eval --compare-texturing`: every setting swept twice, each texturing
-// against its own truth; the post-scatter rows marked in eval.json and
-// eval.csv, its summary apart, texturing.png/svg beside the chart.
-#[test]
-fn eval_compares_pre_and_post_scatter_texturing() {
-    let d = tmp("eval-texturing");
-    run_ok(&[
+/// `dermis eval` on the quick scene at 96x64, one frame a setting, the
+/// truth at density 8, under validation, with `extra` options, into `out`.
+fn eval_quick(out: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec![
         "eval",
         "--validate",
         "--device",
         "llvmpipe",
         "--scenes",
         "quick",
-        "--only",
-        "none",
-        "--only",
-        "separable/33 samples",
-        "--compare-texturing",
         "--width",
         "96",
         "--height",
@@ -465,8 +457,28 @@ fn eval_compares_pre_and_post_scatter_texturing() {
         "--density",
         "8",
         "--out",
-        d.to_str().unwrap(),
-    ]);
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args)
+}
+
+// `eval --compare-texturing`: every setting swept twice, each texturing
+// against its own truth; the post-scatter rows marked in eval.json and
+// eval.csv, its summary apart, texturing.png/svg beside the chart.
+#[test]
+fn eval_compares_pre_and_post_scatter_texturing() {
+    let d = tmp("eval-texturing");
+    eval_quick(
+        &d,
+        &[
+            "--only",
+            "none",
+            "--only",
+            "separable/33 samples",
+            "--compare-texturing",
+        ],
+    );
     let typed: dermis::eval::sweep::EvalReport =
         serde_json::from_slice(&std::fs::read(d.join("eval.json")).unwrap()).unwrap();
     use dermis::render::settings::Texturing;
@@ -496,26 +508,7 @@ fn eval_compares_pre_and_post_scatter_texturing() {
 #[test]
 fn eval_writes_csv_json_and_chart() {
     let d = tmp("eval");
-    run_ok(&[
-        "eval",
-        "--validate",
-        "--device",
-        "llvmpipe",
-        "--scenes",
-        "quick",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--warmup",
-        "0",
-        "--frames",
-        "1",
-        "--density",
-        "8",
-        "--out",
-        d.to_str().unwrap(),
-    ]);
+    eval_quick(&d, &[]);
     let csv = std::fs::read_to_string(d.join("eval.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), dermis::eval::sweep::registry().len(), "{csv}");

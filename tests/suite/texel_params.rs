@@ -9,7 +9,9 @@
 //!   closed form's moved energy is linear in every sigma);
 //! - a map of 255 changes no bit; a roughness map replaces the material's m.
 
-use crate::accuracy::{card_scene, card_settings, energy_ratio_against, render_card, Output};
+use crate::accuracy::{
+    card_scene, card_settings, energy_ratio_against, render_card, row_moved, Output,
+};
 use crate::common;
 
 use dermis::render::RenderSettings;
@@ -148,18 +150,7 @@ pub(crate) fn truth_ratio(
         }
         .energy_moved(exact[w - 1]);
         for y in 0..rows {
-            let row: Vec<f64> = (0..w).map(|x| out[y * w + x][c] as f64).collect();
-            let mean =
-                |r: std::ops::Range<usize>| r.clone().map(|x| row[x]).sum::<f64>() / r.len() as f64;
-            let (own_left, own_right) = (mean(2..6), mean(w - 6..w - 2));
-            let moved = Row {
-                values: &row,
-                edge_px: w / 2,
-                mm_per_px,
-            }
-            .energy_moved(own_right)
-                * (left - right)
-                / (own_left - own_right);
+            let (moved, ..) = row_moved(out, w, y, c, mm_per_px, left - right);
             ratio[c] += moved / want / rows as f64;
         }
     }
