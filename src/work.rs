@@ -81,6 +81,23 @@ pub struct Fetch {
     pub spread: Vec<Spread>,
 }
 
+impl Fetch {
+    /// At most one bilinear fetch of a skin material's RGBA8 texture (level
+    /// 0; `exact`: every invocation makes it). Texels are shaded in the
+    /// surface's own order, so neighbours fetch neighbours.
+    pub fn material(texture: &str, exact: bool) -> Fetch {
+        Fetch {
+            texture: texture.into(),
+            format: Format::Rgba8Unorm,
+            filter: Filter::Bilinear,
+            count: 1.0,
+            exact,
+            coherent: true,
+            spread: Vec::new(),
+        }
+    }
+}
+
 /// `share` of a pass's invocations tap within about `radius_px` pixels of
 /// their own pixel (one character's kernel at its depth: a frame of several
 /// characters has one entry per character and ring).

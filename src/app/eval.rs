@@ -312,6 +312,10 @@ impl Progress {
             );
         }
     }
+
+    fn inc(&self) {
+        self.bar.inc(1);
+    }
 }
 
 /// Renders the sweep; one row per (view, config).
@@ -350,7 +354,7 @@ pub fn sweep(
                     .capture
                     .context("Burley's reference capture")?;
                 if let Some(b) = &bar {
-                    b.bar.inc(1);
+                    b.inc();
                 }
                 Some(c)
             }
@@ -397,7 +401,7 @@ pub fn sweep(
             mm_per_unit,
         ));
         if let Some(b) = &bar {
-            b.bar.inc(1);
+            b.inc();
         }
         for (i, (c, p, f)) in view.configs.iter().enumerate() {
             let out = match (none_at == Some(i)).then(|| none_run.take()).flatten() {
@@ -442,7 +446,7 @@ pub fn sweep(
                 texturing: f.settings().texturing,
             });
             if let Some(b) = &bar {
-                b.bar.inc(1);
+                b.inc();
             }
         }
     }

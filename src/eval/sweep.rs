@@ -309,7 +309,7 @@ pub fn write_csv(path: &std::path::Path, rows: &[EvalRow]) -> Result<()> {
                 f.push(r.profile.name().to_string());
             }
             if texturing {
-                f.push(texturing_name(r.texturing).to_string());
+                f.push(r.texturing.name().to_string());
             }
             f
         })
@@ -341,14 +341,6 @@ pub struct EvalReport {
     /// holds its rows too, marked); `summary` is then the pre-scatter one.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub post_scatter_summary: Vec<SummaryRow>,
-}
-
-/// The name `--texturing` gives `t`.
-pub fn texturing_name(t: Texturing) -> &'static str {
-    match t {
-        Texturing::Pre => "pre",
-        Texturing::Post => "post",
-    }
 }
 
 /// A view's scene: the embedded face, or the file (no textures given).

@@ -45,8 +45,10 @@ pub struct SurfaceImages<'a> {
 /// measured in units of t mm, as the GPU passes measure them.
 struct PixelPoint {
     /// Millimetres per scene unit over the strength (the tissue test keeps
-    /// the view's own).
+    /// the view's own), and pixels per such millimetre at the pixel's depth,
+    /// in the shaders' float order (the windows' radii follow it).
     mm_over_t: f64,
+    px_per_mm: f32,
     x_o: DVec3,
     x_o32: [f32; 3],
     n_o: [f32; 3],
@@ -66,6 +68,11 @@ impl PixelPoint {
     ) -> Self {
         let (s, sw) = (surface.s as usize, view.width * surface.s as usize);
         let (x, y) = (i % view.width, i / view.width);
+        let px_per_mm = ViewScale {
+            mm_per_unit: view.mm_per_unit / strength,
+            ..view_scale(view)
+        }
+        .px_per_mm(z);
         let z = z as f64;
         let ndc_x = (x as f64 + 0.5) / view.width as f64 * 2.0 - 1.0;
         let ndc_y = (y as f64 + 0.5) / view.height as f64 * 2.0 - 1.0;
@@ -77,6 +84,7 @@ impl PixelPoint {
         let n = surface.normal[centre];
         PixelPoint {
             mm_over_t: (view.mm_per_unit / strength) as f64,
+            px_per_mm,
             x_o,
             x_o32: x_o.as_vec3().to_array(),
             n_o: [n[0], n[1], n[2]],
@@ -175,7 +183,6 @@ pub fn gather_f64(
     radiance: &[[f32; 4]],
 ) -> Vec<[f64; 4]> {
     let inv = DMat4::from_cols_array(&view.inv_view.to_cols_array().map(|v| v as f64));
-    let scale = view_scale(view);
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
@@ -184,12 +191,7 @@ pub fn gather_f64(
             }
             let pt = PixelPoint::new(view, &inv, surface, (linear_depth[i], d0[3]), i);
             // Narrow part: windowed, weight-normalised sums per Gaussian.
-            // As the shaders: millimetres per unit over the strength first.
-            let px_per_mm = ViewScale {
-                mm_per_unit: view.mm_per_unit / d0[3],
-                ..scale
-            }
-            .px_per_mm(linear_depth[i]);
+            let px_per_mm = pt.px_per_mm;
             let r = radius(px_per_mm, surface.s) as i64;
             let mut sum = [[0.0f64; 3]; NARROW_GAUSSIANS];
             let mut norm = [0.0f64; NARROW_GAUSSIANS];
@@ -265,7 +267,6 @@ pub fn gather_f64_burley(
         burley::far_weight(),
     );
     let s = surface.s as usize;
-    let scale = view_scale(view);
     (0..view.width * view.height)
         .map(|i| {
             let d0 = diffuse[i];
@@ -276,12 +277,7 @@ pub fn gather_f64_burley(
             let (x, y) = (i % view.width, i / view.width);
             // The pixel's point on the subsample grid (continuous coordinates).
             let (gx, gy) = ((x as f64 + 0.5) * s as f64, (y as f64 + 0.5) * s as f64);
-            // As the shaders: millimetres per unit over the strength first.
-            let px_per_mm = ViewScale {
-                mm_per_unit: view.mm_per_unit / d0[3],
-                ..scale
-            }
-            .px_per_mm(linear_depth[i]);
+            let px_per_mm = pt.px_per_mm;
             let r = burley::radius(px_per_mm, surface.s) as i64;
             let mut sum = [0.0f64; 3];
             let mut norm = [0.0f64; 3];

@@ -543,15 +543,6 @@ impl Frame {
         let t = self.targets;
         debug_assert!(self.frame_set.reads(shadow));
         let shader = geometry_shader(&t);
-        let rgba8 = |texture: &str, exact| Fetch {
-            texture: texture.into(),
-            format: Format::Rgba8Unorm,
-            filter: Filter::Bilinear,
-            count: 1.0,
-            exact,
-            coherent: true,
-            spread: Vec::new(),
-        };
         let shadow_format = res.texel_format(shadow);
         // Per fragment: the 3x3 PCF, the three material maps (the normal map
         // only where the tangent frame is valid), the Beckmann lobe where
@@ -566,8 +557,8 @@ impl Frame {
                 coherent: true,
                 spread: Vec::new(),
             },
-            rgba8("normalTex", false),
-            rgba8("albedoTex", true),
+            Fetch::material("normalTex", false),
+            Fetch::material("albedoTex", true),
             Fetch {
                 texture: "shadowMap".into(),
                 format: shadow_format,
@@ -577,7 +568,7 @@ impl Frame {
                 coherent: true,
                 spread: Vec::new(),
             },
-            rgba8("specTex", true),
+            Fetch::material("specTex", true),
             Fetch {
                 texture: "beckmannTex".into(),
                 format: Format::R16Float,

@@ -160,6 +160,14 @@ impl Texturing {
     pub fn is_pre(&self) -> bool {
         *self == Texturing::Pre
     }
+
+    /// Its name on the command line and in the files (`pre`, `post`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Texturing::Pre => "pre",
+            Texturing::Post => "post",
+        }
+    }
 }
 
 /// The sample counts `--msaa` takes.

@@ -5,7 +5,7 @@
 use ash::vk;
 
 use super::{Reference, GROUP, SURFACE_SHADER};
-use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork, Work};
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork, Work};
 use crate::graph::{ColorTarget, DepthStencil, Load, Pass, PassContext, SetRef};
 use crate::method::profile::Profile;
 use crate::method::screen::fetch;
@@ -53,8 +53,8 @@ impl Reference {
                     )
                 },
                 // Material textures are not frame images: RGBA8 bilinear.
-                material_fetch("normalTex"),
-                material_fetch("albedoTex"),
+                Fetch::material("normalTex", false),
+                Fetch::material("albedoTex", false),
             ],
             alu: alu_estimate(lit, &PCF_TRIPS),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
@@ -118,13 +118,10 @@ impl Reference {
             Filter::DepthCompare,
             9.0,
         );
-        let albedo = Fetch {
-            exact: true,
-            ..material_fetch("albedoTex")
-        };
+        let albedo = Fetch::material("albedoTex", true);
         let work = ShaderWork {
             shader: SURFACE_SHADER.into(),
-            fetches: vec![shadow, material_fetch("normalTex"), albedo],
+            fetches: vec![shadow, Fetch::material("normalTex", false), albedo],
             alu: alu_estimate(SURFACE_SHADER, &PCF_TRIPS),
             ..Default::default()
         };
@@ -339,17 +336,4 @@ fn screen_groups(extent: vk::Extent2D) -> [u32; 3] {
         extent.height.div_ceil(GROUP),
         1,
     ]
-}
-
-/// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
-fn material_fetch(texture: &str) -> Fetch {
-    Fetch {
-        texture: texture.into(),
-        format: Format::Rgba8Unorm,
-        filter: Filter::Bilinear,
-        count: 1.0,
-        exact: false,
-        coherent: true,
-        spread: Vec::new(),
-    }
 }

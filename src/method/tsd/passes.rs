@@ -9,7 +9,7 @@ use super::{
     IRRADIANCE_SHADER, MASK_SHADER,
 };
 use crate::graph::draw::fullscreen;
-use crate::graph::work::{Fetch, Filter, Format, PassRole, ShaderWork};
+use crate::graph::work::{Fetch, Filter, PassRole, ShaderWork};
 use crate::graph::{ColorTarget, DepthStencil, ImageId, Load, Pass, PassContext};
 use crate::method::screen::fetch;
 use crate::method::FrameView;
@@ -140,8 +140,8 @@ impl Tsd {
         };
         let fetches = vec![
             shadow(Filter::DepthCompare, 9.0, !culls),
-            material_fetch("normalTex", false),
-            material_fetch("albedoTex", !culls),
+            Fetch::material("normalTex", false),
+            Fetch::material("albedoTex", !culls),
             shadow(Filter::Point, 1.0, false),
         ];
         let work = ShaderWork {
@@ -290,22 +290,13 @@ impl Tsd {
     pub(super) fn final_pass<'a>(&'a self, f: &FrameView<'a, '_>) -> Pass<'a> {
         let ds = f.targets.depth_stencil;
         let first_map = self.characters[0].map;
-        // The map, and the strength of the material's per-texel parameters
-        // (after the discard where no map is near: at most one a fragment).
-        let texel = Fetch {
-            texture: "specTex".into(),
-            format: Format::Rgba8Unorm,
-            filter: Filter::Bilinear,
-            count: 1.0,
-            exact: false,
-            coherent: true,
-            spread: Vec::new(),
-        };
         let work = ShaderWork {
             shader: FINAL_SHADER.into(),
             fetches: vec![
                 fetch(f.res, first_map, "mapTex", Filter::Bilinear, 1.0),
-                texel,
+                // The strength of the material's per-texel parameters, after
+                // the discard where no map is near: at most one a fragment.
+                Fetch::material("specTex", false),
             ],
             alu: alu_estimate(FINAL_SHADER, &[]),
             ..Default::default()
@@ -340,19 +331,5 @@ fn uv_push(z: f32, threshold: f32, keep_above: f32) -> UvPush {
         z,
         threshold,
         keep_above,
-    }
-}
-
-/// At most one fetch of a skin material's RGBA8 texture (bilinear, level 0).
-fn material_fetch(texture: &str, exact: bool) -> Fetch {
-    Fetch {
-        texture: texture.into(),
-        format: Format::Rgba8Unorm,
-        filter: Filter::Bilinear,
-        count: 1.0,
-        exact,
-        // Texels are shaded in the map's own order: neighbours fetch neighbours.
-        coherent: true,
-        spread: Vec::new(),
     }
 }
