@@ -9,6 +9,9 @@ layout(location = 1) in vec3 vNormal;
 layout(location = 2) in vec4 vTangent;
 layout(location = 3) in vec2 vUv;
 layout(location = 4) in float vViewDepth;
+// The character's wrinkle zone weights (geometry_instanced.vert).
+layout(location = 5) flat in vec4 vZones0;
+layout(location = 6) flat in vec4 vZones1;
 
 layout(location = 0) out vec4 outDiffuse;
 layout(location = 1) out vec4 outSpecular;
@@ -26,7 +29,7 @@ layout(location = WRITE_ALBEDO) out vec4 outAlbedo;
 void main() {
     COUNT_INVOCATION();
     vec3 Nv = normalize(vNormal);
-    vec3 N = shadingNormal(Nv, vTangent, vUv);
+    vec3 N = shadingNormal(Nv, vTangent, vUv, vec4[2](vZones0, vZones1));
     vec3 albedo = albedoAt(vUv);
     vec3 L = normalize(frame.lightDir.xyz);
     vec3 V = normalize(frame.cameraPos.xyz - vWorldPos);

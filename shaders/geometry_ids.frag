@@ -11,8 +11,10 @@ layout(location = 1) in vec3 vNormal;
 layout(location = 2) in vec4 vTangent;
 layout(location = 3) in vec2 vUv;
 layout(location = 4) in float vViewDepth;
+layout(location = 5) flat in vec4 vZones0;
+layout(location = 6) flat in vec4 vZones1;
 layout(location = 0) out vec4 outId;
 void main() {
-    float unused = vWorldPos.x + vNormal.x + vTangent.x + vUv.x + vViewDepth;
+    float unused = vWorldPos.x + vNormal.x + vTangent.x + vUv.x + vViewDepth + vZones0.x + vZones1.x;
     outId = vec4(pc.id, unused, 0.0, 1.0);
 }

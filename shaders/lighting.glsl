@@ -19,12 +19,17 @@ layout(set = 1, binding = 0) uniform texture2D albedoTex;
 layout(set = 1, binding = 1) uniform texture2D normalTex;
 layout(set = 1, binding = 2) uniform texture2D specTex;
 layout(set = 1, binding = 4) uniform sampler materialSampler;
+// Expression wrinkles (thesis ch. 8, src/scene/wrinkle_maps.rs): the
+// partial-derivative wrinkle map (R, G) and two masks of four zones each.
+layout(set = 1, binding = 5) uniform texture2D wrinkleTex;
+layout(set = 1, binding = 6) uniform texture2D wrinkleMask0;
+layout(set = 1, binding = 7) uniform texture2D wrinkleMask1;
 // specTex holds the per-texel parameters (src/scene/texel_params.rs): R a factor
 // of rho_s, G the Beckmann m where maps.x is 1, B a factor of the SSS strength.
 layout(set = 1, binding = 3) uniform MaterialUniforms {
     vec4 baseColor;   // rgb linear factor
     vec4 params;      // x: Beckmann roughness m, y: rho_s, z: SSS strength, w: 1 if skin
-    vec4 maps;        // x: 1 if specTex's G is a roughness map
+    vec4 maps;        // x: 1 if specTex's G is a roughness map, y: 1 if it has wrinkle maps
 } material;
 
 // Thesis eq. 5.12 with the six-Gaussian weights (Listing 5.1); s in millimetres.
@@ -82,13 +87,44 @@ float kelemenSzirmayKalos(vec3 N, vec3 L, vec3 V, float m, float rhoS) {
 }
 
 
-// The tangent-space normal map applied to the vertex normal.
-vec3 shadingNormal(vec3 Nv, vec4 tangent, vec2 uv) {
+// Listing 8.1's sum: the wrinkle map's partial derivatives (decoded -1 + 2 c)
+// times each zone's mask times its weight, zone by zone. `zones` holds the
+// draw's eight zone weights (Table 8.1 summed over the expressions and
+// clamped: src/skin/wrinkles.rs); all 0, or a material without wrinkle maps,
+// fetches nothing (the thesis' far characters, "progressively disabled").
+vec2 wrinkleSlope(vec2 uv, vec4 zones[2]) {
+    // maps.y is a uniform value: NOT_UNIFORM_ZERO keeps lavapipe from
+    // compiling (and leaking) a copy of each shader per bind.
+    if (material.maps.y + NOT_UNIFORM_ZERO < 0.5 || dot(zones[0] + zones[1], vec4(1.0)) <= 0.0)
+        return vec2(0.0);
+    vec2 wrinkles = -1.0 + 2.0 * COUNTED(SITE(1, 5, FK_BILINEAR), textureLod(sampler2D(wrinkleTex, materialSampler), uv, 0.0)).rg;
+    vec4 mask1 = COUNTED(SITE(1, 6, FK_BILINEAR), textureLod(sampler2D(wrinkleMask0, materialSampler), uv, 0.0)) * zones[0];
+    vec4 mask2 = COUNTED(SITE(1, 7, FK_BILINEAR), textureLod(sampler2D(wrinkleMask1, materialSampler), uv, 0.0)) * zones[1];
+    vec2 d = vec2(0.0);
+    d += mask1.r * wrinkles;
+    d += mask1.g * wrinkles;
+    d += mask1.b * wrinkles;
+    d += mask1.a * wrinkles;
+    d += mask2.r * wrinkles;
+    d += mask2.g * wrinkles;
+    d += mask2.b * wrinkles;
+    d += mask2.a * wrinkles;
+    return d;
+}
+
+// The tangent-space normal map applied to the vertex normal, with the
+// draw's wrinkles (`zones`, see wrinkleSlope) added to it as partial
+// derivatives (8.2: the base normal's (x / z, y / z) plus the wrinkles',
+// renormalised). No wrinkle, no change: the normal map's normal as it is.
+vec3 shadingNormal(vec3 Nv, vec4 tangent, vec2 uv, vec4 zones[2]) {
     vec3 T = tangent.xyz - Nv * dot(Nv, tangent.xyz);
     if (dot(T, T) <= 1e-12) return Nv;
     T = normalize(T);
     vec3 B = cross(Nv, T) * tangent.w;
     vec3 tn = COUNTED(SITE(1, 1, FK_BILINEAR), textureLod(sampler2D(normalTex, materialSampler), uv, 0.0)).xyz * 2.0 - 1.0;
+    vec2 wrinkles = wrinkleSlope(uv, zones);
+    if (wrinkles != vec2(0.0))
+        tn = vec3(tn.xy / max(tn.z, 1e-3) + wrinkles, 1.0);
     return normalize(mat3(T, B, Nv) * tn);
 }
 

@@ -10,9 +10,11 @@ struct Sample {
     vec4 posArea;   // world position (scene units), area represented (mm^2)
     vec4 normal;    // vertex normal
     vec4 tangent;   // tangent, w = handedness
-    vec4 uv;        // xy
+    vec4 uv;        // xy; z: the sample's character (its zone weights' index)
 };
 layout(std430, set = 0, binding = 6) readonly buffer Samples { Sample samples[]; };
+// Each character's wrinkle zone weights, two vec4 (src/reference/sampling.rs).
+layout(std430, set = 0, binding = 7) readonly buffer Zones { vec4 zones[]; };
 // One chunk of the samples per draw (storage-buffer ranges are limited): this
 // draw covers rows firstRow.. of the target and samples first.. of the buffer range.
 layout(push_constant) uniform Push { uint count; uint width; uint firstRow; } pc;
@@ -27,7 +29,8 @@ void main() {
     }
     Sample s = samples[i];
     vec3 Nv = normalize(s.normal.xyz);
-    vec3 N = shadingNormal(Nv, s.tangent, s.uv.xy);
+    uint c = uint(s.uv.z + 0.5);
+    vec3 N = shadingNormal(Nv, s.tangent, s.uv.xy, vec4[2](zones[2 * c], zones[2 * c + 1]));
     float shadow = shadowPcf(s.posArea.xyz, Nv);
     outRadiance = vec4(diffuseLight(scatteredAlbedo(albedoAt(s.uv.xy)), N, shadow), 0.0);
 }

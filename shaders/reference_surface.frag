@@ -10,8 +10,9 @@ layout(location = 1) in vec3 vNormal;
 layout(location = 2) in vec4 vTangent;
 layout(location = 3) in vec2 vUv;
 layout(location = 4) in float vViewDepth;
-// model (vertex stage), then: mm of surface per subsample per unit of view depth.
-layout(push_constant) uniform Push { mat4 model; float mmPerSubsamplePerDepth; } pc;
+// model (vertex stage), then: mm of surface per subsample per unit of view
+// depth, and the character's wrinkle zone weights.
+layout(push_constant) uniform Push { mat4 model; float mmPerSubsamplePerDepth; vec4 zones[2]; } pc;
 layout(location = 0) out vec4 outRadiance;
 layout(location = 1) out vec4 outPosition;
 layout(location = 2) out vec4 outNormal;
@@ -20,7 +21,7 @@ const float MAX_GRAZING = 20.0;
 void main() {
     COUNT_INVOCATION();
     vec3 Nv = normalize(vNormal);
-    vec3 N = shadingNormal(Nv, vTangent, vUv);
+    vec3 N = shadingNormal(Nv, vTangent, vUv, pc.zones);
     float shadow = shadowPcf(vWorldPos, Nv);
     outRadiance = vec4(diffuseLight(scatteredAlbedo(albedoAt(vUv)), N, shadow), 1.0);
     // The subsample's footprint on the surface: its side at this depth, over

@@ -8,6 +8,7 @@ layout(set = 2, binding = 0) uniform CharacterUniforms {
     vec4 planes[6];   // world-space clip planes (eq. 3.4); (0,0,0,1) when clipping is off
     vec4 params;      // x: s (eq. 3.1), y: SSS strength, z: cull cosine (Listing 3.2; -2: off)
     vec4 mapInfo;     // x: 1 / T_max, y: largest tap coordinate (see tsd_blur.glsl)
+    vec4 zones[2];    // the character's wrinkle zone weights (lighting.glsl's wrinkleSlope)
 } ch;
 // The atlas: per UV island, atlas = uv * x + yz (skin::tsd_ref::Atlas). A
 // vertex's island is encoded in its tangent's w: sign(w) (1 + island).

@@ -28,7 +28,7 @@ void main() {
         return;
     }
     vec3 Nv = normalize(vNormal);
-    vec3 N = shadingNormal(Nv, vTangent, vUv);
+    vec3 N = shadingNormal(Nv, vTangent, vUv, ch.zones);
     vec3 albedo = scatteredAlbedo(albedoAt(vUv));  // 1 with post-scatter texturing
     vec3 L = normalize(frame.lightDir.xyz);
     float shadow = shadowPcf(vWorldPos, Nv);

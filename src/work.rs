@@ -98,6 +98,18 @@ impl Fetch {
     }
 }
 
+impl Fetch {
+    /// The expression wrinkles' fetches (thesis ch. 8, Listing 8.1): the
+    /// wrinkle map and the two zone masks, one bilinear fetch each where a
+    /// skin pixel's character weighs a zone (Table 8.2's three memory
+    /// accesses), none elsewhere.
+    pub fn wrinkles() -> Vec<Fetch> {
+        ["wrinkleTex", "wrinkleMask0", "wrinkleMask1"]
+            .map(|t| Fetch::material(t, false))
+            .to_vec()
+    }
+}
+
 /// `share` of a pass's invocations tap within about `radius_px` pixels of
 /// their own pixel (one character's kernel at its depth: a frame of several
 /// characters has one entry per character and ring).

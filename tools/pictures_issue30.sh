@@ -5,7 +5,12 @@
 #   the view axis, strong ambient), hard side (90 degrees, almost no ambient) and back
 #   light (165 degrees round: the ears glow by transmittance);
 # - texturing.jpg: the Lee Perry-Smith head close, pre- (left) and post-scatter
-#   (right) texturing (needs ../shared/assets beside the project).
+#   (right) texturing (needs ../shared/assets beside the project);
+# - wrinkles.jpg: the built-in face's six expressions of Table 8.1 (columns: joy,
+#   surprise, fear, anger, disgust, sad) without (top row, --no-wrinkles) and with
+#   their wrinkles (bottom row), under a light from above that rakes the creases;
+#   wrinkles_compound.jpg: surprise, then surprise and anger together (Figure 8.5:
+#   anger cancels the forehead's wrinkles and creases the brows).
 #
 #   bash tools/pictures_issue30.sh
 set -euo pipefail
@@ -36,6 +41,21 @@ for tone in light medium dark; do
   done
 done
 "$M" "$OUT/tones.jpg" 3 "${tiles[@]}"
+rake="--light-azimuth 25 --light-elevation 55 --ambient 0.15"
+top=()
+bottom=()
+for e in joy surprise fear anger disgust sad; do
+  # shellcheck disable=SC2086
+  run "$e-plain" --morph-weights "$e=1" --no-wrinkles --width 300 --height 360 --shot close $rake
+  # shellcheck disable=SC2086
+  run "$e" --morph-weights "$e=1" --width 300 --height 360 --shot close $rake
+  top+=("$T/$e-plain/frame.png")
+  bottom+=("$T/$e/frame.png")
+done
+"$M" "$OUT/wrinkles.jpg" 6 "${top[@]}" "${bottom[@]}"
+# shellcheck disable=SC2086
+run both --morph-weights "surprise=1,anger=1" --width 300 --height 360 --shot close $rake
+"$M" "$OUT/wrinkles_compound.jpg" 2 "$T/surprise/frame.png" "$T/both/frame.png"
 LPS=../shared/assets/lee-perry-smith/LeePerrySmith.glb
 if [ -f "$LPS" ]; then
   for t in pre post; do

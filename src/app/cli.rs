@@ -393,6 +393,10 @@ pub struct FrameArgs {
     /// melanin axis, for a skin without an albedo texture (the built-in face).
     #[arg(long, value_enum, ignore_case = true)]
     pub skin_tone: Option<crate::scene::source::SkinTone>,
+    /// Draw the skin without its expression wrinkles (thesis ch. 8: the built-in face's
+    /// wrinkle maps, shown by the expression weights; a file's from its wrinkle maps).
+    #[arg(long)]
+    pub no_wrinkles: bool,
     /// The skin's Beckmann roughness per texel, m in red (a glTF --scene only).
     #[arg(long)]
     pub roughness_map: Option<PathBuf>,
@@ -400,6 +404,17 @@ pub struct FrameArgs {
     /// under a beard (thesis eq. 4.3-4.4; a glTF --scene only).
     #[arg(long)]
     pub sss_map: Option<PathBuf>,
+    /// The skin's expression wrinkles (thesis ch. 8): a partial-derivative wrinkle
+    /// normal map (x/z, y/z in red and green, 0.5 + 0.5 d), given with its two zone
+    /// masks (Table 8.1's eight zones, four a mask); a glTF --scene only.
+    #[arg(long)]
+    pub wrinkle_map: Option<PathBuf>,
+    /// The first wrinkle mask: red, green, blue, brown zones of Table 8.1 in RGBA.
+    #[arg(long)]
+    pub wrinkle_mask1: Option<PathBuf>,
+    /// The second wrinkle mask: cyan, magenta, orange, grey zones in RGBA.
+    #[arg(long)]
+    pub wrinkle_mask2: Option<PathBuf>,
     /// Texture files beside the scene (or given above) are top-down; by default they
     /// are taken as bottom-up (OpenGL convention), as the Lee Perry-Smith head's are.
     #[arg(long)]

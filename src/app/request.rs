@@ -123,6 +123,9 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         spec_map: a.spec_map.clone(),
         roughness_map: a.roughness_map.clone(),
         sss_map: a.sss_map.clone(),
+        wrinkle_map: a.wrinkle_map.clone(),
+        wrinkle_mask1: a.wrinkle_mask1.clone(),
+        wrinkle_mask2: a.wrinkle_mask2.clone(),
         sidecar_top_down: a.sidecar_top_down,
         mm_per_unit: a.mm_per_unit,
         skin: a.skin.clone(),
@@ -133,6 +136,7 @@ pub fn scene_source(a: &FrameArgs) -> SceneSource {
         crowd_seed: a.crowd_seed,
         time_step: a.time_step,
         skin_tone: a.skin_tone,
+        no_wrinkles: a.no_wrinkles,
     }
 }
 

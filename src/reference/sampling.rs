@@ -78,7 +78,16 @@ pub fn sample_characters_within(
     }
     Ok(characters
         .iter()
-        .flat_map(|(mesh, m)| sample_surface(mesh, &[*m], mm_per_unit, density))
+        .enumerate()
+        .flat_map(|(k, (mesh, m))| {
+            // uv.z: the sample's character (its wrinkle zones' index).
+            sample_surface(mesh, &[*m], mm_per_unit, density)
+                .into_iter()
+                .map(move |mut s| {
+                    s.uv[2] = k as f32;
+                    s
+                })
+        })
         .collect())
 }
 
@@ -244,7 +253,16 @@ mod tests {
         let each =
             sample_characters_within(&[(&a, Mat4::IDENTITY), (&a, moved)], 10.0, 4.0, u64::MAX)
                 .unwrap();
-        assert!(one == each);
+        // The same samples, each naming its character in uv.z (its wrinkle
+        // zones' index).
+        let own = |s: &SurfaceSample| SurfaceSample {
+            uv: [s.uv[0], s.uv[1], 0.0, 0.0],
+            ..*s
+        };
+        assert!(one == each.iter().map(own).collect::<Vec<_>>());
+        assert!(each
+            .iter()
+            .all(|s| s.uv[2] == if s.pos_area[0] < 5.0 { 0.0 } else { 1.0 }));
         let mixed =
             sample_characters_within(&[(&a, Mat4::IDENTITY), (&b, moved)], 10.0, 4.0, u64::MAX)
                 .unwrap();

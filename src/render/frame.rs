@@ -120,6 +120,12 @@ pub struct Frame {
     /// Every character's model matrix in `skin_groups`' order, then the
     /// backdrop's: the shadow, geometry and id passes draw instances of it.
     instance_buffer: Instances,
+    /// Every character's wrinkle zone weights, in frame order
+    /// (`skin::wrinkles::character_zones`), and the head's target names and
+    /// own weights a stepping run weighs each frame's pose by (`None`: a
+    /// skin without wrinkle maps).
+    pub zones: Vec<[f32; 8]>,
+    wrinkle_rig: Option<motion::WrinkleRig>,
     /// The instance buffer as the shadow pipeline's set 0 and the geometry
     /// and id pipelines' set 2 (no frame image: plain sets).
     shadow_set: vk::DescriptorSet,
@@ -151,6 +157,7 @@ impl Frame {
         let every = (0..framing.instances.len()).collect();
         let stepping = Stepping::new(scene, &framing.instances);
         let instances = turned(scene, framing.instances);
+        let (zones, wrinkle_rig) = motion::wrinkle_state(scene, instances.len());
         let f = Frame {
             settings: settings.clone(),
             extent,
@@ -182,6 +189,8 @@ impl Frame {
                 characters: every,
             }],
             instance_buffer: Instances::default(),
+            zones,
+            wrinkle_rig,
             shadow_set: vk::DescriptorSet::null(),
             instance_set: vk::DescriptorSet::null(),
             ids_instance_set: vk::DescriptorSet::null(),
@@ -259,6 +268,9 @@ impl Frame {
                     .map(|(i, p)| (format!("part {i}"), ObjectKind::Part, p)),
             );
         let first = usize::from(scene.backdrop.is_some());
+        // The wrinkle maps go up only where a zone is weighed (or may be:
+        // a stepping run); otherwise nothing reads them.
+        let wrinkled = self.wrinkles_drawn();
         for (k, (name, kind, o)) in objects.enumerate() {
             let copies = match k.checked_sub(first) {
                 Some(i) => object_copies(scene, i, self.instances.len()),
@@ -272,6 +284,7 @@ impl Frame {
                     o,
                     copies,
                     kind.per_character() && self.settings.wants_levels(),
+                    wrinkled,
                 ),
                 &self.pool,
                 &self.geometry_pipeline,
@@ -285,15 +298,23 @@ impl Frame {
     /// The instance buffer of `skin_groups` and the sets that read it.
     fn write_instances(&mut self, ctx: &Context) -> Result<()> {
         self.instance_buffer.destroy(ctx);
-        self.instance_buffer =
-            Instances::new(ctx, &self.skin_groups, &self.instances, self.backdrop)?;
+        self.instance_buffer = Instances::new(
+            ctx,
+            &self.skin_groups,
+            (&self.instances, &self.zones),
+            self.backdrop,
+        )?;
         let bind = [self.instance_buffer.binding()];
         self.shadow_set = self.pool.write_set(ctx, &self.shadow_pipeline, 0, &bind)?;
+        // The geometry pass's vertex shader reads each slot's wrinkle zones too.
+        let with_zones = [bind[0], self.instance_buffer.zones_binding()];
         self.instance_set = self
             .pool
-            .write_set(ctx, &self.geometry_pipeline, 2, &bind)?;
+            .write_set(ctx, &self.geometry_pipeline, 2, &with_zones)?;
         if self.character_ids.is_some() {
-            self.ids_instance_set = self.pool.write_set(ctx, &self.ids_pipeline, 2, &bind)?;
+            self.ids_instance_set = self
+                .pool
+                .write_set(ctx, &self.ids_pipeline, 2, &with_zones)?;
         }
         Ok(())
     }
@@ -579,6 +600,10 @@ impl Frame {
                 spread: Vec::new(),
             },
         ];
+        let mut fetches = fetches;
+        if self.wrinkles_drawn() {
+            fetches.extend(Fetch::wrinkles());
+        }
         let work = ShaderWork {
             shader: shader.into(),
             fetches,

@@ -4,7 +4,8 @@
 //! backdrop's; and where each character's and each group's lie in it. The
 //! previous frame's models follow, slot for slot (a rigid motion's velocity:
 //! the temporal anti-aliasing's previous position of a vertex is the
-//! previous model times it).
+//! previous model times it). Beside them, each slot's wrinkle zone weights
+//! (thesis ch. 8: every character's own expression creases its own face).
 
 use anyhow::Result;
 use ash::vk;
@@ -26,6 +27,8 @@ pub struct SkinGroup {
 #[derive(Default)]
 pub struct Instances {
     buffer: Buffer,
+    /// Per slot, the character's eight zone weights (the backdrop's 0).
+    zones: Buffer,
     /// Models of one frame in the buffer (the previous frame's follow).
     count: usize,
     /// Each group's first slot and count, in group order.
@@ -41,7 +44,7 @@ impl Instances {
     pub fn new(
         ctx: &Context,
         groups: &[SkinGroup],
-        models: &[Mat4],
+        (models, zones): (&[Mat4], &[[f32; 8]]),
         backdrop: Mat4,
     ) -> Result<Self> {
         let (mut data, group_slots, character_slots) = layout(groups, models, backdrop);
@@ -54,8 +57,23 @@ impl Instances {
             bytemuck::cast_slice(&data),
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
+        // The models' buffer goes if the zones' cannot be made.
+        let zones = match Buffer::with_data(
+            ctx,
+            "character wrinkle zones",
+            bytemuck::cast_slice(&zone_layout(&character_slots, zones)),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        ) {
+            Ok(z) => z,
+            Err(e) => {
+                let mut buffer = buffer;
+                buffer.destroy(ctx);
+                return Err(e);
+            }
+        };
         Ok(Instances {
             buffer,
+            zones,
             count: data.len() / 2,
             group_slots,
             backdrop_slot,
@@ -75,6 +93,26 @@ impl Instances {
         let (mut data, _, _) = layout(groups, models, backdrop);
         data.extend(layout(groups, previous, backdrop).0);
         self.buffer.write(bytemuck::cast_slice(&data))
+    }
+
+    /// Rewrites each character's zone weights (frame index order; between
+    /// frames, as `write_models`).
+    pub fn write_zones(&mut self, zones: &[[f32; 8]]) -> Result<()> {
+        self.zones.write(bytemuck::cast_slice(&zone_layout(
+            &self.character_slots,
+            zones,
+        )))
+    }
+
+    /// The zone buffer as the shaders' `Zones` binding (two vec4 a slot).
+    pub fn zones_binding(&self) -> (&'static str, Bind) {
+        (
+            "Zones",
+            Bind::Uniform {
+                buffer: self.zones.raw,
+                size: self.zones.size,
+            },
+        )
     }
 
     /// The models as the buffer holds them, slot by slot: this frame's and
@@ -102,11 +140,22 @@ impl Instances {
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.buffer.destroy(ctx);
+        self.zones.destroy(ctx);
     }
 }
 
 /// A model matrix as the buffer holds it (columns).
 type Model = [[f32; 4]; 4];
+
+/// Each slot's zone weights from each character's (by frame index), the
+/// backdrop's slot (the last) 0.
+fn zone_layout(character_slots: &[u32], zones: &[[f32; 8]]) -> Vec<[f32; 8]> {
+    let mut out = vec![[0.0; 8]; character_slots.len() + 1];
+    for (&slot, z) in character_slots.iter().zip(zones) {
+        out[slot as usize] = *z;
+    }
+    out
+}
 
 /// The buffer's models (group after group, then the backdrop), each
 /// group's (first slot, count) and each character's slot.

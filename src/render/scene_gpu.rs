@@ -18,7 +18,8 @@ use crate::vk::upload::texture;
 pub struct MaterialUniforms {
     pub base_color: [f32; 4],
     pub params: [f32; 4],
-    /// x: 1 when specTex's G holds a roughness map (`scene::texel_params`).
+    /// x: 1 when specTex's G holds a roughness map (`scene::texel_params`);
+    /// y: 1 when the material has wrinkle maps (`scene::wrinkle_maps`).
     pub maps: [f32; 4],
 }
 
@@ -110,9 +111,10 @@ impl GpuObject {
         ctx: &Context,
         name: &str,
         kind: ObjectKind,
-        // The object, the copies of its vertices (`GpuMesh::copies`), and
-        // whether it gets levels of detail (`scene::lod`).
-        (object, copies, lod): (&Object, u32, bool),
+        // The object, the copies of its vertices (`GpuMesh::copies`),
+        // whether it gets levels of detail (`scene::lod`), and whether its
+        // wrinkle maps are read (a character's expression weighs a zone).
+        (object, copies, lod, wrinkled): (&Object, u32, bool, bool),
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -131,14 +133,20 @@ impl GpuObject {
                 material_set: vk::DescriptorSet::null(),
             },
         );
-        g.upload(ctx, (object, copies, lod), pool, geometry, samplers)?;
+        g.upload(
+            ctx,
+            (object, copies, lod, wrinkled),
+            pool,
+            geometry,
+            samplers,
+        )?;
         Ok(g.keep())
     }
 
     fn upload(
         &mut self,
         ctx: &Context,
-        (object, copies, lod): (&Object, u32, bool),
+        (object, copies, lod, wrinkled): (&Object, u32, bool, bool),
         pool: &DescriptorPool,
         geometry: &Pipeline,
         samplers: &Samplers,
@@ -219,6 +227,21 @@ impl GpuObject {
             let t = upload_texture(ctx, &format!("{name} {what}"), tex, fallback, format)?;
             self.textures.push(t);
         }
+        // The wrinkle map and its masks, when they are read; else the shader
+        // returns before any fetch of them, and their bindings take the
+        // albedo (`material_binds`).
+        let wrinkles = m.wrinkles.as_ref().filter(|_| wrinkled);
+        if let Some(w) = wrinkles {
+            let unorm = vk::Format::R8G8B8A8_UNORM;
+            for (what, t) in [
+                ("wrinkle map", &w.wrinkle),
+                ("wrinkle mask 0", &w.masks[0]),
+                ("wrinkle mask 1", &w.masks[1]),
+            ] {
+                let t = upload_texture(ctx, &format!("{name} {what}"), Some(t), [0; 4], unorm)?;
+                self.textures.push(t);
+            }
+        }
         let u = MaterialUniforms {
             base_color: [
                 m.base_color_factor[0],
@@ -238,7 +261,7 @@ impl GpuObject {
                 } else {
                     0.0
                 },
-                0.0,
+                if wrinkles.is_some() { 1.0 } else { 0.0 },
                 0.0,
                 0.0,
             ],
@@ -259,6 +282,9 @@ impl GpuObject {
             ("albedoTex", Bind::Texture(self.textures[0].view)),
             ("normalTex", Bind::Texture(self.textures[1].view)),
             ("specTex", Bind::Texture(self.textures[2].view)),
+            ("wrinkleTex", Bind::Texture(self.wrinkle_view(0))),
+            ("wrinkleMask0", Bind::Texture(self.wrinkle_view(1))),
+            ("wrinkleMask1", Bind::Texture(self.wrinkle_view(2))),
             ("materialSampler", Bind::Sampler(samplers.linear_repeat)),
             (
                 "material",
@@ -268,6 +294,12 @@ impl GpuObject {
                 },
             ),
         ]
+    }
+
+    /// The wrinkle texture `k` (the map, mask 0, mask 1), or the albedo where
+    /// there are none (the material's `maps.y` is then 0: never fetched).
+    fn wrinkle_view(&self, k: usize) -> vk::ImageView {
+        self.textures.get(3 + k).unwrap_or(&self.textures[0]).view
     }
 
     pub fn bind_and_draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {

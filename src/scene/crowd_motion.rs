@@ -96,6 +96,20 @@ impl Tracks {
         }
     }
 
+    /// Character `c`'s head weights at its own time, given the head's own
+    /// `own` (those no channel drives): a clip of weights', or a file
+    /// clip's over `own`; `own` under a rigid motion.
+    pub fn head_weights(&self, c: usize, own: &[f32]) -> Vec<f32> {
+        match &self.motion {
+            Motion::Weights(_) => self.weights(c).unwrap_or_else(|| own.to_vec()),
+            Motion::File(rig) if rig.moves(0) => self
+                .file_pose(c)
+                .and_then(|p| p.first().map(|h| h.weights_over(own)))
+                .unwrap_or_else(|| own.to_vec()),
+            _ => own.to_vec(),
+        }
+    }
+
     /// Character `c`'s objects (head, then parts) posed by a file's clip
     /// at its own time (`None`: another motion).
     pub fn file_pose(&self, c: usize) -> Option<Vec<ObjectPose>> {

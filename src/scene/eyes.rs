@@ -115,6 +115,7 @@ pub fn eye_material() -> Material {
         specular_map: None,
         roughness_map: None,
         sss_map: None,
+        wrinkles: None,
         roughness: 0.12,
         specular_intensity: 0.35,
         sss_strength: 0.0,

@@ -422,7 +422,7 @@ fn core_ray(theta: f32, phi: f32) -> (Vec3, Vec3) {
 }
 
 /// The skull's surface point (mm) on the core's ray for `theta` and `phi`.
-fn skull_point_mm(theta: f32, phi: f32) -> Vec3 {
+pub(super) fn skull_point_mm(theta: f32, phi: f32) -> Vec3 {
     let (origin, dir) = core_ray(theta, phi);
     origin + dir * outermost_crossing(skull_field, origin, dir, RAY_LENGTH_MM)
 }
@@ -528,6 +528,15 @@ impl Ear {
     }
 }
 
+/// Where an ear's UVs lie (both ears the same square): `[u, v, side]`. The
+/// skull's parameterisation covers the whole unit square, so no square is the
+/// ears' alone; this one is the back of the neck below the frame (theta
+/// beyond 0.8 pi), which no texture of the face paints (the wrinkle maps'
+/// zones are 0 there, `face_wrinkles`). Texture space packs every island
+/// apart by its surface area, so the square's size does not change the
+/// ears' share of its maps.
+pub const EAR_UV: [f32; 3] = [0.0, 0.8, 0.2];
+
 /// Where the tests and the scapha sit: angle from up toward the back, and the fraction of
 /// the outline's radius.
 const SCAPHA_PSI_DEG: f32 = 55.0;
@@ -627,7 +636,10 @@ fn ear_shell(ear: &Ear) -> Mesh {
             let local = side * (r * phi.sin()) + up * (r * phi.cos());
             ear.center + (local + ear.normal * (mid + sign * 0.5 * thick * h)) / MM_PER_UNIT
         },
-        |i, j| [j as f32 / EAR_COLS as f32, i as f32 / rows as f32],
+        |i, j| {
+            let (u, v) = (j as f32 / EAR_COLS as f32, i as f32 / rows as f32);
+            [EAR_UV[0] + EAR_UV[2] * u, EAR_UV[1] + EAR_UV[2] * v]
+        },
     )
 }
 
@@ -723,6 +735,7 @@ fn backdrop_material() -> Material {
         specular_map: None,
         roughness_map: None,
         sss_map: None,
+        wrinkles: None,
         roughness: 0.6,
         specular_intensity: 0.02,
         sss_strength: 0.0,
@@ -753,7 +766,11 @@ fn build_face_scene() -> Scene {
         head: Object {
             morph: Default::default(),
             mesh: head,
-            material: Material::skin(SKIN_ALBEDO),
+            // The expressions' wrinkles (thesis ch. 8), shown by their weights.
+            material: Material {
+                wrinkles: Some(super::face_wrinkles::face_wrinkle_maps(skull_point_mm)),
+                ..Material::skin(SKIN_ALBEDO)
+            },
         },
         parts: vec![eyes::eyes(EYE_MM, MM_PER_UNIT)],
         backdrop: Some(Object {

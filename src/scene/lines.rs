@@ -132,6 +132,7 @@ pub fn lines_scene() -> Scene {
                 specular_map: None,
                 roughness_map: None,
                 sss_map: None,
+                wrinkles: None,
                 roughness: 0.7,
                 specular_intensity: 0.02,
                 sss_strength: 0.0,

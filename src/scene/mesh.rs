@@ -1,5 +1,6 @@
 //! CPU-side geometry and material data, laid out so the renderer can upload it as-is.
 
+use super::wrinkle_maps::{decode, MASKS, ZONES_PER_MASK};
 use anyhow::{bail, Result};
 
 use super::morph::{posed, Morph};
@@ -158,6 +159,9 @@ pub struct Material {
     /// SSS strength in R, linear, a factor of `sss_strength` (thesis eq.
     /// 4.3-4.4: 0 where nothing scatters, a beard or hair).
     pub sss_map: Option<Texture>,
+    /// Expression wrinkles (thesis ch. 8): a partial-derivative wrinkle map
+    /// and two zone masks, shown by the expression weights (`None`: none).
+    pub wrinkles: Option<WrinkleMaps>,
     /// Beckmann m; skin ~0.3.
     pub roughness: f32,
     /// rho_s; skin ~0.18.
@@ -165,6 +169,57 @@ pub struct Material {
     /// 0..1, written to the alpha of the diffuse target so the blur passes know how much
     /// of each pixel scatters.
     pub sss_strength: f32,
+}
+
+/// The wrinkle map and the two zone masks, each RGBA8 (linear, uploaded as
+/// UNORM).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WrinkleMaps {
+    /// R, G: the wrinkles' partial-derivative normal (x, y), encoded.
+    pub wrinkle: Texture,
+    /// Zone coverage in [0, 1], four zones per texture.
+    pub masks: [Texture; MASKS],
+}
+
+impl WrinkleMaps {
+    /// Checks the maps are what the shaders sample: non-empty, each texture's
+    /// bytes four per texel.
+    pub fn check(&self) -> anyhow::Result<()> {
+        for (what, t) in [
+            ("wrinkle map", &self.wrinkle),
+            ("wrinkle mask 0", &self.masks[0]),
+            ("wrinkle mask 1", &self.masks[1]),
+        ] {
+            if t.width == 0 || t.height == 0 || t.rgba8.len() != 4 * (t.width * t.height) as usize {
+                anyhow::bail!(
+                    "{what}: {}x{} with {} bytes (4 a texel expected)",
+                    t.width,
+                    t.height,
+                    t.rgba8.len()
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The bytes the three textures hold (what the chapter's 96 KB counts).
+    pub fn bytes(&self) -> usize {
+        self.wrinkle.rgba8.len() + self.masks.iter().map(|m| m.rgba8.len()).sum::<usize>()
+    }
+
+    /// Zone `z`'s mask (0..8) at texel `(x, y)` of its mask texture, in [0, 1].
+    pub fn mask_texel(&self, z: usize, x: u32, y: u32) -> f32 {
+        let t = &self.masks[z / ZONES_PER_MASK];
+        let i = 4 * (y * t.width + x) as usize + z % ZONES_PER_MASK;
+        f32::from(t.rgba8[i]) / 255.0
+    }
+
+    /// The wrinkle map's decoded partial derivative at texel `(x, y)`.
+    pub fn wrinkle_texel(&self, x: u32, y: u32) -> [f32; 2] {
+        let t = &self.wrinkle;
+        let i = 4 * (y * t.width + x) as usize;
+        [decode(t.rgba8[i]), decode(t.rgba8[i + 1])]
+    }
 }
 
 impl Material {
@@ -178,6 +233,7 @@ impl Material {
             specular_map: None,
             roughness_map: None,
             sss_map: None,
+            wrinkles: None,
             roughness: 0.3,
             specular_intensity: 0.18,
             sss_strength: 1.0,

@@ -11,6 +11,7 @@ pub mod enclosed;
 pub mod expressions;
 pub mod eyes;
 pub mod face;
+pub mod face_wrinkles;
 pub mod framing;
 pub mod gltf_accessor;
 pub mod gltf_load;
@@ -30,6 +31,7 @@ pub mod skin_rule;
 pub mod source;
 pub mod texel_params;
 pub mod vertex;
+pub mod wrinkle_maps;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
@@ -163,6 +165,22 @@ impl Scene {
     /// deform pass poses its copy; `None` where it is the scene's head
     /// (character 0, a still or rigid crowd, a head without targets).
     pub fn character_head(&self, c: usize) -> Option<mesh::Mesh> {
+        self.character_head_posed(c)
+    }
+
+    /// The head's morph weights for character `c` (frame index): a moving
+    /// crowd's character at its own phase (a clip of weights, or a file's
+    /// clip that moves the head), else the head's own; character 0 is the
+    /// scene as posed. What its deformed copy and its wrinkles follow.
+    pub fn character_weights(&self, c: usize) -> Vec<f32> {
+        let own = &self.head.morph.weights;
+        match self.tracks.as_ref().filter(|_| c > 0) {
+            Some(t) => t.head_weights(c, own),
+            None => own.clone(),
+        }
+    }
+
+    fn character_head_posed(&self, c: usize) -> Option<mesh::Mesh> {
         let t = self.tracks.as_ref().filter(|_| c > 0)?;
         if let crowd_motion::Motion::File(rig) = &t.motion {
             if !rig.moves(0) {
@@ -283,10 +301,12 @@ pub fn builtin_scene(
         || o.specular_map.is_some()
         || o.roughness_map.is_some()
         || o.sss_map.is_some()
+        || o.wrinkle_map.is_some()
+        || o.wrinkle_masks.iter().any(Option::is_some)
         || o.sidecar_top_down
         || !o.skin.is_empty()
     {
-        bail!("--albedo, --normal-map, --spec-map, --roughness-map, --sss-map, --sidecar-top-down, --skin and --not-skin apply to a glTF --scene, not to builtin:{name}");
+        bail!("--albedo, --normal-map, --spec-map, --roughness-map, --sss-map, the --wrinkle-map and masks, --sidecar-top-down, --skin and --not-skin apply to a glTF --scene, not to builtin:{name}");
     }
     let mut s = builtin(name)?;
     if let Some(mm) = mm_per_unit {
@@ -334,6 +354,7 @@ fn backdrop(mesh: mesh::Mesh) -> mesh::Object {
             specular_map: None,
             roughness_map: None,
             sss_map: None,
+            wrinkles: None,
             roughness: 0.6,
             specular_intensity: 0.02,
             sss_strength: 0.0,
@@ -437,6 +458,9 @@ pub fn load_gltf_scene(
         spec_map: overrides.specular_map.clone(),
         roughness_map: overrides.roughness_map.clone(),
         sss_map: overrides.sss_map.clone(),
+        wrinkle_map: overrides.wrinkle_map.clone(),
+        wrinkle_mask1: overrides.wrinkle_masks[0].clone(),
+        wrinkle_mask2: overrides.wrinkle_masks[1].clone(),
         sidecar_top_down: overrides.sidecar_top_down,
         mm_per_unit,
         skin: overrides.skin.skin.clone(),
@@ -447,6 +471,7 @@ pub fn load_gltf_scene(
         crowd_seed: None,
         time_step: None,
         skin_tone: None,
+        no_wrinkles: false,
     });
     Ok(scene)
 }

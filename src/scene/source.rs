@@ -30,6 +30,14 @@ pub struct SceneSource {
     pub roughness_map: Option<PathBuf>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sss_map: Option<PathBuf>,
+    /// The wrinkle map and its two zone masks (`--wrinkle-map`,
+    /// `--wrinkle-mask1`, `--wrinkle-mask2`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrinkle_map: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrinkle_mask1: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrinkle_mask2: Option<PathBuf>,
     /// Texture files beside the scene (or given above) are top-down.
     pub sidecar_top_down: bool,
     /// Millimetres per scene unit (`None`: from a 230 mm chin-to-crown head).
@@ -65,6 +73,10 @@ pub struct SceneSource {
     /// `load_scene` (the model lives above the scene).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub skin_tone: Option<SkinTone>,
+    /// The skin drawn without its wrinkle maps (`--no-wrinkles`): the
+    /// expressions move the face and crease nothing.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub no_wrinkles: bool,
 }
 
 /// Three skin tones along the melanin axis (thesis ch. 7's model:
@@ -113,6 +125,8 @@ impl SceneSource {
             specular_map: self.spec_map.clone(),
             roughness_map: self.roughness_map.clone(),
             sss_map: self.sss_map.clone(),
+            wrinkle_map: self.wrinkle_map.clone(),
+            wrinkle_masks: [self.wrinkle_mask1.clone(), self.wrinkle_mask2.clone()],
             sidecar_top_down: self.sidecar_top_down,
             skin: crate::scene::skin_rule::SkinChoice {
                 skin: self.skin.clone(),
@@ -164,7 +178,11 @@ impl SceneSource {
             tracks.step = self.time_step;
         }
         scene.set_morph_weights(&weights)?;
+        if self.no_wrinkles {
+            scene.head.material.wrinkles = None;
+        }
         if let Some(src) = &mut scene.source {
+            src.no_wrinkles = self.no_wrinkles;
             src.skin_tone = self.skin_tone;
             src.morph_weights = self.morph_weights.clone();
             src.time = self.time;

@@ -62,6 +62,41 @@ pub fn zone_weights(expressions: &[f32]) -> [f32; 8] {
     z.map(|v| v.clamp(0.0, 1.0))
 }
 
+/// The zone weights of a head whose morph targets are named `names`
+/// ([`expression_weights`]) at `weights`: what its draws' wrinkles show.
+pub fn zones_of(names: &[Option<String>], weights: &[f32]) -> [f32; 8] {
+    zone_weights(&expression_weights(
+        names.iter().map(Option::as_deref),
+        weights,
+    ))
+}
+
+/// Character `c`'s zone weights (frame index; `Scene::character_weights`);
+/// all 0 for a skin without wrinkle maps (nothing to weigh).
+pub fn character_zones(scene: &crate::scene::Scene, c: usize) -> [f32; 8] {
+    if scene.head.material.wrinkles.is_none() {
+        return [0.0; 8];
+    }
+    zones_of(&head_target_names(scene), &scene.character_weights(c))
+}
+
+/// The head's morph targets' names, in order.
+pub fn head_target_names(scene: &crate::scene::Scene) -> Vec<Option<String>> {
+    scene
+        .head
+        .morph
+        .targets
+        .iter()
+        .map(|t| t.name.clone())
+        .collect()
+}
+
+/// Zone weights as the shaders read them: two vec4 (Listing 8.1's
+/// `weights[2]`).
+pub fn zones_std430(z: [f32; 8]) -> [[f32; 4]; 2] {
+    [[z[0], z[1], z[2], z[3]], [z[4], z[5], z[6], z[7]]]
+}
+
 /// A normal (z > 0, the tangent-space hemisphere) as a partial-derivative
 /// normal: (n_x / n_z, n_y / n_z).
 pub fn to_partial_derivative(n: Vec3) -> Vec2 {
@@ -74,14 +109,36 @@ pub fn from_partial_derivative(d: Vec2) -> Vec3 {
     d.extend(1.0).normalize()
 }
 
-/// A value in [-1, 1] as an 8-bit UNORM channel stores it (0.5 + 0.5 x), and
-/// back (-1 + 2 x, Listing 8.1's decode).
-pub fn encode(x: f32) -> u8 {
-    ((0.5 + 0.5 * x.clamp(-1.0, 1.0)) * 255.0).round() as u8
-}
+/// Listing 8.1's 8-bit encoding (`scene::wrinkle_maps`, where the maps are
+/// made): 0.5 + 0.5 x, read back as -1 + 2 c.
+pub use crate::scene::wrinkle_maps::{decode, encode};
 
-pub fn decode(c: u8) -> f32 {
-    -1.0 + 2.0 * (f32::from(c) / 255.0)
+/// The expression weights Table 8.1's rows take from a morph's targets:
+/// each target named after an expression (`scene::expressions::EXPRESSIONS`,
+/// any case; "sadness" for "sad") gives its row its weight. Targets of
+/// other names drive no wrinkles.
+pub fn expression_weights<'a>(
+    names: impl IntoIterator<Item = Option<&'a str>>,
+    weights: &[f32],
+) -> [f32; 6] {
+    let mut out = [0.0; 6];
+    for (name, w) in names.into_iter().zip(weights) {
+        let Some(name) = name.map(str::to_ascii_lowercase) else {
+            continue;
+        };
+        let name = if name == "sadness" {
+            "sad".into()
+        } else {
+            name
+        };
+        if let Some(row) = crate::scene::expressions::EXPRESSIONS
+            .iter()
+            .position(|e| *e == name)
+        {
+            out[row] += w;
+        }
+    }
+    out
 }
 
 /// Listing 8.1: the base partial-derivative normal plus the wrinkle map's,
@@ -170,6 +227,19 @@ mod tests {
         // The sum clamps at 1: joy and surprise on the crow's feet.
         assert_eq!(zone_weights(&[1.0, 1.0])[0], 1.0);
         assert_eq!(zone_weights(&[]), [0.0; 8]);
+    }
+
+    #[test]
+    fn targets_drive_the_rows_they_are_named_after() {
+        let names = [
+            Some("Anger"),
+            None,
+            Some("blink"),
+            Some("sadness"),
+            Some("joy"),
+        ];
+        let w = expression_weights(names, &[0.5, 1.0, 1.0, 0.25, 0.75]);
+        assert_eq!(w, [0.75, 0.0, 0.0, 0.5, 0.0, 0.25]);
     }
 
     #[test]

@@ -51,6 +51,7 @@ mod stepping;
 mod texel_params;
 mod texturing;
 mod tsd;
+mod wrinkles;
 
 mod cli;
 mod gltf_fuzz;

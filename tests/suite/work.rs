@@ -17,6 +17,111 @@ use dermis::render::{RenderSettings, Renderer};
 use dermis::scene::egg_scene;
 use dermis::vk::shader::reflect;
 
+/// Renders `s` with the fetch-counting build and holds every pass's counted
+/// fetches to its declaration; the passes checked.
+fn check_declarations(
+    ctx: &dermis::vk::context::Context,
+    scene: &dermis::scene::Scene,
+    label: &str,
+    s: RenderSettings,
+) -> usize {
+    let mut checked = 0;
+    let s = RenderSettings {
+        width: 96,
+        height: 64,
+        shadow_size: 128,
+        distance_heads: 1.5,
+        ..s
+    };
+    let mut r = Renderer::new(ctx, scene, &s).unwrap();
+    let counts = r.count_fetches().unwrap();
+    let passes = r.passes();
+    assert_eq!(counts.len(), passes.len());
+    for (c, p) in counts.iter().zip(&passes) {
+        let at = format!("{label}: pass '{}'", p.name);
+        let work = p.declared_work(&r.resources);
+        let shader = match &work {
+            Some(Work::Raster {
+                shader: Some(sh), ..
+            }) => sh,
+            Some(Work::Compute { shader, .. }) => shader,
+            _ => {
+                assert_eq!(c.invocations, 0, "{at}: runs no shader");
+                assert!(c.fetches.is_empty(), "{at}: {:?}", c.fetches);
+                continue;
+            }
+        };
+        let refl = reflect(&[&shader.shader]).unwrap();
+        // Declared fetches per counter site: (exact sum, bound sum, all exact).
+        let mut declared: BTreeMap<u32, (f64, bool)> = BTreeMap::new();
+        for f in &shader.fetches {
+            let b = refl
+                .bindings
+                .iter()
+                .find(|b| b.name == f.texture)
+                .unwrap_or_else(|| {
+                    panic!(
+                        "{at}: {} declares '{}', which it has no binding for",
+                        shader.shader, f.texture
+                    )
+                });
+            let e = declared
+                .entry(site(b.set, b.binding, filter_kind(f.filter)))
+                .or_insert((0.0, true));
+            e.0 += f.count;
+            e.1 &= f.exact;
+        }
+        let n = c.invocations as f64;
+        let counted: BTreeMap<u32, u64> = c.fetches.iter().copied().collect();
+        for (s, &got) in &counted {
+            assert!(
+                declared.contains_key(s),
+                "{at}: site {s} fetched {got} times but is not declared ({:?})",
+                shader.fetches
+            );
+        }
+        for (s, &(per, exact)) in &declared {
+            let got = counted.get(s).copied().unwrap_or(0) as f64;
+            if exact {
+                assert_eq!(
+                    got,
+                    per * n,
+                    "{at}: site {s}: {got} fetches for {n} invocations, {per} declared each"
+                );
+            } else {
+                assert!(
+                    got <= per * n,
+                    "{at}: site {s}: {got} fetches exceed the bound {per} x {n}"
+                );
+            }
+        }
+        checked += 1;
+    }
+    checked
+}
+
+// The wrinkle maps' fetches (thesis ch. 8): the geometry pass, texture
+// space's irradiance and both of the ground truth's shading passes read them
+// where an expression weighs a zone, and declare them.
+#[test]
+fn wrinkle_fetches_are_declared() {
+    let ctx = common::counting_ctx();
+    let mut scene = dermis::scene::face::face_scene();
+    scene
+        .set_morph_weights(&[("surprise".into(), 1.0), ("disgust".into(), 0.5)])
+        .unwrap();
+    let mut checked = 0;
+    for (name, options) in [
+        ("separable", &[][..]),
+        ("tsd", &[]),
+        ("reference", &[("density", "2")]),
+    ] {
+        let s = RenderSettings::study().with(common::m(name), options);
+        checked += check_declarations(&ctx, &scene, &format!("{name} wrinkled"), s);
+    }
+    assert!(checked >= 10, "{checked}");
+}
+
 #[test]
 fn declared_fetches_are_what_the_shaders_fetch() {
     let ctx = common::counting_ctx();
@@ -91,73 +196,7 @@ fn declared_fetches_are_what_the_shaders_fetch() {
             ));
         }
         for (label, s) in settings {
-            let s = RenderSettings {
-                width: 96,
-                height: 64,
-                shadow_size: 128,
-                distance_heads: 1.5,
-                ..s
-            };
-            let mut r = Renderer::new(&ctx, &scene, &s).unwrap();
-            let counts = r.count_fetches().unwrap();
-            let passes = r.passes();
-            assert_eq!(counts.len(), passes.len());
-            for (c, p) in counts.iter().zip(&passes) {
-                let at = format!("{label}: pass '{}'", p.name);
-                let work = p.declared_work(&r.resources);
-                let shader = match &work {
-                    Some(Work::Raster {
-                        shader: Some(sh), ..
-                    }) => sh,
-                    Some(Work::Compute { shader, .. }) => shader,
-                    _ => {
-                        assert_eq!(c.invocations, 0, "{at}: runs no shader");
-                        assert!(c.fetches.is_empty(), "{at}: {:?}", c.fetches);
-                        continue;
-                    }
-                };
-                let refl = reflect(&[&shader.shader]).unwrap();
-                // Declared fetches per counter site: (exact sum, bound sum, all exact).
-                let mut declared: BTreeMap<u32, (f64, bool)> = BTreeMap::new();
-                for f in &shader.fetches {
-                    let b = refl
-                        .bindings
-                        .iter()
-                        .find(|b| b.name == f.texture)
-                        .unwrap_or_else(|| {
-                            panic!(
-                                "{at}: {} declares '{}', which it has no binding for",
-                                shader.shader, f.texture
-                            )
-                        });
-                    let e = declared
-                        .entry(site(b.set, b.binding, filter_kind(f.filter)))
-                        .or_insert((0.0, true));
-                    e.0 += f.count;
-                    e.1 &= f.exact;
-                }
-                let n = c.invocations as f64;
-                let counted: BTreeMap<u32, u64> = c.fetches.iter().copied().collect();
-                for (s, &got) in &counted {
-                    assert!(
-                        declared.contains_key(s),
-                        "{at}: site {s} fetched {got} times but is not declared ({:?})",
-                        shader.fetches
-                    );
-                }
-                for (s, &(per, exact)) in &declared {
-                    let got = counted.get(s).copied().unwrap_or(0) as f64;
-                    if exact {
-                        assert_eq!(got, per * n, "{at}: site {s}: {got} fetches for {n} invocations, {per} declared each");
-                    } else {
-                        assert!(
-                            got <= per * n,
-                            "{at}: site {s}: {got} fetches exceed the bound {per} x {n}"
-                        );
-                    }
-                }
-                checked += 1;
-            }
+            checked += check_declarations(&ctx, &scene, &label, s);
         }
     }
     println!("{checked} pass declarations checked against their shaders");

@@ -202,6 +202,12 @@ pub struct Reference {
     max_candidates: u32,
     surf: Surface,
     instances: Vec<glam::Mat4>,
+    /// Each instance's wrinkle zone weights (two vec4: the surface pass
+    /// pushes them, the irradiance pass reads `zones` by the sample's
+    /// character), and whether any zone is weighed (its fetches declared).
+    zone_rows: Vec<[[f32; 4]; 2]>,
+    zones: Buffer,
+    wrinkled: bool,
     pub sample_count: u32,
     /// Cells of the sample grid along x, y, z (reported in `details`).
     pub grid_dims: [u32; 3],
@@ -305,6 +311,7 @@ impl SssMethod for Reference {
             &mut self.cells,
             &mut self.params,
             &mut self.narrow_params,
+            &mut self.zones,
             &mut self.surf.vertices,
             &mut self.surf.indices,
         ] {

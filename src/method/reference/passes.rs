@@ -15,12 +15,15 @@ use crate::reference::sampling::SurfaceSample;
 use crate::shader_constants::{NARROW_GAUSSIANS as NARROW, PCF_TRIPS, WIDE_GAUSSIANS};
 use crate::vk::shader_stats::alu_estimate;
 
-/// Push constants of the surface pass (geometry.vert's model, then the frag's scale).
+/// Push constants of the surface pass (geometry.vert's model, then the
+/// frag's scale and the character's wrinkle zones, std430: the zones at 80).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct SurfacePush {
     model: [[f32; 4]; 4],
     mm_per_subsample_per_depth: f32,
+    pad: [f32; 3],
+    zones: [[f32; 4]; 2],
 }
 
 /// Push constants of the gather: the slab, and the chunk's range of samples.
@@ -55,7 +58,10 @@ impl Reference {
                 // Material textures are not frame images: RGBA8 bilinear.
                 Fetch::material("normalTex", false),
                 Fetch::material("albedoTex", false),
-            ],
+            ]
+            .into_iter()
+            .chain(self.wrinkle_fetches())
+            .collect(),
             alu: alu_estimate(lit, &PCF_TRIPS),
             storage_read_bytes: std::mem::size_of::<SurfaceSample>() as f64,
             storage_write_bytes: 0.0,
@@ -121,7 +127,10 @@ impl Reference {
         let albedo = Fetch::material("albedoTex", true);
         let work = ShaderWork {
             shader: SURFACE_SHADER.into(),
-            fetches: vec![shadow, Fetch::material("normalTex", false), albedo],
+            fetches: [shadow, Fetch::material("normalTex", false), albedo]
+                .into_iter()
+                .chain(self.wrinkle_fetches())
+                .collect(),
             alu: alu_estimate(SURFACE_SHADER, &PCF_TRIPS),
             ..Default::default()
         };
@@ -154,12 +163,13 @@ impl Reference {
                     );
                 }
                 let (skin, all) = (self.surf.skin_index_count, self.surf.index_count);
-                for (m, &offset) in self.instances.iter().zip(&self.surf.copy_offsets) {
-                    // The skin with its subsamples' area; the parts with
-                    // none: occluders only.
-                    for (first, count, scale) in [
-                        (0, skin, self.surf.mm_per_subsample_per_depth),
-                        (skin, all - skin, 0.0),
+                let characters = self.instances.iter().zip(&self.surf.copy_offsets);
+                for ((m, &offset), &zones) in characters.zip(&self.zone_rows) {
+                    // The skin with its subsamples' area and wrinkles; the
+                    // parts with neither: occluders only.
+                    for (first, count, scale, zones) in [
+                        (0, skin, self.surf.mm_per_subsample_per_depth, zones),
+                        (skin, all - skin, 0.0, [[0.0; 4]; 2]),
                     ] {
                         if count == 0 {
                             continue;
@@ -170,12 +180,24 @@ impl Reference {
                             &SurfacePush {
                                 model: m.to_cols_array_2d(),
                                 mm_per_subsample_per_depth: scale,
+                                pad: [0.0; 3],
+                                zones,
                             },
                         );
                         unsafe { ctx.device.cmd_draw_indexed(cmd, count, 1, first, offset, 0) };
                     }
                 }
             })
+    }
+
+    /// The wrinkle maps' fetches where a character's expression weighs a
+    /// zone (`Fetch::wrinkles`), else none.
+    fn wrinkle_fetches(&self) -> Vec<Fetch> {
+        if self.wrinkled {
+            Fetch::wrinkles()
+        } else {
+            Vec::new()
+        }
     }
 
     /// Zeroes the wide Gaussians' accumulators before the gather adds to them.

@@ -68,6 +68,13 @@ impl Reference {
                 let n = (c.count - first).min(self.draw_samples);
                 let mut binds = s.frame_binds.clone();
                 binds.push((
+                    "Zones",
+                    Binding::Fixed(Bind::Uniform {
+                        buffer: self.zones.raw,
+                        size: self.zones.size,
+                    }),
+                ));
+                binds.push((
                     "Samples",
                     Binding::StorageBuffer {
                         id: c.buffer_ids[0],

@@ -17,6 +17,7 @@ use crate::reference::narrow::{radius, supersampling};
 use crate::reference::sampling::{build_grid, cutoff_mm, sample_characters_within};
 use crate::scene::mesh::Mesh;
 use crate::skin::tissue::TISSUE_TOLERANCE;
+use crate::skin::wrinkles;
 use crate::vk::barrier::AccessKind;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
@@ -153,6 +154,20 @@ impl Reference {
             uniform,
         )?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        // Each character's wrinkle zones (thesis ch. 8): its expression's.
+        let zones: Vec<[f32; 8]> = s
+            .characters
+            .iter()
+            .map(|&c| wrinkles::character_zones(s.scene, c))
+            .collect();
+        self.wrinkled = zones.iter().flatten().any(|&z| z > 0.0);
+        self.zone_rows = zones.iter().map(|&z| wrinkles::zones_std430(z)).collect();
+        self.zones = Buffer::with_data(
+            s.ctx,
+            "reference wrinkle zones",
+            bytemuck::cast_slice(&self.zone_rows),
+            storage,
+        )?;
         self.cells = device_buffer(
             s.ctx,
             "reference grid cells",

@@ -318,6 +318,8 @@ struct CharacterUniforms {
     planes: [[f32; 4]; 6],
     params: [f32; 4],
     map_info: [f32; 4],
+    /// The character's wrinkle zone weights (`skin::wrinkles`).
+    zones: [[f32; 4]; 2],
 }
 
 /// One character: where it stands, what the optimisations decided for it, its map.
@@ -336,6 +338,9 @@ pub struct Character {
     pub outside: bool,
     /// Under `--far-px`: refreshed once every `--refresh` frames.
     pub far: bool,
+    /// Its expression weighs a wrinkle zone: its irradiance pass reads the
+    /// wrinkle maps.
+    pub wrinkled: bool,
     /// Its map: the scattered diffuse light (alpha: coverage).
     pub map: ImageId,
     /// Set 2 of the mask pipelines (depth, backface, cull) and of the irradiance one.

@@ -138,12 +138,15 @@ impl Tsd {
             exact,
             ..fetch(f.res, self.shadow, "shadowMap", filter, count)
         };
-        let fetches = vec![
+        let mut fetches = vec![
             shadow(Filter::DepthCompare, 9.0, !culls),
             Fetch::material("normalTex", false),
             Fetch::material("albedoTex", !culls),
             shadow(Filter::Point, 1.0, false),
         ];
+        if c.wrinkled {
+            fetches.extend(Fetch::wrinkles());
+        }
         let work = ShaderWork {
             shader: IRRADIANCE_SHADER.into(),
             fetches,

@@ -21,6 +21,7 @@ use crate::skin::tsd::{
     atlas, box_outside, clip_planes, depth_scale, map_size, nearest_corner_distance, projected_px,
     reference_distance, tsd_gaussians, CULL_COS, NO_CLIP,
 };
+use crate::skin::wrinkles;
 use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::DescriptorPool;
@@ -115,6 +116,7 @@ impl Tsd {
             };
             let size = map_size(sc, cfg.size);
             let head_px = projected_px(head_height, d, h, view.camera.fovy_rad);
+            let zones = wrinkles::character_zones(s.scene, s.characters[k]);
             let u = CharacterUniforms {
                 model: model.to_cols_array_2d(),
                 planes: planes.map(|p: Vec4| p.to_array()),
@@ -129,6 +131,7 @@ impl Tsd {
                     0.0,
                 ],
                 map_info: [1.0 / cfg.size as f32, uv_max(size, cfg.size), 0.0, 0.0],
+                zones: wrinkles::zones_std430(zones),
             };
             let at = k * CHARACTER_STRIDE as usize;
             uniforms[at..at + std::mem::size_of::<CharacterUniforms>()]
@@ -139,6 +142,7 @@ impl Tsd {
                 MAP_FORMAT,
             ));
             self.characters.push(Character {
+                wrinkled: zones.iter().any(|&z| z > 0.0),
                 model,
                 s: size as f32 / cfg.size as f32,
                 size,

@@ -10,6 +10,7 @@ use crate::scene::crowd_geometry::turned_by;
 use crate::scene::crowd_geometry::{self, CharacterGeometry, GeometryView};
 use crate::scene::crowd_motion::{Motion, Tracks};
 use crate::scene::rig::ObjectPose;
+use crate::skin::wrinkles;
 use glam::Vec3;
 
 impl Frame {
@@ -311,7 +312,9 @@ impl Frame {
         let result = match st.tracks.at_frame(k).filter(|_| k > 0) {
             None => Ok(()),
             Some(t) => match &t.motion {
-                Motion::Weights(_) | Motion::File(_) => st.pose(&mut self.deform, &t),
+                Motion::Weights(_) | Motion::File(_) => st
+                    .pose(&mut self.deform, &t)
+                    .and_then(|()| self.pose_wrinkles(&t)),
                 Motion::Rigid => {
                     let posed = st.tracks.time;
                     let previous = std::mem::replace(
@@ -328,6 +331,51 @@ impl Frame {
         };
         self.stepping = Some(st);
         result
+    }
+}
+
+/// The head's morph target names and its own weights: what a stepping run
+/// weighs each frame's pose by for the wrinkles.
+pub(super) type WrinkleRig = (Vec<Option<String>>, Vec<f32>);
+
+/// Each of `characters` characters' wrinkle zones (frame order), and the
+/// rig a stepping run poses them by (`None`: a skin without wrinkle maps).
+pub(super) fn wrinkle_state(
+    scene: &Scene,
+    characters: usize,
+) -> (Vec<[f32; 8]>, Option<WrinkleRig>) {
+    let zones = (0..characters)
+        .map(|c| wrinkles::character_zones(scene, c))
+        .collect();
+    let rig = scene.head.material.wrinkles.as_ref().map(|_| {
+        (
+            wrinkles::head_target_names(scene),
+            scene.head.morph.weights.clone(),
+        )
+    });
+    (zones, rig)
+}
+
+impl Frame {
+    /// Whether the skin's wrinkle maps are read this frame: the skin has
+    /// them and a character's expression weighs a zone, or a stepping run
+    /// may pose one that does.
+    pub fn wrinkles_drawn(&self) -> bool {
+        self.wrinkle_rig.is_some()
+            && (self.stepping.is_some() || self.zones.iter().flatten().any(|&z| z > 0.0))
+    }
+
+    /// Each character's wrinkle zones at the stepping run's pose `t` (every
+    /// character its head's weights there, character 0 too: stepping moves
+    /// it), written to the instance buffer. Nothing without wrinkle maps.
+    fn pose_wrinkles(&mut self, t: &Tracks) -> Result<()> {
+        let Some((names, own)) = &self.wrinkle_rig else {
+            return Ok(());
+        };
+        self.zones = (0..self.instances.len())
+            .map(|c| wrinkles::zones_of(names, &t.head_weights(c, own)))
+            .collect();
+        self.instance_buffer.write_zones(&self.zones)
     }
 }
 

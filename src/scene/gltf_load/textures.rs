@@ -17,6 +17,14 @@
 //!    - roughness (the Beckmann m in red): `rough`, `roughness`;
 //!    - SSS strength (red, a factor of the material's): `sss`, `scatter`,
 //!      `scattering`, `subsurface`;
+//!    - expression wrinkles (thesis ch. 8, `mesh::WrinkleMaps`): the wrinkle
+//!      map (its partial-derivative normal in red and green) has the word
+//!      `wrinkle` or `wrinkles`; its two zone masks have that word too and
+//!      one of `mask1`, `maska` (the first: red, green, blue, brown of Table
+//!      8.1) or `mask2`, `maskb` (the second: cyan, magenta, orange, grey),
+//!      or the word `mask` followed by the word `1`, `a`, `2` or `b`. A
+//!      file with `wrinkle` and `mask` but no number claims nothing. The three
+//!      are taken together or not at all (a warning names what is missing);
 //! 3. and no other file there claims the same role.
 //!
 //! Words are whole: `collar.png`, `Normalized.png` and a displacement map
@@ -36,6 +44,11 @@
 //!
 //! `--sidecar-top-down` (how files from beside the scene or the command line are
 //! oriented) is named in a note as ignored when no texture came from either.
+//!
+//! Over 800 lines because the naming rule, its eight roles and the head
+//! material's assembly from the file, the files beside it and the command
+//! line are one sequence (590 lines), and their tests (265) load real files
+//! for each role.
 
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
@@ -46,7 +59,7 @@ use super::Warnings;
 use crate::files::{self, ImageBound};
 use crate::scene::gltf_accessor::view_bytes;
 use crate::scene::gltf_source::{read_uri, short, Source};
-use crate::scene::mesh::{Material, Texture};
+use crate::scene::mesh::{Material, Texture, WrinkleMaps};
 
 /// Texture files that replace whatever the glTF or the files beside it give.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -56,6 +69,10 @@ pub struct TextureOverrides {
     pub specular_map: Option<PathBuf>,
     pub roughness_map: Option<PathBuf>,
     pub sss_map: Option<PathBuf>,
+    /// The wrinkle map and its two zone masks (`--wrinkle-map`,
+    /// `--wrinkle-mask1`, `--wrinkle-mask2`).
+    pub wrinkle_map: Option<PathBuf>,
+    pub wrinkle_masks: [Option<PathBuf>; 2],
     /// Textures found beside the file or given as overrides were not authored
     /// against the glTF's texture-coordinate convention (v = 0 at the top row).
     /// By default they are taken as bottom-up (OpenGL convention: the three.js
@@ -81,10 +98,16 @@ pub(super) enum Slot {
     Specular,
     Roughness,
     Strength,
+    Wrinkle,
+    WrinkleMask1,
+    WrinkleMask2,
 }
 
 /// How many texture roles a skin material has.
-const SLOTS: usize = 5;
+const SLOTS: usize = 8;
+/// The roles whose words alone claim a file (the wrinkle roles are read
+/// together: `classify`).
+const WORD_SLOTS: usize = 5;
 
 impl Slot {
     const ALL: [Slot; SLOTS] = [
@@ -93,6 +116,9 @@ impl Slot {
         Slot::Specular,
         Slot::Roughness,
         Slot::Strength,
+        Slot::Wrinkle,
+        Slot::WrinkleMask1,
+        Slot::WrinkleMask2,
     ];
 
     /// The role's words in a file name (module docs).
@@ -103,6 +129,7 @@ impl Slot {
             Slot::Specular => &["spec", "specular"],
             Slot::Roughness => &["rough", "roughness"],
             Slot::Strength => &["sss", "scatter", "scattering", "subsurface"],
+            Slot::Wrinkle | Slot::WrinkleMask1 | Slot::WrinkleMask2 => &["wrinkle", "wrinkles"],
         }
     }
 
@@ -113,6 +140,9 @@ impl Slot {
             Slot::Specular => "specular",
             Slot::Roughness => "roughness",
             Slot::Strength => "SSS strength",
+            Slot::Wrinkle => "wrinkle map",
+            Slot::WrinkleMask1 => "first wrinkle mask",
+            Slot::WrinkleMask2 => "second wrinkle mask",
         }
     }
 
@@ -123,6 +153,9 @@ impl Slot {
             Slot::Specular => "--spec-map",
             Slot::Roughness => "--roughness-map",
             Slot::Strength => "--sss-map",
+            Slot::Wrinkle => "--wrinkle-map",
+            Slot::WrinkleMask1 => "--wrinkle-mask1",
+            Slot::WrinkleMask2 => "--wrinkle-mask2",
         }
     }
 }
@@ -140,10 +173,34 @@ pub(super) fn classify(file_name: &str) -> Vec<Slot> {
         .split(|c: char| !c.is_ascii_alphanumeric())
         .map(str::to_ascii_lowercase)
         .collect();
-    Slot::ALL
-        .into_iter()
+    let mut roles: Vec<Slot> = Slot::ALL[..WORD_SLOTS]
+        .iter()
+        .copied()
         .filter(|s| words.iter().any(|w| s.words().contains(&w.as_str())))
-        .collect()
+        .collect();
+    if words
+        .iter()
+        .any(|w| Slot::Wrinkle.words().contains(&w.as_str()))
+    {
+        let number = |w: &str| match w {
+            "1" | "a" => Some(Slot::WrinkleMask1),
+            "2" | "b" => Some(Slot::WrinkleMask2),
+            _ => None,
+        };
+        let joined = words
+            .iter()
+            .find_map(|w| w.strip_prefix("mask").and_then(number));
+        let apart = words
+            .windows(2)
+            .find_map(|p| (p[0] == "mask").then(|| number(&p[1])).flatten());
+        let is_mask = words.iter().any(|w| w.starts_with("mask"));
+        match joined.or(apart) {
+            Some(mask) => roles.push(mask),
+            None if !is_mask => roles.push(Slot::Wrinkle),
+            None => {}
+        }
+    }
+    roles
 }
 
 /// What the naming rule makes of the files in `dir`: for each role, the files
@@ -322,6 +379,9 @@ pub(super) fn material(
         )?,
         None,
         None,
+        None,
+        None,
+        None,
     ];
     // The glTF's base colour factor tints the glTF's own texture (or is the colour when
     // there is none); a texture found beside the file was not authored against it (the
@@ -350,6 +410,9 @@ pub(super) fn material(
         &overrides.specular_map,
         &overrides.roughness_map,
         &overrides.sss_map,
+        &overrides.wrinkle_map,
+        &overrides.wrinkle_masks[0],
+        &overrides.wrinkle_masks[1],
     ];
     let beside = detect_beside(&src.dir);
     let name = |p: &Path| p.display().to_string();
@@ -436,6 +499,26 @@ pub(super) fn material(
             factor = [1.0; 4];
         }
     }
+    // The wrinkle map and its masks work together: a partial set is named
+    // and left out.
+    let wrinkle = &mut slots[Slot::Wrinkle as usize..];
+    let found = wrinkle.iter().filter(|t| t.is_some()).count();
+    if found > 0 && found < wrinkle.len() {
+        let missing: Vec<&str> = Slot::ALL[Slot::Wrinkle as usize..]
+            .iter()
+            .zip(wrinkle.iter())
+            .filter(|(_, t)| t.is_none())
+            .map(|(s, _)| s.what())
+            .collect();
+        warn.push(format!(
+            "the wrinkle maps are not used: the {} is missing (beside the scene by the naming rule, or {}, {} and {})",
+            missing.join(" and the "),
+            Slot::Wrinkle.flag(),
+            Slot::WrinkleMask1.flag(),
+            Slot::WrinkleMask2.flag()
+        ));
+        wrinkle.fill(None);
+    }
     // An option that changes nothing is named, not ignored in silence.
     let sidecars = taken_beside + given.iter().filter(|g| g.is_some()).count();
     if overrides.sidecar_top_down && sidecars == 0 {
@@ -459,14 +542,24 @@ fn part_material(
     index: Option<usize>,
     skin: bool,
     factor: [f32; 3],
-    [base_color, normal_map, specular_map, roughness_map, sss_map]: [Option<Texture>; SLOTS],
+    [base_color, normal_map, specular_map, roughness_map, sss_map, wrinkle, mask1, mask2]: [Option<
+        Texture,
+    >; SLOTS],
 ) -> Material {
+    let wrinkles = match (wrinkle, mask1, mask2) {
+        (Some(wrinkle), Some(m1), Some(m2)) => Some(WrinkleMaps {
+            wrinkle,
+            masks: [m1, m2],
+        }),
+        _ => None,
+    };
     let mut m = Material {
         base_color,
         normal_map,
         specular_map,
         roughness_map,
         sss_map,
+        wrinkles,
         ..Material::skin(factor)
     };
     if skin {
@@ -598,6 +691,63 @@ mod tests {
         ));
         assert!(e.contains("cannot decode normal map texture"), "{e}");
         assert!(e.contains("broken.jpg"), "{e}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn wrinkle_maps_beside_the_file_come_as_a_set() {
+        use Slot::*;
+        assert_eq!(classify("Head_Wrinkles.png"), [Wrinkle]);
+        assert_eq!(classify("head_wrinkle_mask1.png"), [WrinkleMask1]);
+        assert_eq!(classify("Wrinkle-Mask-B.PNG"), [WrinkleMask2]);
+        assert_eq!(classify("wrinkles_maska.jpg"), [WrinkleMask1]);
+        assert_eq!(classify("wrinkle_mask_2.png"), [WrinkleMask2]);
+        for name in [
+            "wrinkle_mask.png",
+            "mask2.png",
+            "wrinkled.png",
+            "mask1_col.png",
+        ] {
+            assert!(
+                !classify(name).iter().any(|s| *s as usize >= WORD_SLOTS),
+                "{name}"
+            );
+        }
+        let dir = temp_dir("wrinkles");
+        let scene = tiny_gltf(&dir, true, true, [0.0; 3]);
+        image::RgbaImage::new(8, 8)
+            .save(dir.join("head_wrinkles.png"))
+            .unwrap();
+        image::RgbaImage::new(4, 4)
+            .save(dir.join("head_wrinkle_mask1.png"))
+            .unwrap();
+        // Two of the three: none is used, and the warning names the third.
+        let l = crate::scene::gltf_load::load_head_with_notes(&scene, &Default::default()).unwrap();
+        assert!(l.object.material.wrinkles.is_none());
+        assert!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("second wrinkle mask is missing")
+                    && w.contains("--wrinkle-mask2")),
+            "{:?}",
+            l.warnings
+        );
+        image::RgbaImage::new(4, 4)
+            .save(dir.join("head_wrinkle_mask2.png"))
+            .unwrap();
+        let l = crate::scene::gltf_load::load_head_with_notes(&scene, &Default::default()).unwrap();
+        let w = l
+            .object
+            .material
+            .wrinkles
+            .expect("the three files beside the scene");
+        w.check().unwrap();
+        assert_eq!(
+            (w.wrinkle.width, w.masks[0].width, w.masks[1].width),
+            (8, 4, 4)
+        );
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        assert_eq!(l.notes.len(), 3, "{:?}", l.notes);
         let _ = std::fs::remove_dir_all(dir);
     }
 
