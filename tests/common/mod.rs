@@ -233,7 +233,7 @@ pub fn live_allocations(ctx: &Context) -> usize {
 
 /// The creation steps a set-up sweep fails, for its `case`-th case (a
 /// method, a path) of `steps`: every step of the first case; of the others,
-/// every `DERMIS_TEARDOWN_STRIDE`-th (default 4), starting at `case` modulo
+/// every `DERMIS_TEARDOWN_STRIDE`-th (default 8), starting at `case` modulo
 /// the stride, so the cases together still reach every offset. The cases
 /// share the frame's own steps, which the first case covers whole. `.ci/run`
 /// runs the sweeps again with a stride of 1 (docs/tests.md, "Longer runs").
@@ -241,7 +241,7 @@ pub fn sweep_steps(case: usize, steps: usize) -> impl Iterator<Item = usize> {
     let stride = if case == 0 {
         1
     } else {
-        env_usize("DERMIS_TEARDOWN_STRIDE", 4).max(1)
+        env_usize("DERMIS_TEARDOWN_STRIDE", 8).max(1)
     };
     (case % stride..steps).step_by(stride)
 }
