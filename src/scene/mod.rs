@@ -160,14 +160,6 @@ impl Scene {
         });
     }
 
-    /// Character `c`'s head as a crowd at the scene's time draws it: its
-    /// own phase of a clip of weights (`tracks`), posed on the CPU as the
-    /// deform pass poses its copy; `None` where it is the scene's head
-    /// (character 0, a still or rigid crowd, a head without targets).
-    pub fn character_head(&self, c: usize) -> Option<mesh::Mesh> {
-        self.character_head_posed(c)
-    }
-
     /// The head's morph weights for character `c` (frame index): a moving
     /// crowd's character at its own phase (a clip of weights, or a file's
     /// clip that moves the head), else the head's own; character 0 is the
@@ -180,7 +172,11 @@ impl Scene {
         }
     }
 
-    fn character_head_posed(&self, c: usize) -> Option<mesh::Mesh> {
+    /// Character `c`'s head as a crowd at the scene's time draws it: its
+    /// own phase of a clip of weights (`tracks`), posed on the CPU as the
+    /// deform pass poses its copy; `None` where it is the scene's head
+    /// (character 0, a still or rigid crowd, a head without targets).
+    pub fn character_head(&self, c: usize) -> Option<mesh::Mesh> {
         let t = self.tracks.as_ref().filter(|_| c > 0)?;
         if let crowd_motion::Motion::File(rig) = &t.motion {
             if !rig.moves(0) {
