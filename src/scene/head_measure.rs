@@ -39,7 +39,12 @@ fn inside(b: &Aabb, p: Vec3) -> bool {
 /// triangles face (area-weighted normals; +axis when they cancel); `None` for
 /// a solid.
 pub fn flat_axis(mesh: &Mesh) -> Option<Vec3> {
-    let (b, _) = inlier_bounds(mesh);
+    flat_axis_within(mesh, &inlier_bounds(mesh).0)
+}
+
+/// [`flat_axis`] of the mesh's inliers `b` (`inlier_bounds`, which sorts every
+/// coordinate: measured once by the callers that ask several questions).
+fn flat_axis_within(mesh: &Mesh, b: &Aabb) -> Option<Vec3> {
     let size = b.size();
     let largest = size.max_element();
     if !(largest > 0.0 && largest.is_finite()) || size.min_element() >= FLAT_RATIO * largest {
@@ -54,15 +59,7 @@ pub fn flat_axis(mesh: &Mesh) -> Option<Vec3> {
     };
     let mut facing = 0.0f64;
     for tri in mesh.indices.chunks_exact(3) {
-        let p: Option<Vec<Vec3>> = tri
-            .iter()
-            .map(|&i| {
-                mesh.vertices
-                    .get(i as usize)
-                    .map(|v| Vec3::from(v.position))
-            })
-            .collect();
-        let Some(p) = p.filter(|p| p.iter().all(|&q| inside(&b, q))) else {
+        let Some(p) = triangle_within(mesh, tri, b) else {
             continue;
         };
         facing += f64::from((p[1] - p[0]).cross(p[2] - p[0]).dot(axis));
@@ -72,13 +69,75 @@ pub fn flat_axis(mesh: &Mesh) -> Option<Vec3> {
 
 /// Where the camera frames a head: the centre and height (scene units) of the
 /// part from the chin up; for a flat mesh, its centre and largest extent.
+///
+/// Remembered by the mesh's contents (the last `REMEMBERED` meshes asked
+/// about): framing asks it of one head every frame and for every view of a
+/// crowd, and the measure walks every triangle of the head (milliseconds a
+/// call on the built-in face in a test build), where the key reads each
+/// coordinate and index once.
 pub fn framed_part(mesh: &Mesh, forward: Vec3) -> (Vec3, f32) {
-    if flat_axis(mesh).is_some() {
-        let (b, _) = inlier_bounds(mesh);
+    use std::sync::Mutex;
+    static MEMO: Mutex<Vec<(u64, (Vec3, f32))>> = Mutex::new(Vec::new());
+    let key = contents_key(mesh, forward);
+    let hit = MEMO
+        .lock()
+        .ok()
+        .and_then(|m| m.iter().find(|(k, _)| *k == key).map(|e| e.1));
+    if let Some(hit) = hit {
+        return hit;
+    }
+    let measured = measure_framed_part(mesh, forward);
+    if let Ok(mut m) = MEMO.lock() {
+        if m.len() >= REMEMBERED {
+            m.remove(0);
+        }
+        m.push((key, measured));
+    }
+    measured
+}
+
+/// How many meshes' framing `framed_part` remembers.
+const REMEMBERED: usize = 8;
+
+/// A 64-bit key of every bit of the mesh's positions and indices and of
+/// `forward` (a multiply-rotate hash over 32-bit words, two lanes): two
+/// meshes that differ anywhere get different keys but for a 2^-64 chance.
+fn contents_key(mesh: &Mesh, forward: Vec3) -> u64 {
+    let (mut a, mut b) = (0x243f_6a88_85a3_08d3u64, 0x1319_8a2e_0370_7344u64);
+    let mut eat = |w: u32| {
+        a = (a ^ u64::from(w))
+            .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            .rotate_left(29);
+        b = (b.rotate_left(17) ^ u64::from(w)).wrapping_mul(0xff51_afd7_ed55_8ccd);
+    };
+    for v in &mesh.vertices {
+        v.position.iter().for_each(|c| eat(c.to_bits()));
+    }
+    eat(mesh.vertices.len() as u32);
+    mesh.indices.iter().for_each(|&i| eat(i));
+    eat(mesh.indices.len() as u32);
+    forward.to_array().iter().for_each(|c| eat(c.to_bits()));
+    a ^ b.rotate_left(32)
+}
+
+/// [`framed_part`], measured.
+fn measure_framed_part(mesh: &Mesh, forward: Vec3) -> (Vec3, f32) {
+    let (b, _) = inlier_bounds(mesh);
+    if flat_axis_within(mesh, &b).is_some() {
         return (b.center(), b.size().max_element());
     }
-    let (chin, crown) = chin_and_crown(mesh, forward);
-    (head_part_bounds(mesh, forward).center(), crown - chin)
+    let (chin, crown) = chin_and_crown_within(mesh, forward, &b);
+    (part_above(mesh, chin, &b).center(), crown - chin)
+}
+
+/// A triangle's corners when all three are vertices of the mesh inside `b`.
+fn triangle_within(mesh: &Mesh, tri: &[u32], b: &Aabb) -> Option<[Vec3; 3]> {
+    let ids = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+    if ids.iter().any(|&i| i >= mesh.vertices.len()) {
+        return None;
+    }
+    let p = ids.map(|i| Vec3::from(mesh.vertices[i].position));
+    p.iter().all(|&q| inside(b, q)).then_some(p)
 }
 
 /// Unit horizontal vector from the head's centre toward its face. Y is taken as up (glTF's
@@ -138,7 +197,12 @@ pub fn face_direction(mesh: &Mesh) -> Vec3 {
 /// bottom (the menton) on the Lee Perry-Smith scan. A mesh whose bottom narrows to a
 /// point (no neck, like the procedural head) has its chin at its lowest point.
 pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
-    let (b, _) = inlier_bounds(mesh);
+    chin_and_crown_within(mesh, forward, &inlier_bounds(mesh).0)
+}
+
+/// [`chin_and_crown`] of the mesh's inliers `b`.
+fn chin_and_crown_within(mesh: &Mesh, forward: Vec3, b: &Aabb) -> (f32, f32) {
+    let b = *b;
     let (bottom, crown) = (b.min.y, b.max.y);
     let extent = crown - bottom;
     if mesh.vertices.is_empty() || extent <= 0.0 || !extent.is_finite() {
@@ -164,16 +228,7 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
     let mut front = [f32::NEG_INFINITY; SLICES];
     let slice_of = |y: f32| ((((y - bottom) / extent) * SLICES as f32) as usize).min(SLICES - 1);
     for tri in mesh.indices.chunks_exact(3) {
-        let Some(p) = tri
-            .iter()
-            .map(|&i| {
-                mesh.vertices
-                    .get(i as usize)
-                    .map(|v| Vec3::from(v.position))
-            })
-            .collect::<Option<Vec<Vec3>>>()
-            .filter(|p| p.iter().all(|&q| inside(&b, q)))
-        else {
+        let Some(p) = triangle_within(mesh, tri, &b) else {
             continue;
         };
         let (lo, hi) = (
@@ -234,15 +289,19 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
 /// Bounds of the part of the mesh from the chin up: the head without neck or shoulders,
 /// which is what a camera should frame.
 pub fn head_part_bounds(mesh: &Mesh, forward: Vec3) -> Aabb {
-    let (chin, _) = chin_and_crown(mesh, forward);
     let (b, _) = inlier_bounds(mesh);
+    part_above(mesh, chin_and_crown_within(mesh, forward, &b).0, &b)
+}
+
+/// Bounds of the inliers (`b`) at or above `chin`.
+fn part_above(mesh: &Mesh, chin: f32, b: &Aabb) -> Aabb {
     Aabb::from_points(
         mesh.vertices
             .iter()
             .map(|v| Vec3::from(v.position))
-            .filter(|&p| inside(&b, p) && p.y >= chin),
+            .filter(|&p| inside(b, p) && p.y >= chin),
     )
-    .unwrap_or(b)
+    .unwrap_or(*b)
 }
 
 #[cfg(test)]
@@ -266,6 +325,31 @@ mod tests {
             let got = face_direction(&m);
             assert!((got - expect).length() < 1e-4, "{angle}: {got}");
         }
+    }
+
+    // The remembered answer is the mesh's own: a mesh moved by one vertex or
+    // as a whole is measured again, and asked again it answers the same.
+    #[test]
+    fn framing_is_remembered_by_the_meshs_contents() {
+        let head = procedural::head_mesh();
+        let first = framed_part(&head, Vec3::Z);
+        assert_eq!(framed_part(&head, Vec3::Z), first);
+        assert_eq!(first, measure_framed_part(&head, Vec3::Z));
+        let mut moved = head.clone();
+        moved.transform(&Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0)));
+        let (c, h) = framed_part(&moved, Vec3::Z);
+        assert!((c.y - first.0.y - 2.0).abs() < 1e-4 && (h - first.1).abs() < 1e-4);
+        let mut crown = head.clone();
+        let top = crown
+            .vertices
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.position[1].total_cmp(&b.1.position[1]))
+            .map(|(k, _)| k)
+            .unwrap();
+        crown.vertices[top].position[1] += 0.01;
+        assert!(framed_part(&crown, Vec3::Z).1 > first.1);
+        assert_ne!(contents_key(&head, Vec3::Z), contents_key(&head, Vec3::X));
     }
 
     #[test]

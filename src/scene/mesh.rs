@@ -364,29 +364,32 @@ impl Mesh {
     /// treated as one (UV seams duplicate vertices), so seams do not show as creases.
     pub fn compute_normals(&mut self) {
         use std::collections::HashMap;
-        let key = |p: [f32; 3]| [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
-        let mut acc: HashMap<[u32; 3], Vec3> = HashMap::new();
+        // Each vertex's position class (vertices at one position share a normal),
+        // looked up once a vertex rather than three times a triangle: the face's
+        // expressions recompute normals seven times in every process.
+        let mut classes: HashMap<[u32; 3], usize> = HashMap::with_capacity(self.vertices.len());
+        let class: Vec<usize> = self
+            .vertices
+            .iter()
+            .map(|v| {
+                let next = classes.len();
+                *classes.entry(v.position.map(f32::to_bits)).or_insert(next)
+            })
+            .collect();
+        let mut acc = vec![Vec3::ZERO; classes.len()];
         for tri in self.indices.chunks_exact(3) {
-            let p: Vec<Vec3> = tri
-                .iter()
-                .filter_map(|&i| self.vertices.get(i as usize))
-                .map(|v| Vec3::from(v.position))
-                .collect();
-            if p.len() != 3 {
+            let ids = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+            if ids.iter().any(|&i| i >= self.vertices.len()) {
                 continue;
             }
+            let p = ids.map(|i| Vec3::from(self.vertices[i].position));
             let fnrm = (p[1] - p[0]).cross(p[2] - p[0]);
-            for &i in tri {
-                *acc.entry(key(self.vertices[i as usize].position))
-                    .or_insert(Vec3::ZERO) += fnrm;
+            for i in ids {
+                acc[class[i]] += fnrm;
             }
         }
-        for v in &mut self.vertices {
-            let n = acc
-                .get(&key(v.position))
-                .and_then(|n| n.try_normalize())
-                .unwrap_or(Vec3::Y);
-            v.normal = n.into();
+        for (v, c) in self.vertices.iter_mut().zip(class) {
+            v.normal = acc[c].try_normalize().unwrap_or(Vec3::Y).into();
         }
     }
 

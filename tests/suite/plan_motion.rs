@@ -158,12 +158,24 @@ fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::moti
     .unwrap()
 }
 
+/// `nine_walking` with hard switches, run once for the two tests that read
+/// it (a dozen seconds of lavapipe each time), its outputs in cargo's
+/// directory for integration tests' files.
+fn hard_walk() -> &'static (dermis::plan::motion::MotionReport, std::path::PathBuf) {
+    static HARD: std::sync::OnceLock<(dermis::plan::motion::MotionReport, std::path::PathBuf)> =
+        std::sync::OnceLock::new();
+    HARD.get_or_init(|| {
+        let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("plan-motion-hard");
+        let _ = std::fs::remove_dir_all(&out);
+        (nine_walking(0, &out), out)
+    })
+}
+
 #[test]
 fn plan_motion_measures_switches_against_the_truth() {
     use dermis::plan::motion;
-    let out = tmp("measure");
-    let r = nine_walking(0, &out);
-    print!("{}", motion::summary(&r));
+    let (r, out) = hard_walk();
+    print!("{}", motion::summary(r));
     assert_eq!(r.frames.len(), 5);
     assert_eq!(r.truth_density.as_deref(), Some("1"));
     for f in &r.frames {
@@ -229,8 +241,7 @@ fn plan_motion_measures_switches_against_the_truth() {
 #[test]
 fn plan_motion_cross_fades_a_switch_over_three_frames() {
     use dermis::plan::motion;
-    let run = |fade_frames: usize| nine_walking(fade_frames, &tmp(&format!("fade-{fade_frames}")));
-    let (hard, faded) = (run(0), run(3));
+    let (hard, faded) = (hard_walk().0.clone(), nine_walking(3, &tmp("fade-3")));
     print!("{}", motion::summary(&faded));
     // The fades do not change the plan.
     for (a, b) in hard.frames.iter().zip(&faded.frames) {

@@ -98,8 +98,8 @@ pub fn shot(scene: &Scene, s: &RenderSettings) -> Shot {
 /// Camera distance of every character's head centre, in head heights, in
 /// the frame's order (what `--assign`'s distance bands select on).
 pub fn character_distances_heads(scene: &Scene, framing: &Framing) -> Vec<f64> {
-    let centre = scene.head_center();
-    let h = scene.head_height_units().max(f32::MIN_POSITIVE);
+    let size = scene.head_size();
+    let (centre, h) = (size.centre, size.height.max(f32::MIN_POSITIVE));
     framing
         .instances
         .iter()
