@@ -11,11 +11,15 @@
 #   their wrinkles (bottom row), under a light from above that rakes the creases;
 #   wrinkles_compound.jpg: surprise, then surprise and anger together (Figure 8.5:
 #   anger cancels the forehead's wrinkles and creases the brows).
+# - colour_states.jpg: the appearance rig's maps (thesis ch. 7.4) over the built-in
+#   face, one column a state (neutral, joy, surprise, fear, anger, disgust, sad,
+#   exercise, alcohol, blush); rows: the rig's haemoglobin, the albedo at 1% melanin,
+#   the albedo at the light tone's (the colour_states example).
 #
 #   bash tools/pictures_issue30.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --features tools --bin dermis --example montage
+cargo build --release --features tools --bin dermis --example montage --example colour_states
 D=target/release/dermis
 M=target/release/examples/montage
 T=$(mktemp -d)
@@ -56,6 +60,8 @@ done
 # shellcheck disable=SC2086
 run both --morph-weights "surprise=1,anger=1" --width 300 --height 360 --shot close $rake
 "$M" "$OUT/wrinkles_compound.jpg" 2 "$T/surprise/frame.png" "$T/both/frame.png"
+echo "+ colour_states $OUT/colour_states.jpg" >> "$OUT/commands.txt"
+target/release/examples/colour_states "$OUT/colour_states.jpg"
 LPS=../shared/assets/lee-perry-smith/LeePerrySmith.glb
 if [ -f "$LPS" ]; then
   for t in pre post; do

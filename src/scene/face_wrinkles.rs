@@ -21,14 +21,12 @@
 //! 0.7-1.6 mm wide): every slope stays inside the encoding's 45-degree cone.
 
 use glam::{Vec2, Vec3};
-use std::f32::consts::{PI, TAU};
 
+pub use super::face_surface::Skull;
+use super::face_surface::{in_parallel, SurfaceGrid};
 use super::mesh::{Texture, WrinkleMaps};
 use super::procedural::smoothstep;
 use super::wrinkle_maps::{encode, MASKS, ZONES_PER_MASK};
-
-/// Texels between the surface points marched (`face_wrinkle_maps`).
-const MARCH_STRIDE: usize = 4;
 
 /// Texels a side of the wrinkle map and of the masks.
 pub const WRINKLE_SIZE: u32 = 512;
@@ -36,8 +34,8 @@ pub const MASK_SIZE: u32 = 128;
 
 /// The UV rectangle the maps are computed over (the face, with a margin):
 /// outside it the wrinkle map is flat and the masks 0.
-const U_RANGE: (f32, f32) = (0.21, 0.79);
-const V_RANGE: (f32, f32) = (0.12, 0.62);
+pub(super) const U_RANGE: (f32, f32) = (0.21, 0.79);
+pub(super) const V_RANGE: (f32, f32) = (0.12, 0.62);
 
 /// Half-width (mm) of the soft split between a zone's right and left halves.
 const SPLIT_MM: f32 = 3.0;
@@ -148,30 +146,30 @@ fn dimples() -> impl Iterator<Item = Vec2> {
 
 /// The face's front: creases and zones fade in between these depths (mm),
 /// so nothing reaches the back of the head.
-fn front(z: f32) -> f32 {
+pub(super) fn front(z: f32) -> f32 {
     smoothstep(20.0, 40.0, z)
 }
 
 /// Distance from `p` to the polyline and where along it (0..1 of its length).
 fn polyline_distance(points: &[[f32; 2]], p: Vec2) -> (f32, f32) {
-    let segments = || {
-        points
-            .windows(2)
-            .map(|w| (Vec2::from(w[0]), Vec2::from(w[1])))
-    };
-    let total: f32 = segments().map(|(a, b)| a.distance(b)).sum();
-    let (mut best, mut at, mut run) = (f32::MAX, 0.0, 0.0);
-    for (a, b) in segments() {
-        let len = a.distance(b);
-        let t = ((p - a).dot(b - a) / (len * len)).clamp(0.0, 1.0);
-        let d = p.distance(a + (b - a) * t);
-        if d < best {
-            best = d;
-            at = (run + t * len) / total;
+    // Squared distances first; one square root and the lengths for the nearest
+    // segment alone (the maps ask this of 16 creases six times a texel).
+    let (mut best, mut nearest) = (f32::MAX, (0, 0.0));
+    for (k, w) in points.windows(2).enumerate() {
+        let (a, b) = (Vec2::from(w[0]), Vec2::from(w[1]));
+        let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+        let d2 = p.distance_squared(a + (b - a) * t);
+        if d2 < best {
+            (best, nearest) = (d2, (k, t));
         }
-        run += len;
     }
-    (best, at)
+    let lengths = points
+        .windows(2)
+        .map(|w| Vec2::from(w[0]).distance(Vec2::from(w[1])));
+    let before: f32 = lengths.clone().take(nearest.0).sum();
+    let total: f32 = lengths.clone().sum();
+    let along = before + nearest.1 * lengths.clone().nth(nearest.0).unwrap_or(0.0);
+    (best.sqrt(), along / total)
 }
 
 /// The wrinkles' height (mm, creases negative) at surface point `p` (mm).
@@ -194,6 +192,11 @@ pub fn height_mm(p: Vec3) -> f32 {
     }
     for k in dimples() {
         let d2 = plain.distance_squared(k);
+        // Beyond six sigma a dimple is 1e-8 of its depth (and its exponential
+        // underflows, which costs glibc an error path per call).
+        if d2 > (6.0 * DIMPLE_SIGMA_MM).powi(2) {
+            continue;
+        }
         h -= DIMPLE_DEPTH_MM * (-0.5 * d2 / (DIMPLE_SIGMA_MM * DIMPLE_SIGMA_MM)).exp();
     }
     h * gate
@@ -233,15 +236,6 @@ pub fn zones(p: Vec3) -> [f32; 8] {
     .map(|z| z * gate)
 }
 
-/// A skull's surface point (mm) for polar angle theta (from +Y) and azimuth
-/// phi (0: the face, +Z).
-pub type Skull = fn(f32, f32) -> Vec3;
-
-/// The skull's surface point (mm) at UV `(u, v)`.
-fn surface_mm(skull: Skull, u: f32, v: f32) -> Vec3 {
-    skull(v * PI, u * TAU - PI)
-}
-
 /// The partial-derivative normal of the height field at `p` (mm) in the
 /// tangent frame the mesh gives a point whose surface moves by `du`, `dv`
 /// (mm per UV unit): T along du (made perpendicular to the normal), B =
@@ -277,35 +271,11 @@ pub fn face_wrinkle_maps(skull: Skull) -> WrinkleMaps {
     let rows: Vec<usize> = (0..n)
         .filter(|&i| (V_RANGE.0..=V_RANGE.1).contains(&at(i)))
         .collect();
-    // Surface points over the rectangle and one texel around it: marched
-    // every MARCH_STRIDE texels, row by row on every core (the ray marches
-    // are the cost: a second per process in a test build when every texel
-    // marched), and interpolated between (the skull is smooth at 3.5 mm;
-    // the mesh's own vertices are 1.5 to 8 mm apart).
+    // Surface points over the rectangle and one texel around it.
     let (j0, j1) = (cols[0] - 1, cols[cols.len() - 1] + 1);
     let (i0, i1) = (rows[0] - 1, rows[rows.len() - 1] + 1);
-    let coarse = |k0: usize, k1: usize| (k1 - k0).div_ceil(MARCH_STRIDE) + 1;
-    let (ci, cj) = (coarse(i0, i1), coarse(j0, j1));
-    let coarse_rows: Vec<usize> = (0..ci).collect();
-    let points = in_parallel(&coarse_rows, |&a| {
-        (0..cj)
-            .map(|b| {
-                let (i, j) = (i0 + a * MARCH_STRIDE, j0 + b * MARCH_STRIDE);
-                surface_mm(skull, at(j), at(i))
-            })
-            .collect::<Vec<Vec3>>()
-    });
-    let p = |i: usize, j: usize| {
-        let (y, x) = ((i - i0) as f32, (j - j0) as f32);
-        let s = MARCH_STRIDE as f32;
-        let (a, b) = (
-            ((y / s) as usize).min(ci - 2),
-            ((x / s) as usize).min(cj - 2),
-        );
-        let (fy, fx) = (y / s - a as f32, x / s - b as f32);
-        let row = |r: usize| points[r][b].lerp(points[r][b + 1], fx);
-        row(a).lerp(row(a + 1), fy)
-    };
+    let grid = SurfaceGrid::new(skull, n, (i0, i1), (j0, j1));
+    let p = |i: usize, j: usize| grid.point(i, j);
     let mut wrinkle = vec![0u8; 4 * n * n];
     for px in wrinkle.chunks_exact_mut(4) {
         px.copy_from_slice(&[encode(0.0), encode(0.0), 0, 255]);
@@ -366,27 +336,6 @@ fn masks_from(fine: &[[f32; 8]], n: usize, size: usize) -> [Texture; MASKS] {
         width: size as u32,
         height: size as u32,
         rgba8,
-    })
-}
-
-/// `f` of each item, on every core, in order.
-fn in_parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(16);
-    let chunk = items.len().div_ceil(threads).max(1);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = items
-            .chunks(chunk)
-            .map(|c| {
-                let f = &f;
-                s.spawn(move || c.iter().map(f).collect::<Vec<R>>())
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("a wrinkle-map thread panicked"))
-            .collect()
     })
 }
 
@@ -460,6 +409,12 @@ mod tests {
         assert_eq!(m.wrinkle_texel(0, 0), [decode(128); 2]);
         assert!((0..8).all(|z| m.mask_texel(z, 0, 0) == 0.0));
         assert!(m.bytes() < 1_200_000, "{}", m.bytes());
+    }
+
+    /// The skull's surface point (mm) at UV `(u, v)`.
+    fn surface_mm(skull: Skull, u: f32, v: f32) -> Vec3 {
+        use std::f32::consts::{PI, TAU};
+        skull(v * PI, u * TAU - PI)
     }
 
     /// The v of the skull's midline point at height `y` (mm).

@@ -11,6 +11,8 @@ pub mod enclosed;
 pub mod expressions;
 pub mod eyes;
 pub mod face;
+pub mod face_colour;
+pub mod face_surface;
 pub mod face_wrinkles;
 pub mod framing;
 pub mod gltf_accessor;

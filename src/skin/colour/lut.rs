@@ -69,6 +69,31 @@ impl ColourTable {
     pub fn at(&self, u: usize, v: usize) -> [f32; 3] {
         self.rgb[v * self.size + u]
     }
+
+    /// Bilinear between entries at table coordinates `(u, v)` in [0, 1]^2,
+    /// clamped to the edge entries: what a linear sampler of the table
+    /// uploaded as a texture returns.
+    pub fn sample(&self, u: f64, v: f64) -> [f32; 3] {
+        let last = (self.size - 1) as f64;
+        let fx = (u * self.size as f64 - 0.5).clamp(0.0, last);
+        let fy = (v * self.size as f64 - 0.5).clamp(0.0, last);
+        let (x0, y0) = (fx as usize, fy as usize);
+        let (x1, y1) = ((x0 + 1).min(self.size - 1), (y0 + 1).min(self.size - 1));
+        let (tx, ty) = ((fx - x0 as f64) as f32, (fy - y0 as f64) as f32);
+        let lerp = |a: [f32; 3], b: [f32; 3], t: f32| [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t);
+        lerp(
+            lerp(self.at(x0, y0), self.at(x1, y0), tx),
+            lerp(self.at(x0, y1), self.at(x1, y1), tx),
+            ty,
+        )
+    }
+
+    /// The linear sRGB of skin with volume fractions `melanin` and
+    /// `dermal_blood`, looked up by eq. 7.7's cube roots.
+    pub fn skin(&self, melanin: f64, dermal_blood: f64) -> [f32; 3] {
+        let (u, v) = coordinates(melanin, dermal_blood);
+        self.sample(u, v)
+    }
 }
 
 /// A fair dermal blood fraction (2%) the tones share.
