@@ -290,8 +290,9 @@ fn neck_field(p: Vec3) -> f32 {
 /// Why these and not plain steps and bisection: the head is built in every process
 /// (about 50 000 rays), and steps capped at 6 mm with 14 bisections took 48 field
 /// evaluations a ray, a second of a test build's start. Steps capped at 25 mm and the
-/// secant's convergence take about 17, and find the same crossing on every ray to
-/// within a micrometre (`tests::the_march_finds_the_careful_marchs_crossings`).
+/// secant's convergence take about 17, and find the same crossing to within a
+/// micrometre on every ray of the shell and of the wrinkle maps' grid (checked on every
+/// third: `tests::the_march_finds_the_careful_marchs_crossings`).
 fn outermost_crossing(field: impl Fn(Vec3) -> f32, origin: Vec3, dir: Vec3, length: f32) -> f32 {
     const STEP_FRACTION: f32 = 0.6;
     const MIN_STEP_MM: f32 = 0.2;
@@ -312,32 +313,27 @@ fn outermost_crossing(field: impl Fn(Vec3) -> f32, origin: Vec3, dir: Vec3, leng
 /// The zero of `f` between `inside` (t, f(t) < 0) and `outside` (t and f(t) >= 0 where
 /// known), to within `CROSSING_TOLERANCE_MM`: the Illinois method, which halves the
 /// weight of an end kept twice so the bracket closes from both sides; bisection where
-/// an end's value is unknown or not of its sign (a ray that never left the surface).
+/// an end's value is unknown or not of its sign (a ray that never left the surface),
+/// or once the field answers something not finite.
 fn refine_crossing(f: &dyn Fn(f32) -> f32, inside: (f32, f32), outside: (f32, Option<f32>)) -> f32 {
-    const MAX_ITERATIONS: usize = 40;
     let ((mut ti, mut fi), (mut to, fo)) = (inside, outside);
     let Some(mut fo) = fo.filter(|&fo| fo >= 0.0 && fi < 0.0) else {
-        for _ in 0..MAX_ITERATIONS {
-            if (to - ti).abs() <= CROSSING_TOLERANCE_MM {
-                break;
-            }
-            let mid = 0.5 * (ti + to);
-            if f(mid) < 0.0 {
-                ti = mid;
-            } else {
-                to = mid;
-            }
-        }
-        return 0.5 * (ti + to);
+        return bisect_crossing(f, ti, to);
     };
     let mut kept = 0i8;
-    for _ in 0..MAX_ITERATIONS {
+    // The latest secant point: the answer when the bracket stops closing (an end at
+    // an exact zero, or steps below the coordinates' rounding).
+    let mut t = 0.5 * (ti + to);
+    for _ in 0..MAX_REFINEMENTS {
         if (to - ti).abs() <= CROSSING_TOLERANCE_MM {
-            break;
+            return 0.5 * (ti + to);
         }
-        let t = (ti * fo - to * fi) / (fo - fi);
+        t = (ti * fo - to * fi) / (fo - fi);
         let ft = f(t);
-        if ft.abs() <= CROSSING_TOLERANCE_MM * 0.1 {
+        if !ft.is_finite() {
+            return bisect_crossing(f, ti, to);
+        }
+        if ft == 0.0 {
             return t;
         }
         if ft < 0.0 {
@@ -354,7 +350,27 @@ fn refine_crossing(f: &dyn Fn(f32) -> f32, inside: (f32, f32), outside: (f32, Op
             kept = 1;
         }
     }
-    0.5 * (ti + to)
+    t
+}
+
+/// Most steps either refinement takes (bisection halves 200 mm to the tolerance in 21).
+const MAX_REFINEMENTS: usize = 40;
+
+/// Bisection between `inside` and `outside` (distances along the ray; a value that is
+/// not below 0, NaN included, counts as outside), to the tolerance.
+fn bisect_crossing(f: &dyn Fn(f32) -> f32, mut inside: f32, mut outside: f32) -> f32 {
+    for _ in 0..MAX_REFINEMENTS {
+        if (outside - inside).abs() <= CROSSING_TOLERANCE_MM {
+            break;
+        }
+        let mid = 0.5 * (inside + outside);
+        if f(mid) < 0.0 {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    0.5 * (inside + outside)
 }
 
 /// Maps a uniform parameter in 0..1 to 0..1 so that samples crowd where a density is

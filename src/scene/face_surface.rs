@@ -30,7 +30,8 @@ pub struct SurfaceGrid {
 impl SurfaceGrid {
     pub fn new(skull: Skull, n: usize, rows: (usize, usize), cols: (usize, usize)) -> SurfaceGrid {
         let at = |k: usize| (k as f32 + 0.5) / n as f32;
-        let coarse = |(k0, k1): (usize, usize)| (k1 - k0).div_ceil(MARCH_STRIDE) + 1;
+        // At least two points a side: `point` interpolates between neighbours.
+        let coarse = |(k0, k1): (usize, usize)| ((k1 - k0).div_ceil(MARCH_STRIDE) + 1).max(2);
         let (ci, cj) = (coarse(rows), coarse(cols));
         let coarse_rows: Vec<usize> = (0..ci).collect();
         let points = in_parallel(&coarse_rows, |&a| {

@@ -160,12 +160,14 @@ fn nine_walking(fade_frames: usize, out: &std::path::Path) -> dermis::plan::moti
 
 /// `nine_walking` with hard switches, run once for the two tests that read
 /// it (a dozen seconds of lavapipe each time), its outputs in cargo's
-/// directory for integration tests' files.
+/// directory for integration tests' files, one a process (a runner that
+/// starts a process a test runs it in each, at the same time).
 fn hard_walk() -> &'static (dermis::plan::motion::MotionReport, std::path::PathBuf) {
     static HARD: std::sync::OnceLock<(dermis::plan::motion::MotionReport, std::path::PathBuf)> =
         std::sync::OnceLock::new();
     HARD.get_or_init(|| {
-        let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("plan-motion-hard");
+        let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("plan-motion-hard-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&out);
         (nine_walking(0, &out), out)
     })

@@ -62,11 +62,12 @@ impl FaceAppearance {
 mod tests {
     use super::super::histogram::{correlation, local_stats};
     use super::*;
+    use crate::scene::face_colour::COLOUR_SIZE;
     use std::sync::OnceLock;
 
     fn face() -> &'static FaceAppearance {
         static FACE: OnceLock<FaceAppearance> = OnceLock::new();
-        FACE.get_or_init(|| FaceAppearance::builtin(0.038))
+        FACE.get_or_init(|| FaceAppearance::from_maps(crate::scene::face_colour::tests::maps()))
     }
 
     fn weights(name: &str) -> Vec<f32> {
@@ -82,7 +83,7 @@ mod tests {
     #[test]
     fn each_state_matches_its_windows_and_keeps_the_capillaries() {
         let f = face();
-        let maps = face_chromophore_maps(crate::scene::face::skull_point_mm, 0.038);
+        let maps = crate::scene::face_colour::tests::maps();
         let n = maps.size;
         let neutral = Map::new(n, n, maps.haemoglobin.clone()).unwrap();
         for (k, name) in STATES.iter().enumerate() {
@@ -133,8 +134,8 @@ mod tests {
             let (mut r, mut g) = (0.0, 0.0);
             for y in cy - 8..cy + 8 {
                 for x in cx - 8..cx + 8 {
-                    r += a[y * 512 + x][0];
-                    g += a[y * 512 + x][1];
+                    r += a[y * COLOUR_SIZE + x][0];
+                    g += a[y * COLOUR_SIZE + x][1];
                 }
             }
             r / g
