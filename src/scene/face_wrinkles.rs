@@ -48,15 +48,15 @@ const MIRROR_ROUNDING_MM2: f32 = 4.0;
 /// and out over its first and last fifth. `mirrored`: written for the right
 /// side (+x) and mirrored.
 struct Crease {
-    points: &'static [[f32; 2]],
+    points: Vec<[f32; 2]>,
     depth: f32,
     sigma: f32,
     mirrored: bool,
 }
 
-const fn crease(points: &'static [[f32; 2]], depth: f32, sigma: f32, mirrored: bool) -> Crease {
+fn crease(points: &[[f32; 2]], depth: f32, sigma: f32, mirrored: bool) -> Crease {
     Crease {
-        points,
+        points: points.to_vec(),
         depth,
         sigma,
         mirrored,
@@ -66,25 +66,15 @@ const fn crease(points: &'static [[f32; 2]], depth: f32, sigma: f32, mirrored: b
 /// The outer corner of the right eye (mm, x and y).
 const CANTHUS: [f32; 2] = [44.0, 1.0];
 
-/// Crow's feet: rays fanning out from the canthus, 5 to 20 mm from it, at
-/// -40, -15, 10 and 35 degrees from the horizontal.
-const fn ray(angle_deg: f32) -> [[f32; 2]; 2] {
-    // cos and sin are not const: the four rays' values, precomputed.
-    let (c, s) = match angle_deg as i32 {
-        -40 => (0.766, -0.643),
-        -15 => (0.966, -0.259),
-        10 => (0.985, 0.174),
-        _ => (0.819, 0.574),
-    };
+/// A crow's foot: a ray fanning out from the canthus, 5 to 20 mm from it,
+/// `angle_deg` from the horizontal.
+fn ray(angle_deg: f32) -> [[f32; 2]; 2] {
+    let (s, c) = angle_deg.to_radians().sin_cos();
     [
         [CANTHUS[0] + 5.0 * c, CANTHUS[1] + 5.0 * s],
         [CANTHUS[0] + 20.0 * c, CANTHUS[1] + 20.0 * s],
     ]
 }
-const CROW_0: [[f32; 2]; 2] = ray(-40.0);
-const CROW_1: [[f32; 2]; 2] = ray(-15.0);
-const CROW_2: [[f32; 2]; 2] = ray(10.0);
-const CROW_3: [[f32; 2]; 2] = ray(35.0);
 
 /// The forehead's lines, drooping 4 mm toward the temples.
 const fn forehead(y: f32) -> [[f32; 2]; 5] {
@@ -105,27 +95,30 @@ const NASOLABIAL: [[f32; 2]; 4] = [[15.0, -36.0], [22.0, -48.0], [27.0, -60.0], 
 /// The mentolabial sulcus over the chin.
 const MENTOLABIAL: [[f32; 2]; 3] = [[-14.0, -87.0], [0.0, -85.0], [14.0, -87.0]];
 
-const CREASES: [Crease; 16] = [
-    crease(&FOREHEAD_0, 0.35, 1.0, false),
-    crease(&FOREHEAD_1, 0.4, 1.0, false),
-    crease(&FOREHEAD_2, 0.4, 1.0, false),
-    crease(&FOREHEAD_3, 0.3, 1.0, false),
-    // The corrugator's vertical lines between the brows.
-    crease(&[[5.0, 3.0], [8.0, 20.0]], 0.45, 0.8, true),
-    crease(&[[10.0, 6.0], [12.0, 16.0]], 0.25, 0.7, true),
-    // The nasalis' lines across the bridge.
-    crease(&[[-9.0, -6.0], [9.0, -6.0]], 0.25, 0.7, false),
-    crease(&[[-10.0, -10.5], [10.0, -10.5]], 0.3, 0.7, false),
-    crease(&[[-10.0, -15.0], [10.0, -15.0]], 0.25, 0.7, false),
-    crease(&CROW_0, 0.3, 0.7, true),
-    crease(&CROW_1, 0.35, 0.7, true),
-    crease(&CROW_2, 0.35, 0.7, true),
-    crease(&CROW_3, 0.3, 0.7, true),
-    crease(&NASOLABIAL, 0.7, 1.6, true),
-    crease(&MENTOLABIAL, 0.5, 1.3, false),
-    // The lower lip's crease under the mouth's corners.
-    crease(&[[20.0, -74.0], [24.0, -84.0]], 0.3, 1.0, true),
-];
+/// Every crease of the face (made once: the crow's feet need trigonometry).
+static CREASES: std::sync::LazyLock<[Crease; 16]> = std::sync::LazyLock::new(|| {
+    [
+        crease(&FOREHEAD_0, 0.35, 1.0, false),
+        crease(&FOREHEAD_1, 0.4, 1.0, false),
+        crease(&FOREHEAD_2, 0.4, 1.0, false),
+        crease(&FOREHEAD_3, 0.3, 1.0, false),
+        // The corrugator's vertical lines between the brows.
+        crease(&[[5.0, 3.0], [8.0, 20.0]], 0.45, 0.8, true),
+        crease(&[[10.0, 6.0], [12.0, 16.0]], 0.25, 0.7, true),
+        // The nasalis' lines across the bridge.
+        crease(&[[-9.0, -6.0], [9.0, -6.0]], 0.25, 0.7, false),
+        crease(&[[-10.0, -10.5], [10.0, -10.5]], 0.3, 0.7, false),
+        crease(&[[-10.0, -15.0], [10.0, -15.0]], 0.25, 0.7, false),
+        crease(&ray(-40.0), 0.3, 0.7, true),
+        crease(&ray(-15.0), 0.35, 0.7, true),
+        crease(&ray(10.0), 0.35, 0.7, true),
+        crease(&ray(35.0), 0.3, 0.7, true),
+        crease(&NASOLABIAL, 0.7, 1.6, true),
+        crease(&MENTOLABIAL, 0.5, 1.3, false),
+        // The lower lip's crease under the mouth's corners.
+        crease(&[[20.0, -74.0], [24.0, -84.0]], 0.3, 1.0, true),
+    ]
+});
 
 /// The mentalis' dimples: pits over the chin (mm).
 const DIMPLE_DEPTH_MM: f32 = 0.15;
@@ -181,9 +174,9 @@ pub fn height_mm(p: Vec3) -> f32 {
     let mirrored = Vec2::new((p.x * p.x + MIRROR_ROUNDING_MM2).sqrt(), p.y);
     let plain = Vec2::new(p.x, p.y);
     let mut h = 0.0;
-    for c in &CREASES {
+    for c in CREASES.iter() {
         let q = if c.mirrored { mirrored } else { plain };
-        let (d, s) = polyline_distance(c.points, q);
+        let (d, s) = polyline_distance(&c.points, q);
         if d > 4.0 * c.sigma {
             continue;
         }

@@ -12,6 +12,7 @@
 
 use anyhow::{bail, Context, Result};
 use dermis::scene::face_colour::{COLOUR_SIZE, STATES};
+use dermis::skin::colour::colorimetry::srgb8;
 use dermis::skin::colour::face::FaceAppearance;
 use dermis::skin::colour::lut::{tone_melanin, ColourTable};
 
@@ -20,14 +21,9 @@ use dermis::skin::colour::lut::{tone_melanin, ColourTable};
 const ROWS: (usize, usize) = (112, 276);
 const COLS: (usize, usize) = (170, 342);
 
-fn srgb(c: f32) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let e = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (e * 255.0).round() as u8
+/// A linear value (or colour) to 8-bit sRGB.
+fn srgb(c: [f32; 3]) -> [u8; 3] {
+    srgb8(c.map(f64::from))
 }
 
 fn main() -> Result<()> {
@@ -55,11 +51,11 @@ fn main() -> Result<()> {
             for x in 0..w {
                 let k = (y + ROWS.0) * COLOUR_SIZE + x + COLS.0;
                 let px = |row: usize| ((c * w + x) as u32, (row * h + y) as u32);
-                let g = srgb(blood.data[k] / 0.04);
-                sheet.put_pixel(px(0).0, px(0).1, image::Rgb([g, g, g]));
+                let g = blood.data[k] / 0.04;
+                sheet.put_pixel(px(0).0, px(0).1, image::Rgb(srgb([g; 3])));
                 for (r, a) in albedo.iter().enumerate() {
                     let (x1, y1) = px(r + 1);
-                    sheet.put_pixel(x1, y1, image::Rgb(a[k].map(srgb)));
+                    sheet.put_pixel(x1, y1, image::Rgb(srgb(a[k])));
                 }
             }
         }
