@@ -21,13 +21,16 @@
 //!   real cartilage; their front edge is pushed into the side of the skull.
 //!
 //! Over 800 lines because the skull, the features, the ears and the backdrop are
-//! built from one set of measurements (740 lines of code) and their tests (360)
-//! check those measurements against each other.
+//! built from one set of measurements (about 720 lines) and their tests (about 430)
+//! check those measurements against each other. The field's primitives
+//! are `sdf`'s, the rays' root finding `crossing`'s.
 
+use super::crossing::outermost_crossing;
 use super::expressions::expression_morph;
 use super::eyes::{self, EYEBALL_RADIUS_MM};
 use super::mesh::{Material, Mesh, Object, Vertex};
-use super::procedural::MM_PER_UNIT;
+use super::procedural::{plateau, smoothstep, MM_PER_UNIT};
+use super::sdf::{cone, ellipse, ellipsoid, smax, smin};
 use super::Scene;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
@@ -50,8 +53,6 @@ const CORE_CENTER_MM: Vec3 = Vec3::new(0.0, -95.0, -5.0);
 const CORE_RADII_MM: Vec3 = Vec3::new(40.0, 205.0, 45.0);
 /// Longer than the distance from the core to any point of the skull's field.
 const RAY_LENGTH_MM: f32 = 200.0;
-/// How closely a ray's crossing is found (mm): far below a texel of any map.
-const CROSSING_TOLERANCE_MM: f32 = 1e-4;
 /// Rows (crown to the base of the neck) and columns (around) of the skull's grid.
 const HEAD_ROWS: usize = 190;
 const HEAD_COLS: usize = 176;
@@ -148,50 +149,6 @@ const BACKDROP_HALF_HEIGHT: f32 = 110.0;
 const BACKDROP_COLS: usize = 120;
 const BACKDROP_ROWS: usize = 80;
 
-fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
-/// Polynomial smooth minimum: the union of two fields with a fillet of size `k`.
-fn smin(a: f32, b: f32, k: f32) -> f32 {
-    let h = (0.5 + 0.5 * (b - a) / k).clamp(0.0, 1.0);
-    b + (a - b) * h - k * h * (1.0 - h)
-}
-
-/// Smooth maximum: intersection (or, with a negated field, subtraction) with a fillet.
-fn smax(a: f32, b: f32, k: f32) -> f32 {
-    -smin(-a, -b, k)
-}
-
-/// Approximate distance to an axis-aligned ellipsoid centred on the origin (exact on the
-/// surface, close nearby: good enough for blending and root finding).
-fn ellipsoid(p: Vec3, r: Vec3) -> f32 {
-    let k0 = (p / r).length();
-    let k1 = (p / (r * r)).length();
-    if k1 <= f32::EPSILON {
-        return -r.min_element();
-    }
-    k0 * (k0 - 1.0) / k1
-}
-
-/// The 2D version of `ellipsoid`.
-fn ellipse(p: Vec2, r: Vec2) -> f32 {
-    let k0 = (p / r).length();
-    let k1 = (p / (r * r)).length();
-    if k1 <= f32::EPSILON {
-        return -r.min_element();
-    }
-    k0 * (k0 - 1.0) / k1
-}
-
-/// Distance to a segment from `a` to `b` whose radius goes from `ra` to `rb`.
-fn cone(p: Vec3, a: Vec3, ra: f32, b: Vec3, rb: f32) -> f32 {
-    let ab = b - a;
-    let h = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-    (p - a - ab * h).length() - (ra + (rb - ra) * h)
-}
-
 /// An ellipsoid's field at `p`, centred at `c` with radii `r` (mm): keeps the shapes
 /// of `skull_field` one line each.
 fn blob(p: Vec3, c: [f32; 3], r: [f32; 3]) -> f32 {
@@ -282,97 +239,6 @@ fn neck_field(p: Vec3) -> f32 {
     ellipse(Vec2::new(p.x, p.z) - center, radii)
 }
 
-/// Distance along `dir` from `origin` to the outermost zero crossing of `field` within
-/// `length`, with `origin` inside. Sphere tracing inward from the far end (steps of 60%
-/// of the field, since it is only roughly a distance), then the Illinois variant of
-/// regula falsi on the bracket it leaves.
-///
-/// Why these and not plain steps and bisection: the head is built in every process
-/// (about 50 000 rays), and steps capped at 6 mm with 14 bisections took 48 field
-/// evaluations a ray, a second of a test build's start. Steps capped at 25 mm and the
-/// secant's convergence take about 17, and find the same crossing to within a
-/// micrometre on every ray of the shell and of the wrinkle maps' grid (checked on every
-/// third: `tests::the_march_finds_the_careful_marchs_crossings`).
-fn outermost_crossing(field: impl Fn(Vec3) -> f32, origin: Vec3, dir: Vec3, length: f32) -> f32 {
-    const STEP_FRACTION: f32 = 0.6;
-    const MIN_STEP_MM: f32 = 0.2;
-    const MAX_STEP_MM: f32 = 25.0;
-    let mut outside = (length, None);
-    let mut t = length;
-    let inside = loop {
-        let d = field(origin + dir * t);
-        if d < 0.0 || t <= 0.0 {
-            break (t, d);
-        }
-        outside = (t, Some(d));
-        t = (t - (d * STEP_FRACTION).clamp(MIN_STEP_MM, MAX_STEP_MM)).max(0.0);
-    };
-    refine_crossing(&|t| field(origin + dir * t), inside, outside)
-}
-
-/// The zero of `f` between `inside` (t, f(t) < 0) and `outside` (t and f(t) >= 0 where
-/// known), to within `CROSSING_TOLERANCE_MM`: the Illinois method, which halves the
-/// weight of an end kept twice so the bracket closes from both sides; bisection where
-/// an end's value is unknown or not of its sign (a ray that never left the surface),
-/// or once the field answers something not finite.
-fn refine_crossing(f: &dyn Fn(f32) -> f32, inside: (f32, f32), outside: (f32, Option<f32>)) -> f32 {
-    let ((mut ti, mut fi), (mut to, fo)) = (inside, outside);
-    let Some(mut fo) = fo.filter(|&fo| fo >= 0.0 && fi < 0.0) else {
-        return bisect_crossing(f, ti, to);
-    };
-    let mut kept = 0i8;
-    // The latest secant point: the answer when the bracket stops closing (an end at
-    // an exact zero, or steps below the coordinates' rounding).
-    let mut t = 0.5 * (ti + to);
-    for _ in 0..MAX_REFINEMENTS {
-        if (to - ti).abs() <= CROSSING_TOLERANCE_MM {
-            return 0.5 * (ti + to);
-        }
-        t = (ti * fo - to * fi) / (fo - fi);
-        let ft = f(t);
-        if !ft.is_finite() {
-            return bisect_crossing(f, ti, to);
-        }
-        if ft == 0.0 {
-            return t;
-        }
-        if ft < 0.0 {
-            (ti, fi) = (t, ft);
-            if kept == -1 {
-                fo *= 0.5;
-            }
-            kept = -1;
-        } else {
-            (to, fo) = (t, ft);
-            if kept == 1 {
-                fi *= 0.5;
-            }
-            kept = 1;
-        }
-    }
-    t
-}
-
-/// Most steps either refinement takes (bisection halves 200 mm to the tolerance in 21).
-const MAX_REFINEMENTS: usize = 40;
-
-/// Bisection between `inside` and `outside` (distances along the ray; a value that is
-/// not below 0, NaN included, counts as outside), to the tolerance.
-fn bisect_crossing(f: &dyn Fn(f32) -> f32, mut inside: f32, mut outside: f32) -> f32 {
-    for _ in 0..MAX_REFINEMENTS {
-        if (outside - inside).abs() <= CROSSING_TOLERANCE_MM {
-            break;
-        }
-        let mid = 0.5 * (inside + outside);
-        if f(mid) < 0.0 {
-            inside = mid;
-        } else {
-            outside = mid;
-        }
-    }
-    0.5 * (inside + outside)
-}
-
 /// Maps a uniform parameter in 0..1 to 0..1 so that samples crowd where a density is
 /// high: the inverse of the normalised integral of a density given per equal cell.
 struct Warp {
@@ -409,11 +275,6 @@ impl Warp {
         let f = if c1 > c0 { (x - c0) / (c1 - c0) } else { 0.0 };
         (i as f32 - 1.0 + f) / cells as f32
     }
-}
-
-/// 1 inside `lo..hi`, 0 outside, with smooth shoulders of width `soft`.
-fn plateau(x: f32, lo: f32, hi: f32, soft: f32) -> f32 {
-    smoothstep(lo - soft, lo, x) * (1.0 - smoothstep(hi, hi + soft, x))
 }
 
 /// A closed grid with sphere topology: rows 0 and `rows` are poles, column `cols` repeats
@@ -926,18 +787,6 @@ mod tests {
             worst = worst.max(off);
         }
         assert!(worst > 0.0, "the two marches cannot agree to the bit");
-    }
-
-    /// The secant refinement: a root to the tolerance from a bracket with both values,
-    /// and bisection where the outer value is unknown.
-    #[test]
-    fn refinement_finds_a_root_either_way() {
-        let f = |t: f32| (t - 1.234567) * (1.0 + t);
-        let with = refine_crossing(&f, (0.0, f(0.0)), (5.0, Some(f(5.0))));
-        let without = refine_crossing(&f, (0.0, f(0.0)), (5.0, None));
-        for t in [with, without] {
-            assert!((t - 1.234567).abs() <= CROSSING_TOLERANCE_MM, "{t}");
-        }
     }
 
     /// Every directed edge (keyed by position, so seam and pole duplicates count as

@@ -25,7 +25,7 @@ use glam::{Vec2, Vec3};
 pub use super::face_surface::Skull;
 use super::face_surface::{in_parallel, SurfaceGrid};
 use super::mesh::{Texture, WrinkleMaps};
-use super::procedural::smoothstep;
+use super::procedural::{plateau, smoothstep};
 use super::wrinkle_maps::{encode, MASKS, ZONES_PER_MASK};
 
 /// Texels a side of the wrinkle map and of the masks.
@@ -193,11 +193,6 @@ pub fn height_mm(p: Vec3) -> f32 {
         h -= DIMPLE_DEPTH_MM * (-0.5 * d2 / (DIMPLE_SIGMA_MM * DIMPLE_SIGMA_MM)).exp();
     }
     h * gate
-}
-
-/// 1 inside `lo..hi`, 0 outside, with smooth shoulders `soft` wide.
-fn plateau(x: f32, lo: f32, hi: f32, soft: f32) -> f32 {
-    smoothstep(lo - soft, lo, x) * (1.0 - smoothstep(hi, hi + soft, x))
 }
 
 /// Table 8.1's eight zones (`skin::wrinkles::ZONES`' order) at surface

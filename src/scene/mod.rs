@@ -5,6 +5,7 @@
 pub mod animation;
 pub mod camera;
 pub mod casters;
+pub mod crossing;
 pub mod crowd_geometry;
 pub mod crowd_motion;
 pub mod enclosed;
@@ -28,6 +29,7 @@ pub mod morph;
 pub mod procedural;
 pub mod rig;
 pub mod robust_bounds;
+pub mod sdf;
 pub mod skin;
 pub mod skin_rule;
 pub mod source;

@@ -39,6 +39,11 @@ pub(super) fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// 1 inside `lo..hi`, 0 outside, with smooth shoulders `soft` wide.
+pub(super) fn plateau(x: f32, lo: f32, hi: f32, soft: f32) -> f32 {
+    smoothstep(lo - soft, lo, x) * (1.0 - smoothstep(hi, hi + soft, x))
+}
+
 /// Skull surface for polar angle `theta` (from +Y) and azimuth `phi` (0 = +Z, the face).
 /// Every latitude ring keeps a single height and is only squeezed in x/z or pushed forward
 /// on its front half, so the surface stays a stack of simple closed curves: it can never
