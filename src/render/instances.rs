@@ -12,6 +12,7 @@ use ash::vk;
 use glam::Mat4;
 
 use crate::vk::context::Context;
+use crate::vk::guard::Guard;
 use crate::vk::memory::Buffer;
 use crate::vk::pipeline::Bind;
 
@@ -51,28 +52,24 @@ impl Instances {
         let backdrop_slot = data.len() as u32 - 1;
         // No frame before the first: the previous models are these.
         data.extend_from_within(..);
-        let buffer = Buffer::with_data(
-            ctx,
-            "character instances",
-            bytemuck::cast_slice(&data),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )?;
         // The models' buffer goes if the zones' cannot be made.
-        let zones = match Buffer::with_data(
+        let buffer = Guard::new(
+            ctx,
+            Buffer::with_data(
+                ctx,
+                "character instances",
+                bytemuck::cast_slice(&data),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+        );
+        let zones = Buffer::with_data(
             ctx,
             "character wrinkle zones",
             bytemuck::cast_slice(&zone_layout(&character_slots, zones)),
             vk::BufferUsageFlags::STORAGE_BUFFER,
-        ) {
-            Ok(z) => z,
-            Err(e) => {
-                let mut buffer = buffer;
-                buffer.destroy(ctx);
-                return Err(e);
-            }
-        };
+        )?;
         Ok(Instances {
-            buffer,
+            buffer: buffer.keep(),
             zones,
             count: data.len() / 2,
             group_slots,

@@ -203,6 +203,7 @@ impl GpuObject {
             m.sss_map.as_ref(),
         );
         // Missing maps fall back to neutral 1x1 textures so one shader serves all.
+        let unorm = vk::Format::R8G8B8A8_UNORM;
         let maps = [
             (
                 "albedo",
@@ -214,33 +215,30 @@ impl GpuObject {
                 "normal map",
                 m.normal_map.as_ref(),
                 [128, 128, 255, 255],
-                vk::Format::R8G8B8A8_UNORM,
+                unorm,
             ),
             (
                 "texel parameters",
                 packed.as_ref().map(|p| &p.texture),
                 [255; 4],
-                vk::Format::R8G8B8A8_UNORM,
+                unorm,
             ),
         ];
-        for (what, tex, fallback, format) in maps {
-            let t = upload_texture(ctx, &format!("{name} {what}"), tex, fallback, format)?;
-            self.textures.push(t);
-        }
         // The wrinkle map and its masks, when they are read; else the shader
         // returns before any fetch of them, and their bindings take the
         // albedo (`material_binds`).
-        let wrinkles = m.wrinkles.as_ref().filter(|_| wrinkled);
-        if let Some(w) = wrinkles {
-            let unorm = vk::Format::R8G8B8A8_UNORM;
-            for (what, t) in [
+        let wrinkles = m.wrinkles.as_ref().filter(|_| wrinkled).map(|w| {
+            [
                 ("wrinkle map", &w.wrinkle),
                 ("wrinkle mask 0", &w.masks[0]),
                 ("wrinkle mask 1", &w.masks[1]),
-            ] {
-                let t = upload_texture(ctx, &format!("{name} {what}"), Some(t), [0; 4], unorm)?;
-                self.textures.push(t);
-            }
+            ]
+            .map(|(what, t)| (what, Some(t), [0; 4], unorm))
+        });
+        for (what, tex, fallback, format) in maps.into_iter().chain(wrinkles.into_iter().flatten())
+        {
+            let t = upload_texture(ctx, &format!("{name} {what}"), tex, fallback, format)?;
+            self.textures.push(t);
         }
         let u = MaterialUniforms {
             base_color: [

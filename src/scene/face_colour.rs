@@ -42,9 +42,6 @@ pub const STATES: [&str; 9] = [
     "joy", "surprise", "fear", "anger", "disgust", "sad", "exercise", "alcohol", "blush",
 ];
 
-/// How many of `STATES` are expressions (driven by the morph weights).
-pub const EXPRESSION_STATES: usize = 6;
-
 /// The neutral dermal haemoglobin away from the face's vascular regions: 1%
 /// (a dermis carries 0.2-7% blood, Jacques, OMLC). Low in that range on
 /// purpose: the skin model's colour saturates with blood (at 1% melanin,

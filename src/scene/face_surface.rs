@@ -21,7 +21,6 @@ const MARCH_STRIDE: usize = 4;
 /// The surface points of texel rows `rows` and columns `cols` (inclusive) of
 /// a map `n` texels a side.
 pub struct SurfaceGrid {
-    n: usize,
     first: (usize, usize),
     coarse: (usize, usize),
     points: Vec<Vec<Vec3>>,
@@ -43,16 +42,10 @@ impl SurfaceGrid {
                 .collect::<Vec<Vec3>>()
         });
         SurfaceGrid {
-            n,
             first: (rows.0, cols.0),
             coarse: (ci, cj),
             points,
         }
-    }
-
-    /// Texels a side of the map the grid belongs to.
-    pub fn size(&self) -> usize {
-        self.n
     }
 
     /// The surface point (mm) of texel row `i`, column `j` (inside the

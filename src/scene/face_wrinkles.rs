@@ -22,8 +22,7 @@
 
 use glam::{Vec2, Vec3};
 
-pub use super::face_surface::Skull;
-use super::face_surface::{in_parallel, SurfaceGrid};
+use super::face_surface::{in_parallel, Skull, SurfaceGrid};
 use super::mesh::{Texture, WrinkleMaps};
 use super::procedural::{plateau, smoothstep};
 use super::wrinkle_maps::{encode, MASKS, ZONES_PER_MASK};

@@ -202,7 +202,6 @@ pub fn chin_and_crown(mesh: &Mesh, forward: Vec3) -> (f32, f32) {
 
 /// [`chin_and_crown`] of the mesh's inliers `b`.
 fn chin_and_crown_within(mesh: &Mesh, forward: Vec3, b: &Aabb) -> (f32, f32) {
-    let b = *b;
     let (bottom, crown) = (b.min.y, b.max.y);
     let extent = crown - bottom;
     if mesh.vertices.is_empty() || extent <= 0.0 || !extent.is_finite() {
@@ -214,7 +213,7 @@ fn chin_and_crown_within(mesh: &Mesh, forward: Vec3, b: &Aabb) -> (f32, f32) {
         .vertices
         .iter()
         .map(|v| Vec3::from(v.position))
-        .filter(|&p| inside(&b, p) && p.y <= bottom + 0.02 * extent)
+        .filter(|&p| inside(b, p) && p.y <= bottom + 0.02 * extent)
         .collect();
     if let Some(bb) = Aabb::from_points(band) {
         let base = bb.size().x.max(bb.size().z);
@@ -228,7 +227,7 @@ fn chin_and_crown_within(mesh: &Mesh, forward: Vec3, b: &Aabb) -> (f32, f32) {
     let mut front = [f32::NEG_INFINITY; SLICES];
     let slice_of = |y: f32| ((((y - bottom) / extent) * SLICES as f32) as usize).min(SLICES - 1);
     for tri in mesh.indices.chunks_exact(3) {
-        let Some(p) = triangle_within(mesh, tri, &b) else {
+        let Some(p) = triangle_within(mesh, tri, b) else {
             continue;
         };
         let (lo, hi) = (
@@ -284,13 +283,6 @@ fn chin_and_crown_within(mesh: &Mesh, forward: Vec3, b: &Aabb) -> (f32, f32) {
         chin = i;
     }
     (slice_y(chin) - 0.5 / SLICES as f32 * extent, crown)
-}
-
-/// Bounds of the part of the mesh from the chin up: the head without neck or shoulders,
-/// which is what a camera should frame.
-pub fn head_part_bounds(mesh: &Mesh, forward: Vec3) -> Aabb {
-    let (b, _) = inlier_bounds(mesh);
-    part_above(mesh, chin_and_crown_within(mesh, forward, &b).0, &b)
 }
 
 /// Bounds of the inliers (`b`) at or above `chin`.

@@ -61,19 +61,20 @@ impl Reference {
             resolve.push((name, Binding::StorageImage(a, Storage::Read)));
         }
         self.resolve_set = GraphSet::new(res, &self.resolve, 0, resolve);
+        let mut frame_binds = s.frame_binds.clone();
+        frame_binds.push((
+            "Zones",
+            Binding::Fixed(Bind::Uniform {
+                buffer: self.zones.raw,
+                size: self.zones.size,
+            }),
+        ));
         for c in &mut self.chunks {
             c.draws.clear();
             let mut first = 0;
             while first < c.count {
                 let n = (c.count - first).min(self.draw_samples);
-                let mut binds = s.frame_binds.clone();
-                binds.push((
-                    "Zones",
-                    Binding::Fixed(Bind::Uniform {
-                        buffer: self.zones.raw,
-                        size: self.zones.size,
-                    }),
-                ));
+                let mut binds = frame_binds.clone();
                 binds.push((
                     "Samples",
                     Binding::StorageBuffer {

@@ -51,13 +51,7 @@ impl Map {
     /// Bilinear between texel centres at `(u, v)` in [0, 1]^2, clamped to the
     /// edge texels (a texture's clamp-to-edge linear filter).
     pub fn sample(&self, u: f32, v: f32) -> f32 {
-        let fx = (u * self.width as f32 - 0.5).clamp(0.0, (self.width - 1) as f32);
-        let fy = (v * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
-        let (x0, y0) = (fx as usize, fy as usize);
-        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
-        let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
-        let row = |y: usize| self.at(x0, y) + (self.at(x1, y) - self.at(x0, y)) * tx;
-        row(y0) + (row(y1) - row(y0)) * ty
+        crate::skin::texel::bilinear1(&self.data, self.width, self.height, u, v)
     }
 
     /// The map at `width` x `height`: each texel the mean of the texels under

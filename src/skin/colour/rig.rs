@@ -108,7 +108,8 @@ fn scale_map(state: &LocalStats, neutral: &LocalStats) -> Map {
 }
 
 fn texel_centre(x: usize, y: usize, w: usize, h: usize) -> (f32, f32) {
-    ((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32)
+    let [u, v] = crate::skin::texel::pixel_uv(x, y, w, h);
+    (u, v)
 }
 
 /// A colour state's weight `t` seconds after it began, rising over `rise`
@@ -118,8 +119,7 @@ pub fn rising_weight(t: f32, rise: f32) -> f32 {
     if rise <= 0.0 {
         return if t >= 0.0 { 1.0 } else { 0.0 };
     }
-    let x = (t / rise).clamp(0.0, 1.0);
-    x * x * (3.0 - 2.0 * x)
+    crate::scene::procedural::smoothstep(0.0, rise, t)
 }
 
 #[cfg(test)]
